@@ -1,0 +1,37 @@
+"""graphsdg: Replicator-style synthetic data generation on MuJoCo and OpenUSD.
+
+Use it as Isaac Sim's ``omni.replicator.core``::
+
+    import graphsdg as rep
+
+    rep.stage.new_stage()
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=500, parent="/World")
+    cube = rep.functional.create.cube(parent="/World", semantics={"class": "cube"})
+    cam = rep.functional.create.camera(position=(5, 5, 5), look_at=(0, 0, 0), parent="/World")
+    rp = rep.create.render_product(cam, (512, 512))
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir="_out", rgb=True, bounding_box_2d_tight=True)
+    writer.attach(rp)
+    for _ in range(3):
+        rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+"""
+from graphsdg.render.gl_platform import select_gl_platform
+
+select_gl_platform()   # before anything imports mujoco
+
+from graphsdg import (annotators, backends, create, functional, orchestrator, rng, settings,  # noqa: E402
+                      stage, writers)
+from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry  # noqa: E402
+from graphsdg.io import writers as _builtin_writers  # noqa: E402,F401  (registers BasicWriter)
+from graphsdg.io.backends import BackendDispatch  # noqa: E402
+from graphsdg.io.writer import Writer, WriterRegistry  # noqa: E402
+from graphsdg.rng import get_global_seed, set_global_seed  # noqa: E402
+from graphsdg import nodes  # noqa: E402,F401  (registers the node library)
+
+__version__ = "0.1.0"
+
+__all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
+           "writers", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
+           "get_global_seed", "set_global_seed"]

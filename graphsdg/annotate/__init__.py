@@ -1,0 +1,1 @@
+"""Annotators: labels derived from render passes and the stage."""

@@ -1,0 +1,45 @@
+"""Exception types graphsdg raises. Each message names the bad value and what was expected."""
+from __future__ import annotations
+
+import difflib
+from typing import Iterable
+
+
+class GraphSDGError(Exception):
+    """Base class of graphsdg's own errors."""
+
+
+class PrimNotFoundError(GraphSDGError, ValueError):
+    """A prim path that does not exist on the stage."""
+
+
+class InvalidPrimError(GraphSDGError, TypeError):
+    """A prim of the wrong kind (for example a render product for a non-camera)."""
+
+
+class UnknownNameError(GraphSDGError, KeyError, ValueError):
+    """An unknown annotator, writer, backend or node name."""
+
+    def __str__(self) -> str:  # KeyError would repr() the message
+        return str(self.args[0]) if self.args else ""
+
+
+class RenderProductDestroyedError(GraphSDGError, RuntimeError):
+    """A render product used after ``destroy()``."""
+
+
+class WriterError(GraphSDGError, RuntimeError):
+    """A failure inside a writer or backend worker, re-raised in the script."""
+
+
+def closest(name: str, known: Iterable[str]) -> str:
+    """Return a ``" (did you mean 'x'?)"`` hint, or an empty string."""
+    match = difflib.get_close_matches(name, list(known), n=1)
+    return f" (did you mean {match[0]!r}?)" if match else ""
+
+
+def unknown_name(kind: str, name: object, known: Iterable[str]) -> UnknownNameError:
+    """Build the standard error for an unknown ``kind`` name."""
+    known = sorted(known)
+    hint = closest(str(name), known)
+    return UnknownNameError(f"unknown {kind} {name!r}{hint}; known {kind}s: {', '.join(known)}")

@@ -1,0 +1,239 @@
+"""``rep.functional.create``: define prims on the stage and return them (real ``Usd.Prim`` s).
+
+Shapes are one unit across (see :mod:`graphsdg.stage.shapes`); ``parent`` must
+exist; ``name`` collisions get ``_01``, ``_02``... suffixes.
+
+Example:
+    >>> import graphsdg as rep
+    >>> _ = rep.stage.new_stage()
+    >>> world = rep.functional.create.xform(name="World")
+    >>> cam = rep.functional.create.camera(position=(5, 5, 5), look_at=(0, 0, 0), parent="/World")
+    >>> cam.GetTypeName()
+    'Camera'
+"""
+from __future__ import annotations
+
+import os
+from typing import Any, Sequence
+
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux
+
+from graphsdg.stage import materials as matlib
+from graphsdg.stage import semantics as semlib
+from graphsdg.stage import shapes
+from graphsdg.stage.context import get_stage
+from graphsdg.stage.prims import PrimLike, parent_path, resolve_prims, unique_child_path
+from graphsdg.stage.xform import set_local_pose
+
+Vec3 = Sequence[float]
+
+
+def _finish(prim: Usd.Prim, position=None, rotation=None, scale=None, look_at=None, look_at_up_axis=None,
+            semantics=None, visible: bool = True) -> Usd.Prim:
+    if any(v is not None for v in (position, rotation, scale, look_at)):
+        set_local_pose(prim, position=position, rotation=rotation, scale=scale, look_at=look_at,
+                       look_at_up_axis=look_at_up_axis)
+    if semantics:
+        semlib.apply(prim, semantics, mode="add")
+    if not visible:
+        UsdGeom.Imageable(prim).MakeInvisible()
+    return prim
+
+
+def _new_path(name: str | None, default: str, parent: PrimLike | None) -> Sdf.Path:
+    return unique_child_path(parent_path(parent), name or default)
+
+
+def xform(name: str | None = None, parent: PrimLike | None = None, position: Vec3 | None = None,
+          rotation: Vec3 | None = None, scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
+          look_at_up_axis: Vec3 | None = None, semantics: Any = None, visible: bool = True) -> Usd.Prim:
+    """Define a ``UsdGeom.Xform``."""
+    prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, "Xform", parent)).GetPrim()
+    return _finish(prim, position, rotation, scale, look_at, look_at_up_axis, semantics, visible)
+
+
+def scope(name: str | None = None, parent: PrimLike | None = None) -> Usd.Prim:
+    """Define a ``UsdGeom.Scope`` (a grouping prim without a transform)."""
+    return UsdGeom.Scope.Define(get_stage(), _new_path(name, "Scope", parent)).GetPrim()
+
+
+def _shape(shape: str, position, rotation, scale, look_at, look_at_up_axis, semantics, visible, name,
+           parent) -> Usd.Prim:
+    path = _new_path(name, shape.capitalize(), parent)
+    prim = shapes.define_shape(get_stage(), path, shape)
+    return _finish(prim, position, rotation, scale, look_at, look_at_up_axis, semantics, visible)
+
+
+def _shape_fn(shape: str):
+    def create_shape(position: Vec3 | None = None, rotation: Vec3 | None = None,
+                     scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
+                     look_at_up_axis: Vec3 | None = None, semantics: Any = None, visible: bool = True,
+                     name: str | None = None, parent: PrimLike | None = None) -> Usd.Prim:
+        return _shape(shape, position, rotation, scale, look_at, look_at_up_axis, semantics, visible, name, parent)
+
+    create_shape.__name__ = shape
+    create_shape.__doc__ = f"Define a unit {shape} prim and return it."
+    return create_shape
+
+
+cube = _shape_fn("cube")
+sphere = _shape_fn("sphere")
+cylinder = _shape_fn("cylinder")
+cone = _shape_fn("cone")
+capsule = _shape_fn("capsule")
+plane = _shape_fn("plane")
+disk = _shape_fn("disk")
+torus = _shape_fn("torus")
+
+
+def camera(position: Vec3 | None = None, rotation: Vec3 | None = None, look_at: Vec3 | None = None,
+           look_at_up_axis: Vec3 | None = None, focal_length: float = 24.0, focus_distance: float = 400.0,
+           f_stop: float = 0.0, horizontal_aperture: float = 20.955, vertical_aperture: float | None = None,
+           horizontal_aperture_offset: float = 0.0, vertical_aperture_offset: float = 0.0,
+           clipping_range: tuple[float, float] = (0.01, 1000000.0), projection_type: str = "pinhole",
+           name: str | None = None, parent: PrimLike | None = None, semantics: Any = None) -> Usd.Prim:
+    """Define a ``UsdGeom.Camera`` (looks down its -Z; ``look_at`` aims it)."""
+    if focal_length <= 0 or horizontal_aperture <= 0:
+        raise ValueError(f"focal_length ({focal_length}) and horizontal_aperture ({horizontal_aperture}) "
+                         f"must be positive")
+    near, far = clipping_range
+    if not 0 < near < far:
+        raise ValueError(f"clipping_range must be (near, far) with 0 < near < far, got {clipping_range!r}")
+    if projection_type not in ("pinhole", "perspective", "orthographic"):
+        raise ValueError(f"projection_type {projection_type!r} is not available; graphsdg renders 'pinhole' "
+                         f"(perspective) and 'orthographic' cameras")
+    cam = UsdGeom.Camera.Define(get_stage(), _new_path(name, "Camera", parent))
+    cam.CreateFocalLengthAttr(float(focal_length))
+    cam.CreateFocusDistanceAttr(float(focus_distance))
+    cam.CreateFStopAttr(float(f_stop))
+    cam.CreateHorizontalApertureAttr(float(horizontal_aperture))
+    cam.CreateVerticalApertureAttr(float(vertical_aperture if vertical_aperture is not None
+                                         else horizontal_aperture * 9.0 / 16.0))
+    cam.CreateHorizontalApertureOffsetAttr(float(horizontal_aperture_offset))
+    cam.CreateVerticalApertureOffsetAttr(float(vertical_aperture_offset))
+    cam.CreateClippingRangeAttr(Gf.Vec2f(float(near), float(far)))
+    cam.CreateProjectionAttr("orthographic" if projection_type == "orthographic" else "perspective")
+    return _finish(cam.GetPrim(), position, rotation, None, look_at, look_at_up_axis, semantics)
+
+
+def _light(schema, default_name: str, intensity: float, exposure: float | None, color: Vec3 | None,
+           temperature: float | None, name, parent, position, rotation, scale, look_at, look_at_up_axis,
+           **shape: float) -> Usd.Prim:
+    light = schema.Define(get_stage(), _new_path(name, default_name, parent))
+    light.CreateIntensityAttr(float(intensity))
+    if exposure is not None:
+        light.CreateExposureAttr(float(exposure))
+    if color is not None:
+        light.CreateColorAttr(Gf.Vec3f(*(float(c) for c in color)))
+    if temperature is not None:
+        light.CreateEnableColorTemperatureAttr(True)
+        light.CreateColorTemperatureAttr(float(temperature))
+    for attr, value in shape.items():
+        if value is not None:
+            getattr(light, f"Create{attr}Attr")(value)
+    return _finish(light.GetPrim(), position, rotation, scale, look_at, look_at_up_axis)
+
+
+def dome_light(intensity: float = 1000.0, exposure: float | None = None, color: Vec3 | None = None,
+               temperature: float | None = None, texture: str | None = None, name: str | None = None,
+               parent: PrimLike | None = None, position: Vec3 | None = None, rotation: Vec3 | None = None,
+               scale: Vec3 | None = None) -> Usd.Prim:
+    """Define a ``UsdLux.DomeLight`` (ambient sky light; ``texture`` an equirect image)."""
+    prim = _light(UsdLux.DomeLight, "DomeLight", intensity, exposure, color, temperature, name, parent,
+                  position, rotation, scale, None, None)
+    if texture is not None:
+        UsdLux.DomeLight(prim).CreateTextureFileAttr(Sdf.AssetPath(os.fspath(texture)))
+    return prim
+
+
+def distant_light(intensity: float = 1000.0, exposure: float | None = None, color: Vec3 | None = None,
+                  temperature: float | None = None, angle: float | None = None, name: str | None = None,
+                  parent: PrimLike | None = None, position: Vec3 | None = None, rotation: Vec3 | None = None,
+                  look_at: Vec3 | None = None, look_at_up_axis: Vec3 | None = None) -> Usd.Prim:
+    """Define a ``UsdLux.DistantLight`` shining along its -Z."""
+    return _light(UsdLux.DistantLight, "DistantLight", intensity, exposure, color, temperature, name, parent,
+                  position, rotation, None, look_at, look_at_up_axis, Angle=angle)
+
+
+def sphere_light(intensity: float = 1000.0, exposure: float | None = None, color: Vec3 | None = None,
+                 temperature: float | None = None, radius: float = 0.5, name: str | None = None,
+                 parent: PrimLike | None = None, position: Vec3 | None = None, rotation: Vec3 | None = None,
+                 scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
+                 look_at_up_axis: Vec3 | None = None) -> Usd.Prim:
+    """Define a ``UsdLux.SphereLight`` (a point-like light with a radius)."""
+    return _light(UsdLux.SphereLight, "SphereLight", intensity, exposure, color, temperature, name, parent,
+                  position, rotation, scale, look_at, look_at_up_axis, Radius=float(radius))
+
+
+def rect_light(intensity: float = 1000.0, exposure: float | None = None, color: Vec3 | None = None,
+               temperature: float | None = None, width: float = 1.0, height: float = 1.0,
+               name: str | None = None, parent: PrimLike | None = None, position: Vec3 | None = None,
+               rotation: Vec3 | None = None, scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
+               look_at_up_axis: Vec3 | None = None) -> Usd.Prim:
+    """Define a ``UsdLux.RectLight`` emitting along its -Z."""
+    return _light(UsdLux.RectLight, "RectLight", intensity, exposure, color, temperature, name, parent,
+                  position, rotation, scale, look_at, look_at_up_axis, Width=float(width), Height=float(height))
+
+
+def disk_light(intensity: float = 1000.0, exposure: float | None = None, color: Vec3 | None = None,
+               temperature: float | None = None, radius: float = 0.5, name: str | None = None,
+               parent: PrimLike | None = None, position: Vec3 | None = None, rotation: Vec3 | None = None,
+               scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
+               look_at_up_axis: Vec3 | None = None) -> Usd.Prim:
+    """Define a ``UsdLux.DiskLight`` emitting along its -Z."""
+    return _light(UsdLux.DiskLight, "DiskLight", intensity, exposure, color, temperature, name, parent,
+                  position, rotation, scale, look_at, look_at_up_axis, Radius=float(radius))
+
+
+def material(mdl: str = "OmniPBR.mdl", bind_prims: Sequence[PrimLike] | PrimLike | None = None,
+             name: str | None = None, parent: PrimLike | None = None, **inputs: Any) -> Usd.Prim:
+    """Define a material from OmniPBR-style inputs and optionally bind it to ``bind_prims``.
+
+    Accepted inputs: ``diffuse_color_constant``, ``reflection_roughness_constant``,
+    ``metallic_constant``, ``diffuse_texture``, ``emissive_color``,
+    ``emissive_intensity``, ``texture_scale``, ``texture_rotate``.
+    """
+    known = {"diffuse_color_constant", "reflection_roughness_constant", "metallic_constant", "diffuse_texture",
+             "emissive_color", "emissive_intensity", "texture_scale", "texture_rotate", "enable_emission",
+             "project_uvw", "specular_level"}
+    unknown = set(inputs) - known
+    if unknown:
+        raise ValueError(f"unknown material input(s) {sorted(unknown)}; known: {sorted(known)}")
+    if not isinstance(mdl, str) or not mdl:
+        raise ValueError(f"mdl must name a material such as 'OmniPBR.mdl', got {mdl!r}")
+    stage = get_stage()
+    path = _new_path(name, os.path.splitext(os.path.basename(mdl))[0] or "Material", parent)
+    tex = inputs.get("diffuse_texture")
+    if tex is not None and not os.path.isfile(os.fspath(tex)):
+        raise FileNotFoundError(f"diffuse_texture {os.fspath(tex)!r} does not exist")
+    mat = matlib.define_preview_material(
+        stage, path, diffuse=inputs.get("diffuse_color_constant"), roughness=inputs.get(
+            "reflection_roughness_constant"), metallic=inputs.get("metallic_constant"),
+        diffuse_texture=os.fspath(tex) if tex is not None else None, emissive_color=inputs.get("emissive_color"),
+        emissive_intensity=inputs.get("emissive_intensity"))
+    if inputs.get("texture_scale") is not None or inputs.get("texture_rotate") is not None:
+        matlib.set_inputs(mat, texture_scale=inputs.get("texture_scale"), texture_rotate=inputs.get("texture_rotate"))
+    mat.GetPrim().CreateAttribute("info:mdl:sourceAsset", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(mdl))
+    if bind_prims is not None:
+        for prim in resolve_prims(bind_prims):
+            matlib.bind(prim, mat)
+    return mat.GetPrim()
+
+
+def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = None,
+              position: Vec3 | None = None, rotation: Vec3 | None = None, scale: Vec3 | float | None = None,
+              semantics: Any = None, visible: bool = True) -> Usd.Prim:
+    """Add ``usd_path`` as a reference under a new Xform and return that prim."""
+    path_str = os.fspath(usd_path)
+    if "://" not in path_str and not os.path.isfile(path_str):
+        raise FileNotFoundError(f"reference usd_path {path_str!r} does not exist")
+    try:
+        layer = Sdf.Layer.FindOrOpen(path_str)
+    except Exception as exc:  # pxr raises Tf.ErrorException on parse errors
+        raise ValueError(f"reference usd_path {path_str!r} does not parse as USD: {exc}") from exc
+    if layer is None:
+        raise ValueError(f"reference usd_path {path_str!r} does not parse as USD")
+    default = os.path.splitext(os.path.basename(path_str))[0]
+    prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, default, parent)).GetPrim()
+    prim.GetReferences().AddReference(path_str)
+    return _finish(prim, position, rotation, scale, None, None, semantics, visible)

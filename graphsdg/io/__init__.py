@@ -1,0 +1,1 @@
+"""Dataset output: writers, backends, the background write queue."""

@@ -1,0 +1,248 @@
+"""The Writer base class and the writer registry.
+
+A writer declares ``annotators`` (names or :class:`Annotator` objects) and a
+``data_structure``; after ``attach(render_products)`` it receives one ``data``
+dict per captured frame in :meth:`Writer.write`, shaped as in Replicator:
+
+* ``"legacy"``: ``{anno: data}`` (one product) or ``{"anno-rp_name": data}``;
+* ``"annotator"``: ``{"annotators": {anno: {rp_name: {"data": ..., **info}}}}``;
+* ``"renderProduct"``: ``{"renderProducts": {rp_name: {"camera", "resolution", anno: {...}}}}``;
+
+each also with ``trigger_outputs`` and ``reference_time``.
+
+Example:
+    >>> import graphsdg as rep
+    >>> class CountingWriter(rep.Writer):
+    ...     def __init__(self):
+    ...         self.annotators = ["rgb"]
+    ...         self.frames = 0
+    ...     def write(self, data):
+    ...         self.frames += 1
+    >>> rep.WriterRegistry.register(CountingWriter)
+    >>> rep.writers.get("CountingWriter").__class__.__name__
+    'CountingWriter'
+"""
+from __future__ import annotations
+
+import inspect
+import json
+from typing import Any, Iterable
+
+from graphsdg import rng
+from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry, shape_output
+from graphsdg.errors import unknown_name
+from graphsdg.render.render_product import RenderProduct, registry as rp_registry
+
+DATA_STRUCTURES = ("legacy", "annotator", "renderProduct")
+ON_FRAME = "omni.replicator.core.OgnOnFrame"
+
+
+class Writer:
+    """Base class of dataset writers (``rep.Writer``)."""
+
+    backend: Any = None
+    version: str = "0.0.0"
+    annotators: list = []
+    num_written: int = 0
+    data_structure: str = "legacy"
+
+    def write(self, data: dict) -> None:
+        """Called once per captured frame."""
+        raise NotImplementedError(f"{type(self).__name__} must implement write(self, data)")
+
+    def initialize(self, **kwargs: Any) -> None:
+        """Construct the writer with ``kwargs`` (``WriterRegistry.get(name).initialize(...)``)."""
+        sig = inspect.signature(type(self).__init__)
+        params = sig.parameters
+        if not any(p.kind == p.VAR_KEYWORD for p in params.values()):
+            unknown = [k for k in kwargs if k not in params]
+            if unknown:
+                known = [k for k in params if k != "self"]
+                raise TypeError(f"{type(self).__name__}.initialize() got unknown parameter(s) {unknown}; "
+                                f"known: {known}")
+        self.__init__(**kwargs)  # type: ignore[misc]
+        self._initialized = True
+
+    # ---- attachment ----------------------------------------------------
+    def _annotator_objects(self) -> list[Annotator]:
+        objs = getattr(self, "_annotator_objs", None)
+        if objs is None:
+            objs = []
+            for entry in self.annotators or []:
+                if isinstance(entry, Annotator):
+                    objs.append(entry)
+                elif isinstance(entry, str):
+                    objs.append(AnnotatorRegistry.get_annotator(entry))
+                else:
+                    raise TypeError(f"{type(self).__name__}.annotators holds {entry!r}; expected annotator "
+                                    f"names or rep.annotators.get(...) objects")
+            self._annotator_objs = objs
+        return objs
+
+    def get_annotators(self) -> dict[str, Annotator]:
+        return {a.name: a for a in self._annotator_objects()}
+
+    def add_annotator(self, annotator: "Annotator | str") -> None:
+        self.annotators = list(self.annotators or []) + [annotator]
+        self._annotator_objs = None
+
+    @property
+    def render_products(self) -> list[RenderProduct]:
+        return list(getattr(self, "_render_products", []))
+
+    def attach(self, render_products: "RenderProduct | str | Iterable[RenderProduct | str]",
+               trigger: Any = ON_FRAME) -> None:
+        """Attach to render products; frames are written when ``trigger`` fires (every step by default)."""
+        from graphsdg.runtime import runtime
+        if render_products is None or (isinstance(render_products, (list, tuple)) and not render_products):
+            raise ValueError(f"{type(self).__name__}.attach() needs at least one render product, got "
+                             f"{render_products!r}")
+        if self.data_structure not in DATA_STRUCTURES:
+            raise ValueError(f"{type(self).__name__}.data_structure is {self.data_structure!r}; expected one of "
+                             f"{DATA_STRUCTURES}")
+        items = render_products if isinstance(render_products, (list, tuple)) else [render_products]
+        rps = [rp_registry.find(item) for item in items]
+        annotators = self._annotator_objects()
+        if not annotators:
+            raise ValueError(f"{type(self).__name__} has no annotators to write; set self.annotators "
+                             f"(e.g. rgb=True for BasicWriter)")
+        self._render_products = rps
+        self._trigger = trigger
+        self._manual_requests = 0
+        for a in annotators:
+            a.attach(rps)
+        runtime().writers.add(self)
+
+    def attach_async(self, render_products, trigger: Any = ON_FRAME):
+        async def _attach():
+            self.attach(render_products, trigger)
+        return _attach()
+
+    def detach(self) -> None:
+        """Stop receiving frames; the writer's annotators detach."""
+        from graphsdg.runtime import runtime
+        for a in self._annotator_objects():
+            a.detach(self.render_products) if self.render_products else None
+        self._render_products = []
+        runtime().writers.discard(self)
+
+    def forget_render_product(self, rp: RenderProduct) -> None:
+        remaining = [p for p in self.render_products if p is not rp]
+        if len(remaining) != len(self.render_products):
+            self._render_products = remaining
+            if not remaining:
+                from graphsdg.runtime import runtime
+                runtime().writers.discard(self)
+
+    def schedule_write(self) -> None:
+        """With ``attach(..., trigger=None)``: write the next captured frame."""
+        self._manual_requests = getattr(self, "_manual_requests", 0) + 1
+
+    def wants_frame(self, fired_triggers: set) -> bool:
+        trigger = getattr(self, "_trigger", ON_FRAME)
+        if trigger is None:
+            if getattr(self, "_manual_requests", 0) > 0:
+                self._manual_requests -= 1
+                return True
+            return False
+        if trigger == ON_FRAME or isinstance(trigger, str):
+            return True
+        if callable(trigger) and not hasattr(trigger, "node"):
+            return bool(trigger())
+        return trigger in fired_triggers
+
+    def on_final_frame(self) -> None:
+        """Called when generation stops (flush aggregate files here)."""
+
+    def write_metadata(self) -> None:
+        """Write ``metadata.txt`` (Replicator's JSON, stray colon in the seed key included)."""
+        if self.backend is None:
+            return
+        meta = {"name": type(self).__name__, "version": self.version,
+                "replicator_global_seed:": rng.get_global_seed()}
+        self.backend.write_blob("metadata.txt", json.dumps(meta).encode())
+
+    # ---- data assembly -------------------------------------------------
+    def build_payload(self, outputs: dict[tuple[int, str], dict], trigger_outputs: dict,
+                      reference_time: tuple[int, int], extra: dict | None = None) -> dict:
+        """Shape per-(annotator, render product) outputs into this writer's ``data_structure``."""
+        annotators = self._annotator_objects()
+        rps = self.render_products
+        data: dict[str, Any]
+        if self.data_structure == "legacy":
+            data = {}
+            for a in annotators:
+                for rp in rps:
+                    out = outputs.get((id(a), rp.path))
+                    if out is None:
+                        continue
+                    key = a.name if len(rps) == 1 else f"{a.name}-{rp.name}"
+                    data[key] = shape_output(out, legacy=True)
+        elif self.data_structure == "annotator":
+            data = {"annotators": {}}
+            for a in annotators:
+                per_rp = {}
+                for rp in rps:
+                    out = outputs.get((id(a), rp.path))
+                    if out is not None:
+                        per_rp[rp.name] = shape_output(out, legacy=False)
+                data["annotators"][a.name] = per_rp
+        else:
+            data = {"renderProducts": {}}
+            for rp in rps:
+                entry: dict[str, Any] = {"camera": rp.camera, "resolution": [rp.width, rp.height]}
+                for a in annotators:
+                    out = outputs.get((id(a), rp.path))
+                    if out is not None:
+                        entry[a.name] = shape_output(out, legacy=False)
+                data["renderProducts"][rp.name] = entry
+        data["trigger_outputs"] = dict(trigger_outputs)
+        data["reference_time"] = reference_time
+        if extra:
+            data.update(extra)
+        return data
+
+
+class WriterRegistry:
+    """Registry of writer classes (``rep.WriterRegistry``)."""
+
+    _writers: dict[str, tuple[type[Writer], str | None]] = {}
+
+    @classmethod
+    def register(cls, writer_cls: type[Writer], category: str | None = None) -> None:
+        if not (inspect.isclass(writer_cls) and issubclass(writer_cls, Writer)):
+            raise TypeError(f"WriterRegistry.register expects a rep.Writer subclass, got {writer_cls!r}")
+        cls._writers[writer_cls.__name__] = (writer_cls, category)
+
+    @classmethod
+    def unregister(cls, name: str) -> None:
+        cls._writers.pop(name, None)
+
+    @classmethod
+    def get(cls, name: str, init_params: dict | None = None, render_products=None,
+            trigger: Any = ON_FRAME) -> Writer:
+        """A new writer of type ``name``; initialized and attached if those arguments are given."""
+        entry = cls._writers.get(name)
+        if entry is None:
+            raise unknown_name("writer", name, cls._writers)
+        writer_cls = entry[0]
+        writer = writer_cls.__new__(writer_cls)
+        if init_params is not None:
+            writer.initialize(**init_params)
+        if render_products is not None:
+            writer.attach(render_products, trigger=trigger)
+        return writer
+
+    @classmethod
+    def get_writers(cls, category: str | None = None) -> dict[str, type[Writer]]:
+        return {n: c for n, (c, cat) in cls._writers.items() if category is None or cat == category}
+
+    @classmethod
+    def get_attached_writers(cls) -> list[Writer]:
+        from graphsdg.runtime import runtime
+        return list(runtime().writers)
+
+    @classmethod
+    def detach_all(cls) -> None:
+        for w in cls.get_attached_writers():
+            w.detach()

@@ -1,0 +1,225 @@
+"""BasicWriter: Replicator's default writer, with its file names and layouts.
+
+Per frame ``n`` (zero-padded to ``frame_padding``) and per enabled flag:
+``rgb_{n}.png``; ``bounding_box_2d_tight_{n}.npy`` with ``_labels_{n}.json`` and
+``_prim_paths_{n}.json``; ``semantic_segmentation_{n}.png`` with
+``semantic_segmentation_labels_{n}.json``; ... With several render products
+each file goes to ``<rp_name>/<annotator>/`` (or ``<annotator>/<rp_name>_`` with
+``use_common_output_dir=True``).
+
+Example:
+    >>> import graphsdg as rep, tempfile
+    >>> w = rep.writers.get("BasicWriter")
+    >>> w.initialize(output_dir=tempfile.mkdtemp(), rgb=True)
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from graphsdg.annotate.annotator import AnnotatorRegistry
+from graphsdg.io import io_functions as iof
+from graphsdg.io.backends import BackendDispatch, BackendGroup, BaseBackend
+from graphsdg.io.writer import Writer
+
+# flag -> (annotator name BasicWriter requests, file stem)
+_FLAGS = {
+    "rgb": ("rgb", "rgb"),
+    "bounding_box_2d_tight": ("bounding_box_2d_tight_fast", "bounding_box_2d_tight"),
+    "bounding_box_2d_loose": ("bounding_box_2d_loose_fast", "bounding_box_2d_loose"),
+    "semantic_segmentation": ("semantic_segmentation", "semantic_segmentation"),
+    "instance_id_segmentation": ("instance_id_segmentation_fast", "instance_id_segmentation"),
+    "instance_segmentation": ("instance_segmentation_fast", "instance_segmentation"),
+    "distance_to_camera": ("distance_to_camera", "distance_to_camera"),
+    "distance_to_image_plane": ("distance_to_image_plane", "distance_to_image_plane"),
+    "bounding_box_3d": ("bounding_box_3d_fast", "bounding_box_3d"),
+    "occlusion": ("occlusion", "occlusion"),
+    "normals": ("normals", "normals"),
+    "motion_vectors": ("motion_vectors", "motion_vectors"),
+    "camera_params": ("camera_params", "camera_params"),
+    "pointcloud": ("pointcloud", "pointcloud"),
+    "skeleton_data": ("skeleton_data", "skeleton"),
+}
+_SEMANTIC = {"bounding_box_2d_tight", "bounding_box_2d_loose", "semantic_segmentation", "instance_segmentation",
+             "bounding_box_3d", "occlusion", "pointcloud"}
+IMAGE_FORMATS = ("png", "jpg", "jpeg")
+
+
+def semantic_types_from_predicate(predicate: str) -> list[str]:
+    """The types of a ``"class:*; foo:*"`` filter predicate (label-level filters are not parsed)."""
+    types = []
+    for clause in str(predicate).split(";"):
+        clause = clause.strip()
+        if not clause:
+            continue
+        if ":" not in clause:
+            raise ValueError(f"semantic_filter_predicate clause {clause!r} must look like 'type:*'")
+        sem_type, labels = (s.strip() for s in clause.split(":", 1))
+        if labels != "*" or not sem_type or sem_type == "*":
+            raise ValueError(f"semantic_filter_predicate clause {clause!r}: only 'type:*' clauses are "
+                             f"supported by graphsdg's BasicWriter")
+        types.append(sem_type)
+    if not types:
+        raise ValueError(f"semantic_filter_predicate {predicate!r} names no semantic type")
+    return types
+
+
+class BasicWriter(Writer):
+    """Replicator's BasicWriter (see the module docstring for the files it writes)."""
+
+    def __init__(self, output_dir: str | None = None, s3_bucket: str | None = None, s3_region: str | None = None,
+                 s3_endpoint: str | None = None, semantic_types: list[str] | None = None, rgb: bool = False,
+                 bounding_box_2d_tight: bool = False, bounding_box_2d_loose: bool = False,
+                 semantic_segmentation: bool = False, instance_id_segmentation: bool = False,
+                 instance_segmentation: bool = False, distance_to_camera: bool = False,
+                 distance_to_image_plane: bool = False, bounding_box_3d: bool = False, occlusion: bool = False,
+                 normals: bool = False, motion_vectors: bool = False, camera_params: bool = False,
+                 pointcloud: bool = False, pointcloud_include_unlabelled: bool = False,
+                 image_output_format: str = "png", colorize_semantic_segmentation: bool = True,
+                 colorize_instance_id_segmentation: bool = True, colorize_instance_segmentation: bool = True,
+                 colorize_depth: bool = False, skeleton_data: bool = False, frame_padding: int = 4,
+                 semantic_filter_predicate: str | None = None, use_common_output_dir: bool = False,
+                 backend: BaseBackend | None = None) -> None:
+        if s3_bucket or s3_region or s3_endpoint:
+            raise ValueError("BasicWriter: S3 output is not available in graphsdg; pass output_dir or backend")
+        if output_dir is None and backend is None:
+            raise ValueError("No `backend`, `output_dir` or `s3_` parameter specified; BasicWriter needs "
+                             "somewhere to write (e.g. output_dir='_out')")
+        if str(image_output_format).lower() not in IMAGE_FORMATS:
+            raise ValueError(f"image_output_format must be one of {IMAGE_FORMATS}, got {image_output_format!r}")
+        if isinstance(frame_padding, bool) or not isinstance(frame_padding, int) or frame_padding < 0:
+            raise ValueError(f"frame_padding must be a non-negative integer, got {frame_padding!r}")
+        if semantic_types is not None and semantic_filter_predicate is not None:
+            raise ValueError("BasicWriter: pass semantic_types or semantic_filter_predicate, not both")
+        types = list(semantic_types) if semantic_types is not None else (
+            semantic_types_from_predicate(semantic_filter_predicate) if semantic_filter_predicate else ["class"])
+        self.version = "0.0.2"
+        self.data_structure = "annotator"
+        backends = [backend] if backend is not None else []
+        if output_dir is not None:
+            backends.append(BackendDispatch(output_dir=output_dir))
+        self.backend = backends[0] if len(backends) == 1 else BackendGroup(backends)
+        self.output_dir = getattr(self.backend, "output_dir", None)
+        self._frame_id = 0
+        self._sequence = ""
+        self._padding = frame_padding
+        self._image_ext = "jpg" if str(image_output_format).lower() == "jpeg" else str(image_output_format).lower()
+        self._common_dir = use_common_output_dir
+        self._colorize = {"semantic_segmentation": colorize_semantic_segmentation,
+                          "instance_id_segmentation": colorize_instance_id_segmentation,
+                          "instance_segmentation": colorize_instance_segmentation}
+        self._colorize_depth = colorize_depth
+        flags = {"rgb": rgb, "bounding_box_2d_tight": bounding_box_2d_tight,
+                 "bounding_box_2d_loose": bounding_box_2d_loose, "semantic_segmentation": semantic_segmentation,
+                 "instance_id_segmentation": instance_id_segmentation,
+                 "instance_segmentation": instance_segmentation, "distance_to_camera": distance_to_camera,
+                 "distance_to_image_plane": distance_to_image_plane, "bounding_box_3d": bounding_box_3d,
+                 "occlusion": occlusion, "normals": normals, "motion_vectors": motion_vectors,
+                 "camera_params": camera_params, "pointcloud": pointcloud, "skeleton_data": skeleton_data}
+        self._stems: dict[str, str] = {}
+        self.annotators = []
+        for flag, enabled in flags.items():
+            if not enabled:
+                continue
+            anno_name, stem = _FLAGS[flag]
+            spec = AnnotatorRegistry.resolve(anno_name)   # clear error if not available
+            params: dict[str, Any] = {}
+            if flag in _SEMANTIC and "semanticTypes" in spec.defaults:
+                params["semanticTypes"] = types
+            if flag in self._colorize and "colorize" in spec.defaults:
+                params["colorize"] = self._colorize[flag]
+            if flag == "pointcloud" and "includeUnlabelled" in spec.defaults:
+                params["includeUnlabelled"] = pointcloud_include_unlabelled
+            self.annotators.append(AnnotatorRegistry.get_annotator(anno_name, init_params=params))
+            self._stems[anno_name] = stem
+        if not self.annotators:
+            raise ValueError("BasicWriter: no annotator enabled; set at least one flag such as rgb=True")
+        self._annotator_objs = None
+
+    # ---- paths ---------------------------------------------------------
+    def _path(self, stem: str, rp_name: str, multi: bool, suffix: str) -> str:
+        n = f"{self._frame_id:0{self._padding}d}"
+        if not multi:
+            prefix = ""
+        elif self._common_dir:
+            prefix = f"{stem}/{rp_name}_"
+        else:
+            prefix = f"{rp_name}/{stem}/"
+        return f"{prefix}{stem}{suffix}_{self._sequence}{n}"
+
+    def write(self, data: dict) -> None:
+        seq = "".join(f"{count}_" for name, count in sorted(data.get("trigger_outputs", {}).items())
+                      if "on_time" in name)
+        if seq != self._sequence:
+            self._sequence = seq
+            self._frame_id = 0
+        annotators = data["annotators"]
+        multi = len({rp for per_rp in annotators.values() for rp in per_rp}) > 1
+        for anno_name, per_rp in annotators.items():
+            stem = self._stems.get(anno_name, anno_name[:-5] if anno_name.endswith("_fast") else anno_name)
+            for rp_name, payload in per_rp.items():
+                self._write_one(stem, rp_name, multi, payload)
+        self._frame_id += 1
+        self.num_written += 1
+
+    def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
+        b = self.backend
+        path = lambda suffix="": self._path(stem, rp_name, multi, suffix)  # noqa: E731
+        arr = payload.get("data")
+        if stem == "rgb":
+            b.schedule(iof.write_image, data=arr, path=f"{path()}.{self._image_ext}")
+        elif stem.startswith("bounding_box"):
+            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_labels')}.json")
+            b.schedule(iof.write_json, data=list(payload["primPaths"]), path=f"{path('_prim_paths')}.json")
+        elif stem == "semantic_segmentation":
+            b.schedule(iof.write_image, data=arr, path=f"{path()}.png")
+            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_labels')}.json")
+        elif stem == "instance_id_segmentation":
+            b.schedule(iof.write_image, data=arr, path=f"{path()}.png")
+            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_mapping')}.json")
+        elif stem == "instance_segmentation":
+            b.schedule(iof.write_image, data=arr, path=f"{path()}.png")
+            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_mapping')}.json")
+            b.schedule(iof.write_json, data=payload["idToSemantics"], path=f"{path('_semantics_mapping')}.json")
+        elif stem.startswith("distance_to"):
+            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+            if self._colorize_depth:
+                b.schedule(iof.write_image, data=colorize_depth(arr), path=f"{path()}.png")
+        elif stem == "camera_params":
+            b.schedule(iof.write_json, data=payload, path=f"{path()}.json")
+        elif stem == "normals":
+            b.schedule(iof.write_image, data=colorize_normals(arr), path=f"{path()}.png")
+        elif stem == "pointcloud":
+            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+            for key, suffix in (("pointRgb", "_rgb"), ("pointNormals", "_normals"),
+                                ("pointSemantic", "_semantic"), ("pointInstance", "_instance")):
+                if key in payload:
+                    b.schedule(iof.write_np, data=payload[key], path=f"{path(suffix)}.npy")
+        elif stem == "skeleton":
+            b.schedule(iof.write_json, data={k: v for k, v in payload.items() if k != "data"},
+                       path=f"{path()}.json")
+        else:
+            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+
+
+def colorize_depth(depth: np.ndarray) -> np.ndarray:
+    """Depth as an 8-bit grey PNG (near bright, far dark; background black), log-scaled."""
+    d = np.asarray(depth, dtype=np.float64)
+    finite = np.isfinite(d) & (d > 0)
+    out = np.zeros(d.shape, dtype=np.uint8)
+    if finite.any():
+        logd = np.log(d[finite])
+        lo, hi = logd.min(), logd.max()
+        scale = (hi - lo) or 1.0
+        out[finite] = (255 - (logd - lo) / scale * 215).astype(np.uint8)
+    return out
+
+
+def colorize_normals(normals: np.ndarray) -> np.ndarray:
+    """World normals (H, W, 4) to an RGBA image ((n + 1) / 2 * 255)."""
+    n = np.asarray(normals, dtype=np.float32)
+    rgb = np.clip((n[..., :3] + 1.0) * 0.5 * 255.0, 0, 255).astype(np.uint8)
+    alpha = np.where(np.any(n[..., :3] != 0, axis=-1), 255, 0).astype(np.uint8)
+    return np.dstack([rgb, alpha])

@@ -1,0 +1,267 @@
+"""The orchestrator: one ``step()`` = randomize, sync, simulate, render, annotate, write.
+
+Example:
+    >>> import graphsdg as rep
+    >>> rep.orchestrator.get_status()
+    <Status.STOPPED: 0>
+"""
+from __future__ import annotations
+
+import atexit
+import enum
+import logging
+import time
+from fractions import Fraction
+from typing import Any, Callable
+
+from graphsdg import settings
+from graphsdg.annotate.annotator import Annotator
+from graphsdg.annotate.frame import FrameView
+from graphsdg.io.write_queue import get_write_queue
+from graphsdg.render.camera import camera_view
+from graphsdg.runtime import runtime
+
+log = logging.getLogger("graphsdg.orchestrator")
+
+
+class Status(enum.IntEnum):
+    STOPPED = 0
+    STARTED = 1
+    STARTING = 2
+    LOADING = 3
+    STOPPING = 4
+    PAUSED = 5
+    INITIALIZING = 6
+    STEPPING = 7
+    STEPPED = 8
+
+
+class OrchestratorError(RuntimeError):
+    """A call that does not fit the orchestrator's state."""
+
+
+class _State:
+    def __init__(self) -> None:
+        self.status = Status.STOPPED
+        self.frame_index = 0
+        self.callbacks: dict[int, Callable[[Status], None]] = {}
+        self.profile: dict[str, float] = {}
+        self.stop_requested = False
+
+    def set(self, status: Status) -> None:
+        if status != self.status:
+            self.status = status
+            for cb in list(self.callbacks.values()):
+                cb(status)
+
+
+_state = _State()
+
+
+def _validate_subframes(rt_subframes: Any) -> int:
+    if isinstance(rt_subframes, bool) or not isinstance(rt_subframes, int) or (rt_subframes < 1
+                                                                                and rt_subframes != -1):
+        raise ValueError(f"rt_subframes must be -1 (use the default) or a positive integer, got {rt_subframes!r}")
+    return rt_subframes
+
+
+def _timed(name: str, start: float) -> float:
+    now = time.perf_counter()
+    _state.profile[name] = _state.profile.get(name, 0.0) + (now - start)
+    return now
+
+
+def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float | None = None,
+         wait_for_render: bool = True) -> None:
+    """Run one capture: fired graph triggers, stage sync, time advance, render, annotators, writers.
+
+    ``delta_time=None`` advances a playing timeline by one tick; ``0`` captures
+    without advancing; a positive value advances by that many seconds.
+    ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
+    """
+    rt_subframes = _validate_subframes(rt_subframes)
+    if delta_time is not None and (not isinstance(delta_time, (int, float)) or delta_time < 0):
+        raise ValueError(f"delta_time must be None, 0 or a positive number of seconds, got {delta_time!r}")
+    queue = get_write_queue()
+    queue.raise_errors()
+    rt = runtime()
+    _state.set(Status.STEPPING)
+    t = time.perf_counter()
+    fired: set = set()
+    trigger_outputs: dict[str, int] = {}
+    subframes_override = 0
+    for hook in list(rt.graph_hooks):
+        result = hook()
+        if result:
+            fired |= set(result.get("fired", ()))
+            trigger_outputs.update(result.get("trigger_outputs", {}))
+            subframes_override = max(subframes_override, int(result.get("rt_subframes", 0)))
+    t = _timed("graph", t)
+    sim = rt.sim
+    sim.sync_dirty_prims()
+    t = _timed("sync", t)
+    advance_time(delta_time)
+    if pause_timeline and rt.timeline.is_playing():
+        rt.timeline.pause()
+    t = _timed("physics", t)
+    subframes = rt_subframes if rt_subframes > 0 else max(int(settings.get("/omni/replicator/RTSubframes", 1)),
+                                                          subframes_override, 1)
+    _capture(subframes, fired, trigger_outputs)
+    _timed("capture", t)
+    _state.frame_index += 1
+    _state.set(Status.STEPPED)
+
+
+def advance_time(delta_time: float | None) -> None:
+    """Advance the simulation by ``delta_time`` (``None``: one tick if the timeline plays)."""
+    rt = runtime()
+    timeline = rt.timeline
+    if delta_time is None:
+        if not timeline.is_playing():
+            return
+        dt = timeline.frame_duration
+    else:
+        dt = float(delta_time)
+    if dt <= 0:
+        return
+    sim = rt.sim
+    sim.sync_dirty_prims()
+    sim.advance(dt)
+    timeline.advanced(dt)
+
+
+def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
+    products: dict[str, tuple[Any, list[Annotator]]] = {}
+    for annotator in rt.annotators:
+        for rp in annotator.render_products:
+            if rp.destroyed or not rp.hydra_texture.get_updates_enabled():
+                continue
+            products.setdefault(rp.path, (rp, []))[1].append(annotator)
+    return products
+
+
+def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int]) -> None:
+    rt = runtime()
+    sim = rt.sim
+    stage = rt.stage
+    products = _active_products(rt)
+    outputs: dict[tuple[int, str], dict] = {}
+    sim_time = sim.data.time
+    for path, (rp, annotators) in products.items():
+        t = time.perf_counter()
+        sim.require_offscreen(rp.width, rp.height)
+        view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
+        passes: set[str] = set()
+        for a in annotators:
+            passes |= a.spec.passes
+        render = rt.rasterizer.render(sim, view, passes, subframes) if passes else None
+        t = _timed("render", t)
+        frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time)
+        for a in annotators:
+            outputs[(id(a), path)] = a.compute_for(frame)
+        _timed("annotate", t)
+    t = time.perf_counter()
+    reference_time = Fraction(sim_time).limit_denominator(1_000_000)
+    for writer in rt.writers:
+        if not writer.wants_frame(fired):
+            continue
+        data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator))
+        writer.write(data)
+    _timed("write", t)
+
+
+async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float | None = None,
+                     wait_for_render: bool = True) -> None:
+    """``step`` for asyncio scripts (Isaac's Script Editor form)."""
+    step(rt_subframes=rt_subframes, pause_timeline=pause_timeline, delta_time=delta_time,
+         wait_for_render=wait_for_render)
+
+
+def wait_until_complete() -> None:
+    """Block until every scheduled file is on disk; raise the first writer failure."""
+    get_write_queue().wait_until_done()
+
+
+async def wait_until_complete_async() -> None:
+    wait_until_complete()
+
+
+def set_capture_on_play(value: bool) -> None:
+    """Capture every timeline tick while playing (Replicator's default) or only on ``step()``."""
+    settings.set("/omni/replicator/captureOnPlay", bool(value))
+
+
+def get_capture_on_play() -> bool:
+    return bool(settings.get("/omni/replicator/captureOnPlay", True))
+
+
+def tick() -> None:
+    """One app update: advance a playing timeline one tick, capturing if capture-on-play is on."""
+    rt = runtime()
+    if rt.timeline.is_playing() and get_capture_on_play() and (len(rt.writers) or len(rt.annotators)):
+        step(pause_timeline=False)
+        return
+    advance_time(None)
+
+
+def get_status() -> Status:
+    return _state.status
+
+
+def get_is_started() -> bool:
+    return _state.status in (Status.STARTED, Status.STEPPING, Status.STEPPED)
+
+
+def get_is_paused() -> bool:
+    return _state.status == Status.PAUSED
+
+
+def get_is_stopped() -> bool:
+    return _state.status == Status.STOPPED
+
+
+def register_status_callback(callback: Callable[[Status], None]) -> int:
+    """Call ``callback(status)`` on every status change; returns a handle."""
+    handle = max(_state.callbacks, default=0) + 1
+    _state.callbacks[handle] = callback
+    return handle
+
+
+def unregister_status_callback(handle: int) -> None:
+    _state.callbacks.pop(handle, None)
+
+
+def stop() -> None:
+    """Stop generation: writers' ``on_final_frame`` runs, then pending writes are flushed."""
+    _state.set(Status.STOPPING)
+    for writer in runtime().writers:
+        writer.on_final_frame()
+    wait_until_complete()
+    _state.set(Status.STOPPED)
+
+
+async def stop_async() -> None:
+    stop()
+
+
+def get_profile() -> dict[str, float]:
+    """Seconds spent per phase (graph, sync, physics, render, annotate, write) since the last reset."""
+    return dict(_state.profile)
+
+
+def reset_profile() -> None:
+    _state.profile.clear()
+
+
+def _flush_at_exit() -> None:
+    queue = get_write_queue()
+    pending = queue.pending()
+    if pending:
+        log.warning("graphsdg: %d writes were still queued at exit; flushing them now", pending)
+    try:
+        queue.wait_until_done()
+    except Exception as exc:  # noqa: BLE001 - report, exit continues
+        log.error("graphsdg: writes failed at exit: %s", exc)
+
+
+atexit.register(_flush_at_exit)

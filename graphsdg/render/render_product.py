@@ -1,0 +1,191 @@
+"""Render products: a camera at a resolution, the unit annotators attach to.
+
+Mirrors ``rep.create.render_product``: the returned object has ``.path``
+(``/Render/RenderProduct_<name>``), ``.name``, ``.hydra_texture`` with
+``set_updates_enabled``, and ``destroy()``.
+"""
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+import numpy as np
+from pxr import Usd, UsdGeom
+
+from graphsdg import settings
+from graphsdg.errors import InvalidPrimError, RenderProductDestroyedError
+from graphsdg.stage.context import get_stage
+from graphsdg.stage.prims import resolve_prim
+
+DEFAULT_NAME = "Replicator"
+
+
+class HydraTexture:
+    """The rendering side of a product; ``set_updates_enabled(False)`` skips its renders."""
+
+    def __init__(self) -> None:
+        self._enabled = True
+
+    def set_updates_enabled(self, enabled: bool) -> None:
+        self._enabled = bool(enabled)
+
+    def get_updates_enabled(self) -> bool:
+        return self._enabled
+
+
+class RenderProduct:
+    """A camera prim rendered at ``resolution = (width, height)``."""
+
+    def __init__(self, camera: str, resolution: tuple[int, int], name: str) -> None:
+        self.camera = camera
+        self.resolution = resolution
+        self.name = name
+        self.path = f"/Render/RenderProduct_{name}"
+        self.hydra_texture = HydraTexture()
+        self._destroyed = False
+
+    @property
+    def width(self) -> int:
+        return self.resolution[0]
+
+    @property
+    def height(self) -> int:
+        return self.resolution[1]
+
+    @property
+    def destroyed(self) -> bool:
+        return self._destroyed
+
+    def check_alive(self) -> None:
+        if self._destroyed:
+            raise RenderProductDestroyedError(
+                f"render product {self.name!r} ({self.path}) was destroyed; create a new one with "
+                f"rep.create.render_product(camera, resolution)")
+
+    def camera_prim(self, stage: Usd.Stage | None = None) -> Usd.Prim:
+        stage = stage or get_stage()
+        prim = stage.GetPrimAtPath(self.camera)
+        if not prim or not prim.IsA(UsdGeom.Camera):
+            raise InvalidPrimError(f"render product {self.name!r}: camera {self.camera!r} no longer exists "
+                                   f"or is not a Camera")
+        return prim
+
+    def destroy(self) -> None:
+        """Release the product: annotators and writers attached to it detach; using it again raises."""
+        if self._destroyed:
+            return
+        self._destroyed = True
+        registry.remove(self)
+
+    def __repr__(self) -> str:
+        state = "destroyed" if self._destroyed else f"{self.width}x{self.height}"
+        return f"RenderProduct({self.name!r}, camera={self.camera!r}, {state})"
+
+
+class RenderProductRegistry:
+    """All live render products of the process, in creation order."""
+
+    def __init__(self) -> None:
+        self._products: list[RenderProduct] = []
+        self._listeners: list = []
+
+    def __iter__(self):
+        return iter(list(self._products))
+
+    def __len__(self) -> int:
+        return len(self._products)
+
+    def subscribe_removed(self, callback) -> None:
+        self._listeners.append(callback)
+
+    def unique_name(self, name: str | None) -> str:
+        base = name or DEFAULT_NAME
+        taken = {p.name for p in self._products}
+        if base not in taken:
+            return base
+        i = 1
+        while f"{base}_{i:02d}" in taken:
+            i += 1
+        return f"{base}_{i:02d}"
+
+    def add(self, rp: RenderProduct) -> None:
+        self._products.append(rp)
+
+    def remove(self, rp: RenderProduct) -> None:
+        if rp in self._products:
+            self._products.remove(rp)
+        for cb in list(self._listeners):
+            cb(rp)
+
+    def find(self, value: "RenderProduct | str") -> RenderProduct:
+        if isinstance(value, RenderProduct):
+            value.check_alive()
+            return value
+        for rp in self._products:
+            if value in (rp.path, rp.name):
+                return rp
+        raise ValueError(f"no render product named or at path {value!r}; live products: "
+                         f"{[p.path for p in self._products]}")
+
+    def clear(self) -> None:
+        for rp in list(self._products):
+            rp.destroy()
+
+
+registry = RenderProductRegistry()
+
+
+def _validate_resolution(resolution: object) -> tuple[int, int]:
+    try:
+        w, h = resolution  # type: ignore[misc]
+    except (TypeError, ValueError):
+        raise ValueError(f"resolution must be (width, height), two positive integers; got {resolution!r}") from None
+    if any(isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v <= 0 for v in (w, h)):
+        raise ValueError(f"resolution must be (width, height), two positive integers; got {resolution!r}")
+    limit = int(settings.get("/graphsdg/render/maxResolution", 4096))
+    if w > limit or h > limit:
+        raise ValueError(f"resolution {w}x{h} exceeds the largest supported edge {limit} "
+                         f"(setting /graphsdg/render/maxResolution)")
+    return int(w), int(h)
+
+
+def _camera_path(camera: object) -> str:
+    if hasattr(camera, "get_output_prims"):  # a graph item wrapping a camera node
+        prims = camera.get_output_prims()["prims"]
+        if len(prims) != 1:
+            raise InvalidPrimError(f"render product camera item yields {len(prims)} prims; expected one camera")
+        camera = prims[0]
+    prim = resolve_prim(camera)  # type: ignore[arg-type]
+    if not prim.IsA(UsdGeom.Camera):
+        raise InvalidPrimError(f"render product camera {str(prim.GetPath())!r} is a {prim.GetTypeName() or 'typeless'} "
+                               f"prim, not a UsdGeom.Camera")
+    return str(prim.GetPath())
+
+
+def create_render_product(camera: object, resolution: Sequence[int], force_new: bool = False,
+                          name: str | None = None, render_vars: Iterable[str] | None = None
+                          ) -> RenderProduct | list[RenderProduct]:
+    """Create a render product of ``camera`` (prim, path, or list of them) at ``(width, height)``.
+
+    Example:
+        >>> import graphsdg as rep
+        >>> _ = rep.stage.new_stage()
+        >>> cam = rep.functional.create.camera(position=(5, 5, 5), look_at=(0, 0, 0))
+        >>> rp = rep.create.render_product(cam, (64, 48))
+        >>> rp.resolution
+        (64, 48)
+    """
+    res = _validate_resolution(resolution)
+    if isinstance(camera, (list, tuple)) and not (len(camera) == 3 and all(isinstance(c, (int, float))
+                                                                           for c in camera)):
+        return [create_render_product(c, res, force_new, name, render_vars) for c in camera]  # type: ignore
+    path = _camera_path(camera)
+    if not force_new:
+        for rp in registry:
+            if rp.camera == path and rp.resolution == res and (name is None or rp.name == name):
+                return rp
+    rp = RenderProduct(path, res, registry.unique_name(name))
+    registry.add(rp)
+    return rp
+
+
+__all__ = ["RenderProduct", "HydraTexture", "create_render_product", "registry"]

@@ -1,0 +1,102 @@
+"""The process-wide capture runtime: stage, simulation, renderer, attachments.
+
+One :class:`Runtime` ties together what a capture needs: the current stage and
+its :class:`~graphsdg.sim.scene.SimScene`, the :class:`Rasterizer` (which owns
+the GL context and so lives on the thread that captures), the timeline, and the
+annotators and writers attached to render products. The orchestrator drives it.
+"""
+from __future__ import annotations
+
+from typing import Callable, Generic, Iterator, TypeVar
+
+from pxr import Usd
+
+from graphsdg.annotate.frame import SceneLabels
+from graphsdg.annotate.ids import IdTables
+from graphsdg.render.rasterizer import Rasterizer
+from graphsdg.render.render_product import RenderProduct, registry as rp_registry
+from graphsdg.sim.scene import SimScene
+from graphsdg.sim.timeline import Timeline
+from graphsdg.stage.context import stage_context
+
+T = TypeVar("T")
+
+
+class OrderedSet(Generic[T]):
+    """Insertion-ordered set (attachment order decides evaluation order, deterministically)."""
+
+    def __init__(self) -> None:
+        self._items: dict[int, T] = {}
+
+    def add(self, item: T) -> None:
+        self._items.setdefault(id(item), item)
+
+    def discard(self, item: T) -> None:
+        self._items.pop(id(item), None)
+
+    def __iter__(self) -> Iterator[T]:
+        return iter(list(self._items.values()))
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __contains__(self, item: object) -> bool:
+        return id(item) in self._items
+
+    def clear(self) -> None:
+        self._items.clear()
+
+
+class Runtime:
+    """Everything a capture step touches (see the module docstring)."""
+
+    def __init__(self) -> None:
+        self._sim: SimScene | None = None
+        self._sim_stage: Usd.Stage | None = None
+        self.rasterizer = Rasterizer()
+        self.timeline = Timeline()
+        self.annotators: OrderedSet = OrderedSet()
+        self.writers: OrderedSet = OrderedSet()
+        self.ids = IdTables()
+        self.labels = SceneLabels(self.ids)
+        self.graph_hooks: list[Callable[..., object]] = []
+        stage_context.subscribe_replaced(self._on_stage_replaced)
+        rp_registry.subscribe_removed(self._on_render_product_removed)
+
+    @property
+    def stage(self) -> Usd.Stage:
+        return stage_context.get_stage()
+
+    @property
+    def sim(self) -> SimScene:
+        stage = self.stage
+        if self._sim is None or self._sim_stage is not stage:
+            assert stage_context.tracker is not None
+            self._sim = SimScene(stage, stage_context.tracker)
+            self._sim_stage = stage
+            self.timeline.set_time_codes_per_second(stage.GetTimeCodesPerSecond() or 60.0)
+        return self._sim
+
+    def _on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        self._sim = None
+        self._sim_stage = None
+        self.ids.clear()
+        self.labels = SceneLabels(self.ids)
+        self.timeline.stop()
+
+    def _on_render_product_removed(self, rp: RenderProduct) -> None:
+        for a in list(self.annotators):
+            a.forget_render_product(rp)
+        for w in list(self.writers):
+            w.forget_render_product(rp)
+
+
+_runtime: Runtime | None = None
+
+
+def runtime() -> Runtime:
+    """The process's :class:`Runtime` (created on first use)."""
+    global _runtime
+    if _runtime is None:
+        _runtime = Runtime()
+    return _runtime

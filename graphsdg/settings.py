@@ -1,0 +1,86 @@
+"""A settings store that accepts Replicator's (carb) setting keys.
+
+Isaac Sim scripts configure Replicator through carb settings such as
+``/omni/replicator/captureOnPlay`` or ``rtx/post/dlss/execMode``. graphsdg keeps
+one flat store keyed by normalised path. Keys that graphsdg honours are listed in
+:data:`KNOWN_KEYS`; any other key is stored (so ``get`` returns what was set) and
+a single warning per key says that it has no effect here.
+
+Example:
+    >>> from graphsdg import settings
+    >>> settings.set("/omni/replicator/RTSubframes", 4)
+    >>> settings.get("/omni/replicator/RTSubframes")
+    4
+"""
+from __future__ import annotations
+
+import threading
+import warnings
+from typing import Any
+
+# key -> (default, meaning). Only these keys change graphsdg's behaviour.
+KNOWN_KEYS: dict[str, tuple[Any, str]] = {
+    "/omni/replicator/captureOnPlay": (True, "capture every timeline tick while playing"),
+    "/omni/replicator/RTSubframes": (1, "default number of accumulated subframes per capture"),
+    "/omni/replicator/globalSeed": (None, "global seed of every distribution and ReplicatorRNG"),
+    "/omni/replicator/backend/writeThreads": (4, "writer worker threads of the I/O pool"),
+    "/omni/replicator/backend/queueSize": (1000, "queued writes before the producer is throttled"),
+    "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
+    "/exts/omni.replicator.core/enableWriteToFabric": (
+        False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
+    "/graphsdg/render/shadowSize": (1024, "shadow map size of shadow-casting lights"),
+    "/graphsdg/render/msaaSamples": (4, "multisample anti-aliasing samples of the colour pass"),
+    "/graphsdg/render/exposure": (1.0, "scale from photometric light units to display values"),
+    "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
+    "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
+                        "rasteriser settings (more MSAA samples and larger shadow maps)"),
+}
+
+_values: dict[str, Any] = {}
+_warned: set[str] = set()
+_lock = threading.Lock()
+
+
+def normalize_key(key: str) -> str:
+    """Return ``key`` with exactly one leading slash (carb accepts both forms)."""
+    if not isinstance(key, str) or not key.strip("/"):
+        raise ValueError(f"setting key must be a non-empty path string, got {key!r}")
+    return "/" + key.strip().lstrip("/")
+
+
+def set(key: str, value: Any) -> None:  # noqa: A001 - mirrors carb's API name
+    """Store ``value`` under ``key``; warn once if graphsdg does not use the key."""
+    k = normalize_key(key)
+    with _lock:
+        _values[k] = value
+        unknown = k not in KNOWN_KEYS and k not in _warned
+        if unknown:
+            _warned.add(k)
+    if unknown:
+        warnings.warn(
+            f"setting {k!r} has no effect in graphsdg (stored, but nothing reads it); "
+            f"honoured keys: {', '.join(sorted(KNOWN_KEYS))}",
+            stacklevel=2,
+        )
+
+
+def get(key: str, default: Any = None) -> Any:
+    """Return the value of ``key``: what was set, else graphsdg's default, else ``default``."""
+    k = normalize_key(key)
+    with _lock:
+        if k in _values:
+            return _values[k]
+    if k in KNOWN_KEYS and KNOWN_KEYS[k][0] is not None:
+        return KNOWN_KEYS[k][0]
+    return default
+
+
+def reset() -> None:
+    """Forget every value that was set (defaults apply again)."""
+    with _lock:
+        _values.clear()
+
+
+# carb-style aliases so `settings.get_settings().set(...)` reads naturally.
+set_bool = set_int = set_float = set_string = set
+get_as_bool = get_as_int = get_as_float = get_as_string = get

@@ -1,0 +1,1 @@
+"""MuJoCo: the stage compiler, live sync, physics time."""

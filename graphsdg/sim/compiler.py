@@ -1,0 +1,482 @@
+"""Compile a ``Usd.Stage`` into a MuJoCo model through ``MjSpec``.
+
+Mapping (USD -> MuJoCo):
+
+* every renderable gprim (Cube, Sphere, Cylinder, Cone, Capsule, Plane, Mesh) is
+  one geom. A gprim under a prim with ``UsdPhysics.RigidBodyAPI`` belongs to
+  that rigid body (a free body, or a mocap body if kinematic); any other gprim
+  gets its own mocap body at its world pose, so pose edits are a write into
+  ``mocap_pos``/``mocap_quat`` with no recompile.
+* the world scale of a gprim is baked into the geom size (primitives, editable
+  live) or into the mesh vertices (meshes: a scale edit recompiles).
+* ``UsdShade`` materials become MuJoCo materials; ``primvars:displayColor``
+  becomes the geom colour when no material is bound.
+* UsdLux lights become MuJoCo lights (see :mod:`graphsdg.sim.lights`); a dome
+  light becomes ambient light plus a soft sky light from above, and a skybox.
+* cameras are not compiled: render products read USD cameras directly.
+
+The result, :class:`CompiledScene`, remembers which MuJoCo elements each prim
+drives so :mod:`graphsdg.sim.scene` can write attribute edits straight into the
+model.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+from pxr import Usd, UsdGeom, UsdPhysics
+
+from graphsdg import settings
+from graphsdg.sim import lights as lightmap
+from graphsdg.stage import materials as matlib
+from graphsdg.stage import shapes
+from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+
+HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)
+COLLISION_ONLY_GROUP = 4    # proxy collision shapes (not drawn)
+DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
+MUJOCO_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)   # geom rgba that lets a bound material show through
+GPRIM_TYPES = ("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh")
+SKY_TEXTURE = "graphsdg:sky"
+
+
+class CompileError(ValueError):
+    """The stage holds something that cannot become a MuJoCo model."""
+
+
+@dataclass
+class GeomBinding:
+    """What one gprim drives in the compiled model."""
+
+    path: str
+    type_name: str
+    geom_id: int
+    body_id: int
+    mocap_id: int                    # >= 0 when the gprim owns a mocap body
+    rigid_root: str | None           # path of the rigid body the geom belongs to
+    scale: np.ndarray                # world scale baked into size or vertices
+    material: str | None             # bound material path
+    visible: bool = True
+
+
+@dataclass
+class BodyBinding:
+    """A rigid body (UsdPhysics.RigidBodyAPI) in the compiled model."""
+
+    path: str
+    body_id: int
+    mocap_id: int                    # kinematic bodies are mocap bodies
+    qpos_adr: int = -1               # free joint address (dynamic bodies)
+    qvel_adr: int = -1
+
+
+@dataclass
+class LightBinding:
+    path: str
+    kind: str
+    light_ids: list[int]
+
+
+@dataclass
+class CompiledScene:
+    """A compiled MuJoCo model plus the prim <-> element maps."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    geoms: dict[str, GeomBinding] = field(default_factory=dict)
+    geom_paths: list[str] = field(default_factory=list)      # geom id -> gprim path ("" if none)
+    bodies: dict[str, BodyBinding] = field(default_factory=dict)
+    lights: dict[str, LightBinding] = field(default_factory=dict)
+    materials: dict[str, int] = field(default_factory=dict)
+    sky_texture_id: int = -1
+    has_scene_lights: bool = False
+    compile_seconds: float = 0.0
+
+
+def _is_renderable(prim: Usd.Prim) -> bool:
+    if prim.GetTypeName() not in GPRIM_TYPES:
+        return False
+    purpose = UsdGeom.Imageable(prim).ComputePurpose()
+    return purpose in (UsdGeom.Tokens.default_, UsdGeom.Tokens.render)
+
+
+def _rigid_root(prim: Usd.Prim) -> Usd.Prim | None:
+    p = prim
+    while p and not p.IsPseudoRoot():
+        if p.HasAPI(UsdPhysics.RigidBodyAPI):
+            enabled = UsdPhysics.RigidBodyAPI(p).GetRigidBodyEnabledAttr().Get()
+            if enabled is None or enabled:
+                return p
+        p = p.GetParent()
+    return None
+
+
+def _collides(prim: Usd.Prim) -> bool:
+    p = prim
+    while p and not p.IsPseudoRoot():
+        if p.HasAPI(UsdPhysics.CollisionAPI):
+            enabled = UsdPhysics.CollisionAPI(p).GetCollisionEnabledAttr().Get()
+            return enabled is None or bool(enabled)
+        p = p.GetParent()
+    return False
+
+
+def display_rgba(prim: Usd.Prim) -> tuple[float, float, float, float]:
+    """The gprim's ``primvars:displayColor`` (first value) and opacity, or graphsdg's grey."""
+    gprim = UsdGeom.Gprim(prim)
+    colors = gprim.GetDisplayColorAttr().Get() if gprim else None
+    opacity = gprim.GetDisplayOpacityAttr().Get() if gprim else None
+    rgb = tuple(float(c) for c in colors[0]) if colors is not None and len(colors) else DEFAULT_RGBA[:3]
+    alpha = float(opacity[0]) if opacity is not None and len(opacity) else 1.0
+    return (*rgb, alpha)
+
+
+def _axis_rotation(axis: str) -> np.ndarray:
+    """Rotation taking MuJoCo's +Z (its cylinder/capsule axis) onto USD ``axis``."""
+    if axis == "X":
+        return np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]], dtype=np.float64)
+    if axis == "Y":
+        return np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)
+    return np.eye(3)
+
+
+def _axis_index(axis: str) -> int:
+    return "XYZ".index(axis)
+
+
+def primitive_size(prim: Usd.Prim, scale: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+    """(mjtGeom, size[3], local rotation) of an implicit gprim under world ``scale``."""
+    s = np.abs(scale)
+    t = prim.GetTypeName()
+    if t == "Cube":
+        a = float(UsdGeom.Cube(prim).GetSizeAttr().Get())
+        return mujoco.mjtGeom.mjGEOM_BOX, a / 2 * s, np.eye(3)
+    if t == "Sphere":
+        r = float(UsdGeom.Sphere(prim).GetRadiusAttr().Get())
+        if np.allclose(s, s[0], rtol=1e-6):
+            return mujoco.mjtGeom.mjGEOM_SPHERE, np.array([r * s[0], 0, 0]), np.eye(3)
+        return mujoco.mjtGeom.mjGEOM_ELLIPSOID, r * s, np.eye(3)
+    if t in ("Cylinder", "Capsule"):
+        g = UsdGeom.Cylinder(prim) if t == "Cylinder" else UsdGeom.Capsule(prim)
+        axis = str(g.GetAxisAttr().Get())
+        i = _axis_index(axis)
+        perp = max(s[j] for j in range(3) if j != i)
+        r, h = float(g.GetRadiusAttr().Get()), float(g.GetHeightAttr().Get())
+        kind = mujoco.mjtGeom.mjGEOM_CYLINDER if t == "Cylinder" else mujoco.mjtGeom.mjGEOM_CAPSULE
+        return kind, np.array([r * perp, h / 2 * s[i], 0]), _axis_rotation(axis)
+    if t == "Plane":
+        g = UsdGeom.Plane(prim)
+        axis = str(g.GetAxisAttr().Get())
+        w, length = float(g.GetWidthAttr().Get()), float(g.GetLengthAttr().Get())
+        rot = _axis_rotation(axis)
+        # USD Plane: width along the first in-plane axis, length along the second.
+        in_plane = [j for j in range(3) if j != _axis_index(axis)]
+        half = np.array([w / 2 * s[in_plane[0]], length / 2 * s[in_plane[1]], 1e-4])
+        return mujoco.mjtGeom.mjGEOM_BOX, half, rot
+    raise CompileError(f"{prim.GetPath()}: {t} is not an implicit primitive")
+
+
+def mesh_arrays(prim: Usd.Prim, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (scaled, in the prim's frame) and triangles of a Mesh or Cone prim."""
+    if prim.GetTypeName() == "Cone":
+        g = UsdGeom.Cone(prim)
+        verts, tris = shapes.cone_mesh(float(g.GetRadiusAttr().Get()), float(g.GetHeightAttr().Get()))
+        verts = verts @ _axis_rotation(str(g.GetAxisAttr().Get())).T
+        return verts * scale, tris
+    mesh = UsdGeom.Mesh(prim)
+    points = mesh.GetPointsAttr().Get()
+    counts = mesh.GetFaceVertexCountsAttr().Get()
+    indices = mesh.GetFaceVertexIndicesAttr().Get()
+    if points is None or counts is None or indices is None or len(points) == 0:
+        raise CompileError(f"mesh {prim.GetPath()} has no points or faces")
+    verts = np.array(points, dtype=np.float64) * scale
+    tris = shapes.triangulate(np.array(counts), np.array(indices))
+    if tris.size and (tris.max() >= len(verts) or tris.min() < 0):
+        raise CompileError(f"mesh {prim.GetPath()} has face indices outside its {len(verts)} points")
+    if str(mesh.GetOrientationAttr().Get()) == UsdGeom.Tokens.leftHanded:
+        tris = tris[:, ::-1]
+    return verts, tris
+
+
+class _Builder:
+    """One compile: walks the stage and fills an MjSpec."""
+
+    def __init__(self, stage: Usd.Stage, offscreen: tuple[int, int]) -> None:
+        self.stage = stage
+        self.spec = mujoco.MjSpec()
+        self.cache = UsdGeom.XformCache(Usd.TimeCode.Default())
+        self.offscreen = offscreen
+        self.geom_records: list[tuple[str, object, str | None, np.ndarray, str | None, bool]] = []
+        self.body_records: dict[str, object] = {}
+        self.light_records: list[tuple[str, str, list[object]]] = []
+        self.material_names: dict[str, str] = {}
+        self.mesh_count = 0
+        self.has_lights = False
+        self.ambient = np.zeros(3)
+        self.sky_rgb: np.ndarray | None = None
+
+    # ---- options -------------------------------------------------------
+    def configure(self) -> None:
+        spec = self.spec
+        spec.compiler.boundmass = 1e-6
+        spec.compiler.boundinertia = 1e-9
+        spec.option.timestep = 1.0 / 60.0
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        up = UsdGeom.GetStageUpAxis(self.stage)
+        spec.option.gravity = [0, -9.81, 0] if up == UsdGeom.Tokens.y else [0, 0, -9.81]
+        mpu = UsdGeom.GetStageMetersPerUnit(self.stage) or 1.0
+        for prim in self.stage.Traverse():
+            if prim.IsA(UsdPhysics.Scene):
+                scene = UsdPhysics.Scene(prim)
+                direction = scene.GetGravityDirectionAttr().Get()
+                magnitude = scene.GetGravityMagnitudeAttr().Get()
+                g = 9.81 / mpu if magnitude is None or magnitude < -1e30 else float(magnitude)
+                if direction is not None and np.linalg.norm(np.array(direction)) > 0:
+                    d = np.array(direction, dtype=np.float64)
+                    spec.option.gravity = (d / np.linalg.norm(d) * g).tolist()
+                else:
+                    spec.option.gravity = [0, -g, 0] if up == UsdGeom.Tokens.y else [0, 0, -g]
+                tps = prim.GetAttribute("physxScene:timeStepsPerSecond").Get() if \
+                    prim.GetAttribute("physxScene:timeStepsPerSecond") else None
+                if tps:
+                    spec.option.timestep = 1.0 / float(tps)
+                break
+        vis = spec.visual
+        vis.global_.offwidth, vis.global_.offheight = self.offscreen
+        vis.quality.shadowsize = int(settings.get("/graphsdg/render/shadowSize", 1024))
+        vis.quality.offsamples = int(settings.get("/graphsdg/render/msaaSamples", 4))
+        if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
+            vis.quality.shadowsize = max(vis.quality.shadowsize, 4096)
+        vis.map.znear = 0.001
+        vis.map.zfar = 1000.0
+
+    # ---- materials -----------------------------------------------------
+    def material(self, prim: Usd.Prim) -> str | None:
+        material = matlib.bound_material(prim)
+        if material is None:
+            return None
+        path = str(material.GetPath())
+        if path in self.material_names:
+            return path
+        desc = matlib.describe(material)
+        m = self.spec.add_material(name=path)
+        m.rgba = list(desc.rgba)
+        m.specular = 0.5 * (1.0 - desc.roughness)
+        m.shininess = max(0.0, 1.0 - desc.roughness)
+        m.reflectance = 0.0
+        m.emission = desc.emission
+        if desc.texture:
+            if not os.path.isfile(desc.texture):
+                raise CompileError(f"material {path}: texture file {desc.texture!r} does not exist")
+            tex_name = f"tex:{path}"
+            self.spec.add_texture(name=tex_name, type=mujoco.mjtTexture.mjTEXTURE_2D, file=desc.texture)
+            m.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex_name
+            m.texrepeat = [desc.texture_scale[0], desc.texture_scale[1]]
+            m.texuniform = False
+        self.material_names[path] = path
+        return path
+
+    # ---- geometry ------------------------------------------------------
+    def body_for_rigid(self, root: Usd.Prim):
+        path = str(root.GetPath())
+        if path in self.body_records:
+            return self.body_records[path]
+        t, r, _ = decompose(world_matrix(root, self.cache))
+        kinematic = bool(UsdPhysics.RigidBodyAPI(root).GetKinematicEnabledAttr().Get())
+        body = self.spec.worldbody.add_body(name=path, pos=t.tolist(), quat=matrix_to_quat_wxyz(r).tolist(),
+                                            mocap=kinematic)
+        if not kinematic:
+            body.add_freejoint(name=f"{path}#free")
+        self.body_records[path] = body
+        return body
+
+    def add_gprim(self, prim: Usd.Prim) -> None:
+        path = str(prim.GetPath())
+        m_world = world_matrix(prim, self.cache)
+        root = _rigid_root(prim)
+        if root is not None:
+            body = self.body_for_rigid(root)
+            t_root, r_root, _ = decompose(world_matrix(root, self.cache))
+            m_root = np.eye(4)
+            m_root[:3, :3] = r_root.T
+            m_root[3, :3] = t_root
+            t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
+        else:
+            t, r, scale = decompose(m_world)
+            body = self.spec.worldbody.add_body(name=path, pos=t.tolist(), quat=matrix_to_quat_wxyz(r).tolist(),
+                                                mocap=True)
+            t, r = np.zeros(3), np.eye(3)
+        collides = _collides(prim)
+        visible = UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible
+        material = self.material(prim)
+        type_name = prim.GetTypeName()
+        if type_name in ("Mesh", "Cone"):
+            verts, tris = mesh_arrays(prim, scale)
+            verts = verts @ r.T + t
+            mesh_name = f"mesh:{path}"
+            mesh = self.spec.add_mesh(name=mesh_name, uservert=verts.ravel().tolist(),
+                                      userface=tris.ravel().tolist())
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+            geom = body.add_geom(name=path, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=mesh_name)
+            self.mesh_count += 1
+        else:
+            kind, size, local_rot = primitive_size(prim, scale)
+            geom = body.add_geom(name=path, type=kind, size=size.tolist(), pos=t.tolist(),
+                                 quat=matrix_to_quat_wxyz(r @ local_rot).tolist())
+        geom.contype = geom.conaffinity = 1 if collides else 0
+        geom.group = 0 if visible else HIDDEN_GROUP
+        if material is not None:
+            geom.material = material
+            geom.rgba = list(MUJOCO_DEFAULT_RGBA)
+        else:
+            geom.rgba = list(display_rgba(prim))
+        if root is None:
+            geom.density = 0.0 if not collides else 1000.0
+        self.geom_records.append((path, geom, str(root.GetPath()) if root else None, scale, material, visible))
+
+    # ---- lights --------------------------------------------------------
+    def add_light(self, prim: Usd.Prim) -> None:
+        path = str(prim.GetPath())
+        if UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) == UsdGeom.Tokens.invisible:
+            self.light_records.append((path, lightmap.LIGHT_KINDS[prim.GetTypeName()], []))
+            return
+        m = world_matrix(prim, self.cache)
+        t, r, scale = decompose(m)
+        params = lightmap.light_params(prim, scale)
+        self.has_lights = True
+        wb = self.spec.worldbody
+        made = []
+        if params.kind == "dome":
+            self.ambient += 0.5 * params.color
+            sky = wb.add_light(name=f"{path}#sky", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+                               pos=[0, 0, 10], dir=[0, 0, -1], castshadow=False)
+            _set_light_color(sky, 0.5 * params.color)
+            made.append(sky)
+            self.sky_rgb = params.color if self.sky_rgb is None else self.sky_rgb + params.color
+        elif params.kind == "distant":
+            light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=t.tolist(),
+                                 dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
+            _set_light_color(light, params.color)
+            made.append(light)
+        else:
+            spot = params.kind in ("rect", "disk")
+            light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_SPOT if spot
+                                 else mujoco.mjtLightType.mjLIGHT_POINT,
+                                 pos=t.tolist(), dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
+            light.attenuation = [0.0, 0.0, 1.0]
+            if spot:
+                light.cutoff = 85.0
+                light.exponent = 1.0
+            _set_light_color(light, params.color)
+            made.append(light)
+        self.light_records.append((path, params.kind, made))
+
+    def finish_lighting(self) -> None:
+        head = self.spec.visual.headlight
+        if not self.has_lights:
+            # A stage without lights would render black; light it from the camera like
+            # Kit's default viewport light so a first script shows something.
+            head.active = 1
+            head.ambient = [0.3, 0.3, 0.3]
+            head.diffuse = [0.6, 0.6, 0.6]
+            head.specular = [0.1, 0.1, 0.1]
+            return
+        # The headlight carries the scene's ambient term (MuJoCo drops it when inactive),
+        # so it stays active with no diffuse or specular part.
+        head.active = 1
+        head.ambient = np.minimum(self.ambient, 10.0).tolist()
+        head.diffuse = [0, 0, 0]
+        head.specular = [0, 0, 0]
+        if self.sky_rgb is not None:
+            rgb = np.clip(self.sky_rgb, 0, 1)
+            self.spec.add_texture(name=SKY_TEXTURE, type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+                                  builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb.tolist(), rgb2=rgb.tolist(),
+                                  width=8, height=8)
+
+    # ---- top level -----------------------------------------------------
+    def build(self) -> CompiledScene:
+        self.configure()
+        predicate = Usd.TraverseInstanceProxies(Usd.PrimIsActive & Usd.PrimIsDefined & ~Usd.PrimIsAbstract)
+        for prim in Usd.PrimRange.Stage(self.stage, predicate):
+            type_name = prim.GetTypeName()
+            if type_name in lightmap.LIGHT_KINDS:
+                self.add_light(prim)
+            elif _is_renderable(prim):
+                try:
+                    self.add_gprim(prim)
+                except CompileError:
+                    raise
+                except Exception as exc:  # pxr / mujoco errors: say which prim
+                    raise CompileError(f"cannot compile prim {prim.GetPath()} ({type_name}): {exc}") from exc
+        self.finish_lighting()
+        try:
+            model = self.spec.compile()
+        except Exception as exc:
+            raise CompileError(f"MuJoCo could not compile the stage: {exc}") from exc
+        data = mujoco.MjData(model)
+        return self._bind(model, data)
+
+    def _bind(self, model: mujoco.MjModel, data: mujoco.MjData) -> CompiledScene:
+        scene = CompiledScene(model=model, data=data, has_scene_lights=self.has_lights)
+        scene.geom_paths = [""] * model.ngeom
+        for path, geom, root, scale, material, visible in self.geom_records:
+            gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, path)
+            bid = int(model.geom_bodyid[gid])
+            mocap = int(model.body_mocapid[bid]) if root is None else -1
+            scene.geoms[path] = GeomBinding(path=path, type_name=self.stage.GetPrimAtPath(path).GetTypeName(),
+                                            geom_id=gid, body_id=bid, mocap_id=mocap, rigid_root=root,
+                                            scale=scale, material=material, visible=visible)
+            scene.geom_paths[gid] = path
+        for path in self.body_records:
+            bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, path)
+            binding = BodyBinding(path=path, body_id=bid, mocap_id=int(model.body_mocapid[bid]))
+            if model.body_jntnum[bid] > 0:
+                jid = int(model.body_jntadr[bid])
+                binding.qpos_adr, binding.qvel_adr = int(model.jnt_qposadr[jid]), int(model.jnt_dofadr[jid])
+            scene.bodies[path] = binding
+        for path, kind, made in self.light_records:
+            ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_LIGHT, lt.name) for lt in made]
+            scene.lights[path] = LightBinding(path=path, kind=kind, light_ids=ids)
+        for path in self.material_names:
+            scene.materials[path] = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, path)
+        scene.sky_texture_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, SKY_TEXTURE)
+        mujoco.mj_forward(model, data)
+        return scene
+
+
+def _set_light_color(light, rgb: np.ndarray) -> None:
+    rgb = np.maximum(np.asarray(rgb, dtype=np.float64), 0.0)
+    light.diffuse = rgb.tolist()
+    light.specular = np.minimum(rgb * 0.3, 0.3).tolist()
+    light.ambient = [0.0, 0.0, 0.0]
+
+
+def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480)) -> CompiledScene:
+    """Compile ``stage`` into a :class:`CompiledScene` (model, data and prim maps).
+
+    ``offscreen`` is the size of MuJoCo's offscreen framebuffer (the largest
+    render product).
+
+    Example:
+        >>> from graphsdg import stage
+        >>> from pxr import UsdGeom
+        >>> s = stage.new_stage(); _ = UsdGeom.Cube.Define(s, "/Cube")
+        >>> compile_stage(s).model.ngeom
+        1
+    """
+    import time
+
+    start = time.perf_counter()
+    scene = _Builder(stage, offscreen).build()
+    scene.compile_seconds = time.perf_counter() - start
+    return scene
+
+
+def light_dir_and_pos(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """World position and -Z direction of a light prim."""
+    t, r, _ = decompose(world_matrix(prim, cache))
+    return t, -r[:, 2]
+
+

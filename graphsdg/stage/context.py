@@ -1,0 +1,117 @@
+"""The current stage: create, open, save, and the change tracker that watches it.
+
+graphsdg follows Isaac Sim's stage conventions: Z up, 1 metre per unit.
+
+Example:
+    >>> from graphsdg import stage
+    >>> s = stage.new_stage()
+    >>> s.GetPrimAtPath("/World").IsValid()
+    False
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable
+
+from pxr import Sdf, Usd, UsdGeom
+
+from graphsdg.stage.changes import ChangeTracker
+
+
+class StageContext:
+    """Holds the current ``Usd.Stage`` and notifies listeners when it is replaced."""
+
+    def __init__(self) -> None:
+        self.stage: Usd.Stage | None = None
+        self.tracker: ChangeTracker | None = None
+        self.generation = 0
+        self._on_replaced: list[Callable[[Usd.Stage | None], None]] = []
+
+    def subscribe_replaced(self, callback: Callable[[Usd.Stage | None], None]) -> None:
+        """Call ``callback(new_stage)`` whenever the stage is replaced or closed."""
+        self._on_replaced.append(callback)
+
+    def _install(self, stage: Usd.Stage | None) -> Usd.Stage | None:
+        if self.tracker is not None:
+            self.tracker.revoke()
+        self.stage = stage
+        self.tracker = ChangeTracker(stage) if stage is not None else None
+        self.generation += 1
+        for cb in list(self._on_replaced):
+            cb(stage)
+        return stage
+
+    def new_stage(self) -> Usd.Stage:
+        stage = Usd.Stage.CreateInMemory()
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
+        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+        stage.SetTimeCodesPerSecond(60.0)
+        return self._install(stage)
+
+    def open_stage(self, path: str | os.PathLike) -> Usd.Stage:
+        path = os.fspath(path)
+        if not os.path.isfile(path):
+            raise FileNotFoundError(f"cannot open stage: no USD file at {path!r}")
+        try:
+            stage = Usd.Stage.Open(path)
+        except Exception as exc:  # pxr raises Tf.ErrorException
+            raise ValueError(f"cannot open stage {path!r}: the file does not parse as USD ({exc})") from exc
+        if stage is None:
+            raise ValueError(f"cannot open stage {path!r}: the file does not parse as USD")
+        return self._install(stage)
+
+    def get_stage(self) -> Usd.Stage:
+        if self.stage is None:
+            return self.new_stage()
+        return self.stage
+
+    def close_stage(self) -> None:
+        self._install(None)
+
+
+stage_context = StageContext()
+
+
+def new_stage() -> Usd.Stage:
+    """Replace the current stage with a new, empty in-memory stage (Z up, metres)."""
+    return stage_context.new_stage()
+
+
+def open_stage(path: str | os.PathLike) -> Usd.Stage:
+    """Open a USD file as the current stage."""
+    return stage_context.open_stage(path)
+
+
+def get_stage() -> Usd.Stage:
+    """Return the current stage, creating an empty one if there is none."""
+    return stage_context.get_stage()
+
+
+def close_stage() -> None:
+    """Drop the current stage."""
+    stage_context.close_stage()
+
+
+def save(path: str | os.PathLike | None = None) -> str:
+    """Save the current stage to ``path`` (``.usda`` for a readable file) and return the path."""
+    stage = get_stage()
+    if path is None:
+        layer = stage.GetRootLayer()
+        if layer.anonymous:
+            raise ValueError("the stage is in memory only; pass save(path='scene.usda')")
+        layer.Save()
+        return layer.realPath
+    path = os.fspath(path)
+    stage.GetRootLayer().Export(path)
+    return path
+
+
+def tracker() -> ChangeTracker:
+    """The change tracker of the current stage."""
+    get_stage()
+    assert stage_context.tracker is not None
+    return stage_context.tracker
+
+
+def root_path() -> Sdf.Path:
+    return Sdf.Path.absoluteRootPath

@@ -1,0 +1,168 @@
+"""Materials as ``UsdPreviewSurface`` networks, and reading what a prim is bound to.
+
+Replicator's OmniPBR inputs map onto UsdPreviewSurface inputs:
+``diffuse_color_constant`` -> ``diffuseColor``, ``reflection_roughness_constant``
+-> ``roughness``, ``metallic_constant`` -> ``metallic``, ``diffuse_texture`` -> a
+``UsdUVTexture`` feeding ``diffuseColor``, ``emissive_color`` -> ``emissiveColor``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+from pxr import Gf, Sdf, Usd, UsdShade
+
+OMNIPBR_TO_PREVIEW = {
+    "diffuse_color_constant": "diffuseColor",
+    "reflection_roughness_constant": "roughness",
+    "metallic_constant": "metallic",
+    "specular_level": "specularColor",
+    "emissive_color": "emissiveColor",
+    "opacity_constant": "opacity",
+}
+TEXTURE_INPUTS = {"diffuse_texture": "diffuseColor"}
+
+
+@dataclass(frozen=True)
+class MaterialDesc:
+    """The parts of a bound material the rasteriser uses."""
+
+    path: str
+    rgba: tuple[float, float, float, float] = (0.7, 0.7, 0.7, 1.0)
+    roughness: float = 0.5
+    metallic: float = 0.0
+    emission: float = 0.0
+    texture: str | None = None
+    texture_scale: tuple[float, float] = (1.0, 1.0)
+    texture_rotate: float = 0.0
+
+
+def _color3(value: Sequence[float], what: str) -> Gf.Vec3f:
+    vals = [float(v) for v in value]
+    if len(vals) not in (3, 4):
+        raise ValueError(f"{what} must be an (r, g, b) colour, got {value!r}")
+    return Gf.Vec3f(*vals[:3])
+
+
+def define_preview_material(stage: Usd.Stage, path: str | Sdf.Path, diffuse: Sequence[float] | None = None,
+                            roughness: float | None = None, metallic: float | None = None,
+                            diffuse_texture: str | None = None, emissive_color: Sequence[float] | None = None,
+                            emissive_intensity: float | None = None) -> UsdShade.Material:
+    """Define ``path`` as a Material with a UsdPreviewSurface (and a UsdUVTexture if textured)."""
+    material = UsdShade.Material.Define(stage, path)
+    shader = UsdShade.Shader.Define(stage, Sdf.Path(str(path)).AppendChild("Shader"))
+    shader.CreateIdAttr("UsdPreviewSurface")
+    material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+    set_inputs(material, diffuse=diffuse, roughness=roughness, metallic=metallic,
+               diffuse_texture=diffuse_texture, emissive_color=emissive_color,
+               emissive_intensity=emissive_intensity)
+    return material
+
+
+def surface_shader(material: UsdShade.Material) -> UsdShade.Shader | None:
+    source = material.ComputeSurfaceSource()
+    shader = source[0] if source and source[0] else None
+    return shader if shader and shader.GetPrim().IsValid() else None
+
+
+def set_inputs(material: UsdShade.Material, diffuse: Sequence[float] | None = None,
+               roughness: float | None = None, metallic: float | None = None,
+               diffuse_texture: str | None = None, texture_scale: Sequence[float] | None = None,
+               texture_rotate: float | None = None, emissive_color: Sequence[float] | None = None,
+               emissive_intensity: float | None = None) -> None:
+    """Set preview-surface inputs of ``material`` (only those given)."""
+    shader = surface_shader(material)
+    if shader is None:
+        raise ValueError(f"material {material.GetPath()} has no surface shader to edit")
+    if diffuse is not None:
+        shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(_color3(diffuse, "diffuse"))
+    if roughness is not None:
+        shader.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(float(roughness))
+    if metallic is not None:
+        shader.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(float(metallic))
+    if emissive_color is not None:
+        shader.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).Set(_color3(emissive_color, "emissive"))
+    if emissive_intensity is not None:
+        shader.GetPrim().CreateAttribute("graphsdg:emissiveIntensity", Sdf.ValueTypeNames.Float).Set(
+            float(emissive_intensity))
+    if diffuse_texture is not None or texture_scale is not None or texture_rotate is not None:
+        tex = _texture_shader(material, shader)
+        if diffuse_texture is not None:
+            tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(str(diffuse_texture)))
+        if texture_scale is not None:
+            sx, sy = (list(texture_scale) * 2)[:2] if len(texture_scale) == 1 else list(texture_scale)[:2]
+            tex.CreateInput("scale", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(float(sx), float(sy), 1, 1))
+        if texture_rotate is not None:
+            tex.GetPrim().CreateAttribute("graphsdg:textureRotate", Sdf.ValueTypeNames.Float).Set(
+                float(texture_rotate))
+
+
+def _texture_shader(material: UsdShade.Material, surface: UsdShade.Shader) -> UsdShade.Shader:
+    stage = material.GetPrim().GetStage()
+    tex_path = material.GetPath().AppendChild("DiffuseTexture")
+    tex = UsdShade.Shader(stage.GetPrimAtPath(tex_path))
+    if not tex:
+        tex = UsdShade.Shader.Define(stage, tex_path)
+        tex.CreateIdAttr("UsdUVTexture")
+        reader = UsdShade.Shader.Define(stage, material.GetPath().AppendChild("STReader"))
+        reader.CreateIdAttr("UsdPrimvarReader_float2")
+        reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
+        tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(
+            reader.ConnectableAPI(), "result")
+        tex.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
+        surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(
+            tex.ConnectableAPI(), "rgb")
+    return tex
+
+
+def bound_material(prim: Usd.Prim) -> UsdShade.Material | None:
+    material, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
+    return material if material and material.GetPrim().IsValid() else None
+
+
+def describe(material: UsdShade.Material) -> MaterialDesc:
+    """Read a material's colour, roughness, metallic and diffuse texture."""
+    shader = surface_shader(material)
+    path = str(material.GetPath())
+    if shader is None:
+        return MaterialDesc(path=path)
+
+    def value(name: str, default):
+        inp = shader.GetInput(name)
+        if not inp:
+            return default, None
+        if inp.HasConnectedSource():
+            src = inp.GetConnectedSources()[0]
+            return default, (src[0].source if src else None)
+        v = inp.Get()
+        return (default if v is None else v), None
+
+    diffuse, diffuse_src = value("diffuseColor", Gf.Vec3f(0.7, 0.7, 0.7))
+    opacity, _ = value("opacity", 1.0)
+    roughness, _ = value("roughness", 0.5)
+    metallic, _ = value("metallic", 0.0)
+    emissive, _ = value("emissiveColor", Gf.Vec3f(0, 0, 0))
+    texture, scale, rotate = None, (1.0, 1.0), 0.0
+    if diffuse_src is not None:
+        tex = UsdShade.Shader(diffuse_src.GetPrim())
+        file_in = tex.GetInput("file")
+        asset = file_in.Get() if file_in else None
+        if asset is not None and asset.path:
+            texture = asset.resolvedPath or asset.path
+        scale_in = tex.GetInput("scale")
+        if scale_in and scale_in.Get() is not None:
+            s = scale_in.Get()
+            scale = (float(s[0]), float(s[1]))
+        rot_attr = tex.GetPrim().GetAttribute("graphsdg:textureRotate")
+        if rot_attr and rot_attr.Get() is not None:
+            rotate = float(rot_attr.Get())
+        diffuse = Gf.Vec3f(1, 1, 1)
+    emission = max(float(emissive[0]), float(emissive[1]), float(emissive[2]))
+    return MaterialDesc(path=path, rgba=(float(diffuse[0]), float(diffuse[1]), float(diffuse[2]), float(opacity)),
+                        roughness=float(roughness), metallic=float(metallic), emission=emission,
+                        texture=texture, texture_scale=scale, texture_rotate=rotate)
+
+
+def bind(prim: Usd.Prim, material: UsdShade.Material) -> None:
+    """Bind ``material`` to ``prim`` (stronger than descendants, as Replicator does)."""
+    UsdShade.MaterialBindingAPI.Apply(prim).Bind(material, UsdShade.Tokens.strongerThanDescendants)

@@ -1,0 +1,6 @@
+"""graphsdg's node library: every node type a graph can hold, one module per family.
+
+Importing this package registers the node types with the runtime's registries;
+``import graphsdg`` does so. The runtime itself never imports a concrete node.
+"""
+from . import annotators  # noqa: F401  (registers annotator types)
