@@ -85,6 +85,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     queue = get_write_queue()
     queue.raise_errors()
     rt = runtime()
+    rt.check_attachments()
     _state.set(Status.STEPPING)
     t = time.perf_counter()
     fired: set = set()

@@ -14,7 +14,8 @@ from pxr import Usd
 from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
 from graphsdg.render.rasterizer import Rasterizer
-from graphsdg.render.render_product import RenderProduct, registry as rp_registry
+from graphsdg.errors import RenderProductDestroyedError
+from graphsdg.render.render_product import registry as rp_registry
 from graphsdg.sim.scene import SimScene
 from graphsdg.sim.timeline import Timeline
 from graphsdg.stage.context import stage_context
@@ -61,7 +62,6 @@ class Runtime:
         self.labels = SceneLabels(self.ids)
         self.graph_hooks: list[Callable[..., object]] = []
         stage_context.subscribe_replaced(self._on_stage_replaced)
-        rp_registry.subscribe_removed(self._on_render_product_removed)
 
     @property
     def stage(self) -> Usd.Stage:
@@ -78,17 +78,28 @@ class Runtime:
         return self._sim
 
     def _on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        # Render products, annotators and writers belong to the old stage's session.
+        rp_registry.clear()
+        for w in list(self.writers):
+            w.detach()
+        for a in list(self.annotators):
+            a.detach()
         self._sim = None
         self._sim_stage = None
         self.ids.clear()
         self.labels = SceneLabels(self.ids)
         self.timeline.stop()
 
-    def _on_render_product_removed(self, rp: RenderProduct) -> None:
-        for a in list(self.annotators):
-            a.forget_render_product(rp)
-        for w in list(self.writers):
-            w.forget_render_product(rp)
+    def check_attachments(self) -> None:
+        """Raise if an attached annotator or writer still points at a destroyed render product."""
+        for owner in list(self.writers) + list(self.annotators):
+            for rp in owner.render_products:
+                if rp.destroyed:
+                    kind = "writer" if owner in self.writers else "annotator"
+                    name = type(owner).__name__ if kind == "writer" else owner.name
+                    raise RenderProductDestroyedError(
+                        f"render product {rp.name!r} ({rp.path}) was destroyed but {kind} {name!r} is still "
+                        f"attached to it; call detach() before destroy(), or attach to a live render product")
 
 
 _runtime: Runtime | None = None

@@ -161,10 +161,6 @@ class Annotator:
         if not self._render_products:
             runtime().annotators.discard(self)
 
-    def forget_render_product(self, rp: RenderProduct) -> None:
-        if rp in self._render_products:
-            self.detach([rp])
-
     def compute_for(self, frame) -> dict:
         out = get_output(frame, self.spec, self.init_params)
         self._latest[frame.render_product.path] = out

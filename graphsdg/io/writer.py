@@ -126,14 +126,6 @@ class Writer:
         self._render_products = []
         runtime().writers.discard(self)
 
-    def forget_render_product(self, rp: RenderProduct) -> None:
-        remaining = [p for p in self.render_products if p is not rp]
-        if len(remaining) != len(self.render_products):
-            self._render_products = remaining
-            if not remaining:
-                from graphsdg.runtime import runtime
-                runtime().writers.discard(self)
-
     def schedule_write(self) -> None:
         """With ``attach(..., trigger=None)``: write the next captured frame."""
         self._manual_requests = getattr(self, "_manual_requests", 0) + 1

@@ -30,6 +30,7 @@ from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
 from graphsdg.sim.scene import SimScene
 
 PASSES = ("color", "depth", "segmentation")
+SKY_FAR_FACTOR = 2.0
 
 
 @dataclass
@@ -112,6 +113,7 @@ class Rasterizer:
     def _update_scene(self, sim: SimScene, view: CameraView, jitter: tuple[float, float]) -> None:
         scene = self._scene
         assert scene is not None
+        far = effective_far(sim.model, view)
         mujoco.mjv_updateScene(sim.model, sim.data, self._option, None, self._camera,
                                mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
         near = view.near
@@ -132,7 +134,7 @@ class Rasterizer:
             cam.frustum_bottom = cy_shift - half_h
             cam.frustum_top = cy_shift + half_h
             cam.frustum_near = near
-            cam.frustum_far = view.far
+            cam.frustum_far = SKY_FAR_FACTOR * far
             cam.orthographic = 1 if view.projection == "orthographic" else 0
         scene.enabletransform = 0
 
@@ -175,7 +177,8 @@ class Rasterizer:
                     rgb = np.rint(acc / subframes).astype(np.uint8)
                 out.color = np.ascontiguousarray(rgb[::-1])
             if "depth" in passes:
-                out.depth = _linearize_depth(depth[::-1], view.near, view.far)
+                far = effective_far(model, view)
+                out.depth = _linearize_depth(depth[::-1], view.near, SKY_FAR_FACTOR * far, far)
         if "segmentation" in passes:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 1
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 1
@@ -191,8 +194,19 @@ class Rasterizer:
         return out
 
 
-def _linearize_depth(raw: np.ndarray, near: float, far: float) -> np.ndarray:
-    """Reversed-Z window depth -> planar z (the same algebra as ``mujoco.Renderer``)."""
+def effective_far(model: mujoco.MjModel, view: CameraView) -> float:
+    """The far plane actually used: the camera's, tightened to just beyond the scene.
+
+    MuJoCo fits directional shadow maps to the view frustum and draws the skybox at
+    ~0.6-0.7 of the far plane. A tight far plane (the scene's bounding sphere plus
+    margin) keeps shadows sharp; rendering to twice it keeps the sky behind all geometry.
+    """
+    reach = float(np.linalg.norm(view.position - model.stat.center)) + 4.0 * float(model.stat.extent)
+    return max(min(view.far, reach), view.near * 10)
+
+
+def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float) -> np.ndarray:
+    """Reversed-Z window depth -> planar z (the algebra of ``mujoco.Renderer``); beyond ``clip`` -> inf."""
     zfar, znear = np.float32(far), np.float32(near)
     c = -(zfar + znear) / (zfar - znear)
     d = -(np.float32(2) * zfar * znear) / (zfar - znear)
@@ -202,7 +216,7 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float) -> np.ndarray:
     with np.errstate(divide="ignore"):
         lin = d / (z + c)
     lin = lin.astype(np.float32)
-    lin[raw <= 0.0] = np.inf   # nothing drawn: the far plane / sky
+    lin[(raw <= 0.0) | (lin > clip)] = np.inf   # nothing drawn, or the sky
     return lin
 
 

@@ -70,7 +70,7 @@ class RenderProduct:
         return prim
 
     def destroy(self) -> None:
-        """Release the product: annotators and writers attached to it detach; using it again raises."""
+        """Release the product. Stepping while an annotator or writer is still attached to it raises."""
         if self._destroyed:
             return
         self._destroyed = True
@@ -86,16 +86,12 @@ class RenderProductRegistry:
 
     def __init__(self) -> None:
         self._products: list[RenderProduct] = []
-        self._listeners: list = []
 
     def __iter__(self):
         return iter(list(self._products))
 
     def __len__(self) -> int:
         return len(self._products)
-
-    def subscribe_removed(self, callback) -> None:
-        self._listeners.append(callback)
 
     def unique_name(self, name: str | None) -> str:
         base = name or DEFAULT_NAME
@@ -113,8 +109,6 @@ class RenderProductRegistry:
     def remove(self, rp: RenderProduct) -> None:
         if rp in self._products:
             self._products.remove(rp)
-        for cb in list(self._listeners):
-            cb(rp)
 
     def find(self, value: "RenderProduct | str") -> RenderProduct:
         if isinstance(value, RenderProduct):

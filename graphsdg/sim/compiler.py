@@ -249,8 +249,10 @@ class _Builder:
         vis.quality.offsamples = int(settings.get("/graphsdg/render/msaaSamples", 4))
         if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
             vis.quality.shadowsize = max(vis.quality.shadowsize, 4096)
-        vis.map.znear = 0.001
-        vis.map.zfar = 1000.0
+        # Cameras get their own near/far from USD; these two (relative to the model extent)
+        # only bound MuJoCo's shadow-map depth range, so they are kept tight for precision.
+        vis.map.znear = 0.01
+        vis.map.zfar = 8.0
 
     # ---- materials -----------------------------------------------------
     def material(self, prim: Usd.Prim) -> str | None:
@@ -441,9 +443,23 @@ class _Builder:
             scene.lights[path] = LightBinding(path=path, kind=kind, light_ids=ids)
         for path in self.material_names:
             scene.materials[path] = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, path)
+        place_directional_lights(model)
         scene.sky_texture_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, SKY_TEXTURE)
         mujoco.mj_forward(model, data)
         return scene
+
+
+def place_directional_lights(model: mujoco.MjModel) -> None:
+    """Put directional lights up-light of the scene so their shadow maps cover it.
+
+    A distant light has no position in USD; MuJoCo draws a directional light's
+    shadow from its position, so it is placed at ``center - 2 * extent * dir``.
+    """
+    center, extent = np.asarray(model.stat.center), float(model.stat.extent)
+    for lid in range(model.nlight):
+        if model.light_type[lid] == mujoco.mjtLightType.mjLIGHT_DIRECTIONAL:
+            d = model.light_dir[lid] / max(np.linalg.norm(model.light_dir[lid]), 1e-12)
+            model.light_pos[lid] = center - 2.0 * extent * d
 
 
 def _set_light_color(light, rgb: np.ndarray) -> None:

@@ -22,7 +22,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, CompiledScene, compile_stage,
-                                   display_rgba, light_dir_and_pos, primitive_size)
+                                   display_rgba, light_dir_and_pos, place_directional_lights, primitive_size)
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
@@ -286,6 +286,8 @@ class SimScene:
         lid = binding.light_ids[0]
         m.light_pos[lid] = pos
         m.light_dir[lid] = direction
+        if binding.kind == "distant":
+            place_directional_lights(m)
         m.light_diffuse[lid] = np.maximum(params.color, 0)
         m.light_specular[lid] = np.minimum(params.color * 0.3, 0.3)
         m.light_castshadow[lid] = params.cast_shadow

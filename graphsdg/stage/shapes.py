@@ -88,10 +88,11 @@ def cone_mesh(radius: float, height: float, segments: int = SEGMENTS) -> tuple[n
     """A closed cone along +Z centred on its mid-height: (vertices, triangles)."""
     a = np.linspace(0, 2 * math.pi, segments, endpoint=False)
     ring = np.stack([radius * np.cos(a), radius * np.sin(a), np.full_like(a, -height / 2)], 1)
-    verts = np.vstack([ring, [[0, 0, height / 2], [0, 0, -height / 2]]])
-    apex, base = segments, segments + 1
+    # The base has its own copy of the rim so smooth vertex normals do not bend the side into it.
+    verts = np.vstack([ring, ring, [[0, 0, height / 2], [0, 0, -height / 2]]])
+    apex, base = 2 * segments, 2 * segments + 1
     tris = [[i, (i + 1) % segments, apex] for i in range(segments)]
-    tris += [[(i + 1) % segments, i, base] for i in range(segments)]
+    tris += [[segments + (i + 1) % segments, segments + i, base] for i in range(segments)]
     return verts, np.array(tris)
 
 

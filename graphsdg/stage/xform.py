@@ -163,7 +163,7 @@ class _OpStack:
                 self.scale = op
             else:
                 canonical = False
-        if not canonical or any(op.GetOpSuffix() for op in ops):
+        if not canonical or any(len(op.GetOpName().split(":")) > 2 for op in ops):   # suffixed ops (pivots)
             self._rebuild()
 
     def _rebuild(self) -> None:

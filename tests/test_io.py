@@ -1,0 +1,112 @@
+"""Writers and backends: atomic files, errors that reach the script, custom writers."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import graphsdg as rep
+from graphsdg.errors import WriterError
+from graphsdg.io.backends import write_file_atomic
+
+from conftest import unit_cube_scene
+
+
+def test_write_is_atomic_and_cleans_up(tmp_path, monkeypatch):
+    target = tmp_path / "a.bin"
+
+    def broken_replace(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", broken_replace)
+    with pytest.raises(OSError, match="disk full.*a.bin"):
+        write_file_atomic(str(target), b"x" * 1000)
+    monkeypatch.undo()
+    assert os.listdir(tmp_path) == []          # neither the final name nor a temp file remains
+    write_file_atomic(str(target), b"data")
+    assert target.read_bytes() == b"data"
+
+
+def test_worker_failure_reaches_the_script(out_dir):
+    class BadWriter(rep.Writer):
+        def __init__(self, output_dir):
+            self.annotators = ["rgb"]
+            self.backend = rep.backends.get("DiskBackend")
+            self.backend.initialize(output_dir=output_dir)
+
+        def write(self, data):
+            # a float image cannot be a PNG: the encoder raises on a worker thread
+            self.backend.schedule(rep.functional.write_image, data=np.zeros((4, 4), np.float64),
+                                  path="bad.png")
+
+    rep.WriterRegistry.register(BadWriter)
+    cube, cam, rp = unit_cube_scene()
+    writer = rep.writers.get("BadWriter")
+    writer.initialize(output_dir=out_dir)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    with pytest.raises(WriterError, match="dtype float64"):
+        rep.orchestrator.wait_until_complete()
+    assert not os.path.exists(os.path.join(out_dir, "bad.png"))
+    writer.detach()
+
+
+def test_custom_writer_data_structures(out_dir):
+    seen = {}
+
+    class Probe(rep.Writer):
+        def __init__(self, structure):
+            self.data_structure = structure
+            self.annotators = [rep.annotators.get("rgb"), "bounding_box_2d_tight"]
+
+        def write(self, data):
+            seen[self.data_structure] = data
+
+    rep.writers.register_writer(Probe)
+    cube, cam, rp = unit_cube_scene(resolution=(64, 48))
+    cam2 = rep.functional.create.camera(position=(0, 0, 5), look_at=(0, 0, 0), parent="/World", name="Top")
+    rp2 = rep.create.render_product(cam2, (32, 32), name="top")
+    writers = []
+    for structure in ("legacy", "annotator", "renderProduct"):
+        w = rep.writers.get("Probe")
+        w.initialize(structure=structure)
+        w.attach([rp, rp2])
+        writers.append(w)
+    rep.orchestrator.step()
+    legacy = seen["legacy"]
+    assert legacy[f"rgb-{rp.name}"].shape == (48, 64, 4) and legacy["rgb-top"].shape == (32, 32, 4)
+    assert set(legacy[f"bounding_box_2d_tight-{rp.name}"]) == {"data", "info"}
+    anno = seen["annotator"]["annotators"]
+    assert anno["rgb"]["top"]["data"].shape == (32, 32, 4)
+    assert anno["bounding_box_2d_tight"][rp.name]["primPaths"] == ["/World/Cube"]
+    per_rp = seen["renderProduct"]["renderProducts"]["top"]
+    assert per_rp["camera"] == "/World/Top" and per_rp["resolution"] == [32, 32]
+    assert "trigger_outputs" in legacy and "reference_time" in legacy
+    for w in writers:
+        w.detach()
+
+
+def test_output_dir_that_is_a_file_is_refused(tmp_path):
+    f = tmp_path / "file"
+    f.write_text("x")
+    with pytest.raises(NotADirectoryError, match="file"):
+        rep.writers.get("BasicWriter").initialize(output_dir=str(f), rgb=True)
+
+
+def test_backend_registry():
+    with pytest.raises(KeyError, match="DiskBackend"):
+        rep.backends.get("DiskBackendd")
+
+    class MemoryBackend(rep.backends.BaseBackend):
+        def __init__(self):
+            self.blobs = {}
+
+        def write_blob(self, path, data):
+            self.blobs[path] = data
+
+    rep.backends.register(MemoryBackend)
+    b = rep.backends.get("MemoryBackend", init_params={})
+    b.schedule(rep.functional.write_json, data={"a": np.int64(1)}, path="x.json")
+    rep.orchestrator.wait_until_complete()
+    assert b.blobs == {"x.json": b'{"a": 1}'}

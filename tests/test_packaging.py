@@ -1,0 +1,36 @@
+"""A plain (non-editable) wheel carries the runtime and the node library."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import zipfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def test_wheel_contains_nodes_and_imports(tmp_path):
+    wheel_dir = tmp_path / "dist"
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
+                    "-w", str(wheel_dir), ROOT], check=True)
+    wheels = list(wheel_dir.glob("graphsdg-*.whl"))
+    assert len(wheels) == 1
+    names = zipfile.ZipFile(wheels[0]).namelist()
+    assert "graphsdg/nodes/annotators.py" in names and "graphsdg/orchestrator.py" in names
+    target = tmp_path / "site"
+    subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target),
+                    str(wheels[0])], check=True)
+    code = ("import graphsdg, graphsdg.nodes, sys; "
+            "assert graphsdg.__file__.startswith(sys.argv[1]), graphsdg.__file__; "
+            "assert 'rgb' in graphsdg.annotators.get_registered_annotators(); print('ok')")
+    env = {**os.environ, "PYTHONPATH": str(target)}
+    out = subprocess.run([sys.executable, "-c", code, str(target)], cwd=str(tmp_path), env=env,
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "ok"
+
+
+def test_plain_import_leaves_isaac_names_alone():
+    code = "import graphsdg, sys; bad = [m for m in sys.modules if m.split('.')[0] in ('omni', 'carb', 'isaacsim')]; " \
+           "assert not bad, bad"
+    subprocess.run([sys.executable, "-c", code], check=True)
