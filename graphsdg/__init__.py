@@ -28,10 +28,11 @@ from graphsdg.io import writers as _builtin_writers  # noqa: E402,F401  (registe
 from graphsdg.io.backends import BackendDispatch  # noqa: E402
 from graphsdg.io.writer import Writer, WriterRegistry  # noqa: E402
 from graphsdg.rng import get_global_seed, set_global_seed  # noqa: E402
+from graphsdg.sim import timeline  # noqa: E402
 from graphsdg import nodes  # noqa: E402,F401  (registers the node library)
 
 __version__ = "0.1.0"
 
 __all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
            "writers", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
-           "get_global_seed", "set_global_seed"]
+           "get_global_seed", "set_global_seed", "timeline"]

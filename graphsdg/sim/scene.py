@@ -7,9 +7,15 @@ tracker's :class:`~graphsdg.stage.changes.ChangeSet`:
 * value edits (poses, sizes, colours, visibility, material inputs, lights) are
   written straight into ``MjModel``/``MjData`` fields, then kinematics are
   recomputed: no recompile;
-* structural edits (prims added or removed, schemas applied, a mesh rescaled)
+* structural edits (prims added or removed, schemas applied, physics
+  properties edited, a mesh rescaled, a shape moved inside its rigid body)
   recompile the stage, carrying the simulation state (time, rigid-body poses and
   velocities) over by prim path.
+
+:meth:`SimScene.advance` steps physics and authors the rigid bodies' new poses
+on the stage; :meth:`SimScene.body_pose` and :meth:`SimScene.body_velocity`
+read a body's state; :meth:`SimScene.snapshot` / :meth:`SimScene.restore`
+implement the timeline's stop (bodies return to where they were at play).
 """
 from __future__ import annotations
 
@@ -21,7 +27,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg.sim import lights as lightmap
-from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, CompiledScene, compile_stage,
+from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size)
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
@@ -73,12 +79,12 @@ class SimScene:
                 self.compiled.model.vis.global_.offheight = h
                 self.model_version += 1
 
-    def recompile(self) -> CompiledScene:
-        """Compile the stage anew, keeping time and rigid-body state."""
+    def recompile(self, keep_state: bool = True) -> CompiledScene:
+        """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
         start = time.perf_counter()
         new = compile_stage(self.stage, self.offscreen)
-        if old is not None:
+        if old is not None and keep_state:
             new.data.time = old.data.time
             for path, body in new.bodies.items():
                 prev = old.bodies.get(path)
@@ -220,6 +226,12 @@ class SimScene:
             m_root[:3, :3] = r_root.T
             m_root[3, :3] = t_root
             t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
+        if g.relative is not None:
+            relative = np.eye(4)
+            relative[:3, :3] = r.T
+            relative[3, :3] = t
+            if not np.allclose(relative, g.relative, atol=1e-9):
+                raise NeedsRecompile   # a shape moved inside its rigid body: new mass distribution
         if not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12) or g.rigid_root is not None:
             if g.type_name in ("Mesh", "Cone") or g.rigid_root is not None:
                 if not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12):
@@ -249,7 +261,8 @@ class SimScene:
         m = c.model
         _, r, scale = decompose(world_matrix(prim))
         kind, size, _ = primitive_size(prim, scale)
-        if kind != m.geom_type[g.geom_id]:
+        kind = int(kind)
+        if kind != int(m.geom_type[g.geom_id]):
             raise NeedsRecompile   # e.g. a sphere scaled non-uniformly becomes an ellipsoid
         m.geom_size[g.geom_id] = size
         half = _aabb_half(kind, size)
@@ -324,13 +337,23 @@ class SimScene:
 
     # ---- physics -------------------------------------------------------
     def advance(self, seconds: float) -> None:
-        """Simulate ``seconds`` of physics and write rigid-body poses back to the stage."""
+        """Simulate ``seconds`` of physics and write rigid-body poses back to the stage.
+
+        Steps at the model's timestep until the simulated clock reaches its target,
+        so ticks that are not a multiple of the timestep do not drift.
+        """
         c = self.ensure_compiled()
         if seconds <= 0:
             return
-        n = max(1, int(round(seconds / c.model.opt.timestep)))
-        for _ in range(n):
-            mujoco.mj_step(c.model, c.data)
+        m, d = c.model, c.data
+        target = d.time + seconds
+        steps = 0
+        while d.time < target - 0.5 * m.opt.timestep or steps == 0:
+            mujoco.mj_step(m, d)
+            steps += 1
+        # mj_step leaves positions-derived quantities one step behind; renders,
+        # queries and contacts need them for the new state.
+        mujoco.mj_forward(m, d)
         self.write_back_rigid_bodies()
 
     def write_back_rigid_bodies(self) -> None:
@@ -350,15 +373,95 @@ class SimScene:
                 quat = c.data.qpos[b.qpos_adr + 3:b.qpos_adr + 7]
                 _set_world_pose_sdf(prim, pos, quat, cache)
 
+    # ---- rigid-body state ----------------------------------------------
+    def body(self, path: str) -> BodyBinding:
+        """The compiled rigid body of ``path`` (a prim with ``RigidBodyAPI``)."""
+        self.sync_dirty_prims()
+        c = self.ensure_compiled()
+        binding = c.bodies.get(str(path))
+        if binding is None:
+            raise ValueError(f"prim {path} is not a simulated rigid body; apply "
+                             f"rep.functional.physics.apply_rigid_body to it (with geometry under it) first")
+        return binding
+
+    def body_pose(self, path: str) -> tuple[np.ndarray, np.ndarray]:
+        """World (position, quaternion w, x, y, z) of a rigid body's frame."""
+        b = self.body(path)
+        d = self.data
+        if b.mocap_id >= 0:
+            return d.mocap_pos[b.mocap_id].copy(), d.mocap_quat[b.mocap_id].copy()
+        q = d.qpos[b.qpos_adr:b.qpos_adr + 7]
+        return q[:3].copy(), q[3:].copy()
+
+    def body_velocity(self, path: str) -> tuple[np.ndarray, np.ndarray]:
+        """World-frame (linear m/s, angular rad/s) velocity of a rigid body's frame origin."""
+        b = self.body(path)
+        if b.qvel_adr < 0:
+            return np.zeros(3), np.zeros(3)
+        d = self.data
+        v = d.qvel[b.qvel_adr:b.qvel_adr + 6]
+        rot = quat_wxyz_to_matrix(d.qpos[b.qpos_adr + 3:b.qpos_adr + 7])
+        return v[:3].copy(), rot @ v[3:]      # MuJoCo's free-joint angular velocity is body-local
+
+    def set_body_velocity(self, path: str, linear: np.ndarray | None = None,
+                          angular: np.ndarray | None = None) -> None:
+        """Set a dynamic body's world-frame linear (m/s) and angular (rad/s) velocity."""
+        b = self.body(path)
+        if b.qvel_adr < 0:
+            raise ValueError(f"rigid body {path} is kinematic; it has no simulated velocity to set")
+        d = self.data
+        if linear is not None:
+            d.qvel[b.qvel_adr:b.qvel_adr + 3] = linear
+        if angular is not None:
+            rot = quat_wxyz_to_matrix(d.qpos[b.qpos_adr + 3:b.qpos_adr + 7])
+            d.qvel[b.qvel_adr + 3:b.qvel_adr + 6] = rot.T @ np.asarray(angular, dtype=np.float64)
+
+    def forward(self) -> None:
+        """Recompute every derived quantity (contacts included) for the current state."""
+        c = self.ensure_compiled()
+        mujoco.mj_forward(c.model, c.data)
+
+    # ---- play / stop ---------------------------------------------------
+    def snapshot(self) -> dict[str, dict[str, object]]:
+        """The authored xform values of every rigid body, to restore on stop."""
+        self.sync_dirty_prims()
+        saved: dict[str, dict[str, object]] = {}
+        for path in self.ensure_compiled().bodies:
+            prim = self.stage.GetPrimAtPath(path)
+            if not prim:
+                continue
+            values = {}
+            for attr in prim.GetAttributes():
+                name = attr.GetName()
+                if name.startswith("xformOp") and attr.HasAuthoredValue():
+                    values[name] = attr.Get()
+            saved[path] = values
+        return saved
+
+    def restore(self, saved: dict[str, dict[str, object]]) -> None:
+        """Put rigid bodies back where :meth:`snapshot` found them; time back to 0, at rest."""
+        with Sdf.ChangeBlock():
+            for path, values in saved.items():
+                prim = self.stage.GetPrimAtPath(path)
+                if not prim:
+                    continue
+                for name, value in values.items():
+                    attr = prim.GetAttribute(name)
+                    if attr:
+                        attr.Set(value)
+        self.tracker.drain()
+        self.recompile(keep_state=False)
+
 
 def _aabb_half(kind: int, size: np.ndarray) -> np.ndarray:
-    if kind == mujoco.mjtGeom.mjGEOM_BOX or kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
+    g = mujoco.mjtGeom
+    if kind in (int(g.mjGEOM_BOX), int(g.mjGEOM_ELLIPSOID)):
         return np.asarray(size[:3], dtype=np.float64)
-    if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+    if kind == int(g.mjGEOM_SPHERE):
         return np.full(3, size[0])
-    if kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+    if kind == int(g.mjGEOM_CYLINDER):
         return np.array([size[0], size[0], size[1]])
-    if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
+    if kind == int(g.mjGEOM_CAPSULE):
         return np.array([size[0], size[0], size[1] + size[0]])
     return np.asarray(size[:3], dtype=np.float64)
 

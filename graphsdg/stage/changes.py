@@ -13,6 +13,10 @@ from typing import Iterator
 
 from pxr import Sdf, Tf, Usd
 
+# Properties of these namespaces shape the physics model (masses, colliders, scene
+# settings): an edit recompiles, like a structural change.
+PHYSICS_PROPERTY_PREFIXES = ("physics:", "physx", "material:binding:physics")
+
 
 @dataclass
 class ChangeSet:
@@ -45,7 +49,9 @@ class ChangeTracker:
         for path in notice.GetResyncedPaths():
             if path.IsPropertyPath() and path.name.startswith("semantic"):
                 self._pending.semantics_changed = True
-            if path.IsPropertyPath():
+            if path.IsPropertyPath() and path.name.startswith(PHYSICS_PROPERTY_PREFIXES):
+                self._pending.structural.add(path.GetPrimPath())
+            elif path.IsPropertyPath():
                 # A property that came into existence is a value edit of its prim.
                 self._pending.edited.add(path.GetPrimPath())
             else:
@@ -53,7 +59,10 @@ class ChangeTracker:
         for path in notice.GetChangedInfoOnlyPaths():
             if path.IsPropertyPath() and path.name.startswith("semantic"):
                 self._pending.semantics_changed = True
-            self._pending.edited.add(path.GetPrimPath() if path.IsPropertyPath() else path)
+            if path.IsPropertyPath() and path.name.startswith(PHYSICS_PROPERTY_PREFIXES):
+                self._pending.structural.add(path.GetPrimPath())
+            else:
+                self._pending.edited.add(path.GetPrimPath() if path.IsPropertyPath() else path)
 
     @contextlib.contextmanager
     def muted(self) -> Iterator[None]:
