@@ -403,6 +403,26 @@ class SimScene:
         rot = quat_wxyz_to_matrix(d.qpos[b.qpos_adr + 3:b.qpos_adr + 7])
         return v[:3].copy(), rot @ v[3:]      # MuJoCo's free-joint angular velocity is body-local
 
+    def set_body_pose(self, path: str, position: np.ndarray | None = None,
+                      orientation: np.ndarray | None = None) -> None:
+        """Move a rigid body to a world pose (quaternion w, x, y, z), keeping its velocity; authors the stage."""
+        b = self.body(path)
+        c = self.ensure_compiled()
+        d = c.data
+        pos, quat = self.body_pose(path)
+        if position is not None:
+            pos = np.asarray(position, dtype=np.float64)
+        if orientation is not None:
+            quat = np.asarray(orientation, dtype=np.float64)
+            quat = quat / np.linalg.norm(quat)
+        if b.mocap_id >= 0:
+            d.mocap_pos[b.mocap_id], d.mocap_quat[b.mocap_id] = pos, quat
+        else:
+            d.qpos[b.qpos_adr:b.qpos_adr + 3], d.qpos[b.qpos_adr + 3:b.qpos_adr + 7] = pos, quat
+        mujoco.mj_forward(c.model, d)
+        with self.tracker.muted(), Sdf.ChangeBlock():
+            _set_world_pose_sdf(self.stage.GetPrimAtPath(path), pos, quat, UsdGeom.XformCache(Usd.TimeCode.Default()))
+
     def set_body_velocity(self, path: str, linear: np.ndarray | None = None,
                           angular: np.ndarray | None = None) -> None:
         """Set a dynamic body's world-frame linear (m/s) and angular (rad/s) velocity."""
