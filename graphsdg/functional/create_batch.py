@@ -29,6 +29,8 @@ def per_prim(value: Any, count: int, what: str, width: int = 3) -> list:
         return [row for row in arr]
     if arr.ndim == 0 and what.startswith("scale"):
         return [np.full(3, float(arr))] * count
+    if arr.ndim == 1 and what.startswith("scale") and arr.shape[0] == count and count != 3:
+        return [np.full(3, float(v)) for v in arr]      # one uniform scale per prim
     if arr.ndim == 1 and arr.shape[0] in (3, 4):
         return [arr] * count
     raise ValueError(f"{what} must be one {width}-vector or an (N, {width}) array, got shape {arr.shape}")

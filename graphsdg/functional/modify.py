@@ -24,10 +24,24 @@ from graphsdg.stage.prims import resolve_prim, resolve_prims
 from graphsdg.stage.xform import set_local_pose
 
 
+def _look_at_point(value: Any) -> Any:
+    """A look-at target given as a prim (or prim path) becomes its world position."""
+    if isinstance(value, Usd.Prim) or (isinstance(value, str) and value.startswith("/")):
+        from graphsdg.stage.xform import world_matrix
+        return world_matrix(resolve_prim(value))[3, :3]
+    return value
+
+
 def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, scale_value: Any = None,
-         look_at_value: Any = None, look_at_up_axis: Any = None, rotation_order: str = "XYZ") -> None:
-    """Set position, rotation (Euler degrees or a (w, x, y, z) quaternion), scale, or aim with ``look_at``."""
+         look_at_value: Any = None, look_at_up_axis: Any = None, rotation_order: str = "XYZ",
+         write_to_usd: bool = True) -> None:
+    """Set position, rotation (Euler degrees or a (w, x, y, z) quaternion), scale, or aim with ``look_at``.
+
+    ``look_at_value`` is a world point or a prim (aim at its origin).
+    ``write_to_usd`` is accepted for Replicator scripts; graphsdg always authors the stage.
+    """
     targets = resolve_prims(prims)
+    look_at_value = _look_at_point(look_at_value)
     n = len(targets)
     positions = per_prim(position_value, n, "position_value")
     rotations = per_prim(rotation_value, n, "rotation_value", width=4 if np.ndim(rotation_value) and
