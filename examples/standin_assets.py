@@ -68,6 +68,7 @@ def _new_asset(path):
     stage = Usd.Stage.CreateNew(path)
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    stage.SetTimeCodesPerSecond(60.0)        # Kit's rate: one timeline frame per 1/60 s
     root = UsdGeom.Xform.Define(stage, "/Root").GetPrim()
     stage.SetDefaultPrim(root)
     return stage

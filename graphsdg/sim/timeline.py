@@ -156,6 +156,8 @@ class Timeline:
     def set_time_codes_per_second(self, value: float) -> None:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
             raise ValueError(f"time codes per second must be a positive number, got {value!r}")
+        if float(value) == self.time_codes_per_second:
+            return
         self.time_codes_per_second = float(value)
         self._emit(TimelineEventType.TIME_CODE_PER_SECOND_CHANGED, timeCodesPerSecond=self.time_codes_per_second)
 
