@@ -196,8 +196,9 @@ def update() -> None:
 
     While the timeline plays, advances it one frame (physics, tick events) and,
     with capture-on-play on and a writer or annotator attached, captures that
-    frame. While paused or stopped it only brings the simulation up to date with
-    stage edits.
+    frame. While paused or stopped it does nothing: stage edits reach the
+    simulation when something needs it (a step, a query, the next tick), so a
+    script that rebuilds its scene over many updates recompiles once.
 
     Example:
         >>> import graphsdg as rep
@@ -214,7 +215,6 @@ def update() -> None:
     rt = runtime()
     timeline = rt.timeline
     if not timeline.is_playing():
-        rt.sim.sync_dirty_prims()
         return
     if get_capture_on_play() and (len(rt.writers) or len(rt.annotators)):
         step(pause_timeline=False)

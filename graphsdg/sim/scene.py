@@ -19,6 +19,7 @@ implement the timeline's stop (bodies return to where they were at play).
 """
 from __future__ import annotations
 
+import math
 import time
 from typing import Callable
 
@@ -52,6 +53,7 @@ class SimScene:
         self.textures_to_upload: set[int] = set()
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
+        self._pose_writers: dict[str, PoseWriter] = {}
 
     # ---- compile -------------------------------------------------------
     @property
@@ -362,16 +364,18 @@ class SimScene:
         if c is None or not c.bodies:
             return
         cache = UsdGeom.XformCache(Usd.TimeCode.Default())
+        writers = self._pose_writers
         with self.tracker.muted(), Sdf.ChangeBlock():
             for path, b in c.bodies.items():
                 if b.qpos_adr < 0:
                     continue
-                prim = self.stage.GetPrimAtPath(path)
-                if not prim:
-                    continue
-                pos = c.data.qpos[b.qpos_adr:b.qpos_adr + 3]
-                quat = c.data.qpos[b.qpos_adr + 3:b.qpos_adr + 7]
-                _set_world_pose_sdf(prim, pos, quat, cache)
+                writer = writers.get(path)
+                if writer is None or not writer.prim:
+                    prim = self.stage.GetPrimAtPath(path)
+                    if not prim:
+                        continue
+                    writer = writers[path] = PoseWriter(prim)
+                writer.write(c.data.qpos[b.qpos_adr:b.qpos_adr + 7], cache)
 
     # ---- rigid-body state ----------------------------------------------
     def body(self, path: str) -> BodyBinding:
@@ -484,6 +488,84 @@ def _aabb_half(kind: int, size: np.ndarray) -> np.ndarray:
     if kind == int(g.mjGEOM_CAPSULE):
         return np.array([size[0], size[0], size[1] + size[0]])
     return np.asarray(size[:3], dtype=np.float64)
+
+
+_IDENTITY = Gf.Matrix4d(1.0)
+
+
+class PoseWriter:
+    """Authors a rigid body's simulated world pose on its prim, once per step.
+
+    The common case (a translate and an orient or rotateXYZ op, optionally a
+    scale, under a parent without a transform) is written straight into the two
+    attributes; anything else goes through the general path.
+    """
+
+    def __init__(self, prim: Usd.Prim) -> None:
+        self.prim = prim
+        self._order_attr = prim.GetAttribute("xformOpOrder")
+        self._order: tuple[str, ...] | None = None
+        self._last: np.ndarray | None = None
+        self._read_ops()
+
+    def _read_ops(self) -> None:
+        order = self._order_attr.Get() if self._order_attr else None
+        self._order = tuple(order) if order is not None else ()
+        self._translate = self._rotate = None
+        self._rotate_kind = ""
+        names = list(self._order)
+        if names[-1:] == ["xformOp:scale"]:
+            names = names[:-1]
+        if len(names) == 2 and names[0] == "xformOp:translate" and names[1] in ("xformOp:orient",
+                                                                                 "xformOp:rotateXYZ"):
+            self._translate = self.prim.GetAttribute(names[0])
+            self._rotate = self.prim.GetAttribute(names[1])
+            type_name = str(self._rotate.GetTypeName())
+            self._rotate_kind = {"quatd": "quatd", "quatf": "quatf", "double3": "eulerd",
+                                 "float3": "eulerf"}.get(type_name, "")
+            if str(self._translate.GetTypeName()) != "double3":
+                self._rotate_kind = ""
+
+    def write(self, qpos7: np.ndarray, cache: UsdGeom.XformCache) -> None:
+        """Author ``qpos7`` (position, quaternion w, x, y, z) as the prim's world pose."""
+        if self._last is not None and np.array_equal(qpos7, self._last):
+            return      # unchanged since the last write (a body at rest)
+        self._last = np.array(qpos7, dtype=np.float64)
+        order = self._order_attr.Get() if self._order_attr else None
+        if (tuple(order) if order is not None else ()) != self._order:
+            self._read_ops()
+        parent = self.prim.GetParent()
+        parent_identity = not parent or not parent.IsA(UsdGeom.Xformable) or \
+            cache.GetLocalToWorldTransform(parent) == _IDENTITY
+        if not (parent_identity and self._rotate_kind):
+            _set_world_pose_sdf(self.prim, qpos7[:3], qpos7[3:], cache)
+            return
+        x, y, z = (float(v) for v in qpos7[:3])
+        self._translate.Set(Gf.Vec3d(x, y, z))
+        w, qx, qy, qz = (float(v) for v in qpos7[3:])
+        if self._rotate_kind == "quatd":
+            self._rotate.Set(Gf.Quatd(w, qx, qy, qz))
+        elif self._rotate_kind == "quatf":
+            self._rotate.Set(Gf.Quatf(w, qx, qy, qz))
+        else:
+            euler = _quat_to_euler_xyz(w, qx, qy, qz)
+            self._rotate.Set(Gf.Vec3d(*euler) if self._rotate_kind == "eulerd" else Gf.Vec3f(*euler))
+
+
+def _quat_to_euler_xyz(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """USD rotateXYZ angles (degrees) of a unit quaternion; same convention as ``matrix_to_euler_xyz``."""
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    r20 = 2 * (x * z - y * w)
+    sy = -max(-1.0, min(1.0, r20))
+    b = math.asin(sy)
+    if abs(sy) < 1 - 1e-9:
+        a = math.atan2(2 * (y * z + x * w), 1 - 2 * (x * x + y * y))
+        c = math.atan2(2 * (x * y + z * w), 1 - 2 * (y * y + z * z))
+    else:
+        a = math.atan2(-2 * (y * z - x * w), 1 - 2 * (x * x + z * z))
+        c = 0.0
+    return (math.degrees(a), math.degrees(b), math.degrees(c))
 
 
 def _set_world_pose_sdf(prim: Usd.Prim, pos: np.ndarray, quat_wxyz: np.ndarray,
