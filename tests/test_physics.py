@@ -451,3 +451,32 @@ def test_raycast_and_contacts():
     assert sum(c.normal_force for c in contacts) == pytest.approx(1000 * G, rel=0.02)   # 1 m³ at 1000 kg/m³
     with pytest.raises(ValueError, match="has no colliders"):
         queries.get_contacts(rep.functional.create.cube(name="Loose"))
+
+
+def test_structural_edit_mid_fall_recompiles_and_keeps_the_state():
+    cube = falling_cube(z=10.0)
+    run_ticks(10)
+    compiles = sim().stats["compiles"]
+    rep.functional.create.sphere(name="Newcomer", position=(5, 5, 5))      # a prim added: recompile
+    run_ticks(10)
+    assert sim().stats["compiles"] == compiles + 1
+    assert RigidBodyView(cube).get_world_poses()[0][0, 2] == pytest.approx(free_fall_z(10.0, 20), abs=1e-9)
+
+
+def test_a_pile_of_boxes_is_deterministic():
+    def pile():
+        rep.stage.new_stage()
+        ground = rep.functional.create.plane(scale=(5, 5, 1), name="Ground")
+        rep.functional.physics.apply_collider(ground)
+        g = np.random.default_rng(3)
+        cubes = []
+        for i in range(6):
+            c = rep.functional.create.cube(name=f"C{i}", scale=g.uniform(0.1, 0.3, 3),
+                                           position=(*g.uniform(-0.2, 0.2, 2), 0.3 + 0.3 * i),
+                                           rotation=g.uniform(0, 40, 3))
+            rep.functional.physics.apply_rigid_body(c, with_collider=True)
+            cubes.append(c)
+        run_ticks(60)
+        return np.concatenate(RigidBodyView(cubes).get_world_poses(), axis=1)
+
+    assert np.array_equal(pile(), pile())
