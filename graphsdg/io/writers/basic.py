@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from graphsdg.annotate.annotator import AnnotatorRegistry
+from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
 from graphsdg.io.backends import BackendDispatch, BackendGroup, BaseBackend
 from graphsdg.io.writer import Writer
@@ -44,25 +45,6 @@ _FLAGS = {
 _SEMANTIC = {"bounding_box_2d_tight", "bounding_box_2d_loose", "semantic_segmentation", "instance_segmentation",
              "bounding_box_3d", "occlusion", "pointcloud"}
 IMAGE_FORMATS = ("png", "jpg", "jpeg")
-
-
-def semantic_types_from_predicate(predicate: str) -> list[str]:
-    """The types of a ``"class:*; foo:*"`` filter predicate (label-level filters are not parsed)."""
-    types = []
-    for clause in str(predicate).split(";"):
-        clause = clause.strip()
-        if not clause:
-            continue
-        if ":" not in clause:
-            raise ValueError(f"semantic_filter_predicate clause {clause!r} must look like 'type:*'")
-        sem_type, labels = (s.strip() for s in clause.split(":", 1))
-        if labels != "*" or not sem_type or sem_type == "*":
-            raise ValueError(f"semantic_filter_predicate clause {clause!r}: only 'type:*' clauses are "
-                             f"supported by graphsdg's BasicWriter")
-        types.append(sem_type)
-    if not types:
-        raise ValueError(f"semantic_filter_predicate {predicate!r} names no semantic type")
-    return types
 
 
 class BasicWriter(Writer):
@@ -91,9 +73,15 @@ class BasicWriter(Writer):
         if isinstance(frame_padding, bool) or not isinstance(frame_padding, int) or frame_padding < 0:
             raise ValueError(f"frame_padding must be a non-negative integer, got {frame_padding!r}")
         if semantic_types is not None and semantic_filter_predicate is not None:
-            raise ValueError("BasicWriter: pass semantic_types or semantic_filter_predicate, not both")
-        types = list(semantic_types) if semantic_types is not None else (
-            semantic_types_from_predicate(semantic_filter_predicate) if semantic_filter_predicate else ["class"])
+            raise ValueError(f"BasicWriter: `semantic_types` ({semantic_types!r}) and `semantic_filter_predicate` "
+                             f"({semantic_filter_predicate!r}) are mutually exclusive; pass one")
+        if semantic_filter_predicate is not None:
+            semantic_filter = SemanticFilter.parse(semantic_filter_predicate)
+        elif semantic_types is not None:
+            semantic_filter = SemanticFilter.from_types(semantic_types)
+        else:
+            semantic_filter = SemanticFilter.parse("class:*")
+        self.semantic_filter_predicate = semantic_filter.text
         self.version = "0.0.2"
         self.data_structure = "annotator"
         backends = [backend] if backend is not None else []
@@ -125,8 +113,8 @@ class BasicWriter(Writer):
             anno_name, stem = _FLAGS[flag]
             spec = AnnotatorRegistry.resolve(anno_name)   # clear error if not available
             params: dict[str, Any] = {}
-            if flag in _SEMANTIC and "semanticTypes" in spec.defaults:
-                params["semanticTypes"] = types
+            if flag in _SEMANTIC and "semanticFilter" in spec.defaults:
+                params["semanticFilter"] = semantic_filter.text
             if flag in self._colorize and "colorize" in spec.defaults:
                 params["colorize"] = self._colorize[flag]
             if flag == "pointcloud" and "includeUnlabelled" in spec.defaults:
@@ -193,10 +181,11 @@ class BasicWriter(Writer):
             b.schedule(iof.write_image, data=colorize_normals(arr), path=f"{path()}.png")
         elif stem == "pointcloud":
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
-            for key, suffix in (("pointRgb", "_rgb"), ("pointNormals", "_normals"),
-                                ("pointSemantic", "_semantic"), ("pointInstance", "_instance")):
-                if key in payload:
-                    b.schedule(iof.write_np, data=payload[key], path=f"{path(suffix)}.npy")
+            b.schedule(iof.write_np, data=np.asarray(payload["pointRgb"]).reshape(-1, 4), path=f"{path('_rgb')}.npy")
+            b.schedule(iof.write_np, data=np.asarray(payload["pointNormals"]).reshape(-1, 4),
+                       path=f"{path('_normals')}.npy")
+            b.schedule(iof.write_np, data=payload["pointSemantic"], path=f"{path('_semantic')}.npy")
+            b.schedule(iof.write_np, data=payload["pointInstance"], path=f"{path('_instance')}.npy")
         elif stem == "skeleton":
             b.schedule(iof.write_json, data={k: v for k, v in payload.items() if k != "data"},
                        path=f"{path()}.json")
