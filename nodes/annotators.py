@@ -16,7 +16,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
-from pxr import UsdGeom
+from pxr import Usd, UsdGeom
 
 from graphsdg.annotate.annotator import AnnotatorRegistry, AnnotatorSpec, AovSource
 from graphsdg.annotate.bounds import local_boxes
@@ -24,6 +24,7 @@ from graphsdg.annotate.frame import ALL_LABELS, FrameView
 from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, color_of
 from graphsdg.annotate.motion import motion_vectors as motion_between
 from graphsdg.annotate.semantic_filter import SemanticFilter
+from graphsdg.annotate.skeletons import skeleton_data as skeletons_seen
 
 BBOX_2D_DTYPE = np.dtype([("semanticId", "<u4"), ("x_min", "<i4"), ("y_min", "<i4"), ("x_max", "<i4"),
                           ("y_max", "<i4"), ("occlusionRatio", "<f4")])
@@ -302,6 +303,17 @@ def pointcloud(frame: FrameView, params: dict) -> dict:
                      "pointInstance": frame.instance_id_image(filt)[mask]}}
 
 
+def skeleton_data(frame: FrameView, params: dict) -> dict:
+    """Joints of every ``UsdSkel.Skeleton`` (rest and animated pose, pixels, occlusion), at the capture's time.
+
+    Joints are always reported in the Skeleton's own joint order (``useSkelJoints``
+    is accepted for Replicator scripts; both of its values give that order here).
+    """
+    time = Usd.TimeCode(frame.sim_time * (frame.stage.GetTimeCodesPerSecond() or 60.0))
+    return {"info": skeletons_seen(frame.stage, frame.camera, time, frame.require("geom_ids"),
+                                   frame.sim.ensure_compiled().geom_paths)}
+
+
 def reference_time(frame: FrameView, params: dict) -> dict:
     """The simulation time of the capture as a fraction."""
     t = Fraction(frame.sim_time).limit_denominator(1_000_000)
@@ -335,6 +347,7 @@ _spec("normals", SEG, normals)
 _spec("motion_vectors", SEG | {"depth"}, motion_vectors, aliases=("MotionVectors",))
 _spec("pointcloud", SEG | {"depth", "color"}, pointcloud, {**SEMANTIC_DEFAULTS, "includeUnlabelled": False},
       validate=_validate_semantics)
+_spec("skeleton_data", SEG, skeleton_data, {"useSkelJoints": False})
 _spec("ReferenceTime", set(), reference_time)
 
 # Raw outputs users can register annotators from (AnnotatorRegistry.register_annotator_from_aov).

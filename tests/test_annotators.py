@@ -524,3 +524,129 @@ def test_aperture_offset_shifts_the_image_as_usd_does():
     row = box.get_data()["data"][0]
     x0, x1 = _pixel_extent(min(us), max(us))
     assert abs(row["x_min"] - x0) <= 1 and abs(row["x_max"] - x1) <= 1
+
+
+# ---- skeletons ------------------------------------------------------------------
+def _skeleton_scene():
+    from pxr import Sdf, UsdSkel, Vt
+    cam, rp = _scene(camera_position=(0.0, -6.0, 0.7), look_at=(0.0, 0.0, 0.7))
+    stage = rep.stage.get_stage()
+    root = UsdSkel.Root.Define(stage, "/World/Char")
+    UsdGeom.Xformable(root).AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 0.2))
+    skel = UsdSkel.Skeleton.Define(stage, "/World/Char/Skel")
+    joints = ["root", "root/mid", "root/mid/tip"]
+    rest = Vt.Matrix4dArray([Gf.Matrix4d(1).SetTranslate(Gf.Vec3d(0, 0, z)) for z in (0.0, 0.5, 0.5)])
+    skel.CreateJointsAttr(joints)
+    skel.CreateRestTransformsAttr(rest)
+    skel.CreateBindTransformsAttr(Vt.Matrix4dArray([Gf.Matrix4d(1).SetTranslate(Gf.Vec3d(0, 0, z))
+                                                    for z in (0.0, 0.5, 1.0)]))
+    anim = UsdSkel.Animation.Define(stage, "/World/Char/Skel/Anim")
+    anim.CreateJointsAttr(joints)
+    anim.CreateTranslationsAttr(Vt.Vec3fArray([(0, 0, 0), (0, 0, 0.5), (0, 0, 0.5)]))
+    half = np.sqrt(0.5)
+    anim.CreateRotationsAttr(Vt.QuatfArray([Gf.Quatf(1, 0, 0, 0), Gf.Quatf(half, 0, half, 0), Gf.Quatf(1, 0, 0, 0)]))
+    anim.CreateScalesAttr(Vt.Vec3hArray([(1, 1, 1)] * 3))
+    UsdSkel.BindingAPI.Apply(skel.GetPrim()).CreateAnimationSourceRel().SetTargets([anim.GetPath()])
+    # a body mesh (drawn unskinned, at its authored points) around the root and mid joints
+    body = UsdGeom.Mesh.Define(stage, "/World/Char/Body")
+    pts = cube_corners((0.0, 0.0, 0.35), 0.4)
+    body.CreatePointsAttr(Vt.Vec3fArray([Gf.Vec3f(*p) for p in pts]))
+    faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
+    body.CreateFaceVertexCountsAttr([4] * 6)
+    body.CreateFaceVertexIndicesAttr([i for f in faces for i in f])
+    binding = UsdSkel.BindingAPI.Apply(body.GetPrim())
+    binding.CreateSkeletonRel().SetTargets([skel.GetPath()])
+    binding.CreateJointIndicesPrimvar(True, 1).Set([0])
+    binding.CreateJointWeightsPrimvar(True, 1).Set([1.0])
+    binding.CreateGeomBindTransformAttr(Gf.Matrix4d(1))
+    assert Sdf.Path("/World/Char/Skel").IsAbsolutePath()
+    return cam, rp
+
+
+def test_skeleton_data_from_usdskel(out_dir):
+    import json
+    import os
+    cam, rp = _skeleton_scene()
+    (ann,) = _attach(rp, "skeleton_data")
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir=out_dir, skeleton_data=True)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    d = ann.get_data()
+    assert d["numSkeletons"] == 1 and d["skelPath"] == ["/World/Char/Skel"] and d["skelName"] == ["Skel"]
+    assert d["skeletonJoints"] == ["root", "root/mid", "root/mid/tip"]
+    assert d["skeletonParents"].tolist() == [-1, 0, 1] and d["skeletonParentsSizes"].tolist() == [3]
+    np.testing.assert_allclose(d["restGlobalTranslations"], [[0, 0, 0.2], [0, 0, 0.7], [0, 0, 1.2]], atol=1e-6)
+    np.testing.assert_allclose(d["restLocalTranslations"], [[0, 0, 0], [0, 0, 0.5], [0, 0, 0.5]], atol=1e-6)
+    # the animation turns the mid joint 90 degrees about y: the tip swings to +x
+    np.testing.assert_allclose(d["globalTranslations"], [[0, 0, 0.2], [0, 0, 0.7], [0.5, 0, 0.7]], atol=1e-5)
+    np.testing.assert_allclose(d["localRotations"][1], [np.sqrt(0.5), 0, np.sqrt(0.5), 0], atol=1e-6)
+    uv, _ = camera_view(cam, W, H).project(d["globalTranslations"].astype(np.float64))
+    np.testing.assert_allclose(d["translations2d"], uv, atol=1e-3)
+    # root and mid project onto the body mesh (visible); the tip is beside it (background)
+    assert d["jointOcclusions"].tolist() == [False, False, True]
+    assert d["occlusionTypes"] == [str(["None", "None", "BACKGROUND"])]
+    assert d["inView"].tolist() == [True]
+    rep.orchestrator.wait_until_complete()
+    saved = json.load(open(os.path.join(out_dir, "skeleton_0000.json")))
+    entry = saved["skeleton_0"]
+    assert entry["skel_path"] == "/World/Char/Skel" and entry["skeleton_parents"] == [-1, 0, 1]
+    assert entry["joint_occlusions"] == [False, False, True] and entry["in_view"] is True
+    assert len(entry["translations_2d"]) == 3 and entry["skeleton_joints"][2] == "root/mid/tip"
+
+
+# ---- BasicWriter -----------------------------------------------------------------
+def test_basic_writer_writes_every_flag(out_dir):
+    import json
+    import os
+    from PIL import Image
+    cam, rp = _scene(camera_position=(3.0, -4.0, 2.0))
+    rep.functional.create.cube(parent="/World", name="Cube", semantics={"class": "cube"})
+    rep.functional.create.sphere(position=(0, 0, 1.2), scale=0.6, parent="/World", name="Ball",
+                                 semantics=[("class", "ball"), ("color", "red")])
+    flags = ["rgb", "bounding_box_2d_tight", "bounding_box_2d_loose", "semantic_segmentation",
+             "instance_id_segmentation", "instance_segmentation", "distance_to_camera", "distance_to_image_plane",
+             "bounding_box_3d", "occlusion", "normals", "motion_vectors", "camera_params", "pointcloud",
+             "skeleton_data"]
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir=out_dir, colorize_depth=True, **{f: True for f in flags})
+    writer.attach(rp)
+    for _ in range(2):
+        rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    stems = {"rgb": ["png"], "normals": ["png"], "distance_to_camera": ["npy", "png"],
+             "distance_to_image_plane": ["npy", "png"], "semantic_segmentation": ["png"],
+             "semantic_segmentation_labels": ["json"], "instance_id_segmentation": ["png"],
+             "instance_id_segmentation_mapping": ["json"], "instance_segmentation": ["png"],
+             "instance_segmentation_mapping": ["json"], "instance_segmentation_semantics_mapping": ["json"],
+             "motion_vectors": ["npy"], "occlusion": ["npy"], "camera_params": ["json"], "pointcloud": ["npy"],
+             "pointcloud_rgb": ["npy"], "pointcloud_normals": ["npy"], "pointcloud_semantic": ["npy"],
+             "pointcloud_instance": ["npy"], "skeleton": ["json"]}
+    for box in ("2d_tight", "2d_loose", "3d"):
+        stems[f"bounding_box_{box}"] = ["npy"]
+        stems[f"bounding_box_{box}_labels"] = ["json"]
+        stems[f"bounding_box_{box}_prim_paths"] = ["json"]
+    expected = sorted(f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, exts in stems.items() for ext in exts)
+    assert sorted(os.listdir(out_dir)) == expected
+
+    def load(name):
+        path = os.path.join(out_dir, name)
+        return json.load(open(path)) if name.endswith(".json") else (
+            np.load(path) if name.endswith(".npy") else np.array(Image.open(path)))
+
+    # the default filter is "class:*": the ball's colour label is not exported
+    labels = load("bounding_box_3d_labels_0001.json")
+    assert sorted(v["class"] for v in labels.values()) == ["ball", "cube"] and all(len(v) == 1 for v in labels.values())
+    assert load("bounding_box_3d_0001.npy").dtype == BBOX_3D_DTYPE
+    assert load("occlusion_0001.npy").dtype == OCCLUSION_DTYPE
+    assert load("motion_vectors_0001.npy").shape == (H, W, 4)
+    assert load("normals_0001.png").shape == (H, W, 4)
+    points = load("pointcloud_0001.npy")
+    assert points.dtype == np.float32 and points.shape[1] == 3
+    n = len(points)
+    assert load("pointcloud_rgb_0001.npy").shape == (n, 4) and load("pointcloud_normals_0001.npy").shape == (n, 4)
+    assert load("pointcloud_semantic_0001.npy").shape == (n,) and load("pointcloud_instance_0001.npy").shape == (n,)
+    params = load("camera_params_0001.json")
+    assert params["renderProductResolution"] == [W, H] and len(params["cameraViewTransform"]) == 16
+    assert load("skeleton_0001.json") == {}
+    assert load("distance_to_camera_0001.png").dtype == np.uint8

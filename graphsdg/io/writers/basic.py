@@ -187,10 +187,32 @@ class BasicWriter(Writer):
             b.schedule(iof.write_np, data=payload["pointSemantic"], path=f"{path('_semantic')}.npy")
             b.schedule(iof.write_np, data=payload["pointInstance"], path=f"{path('_instance')}.npy")
         elif stem == "skeleton":
-            b.schedule(iof.write_json, data={k: v for k, v in payload.items() if k != "data"},
-                       path=f"{path()}.json")
+            b.schedule(iof.write_json, data=skeleton_json(payload), path=f"{path()}.json")
         else:
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+
+
+def skeleton_json(payload: dict) -> dict:
+    """Replicator's ``skeleton_{n}.json``: ``{"skeleton_<i>": {snake_case fields}}`` split per skeleton."""
+    out = {}
+    sizes = np.asarray(payload["skeletonParentsSizes"], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    per_joint = {"skeleton_parents": "skeletonParents", "rest_global_translations": "restGlobalTranslations",
+                 "rest_local_translations": "restLocalTranslations", "rest_local_rotations": "restLocalRotations",
+                 "global_translations": "globalTranslations", "local_rotations": "localRotations",
+                 "translations_2d": "translations2d", "skeleton_joints": "skeletonJoints",
+                 "joint_occlusions": "jointOcclusions"}
+    for i in range(int(payload["numSkeletons"])):
+        lo, hi = int(starts[i]), int(starts[i + 1])
+        entry = {"skel_name": payload["skelName"][i], "skel_path": payload["skelPath"][i],
+                 "asset_path": payload["assetPath"][i], "animation_variant": payload["animationVariant"][i]}
+        for key, src in per_joint.items():
+            entry[key] = np.asarray(payload[src][lo:hi]).tolist() if key != "skeleton_joints" \
+                else list(payload[src][lo:hi])
+        entry["occlusion_types"] = payload["occlusionTypes"][i]
+        entry["in_view"] = bool(payload["inView"][i])
+        out[f"skeleton_{i}"] = entry
+    return out
 
 
 def colorize_depth(depth: np.ndarray) -> np.ndarray:
