@@ -650,3 +650,37 @@ def test_basic_writer_writes_every_flag(out_dir):
     assert params["renderProductResolution"] == [W, H] and len(params["cameraViewTransform"]) == 16
     assert load("skeleton_0001.json") == {}
     assert load("distance_to_camera_0001.png").dtype == np.uint8
+
+
+def test_orthographic_camera_boxes_depth_and_normals():
+    cam, rp = _scene(camera_position=(0.0, -5.0, 0.0), projection_type="orthographic", horizontal_aperture=40.0)
+    rep.functional.create.cube(position=(0.3, 0.0, 0.2), parent="/World", name="Cube", semantics={"class": "c"})
+    box, depth, normals = _attach(rp, "bounding_box_2d_loose", "distance_to_image_plane", "normals")
+    rep.orchestrator.step()
+    # USD: an orthographic aperture is in tenths of a stage unit, so the image is 4 units wide
+    px = W / 4.0
+    row = box.get_data()["data"][0]
+    assert (row["x_min"], row["x_max"]) == _pixel_extent(W / 2 + (0.3 - 0.5) * px, W / 2 + (0.3 + 0.5) * px)
+    assert (row["y_min"], row["y_max"]) == _pixel_extent(H / 2 - (0.2 + 0.5) * px, H / 2 - (0.2 - 0.5) * px)
+    z = depth.get_data()
+    np.testing.assert_allclose(z[np.isfinite(z)], 4.5, rtol=1e-5)
+    n = normals.get_data()
+    assert np.all(n[np.isfinite(z)][:, :3] == (0, -1, 0))
+
+
+def test_motion_vectors_of_a_turning_camera():
+    cam, rp = _scene(camera_position=(0.0, 0.0, 0.0), look_at=(0.0, 1.0, 0.0))
+    rep.functional.create.cube(position=(0.0, -5.0, 0.0), parent="/World", name="Behind")
+    (motion,) = _attach(rp, "motion_vectors")
+    rep.orchestrator.step()
+    theta = np.radians(4.0)
+    rep.functional.modify.pose(cam, position_value=(0.0, 0.0, 0.0), look_at_value=(np.sin(theta), np.cos(theta), 0.0))
+    rep.orchestrator.step()
+    mv = motion.get_data()
+    view = camera_view(cam, W, H)
+    row = H // 2
+    u = np.arange(W) + 0.5
+    # the camera turned right by theta: what pixel u shows now was seen theta further right before
+    before = view.cx + view.fx * np.tan(np.arctan((u - view.cx) / view.fx) + theta)
+    np.testing.assert_allclose(mv[row, :, 0], before - u, atol=0.05 * (1 + abs(row + 0.5 - view.cy)))
+    assert mv[row, W // 2, 0] > 0.9 * view.fx * np.tan(theta)

@@ -72,40 +72,62 @@ class CaptureHistory:
 history = CaptureHistory()
 
 
+def _same_camera(a: CameraView, b: CameraView) -> bool:
+    return (a.projection == b.projection and (a.width, a.height) == (b.width, b.height)
+            and np.array_equal(a.position, b.position) and np.array_equal(a.rotation, b.rotation)
+            and (a.fx, a.fy, a.cx, a.cy) == (b.fx, b.fy, b.cx, b.cy))
+
+
 def motion_vectors(current: PoseSnapshot, previous: PoseSnapshot | None, geom_ids: np.ndarray,
                    points: np.ndarray) -> np.ndarray:
     """float32 (H, W, 4) motion vectors (see the module docstring).
 
     ``geom_ids`` (H, W) and ``points`` (H, W, 3, world positions of the pixel
-    centres' surfaces) come from the current capture.
+    centres' surfaces) come from the current capture. Only pixels whose geom or
+    camera moved are projected.
     """
     view = current.view
     h, w = geom_ids.shape
     out = np.zeros((h, w, 4), dtype=np.float32)
     if previous is None:
         return out
-    u = np.arange(w) + 0.5
-    v = np.arange(h) + 0.5
-    uu, vv = np.meshgrid(u, v)
-    hit = geom_ids >= 0
     prev_xpos, prev_xmat = previous.poses_for(current.geom_paths, current)
-    g = geom_ids[hit]
-    p = points[hit]
-    # world -> geom frame (current pose) -> world (previous pose)
-    local = np.einsum("nij,ni->nj", current.xmat[g], p - current.xpos[g])
-    p_prev = np.einsum("nij,nj->ni", prev_xmat[g], local) + prev_xpos[g]
-    uv_prev, _ = previous.view.project(p_prev)
-    out[hit, 0] = uv_prev[:, 0] - uu[hit]
-    out[hit, 1] = uv_prev[:, 1] - vv[hit]
-    if view.projection != "orthographic" and previous.view.projection != "orthographic":
-        sky = ~hit
-        dirs = view.pixel_directions()[sky] @ view.rotation.T          # world directions
-        cam = dirs @ previous.view.rotation                             # in the previous camera frame
+    # Per geom, the map from this capture's world to the previous one's: p' = A p + b.
+    a = np.matmul(prev_xmat, current.xmat.transpose(0, 2, 1))
+    b = prev_xpos - np.einsum("gij,gj->gi", a, current.xpos)
+    moving = ~(np.all(np.abs(a - np.eye(3)) < 1e-12, axis=(1, 2)) & np.all(np.abs(b) < 1e-12, axis=1))
+    camera_moved = not _same_camera(view, previous.view)
+    flat_ids = geom_ids.reshape(-1)
+    pix = np.flatnonzero(flat_ids >= 0)
+    g = flat_ids[pix]
+    if not camera_moved:
+        keep = moving[g]
+        pix, g = pix[keep], g[keep]
+    if pix.size:
+        p = points.reshape(-1, 3)[pix]
+        move = moving[g]
+        if move.any():
+            gm = g[move]
+            p[move] = np.einsum("nij,nj->ni", a[gm], p[move]) + b[gm]
+        uv_prev, _ = previous.view.project(p)
+        ys, xs = np.divmod(pix, w)
+        flat = out.reshape(-1, 4)
+        flat[pix, 0] = uv_prev[:, 0] - (xs + 0.5)
+        flat[pix, 1] = uv_prev[:, 1] - (ys + 0.5)
+    rotated = camera_moved and not (np.array_equal(view.rotation, previous.view.rotation)
+                                    and (view.fx, view.fy, view.cx, view.cy) == (previous.view.fx, previous.view.fy,
+                                                                                 previous.view.cx, previous.view.cy))
+    if rotated and view.projection != "orthographic" and previous.view.projection != "orthographic":
+        # A pixel showing nothing looks at infinity: only the camera's rotation moves it.
+        sky = np.flatnonzero(flat_ids < 0)
+        ys, xs = np.divmod(sky, w)
+        dirs = view.pixel_directions().reshape(-1, 3)[sky].dot(view.rotation.T)
+        cam = dirs.dot(previous.view.rotation)
         ahead = cam[:, 2] < 0
-        du = np.zeros(len(cam))
-        dv = np.zeros(len(cam))
-        du[ahead] = previous.view.cx + previous.view.fx * cam[ahead, 0] / -cam[ahead, 2] - uu[sky][ahead]
-        dv[ahead] = previous.view.cy - previous.view.fy * cam[ahead, 1] / -cam[ahead, 2] - vv[sky][ahead]
-        out[sky, 0] = du
-        out[sky, 1] = dv
+        pv = previous.view
+        flat = out.reshape(-1, 4)
+        rows = sky[ahead]
+        depth = -cam[ahead, 2]
+        flat[rows, 0] = pv.cx + pv.fx * cam[ahead, 0] / depth - (xs[ahead] + 0.5)
+        flat[rows, 1] = pv.cy - pv.fy * cam[ahead, 1] / depth - (ys[ahead] + 0.5)
     return out
