@@ -301,3 +301,24 @@ def test_hydra_texture_updates_disabled_skips_render():
     rp.hydra_texture.set_updates_enabled(True)
     rep.orchestrator.step()
     assert not np.array_equal(ann.get_data(), first)
+
+
+def test_attribute_edits_sync_without_recompiling():
+    from graphsdg.runtime import runtime
+    cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(W, H))
+    ann, _ = _step_boxes(rp)
+    sim = runtime().sim
+    compiles = sim.stats["compiles"]
+    rep.functional.modify.pose(cube, position_value=(0.5, 0, 0), scale_value=(0.5, 0.5, 0.5))
+    rep.functional.modify.display_color(cube, (0.2, 0.9, 0.2))
+    UsdGeom.Imageable(cube).MakeInvisible()
+    rep.orchestrator.step()
+    UsdGeom.Imageable(cube).MakeVisible()
+    rep.orchestrator.step()
+    assert sim.stats["compiles"] == compiles
+    lo, hi = project_box(cam, W, H, cube_corners((0.5, 0, 0), half=0.25))
+    row = ann.get_data()["data"][0]
+    assert abs(row["x_min"] - lo[0]) <= 2 and abs(row["x_max"] + 1 - hi[0]) <= 2
+    rep.functional.create.sphere(parent="/World")      # structural: one recompile, state kept
+    rep.orchestrator.step()
+    assert sim.stats["compiles"] == compiles + 1
