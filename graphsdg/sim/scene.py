@@ -23,6 +23,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, CompiledScene, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size)
+from graphsdg.sim.mesh_scaling import rescale_mesh_geom
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
@@ -72,6 +73,7 @@ class SimScene:
         self.model_version = 0              # bumps on every recompile (renderers rebuild contexts)
         self.labels_version = 0             # bumps when semantic labels may have changed
         self.textures_to_upload: set[int] = set()
+        self.meshes_to_upload: set[int] = set()
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
 
@@ -118,6 +120,7 @@ class SimScene:
         self.model_version += 1
         self.labels_version += 1
         self.textures_to_upload.clear()
+        self.meshes_to_upload.clear()
         self.stats["compiles"] += 1
         self.stats["compile_s"] += time.perf_counter() - start
         for cb in list(self._on_recompile):
@@ -260,8 +263,15 @@ class SimScene:
                 t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
                 if not np.allclose(t, self._geom_local_pos(g), atol=1e-9):
                     raise NeedsRecompile   # a geom moved inside its rigid body
-            if g.type_name in ("Mesh", "Cone") or g.rigid_root is not None:
-                if "shape" in aspects or not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12):
+            rescaled = not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12)
+            if g.type_name in ("Mesh", "Cone") and g.rigid_root is None and "shape" not in aspects:
+                if rescaled:
+                    if np.any(np.abs(scale) < 1e-9) or m.geom_contype[g.geom_id] or m.geom_conaffinity[g.geom_id]:
+                        raise NeedsRecompile   # colliding meshes carry hulls and inertia
+                    self.meshes_to_upload.add(rescale_mesh_geom(m, g.geom_id, g.scale, scale))
+                    g.scale = scale
+            elif g.type_name in ("Mesh", "Cone") or g.rigid_root is not None:
+                if "shape" in aspects or rescaled:
                     raise NeedsRecompile   # vertices (or the body's inertia) change
             elif "shape" in aspects or not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12):
                 self._resize(prim, g, scale)
