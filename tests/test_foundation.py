@@ -344,3 +344,36 @@ def test_mesh_rescale_is_live_and_exact(shape):
     rep.orchestrator.step()
     fresh = ann.get_data()["data"][0]
     assert all(abs(int(live[k]) - int(fresh[k])) <= 1 for k in ("x_min", "y_min", "x_max", "y_max"))
+
+
+def test_write_to_fabric_matches_usd_authoring():
+    """The direct MuJoCo write path renders exactly what authoring USD renders."""
+    def capture(fabric):
+        rep.stage.new_stage()
+        rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", fabric)
+        rep.functional.create.xform(name="World")
+        rep.functional.create.dome_light(intensity=600, parent="/World")
+        prims = [rep.functional.create.cube(parent="/World", semantics={"class": "a"}),
+                 rep.functional.create.sphere(parent="/World", semantics={"class": "b"}),
+                 rep.functional.create.torus(parent="/World", semantics={"class": "c"})]
+        cam = rep.functional.create.camera(position=(5, -5, 4), look_at=(0, 0, 0), parent="/World")
+        rp = rep.create.render_product(cam, (W, H))
+        rgb, box = rep.annotators.get("rgb"), rep.annotators.get("bounding_box_2d_tight")
+        rgb.attach(rp)
+        box.attach(rp)
+        rep.orchestrator.step()
+        rng = np.random.default_rng(4)
+        for _ in range(2):
+            rep.functional.modify.pose(prims, position_value=rng.uniform(-1.5, 1.5, (3, 3)),
+                                       rotation_value=rng.uniform(0, 360, (3, 3)),
+                                       scale_value=rng.uniform(0.3, 1.0, (3, 1)).repeat(3, 1))
+            rep.functional.modify.display_color(prims, rng.uniform(0, 1, (3, 3)))
+            rep.orchestrator.step()
+        authored = prims[0].GetAttribute("xformOp:translate").Get()
+        return rgb.get_data().copy(), box.get_data()["data"].copy(), authored
+
+    usd_rgb, usd_box, usd_t = capture(False)
+    fab_rgb, fab_box, fab_t = capture(True)
+    assert np.array_equal(usd_box, fab_box)
+    assert np.abs(usd_rgb.astype(int) - fab_rgb).max() <= 2
+    assert usd_t is not None and fab_t is None       # the fast path leaves the stage unauthored
