@@ -377,3 +377,26 @@ def test_write_to_fabric_matches_usd_authoring():
     assert np.array_equal(usd_box, fab_box)
     assert np.abs(usd_rgb.astype(int) - fab_rgb).max() <= 2
     assert usd_t is not None and fab_t is None       # the fast path leaves the stage unauthored
+
+
+def test_vectorized_quaternions_match_mujoco():
+    import mujoco
+    from graphsdg.sim.direct_writes import euler_xyz_to_matrices, matrices_to_quats
+    from graphsdg.stage.xform import euler_to_matrix
+    angles = np.random.default_rng(0).uniform(-360, 360, (200, 3))
+    angles[:4] = [[0, 0, 0], [180, 0, 0], [0, 180, 0], [0, 0, 180]]
+    mats = euler_xyz_to_matrices(angles)
+    assert np.allclose(mats, [euler_to_matrix(a, "XYZ") for a in angles], atol=1e-12)
+    quats = matrices_to_quats(mats)
+    for m, q in zip(mats, quats):
+        ref = np.empty(4)
+        mujoco.mju_mat2Quat(ref, m.ravel())
+        assert np.allclose(q, ref if ref[0] >= 0 else -ref, atol=1e-9) or np.allclose(q, -ref, atol=1e-9)
+
+
+def test_euler_convention_matches_usd_rotate_xyz():
+    from graphsdg.stage.xform import euler_to_matrix, matrix_to_euler_xyz
+    cube = rep.functional.create.cube(rotation=(30, -50, 110))
+    usd = np.array(UsdGeom.Xformable(cube).GetLocalTransformation())[:3, :3].T   # row-vector -> column
+    assert np.allclose(usd, euler_to_matrix((30, -50, 110), "XYZ"), atol=1e-9)
+    assert np.allclose(matrix_to_euler_xyz(usd), (30, -50, 110), atol=1e-9)

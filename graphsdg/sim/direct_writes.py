@@ -42,11 +42,23 @@ def euler_xyz_to_matrices(angles_deg: np.ndarray) -> np.ndarray:
 
 
 def matrices_to_quats(r: np.ndarray) -> np.ndarray:
-    """(N, 3, 3) rotations -> (N, 4) unit quaternions (w, x, y, z)."""
-    out = np.empty((len(r), 4))
-    for i, m in enumerate(r):
-        mujoco.mju_mat2Quat(out[i], m.ravel())
-    return out
+    """(N, 3, 3) rotations -> (N, 4) unit quaternions (w, x, y, z), w >= 0 (Shepperd's method)."""
+    r = np.asarray(r, dtype=np.float64)
+    m00, m11, m22 = r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]
+    q = np.empty((len(r), 4))
+    # Take the largest of w, x, y, z from the diagonal for stability, then the rest from off-diagonals.
+    cands = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], 1)
+    k = np.argmax(cands, axis=1)
+    s = np.sqrt(np.maximum(cands[np.arange(len(r)), k], 1e-300)) * 2
+    d = lambda i, j: r[:, i, j]  # noqa: E731
+    sel = [k == 0, k == 1, k == 2, k == 3]
+    q[sel[0]] = np.stack([s / 4, (d(2, 1) - d(1, 2)) / s, (d(0, 2) - d(2, 0)) / s, (d(1, 0) - d(0, 1)) / s], 1)[sel[0]]
+    q[sel[1]] = np.stack([(d(2, 1) - d(1, 2)) / s, s / 4, (d(0, 1) + d(1, 0)) / s, (d(0, 2) + d(2, 0)) / s], 1)[sel[1]]
+    q[sel[2]] = np.stack([(d(0, 2) - d(2, 0)) / s, (d(0, 1) + d(1, 0)) / s, s / 4, (d(1, 2) + d(2, 1)) / s], 1)[sel[2]]
+    q[sel[3]] = np.stack([(d(1, 0) - d(0, 1)) / s, (d(0, 2) + d(2, 0)) / s, (d(1, 2) + d(2, 1)) / s, s / 4], 1)[sel[3]]
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    q[q[:, 0] < 0] *= -1
+    return q
 
 
 class DirectTargets:
@@ -68,6 +80,10 @@ class DirectTargets:
         self.parent_s = np.array([decompose(m)[2] for m in mats])
         self.is_mesh = np.array([b.type_name in ("Mesh", "Cone") for b in self.bindings])
         self.prims = list(prims)
+        # Unit-scale sizes let box scales be written as one array product.
+        self.is_box = np.array([b.type_name == "Cube" for b in self.bindings])
+        self.unit_box = np.array([primitive_size(p, np.ones(3))[1] if box else np.zeros(3)
+                                  for p, box in zip(self.prims, self.is_box)]).reshape(len(self.prims), 3)
 
 
 _cache: dict[tuple, DirectTargets] = {}
@@ -99,7 +115,9 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
     if scales is not None:
         world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3) * t.parent_s
         for i in range(n):
-            if not t.is_mesh[i]:
+            if t.is_box[i]:
+                sizes[i] = t.unit_box[i] * np.abs(world_scale[i])
+            elif not t.is_mesh[i]:
                 kind, size, _ = primitive_size(t.prims[i], world_scale[i])
                 if int(kind) != int(m.geom_type[t.geom_ids[i]]):
                     return False   # e.g. a sphere scaled unevenly becomes an ellipsoid: recompile via USD
@@ -124,7 +142,7 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
                 m.geom_size[b.geom_id] = sizes[i]
                 m.geom_rbound[b.geom_id] = float(np.linalg.norm(_half_extent(int(m.geom_type[b.geom_id]),
                                                                              sizes[i])))
-            b.scale = world_scale[i].copy()
+            b.scale = world_scale[i]
     mujoco.mj_kinematics(m, d)
     return True
 
