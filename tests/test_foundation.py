@@ -400,3 +400,13 @@ def test_euler_convention_matches_usd_rotate_xyz():
     usd = np.array(UsdGeom.Xformable(cube).GetLocalTransformation())[:3, :3].T   # row-vector -> column
     assert np.allclose(usd, euler_to_matrix((30, -50, 110), "XYZ"), atol=1e-9)
     assert np.allclose(matrix_to_euler_xyz(usd), (30, -50, 110), atol=1e-9)
+
+
+def test_pose_value_shapes():
+    cubes = rep.functional.create_batch.cube(count=5)
+    rep.functional.modify.pose(cubes, scale_value=[0.1, 0.2, 0.3, 0.4, 0.5])       # one scalar per prim
+    assert tuple(cubes[3].GetAttribute("xformOp:scale").Get()) == (0.4, 0.4, 0.4)
+    rep.functional.modify.pose(cubes, position_value=(1, 2, 3))                   # one vector for all
+    assert all(tuple(c.GetAttribute("xformOp:translate").Get()) == (1, 2, 3) for c in cubes)
+    with pytest.raises(ValueError, match="4 rows but count/prims is 5"):
+        rep.functional.modify.pose(cubes, position_value=np.zeros((4, 3)))
