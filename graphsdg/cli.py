@@ -139,6 +139,13 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
     bench.add_argument("--profile", action="store_true", help="print where each frame's time goes")
     bench.add_argument("--report", metavar="MD", help="append the result table to this Markdown file")
+    view = sub.add_parser("view", help="contact sheet (and HTML gallery) of a dataset, with statistics")
+    view.add_argument("dir")
+    view.add_argument("--html", action="store_true", help="also write an HTML gallery")
+    view.add_argument("--max", type=int, default=16, help="frames to show (default 16)")
+    view.add_argument("--out", help="output folder (default: DIR.view next to the dataset)")
+    validate = sub.add_parser("validate", help="check a dataset's consistency; exit 1 on any violation")
+    validate.add_argument("dir")
     args = parser.parse_args(argv)
     try:
         if args.command == "demo":
@@ -148,7 +155,21 @@ def main(argv: list[str] | None = None) -> int:
             print(f"wrote {summary['frames']} frames to {summary['output_dir']} in {summary['seconds']:.1f} s")
         elif args.command == "bench":
             run_bench(args)
+        elif args.command == "view":
+            from graphsdg.dataset.view import write_view
+            result = write_view(args.dir, args.out, args.max, args.html)
+            for key, value in result.items():
+                print(f"{key}: {value}")
+        elif args.command == "validate":
+            from graphsdg.dataset.validate import validate
+            violations = validate(args.dir)
+            for v in violations:
+                print(v)
+            print(f"{len(violations)} violation(s) in {args.dir}")
+            return 1 if violations else 0
         return 0
+    except SystemExit:
+        raise
     except Exception as exc:  # one clear line unless --debug
         if args.debug:
             raise
