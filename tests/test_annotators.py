@@ -223,6 +223,8 @@ def test_normals_of_cube_faces_and_sphere():
     rep.functional.create.cube(parent="/World", name="Cube", semantics={"class": "cube"})
     rep.functional.create.sphere(position=(0.0, 1.5, 1.2), scale=0.8, parent="/World", name="Ball",
                                  semantics={"class": "ball"})
+    rep.functional.create.disk(position=(-1.2, 0.5, -0.3), rotation=(0.0, 30.0, 0.0), parent="/World",
+                               name="Disk", semantics={"class": "disk"})   # a triangle mesh
     normals, depth, inst = _attach(rp, "normals", "distance_to_image_plane", "instance_segmentation")
     rep.orchestrator.step()
     n = normals.get_data()
@@ -244,6 +246,10 @@ def test_normals_of_cube_faces_and_sphere():
     radial = points[ball] - np.array([0.0, 1.5, 1.2])
     radial /= np.linalg.norm(radial, axis=1, keepdims=True)
     assert np.median(np.einsum("ij,ij->i", radial, n[ball][:, :3])) > 0.9999
+    disk = ids["data"] == by_path["/World/Disk"]
+    assert disk.sum() > 30
+    np.testing.assert_allclose(n[disk][:, :3], np.tile(euler_to_matrix((0.0, 30.0, 0.0))[:, 2], (disk.sum(), 1)),
+                               atol=1e-5)
 
 
 def test_motion_vectors_of_translated_cube_and_camera():
