@@ -219,11 +219,13 @@ class FrameView:
         return self.cached(("tight_boxes", semantic_filter.text), build)
 
     def footprints(self, semantic_filter: SemanticFilter = ALL_LABELS) -> Footprints:
-        """Unoccluded footprint of every instance in view: one isolated id render per instance.
+        """Unoccluded footprint of every instance in view, from isolated id renders.
 
-        Each instance is drawn alone, cropped to a conservative pixel rectangle of
-        its geoms' bounding spheres, so the cost grows with its projected size.
-        Instances whose rectangle misses the image are not in view (count 0).
+        Each instance is drawn with every other geom hidden, cropped to a
+        conservative pixel rectangle of its geoms' bounding spheres. Instances
+        whose rectangles do not overlap share one render (their footprints cannot
+        touch), so the number of renders is the number of overlap groups, not of
+        instances. Instances whose rectangle misses the image are not in view.
         """
         def build():
             imap = self.instance_map(semantic_filter)
@@ -236,18 +238,25 @@ class FrameView:
             drawn = self.sim.model.geom_group
             shown = (drawn != HIDDEN_GROUP) & (drawn != COLLISION_ONLY_GROUP)
             rects = self._geom_rects()
+            members: list[tuple[int, np.ndarray, tuple[int, int, int, int]]] = []
             for k in range(n):
                 geoms = imap.geoms_of(k)
                 geoms = geoms[shown[geoms]]
                 crop = _union_crop(rects[geoms], self.width, self.height) if geoms.size else None
-                if crop is None:
-                    continue
-                ids = render(geoms, crop)
-                mask = ids >= 0
-                counts[k] = int(mask.sum())
-                if counts[k]:
-                    ys, xs = np.nonzero(mask)
-                    boxes[k] = (xs.min() + crop[0], ys.min() + crop[1], xs.max() + crop[0], ys.max() + crop[1])
+                if crop is not None:
+                    members.append((k, geoms, crop))
+            for group in _disjoint_groups(members):
+                crops = np.array([c for _, _, c in group])
+                x0, y0 = crops[:, :2].min(0)
+                x1, y1 = crops[:, 2:].max(0)
+                ids = render(np.concatenate([g for _, g, _ in group]), (int(x0), int(y0), int(x1), int(y1)))
+                for k, geoms, crop in group:
+                    part = ids[crop[1] - y0:crop[3] - y0, crop[0] - x0:crop[2] - x0]
+                    mask = np.isin(part, geoms)
+                    counts[k] = int(mask.sum())
+                    if counts[k]:
+                        ys, xs = np.nonzero(mask)
+                        boxes[k] = (xs.min() + crop[0], ys.min() + crop[1], xs.max() + crop[0], ys.max() + crop[1])
             # Guard against a pixel drawn in the full render but not the isolated one (the two
             # frusta differ in the last float bit): the footprint always covers the visible part.
             visible = self.visible_counts(semantic_filter)
@@ -313,6 +322,20 @@ def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
     present = hi_x >= 0
     boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
     return boxes.astype(np.int32)
+
+
+def _disjoint_groups(members: list) -> list[list]:
+    """Greedy packing of ``(index, geoms, crop)`` members into groups of pairwise disjoint crops."""
+    groups: list[list] = []
+    for member in members:
+        x0, y0, x1, y1 = member[2]
+        for group in groups:
+            if all(x1 <= c[0] or c[2] <= x0 or y1 <= c[1] or c[3] <= y0 for _, _, c in group):
+                group.append(member)
+                break
+        else:
+            groups.append([member])
+    return groups
 
 
 def _union_crop(rects: np.ndarray, width: int, height: int) -> tuple[int, int, int, int] | None:

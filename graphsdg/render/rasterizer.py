@@ -251,7 +251,8 @@ class Rasterizer:
         x0, y0, x1, y1 = (int(c) for c in crop)
         if not (0 <= x0 < x1 <= view.width and 0 <= y0 < y1 <= view.height):
             raise ValueError(f"crop {crop} is not a non-empty rectangle inside {view.width}x{view.height}")
-        self.bind(sim)
+        if self._model is not sim.model or self._version != sim.model_version:
+            self.bind(sim)   # normally bound (and current) already: this follows render() of the same view
         model = sim.model
         group = model.geom_group
         saved = group.copy()
