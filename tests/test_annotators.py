@@ -516,7 +516,7 @@ def test_bad_annotator_input_errors():
 
 
 def test_aperture_offset_shifts_the_image_as_usd_does():
-    cam, rp = _scene(camera_position=(0.0, -4.0, 0.0), horizontal_aperture_offset=3.0)
+    cam, rp = _scene(camera_position=(0.0, -4.0, 0.0), horizontal_aperture_offset=3.0, vertical_aperture_offset=-2.0)
     rep.functional.create.cube(parent="/World", name="Cube", semantics={"class": "cube"})
     (box,) = _attach(rp, "bounding_box_2d_tight")
     rep.orchestrator.step()
@@ -525,13 +525,18 @@ def test_aperture_offset_shifts_the_image_as_usd_does():
     g.verticalAperture = g.horizontalAperture * H / W
     proj = g.frustum.ComputeProjectionMatrix()
     view_m = g.frustum.ComputeViewMatrix()
-    us = []
+    us, vs = [], []
     for x in (-0.5, 0.5):
-        p = Gf.Vec4d(x, -0.5, 0.0, 1.0) * view_m * proj
-        us.append((p[0] / p[3] + 1) / 2 * W)
+        for z in (-0.5, 0.5):
+            p = Gf.Vec4d(x, -0.5, z, 1.0) * view_m * proj
+            us.append((p[0] / p[3] + 1) / 2 * W)
+            vs.append((1 - p[1] / p[3]) / 2 * H)
     row = box.get_data()["data"][0]
     x0, x1 = _pixel_extent(min(us), max(us))
+    y0, y1 = _pixel_extent(min(vs), max(vs))
     assert abs(row["x_min"] - x0) <= 1 and abs(row["x_max"] - x1) <= 1
+    assert abs(row["y_min"] - y0) <= 1 and abs(row["y_max"] - y1) <= 1
+    assert row["x_min"] < W / 2 - 30 and row["y_min"] < H / 2 - 30     # a +x offset moves it left, a -y one up
 
 
 # ---- skeletons ------------------------------------------------------------------
