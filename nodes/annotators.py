@@ -219,10 +219,11 @@ def bounding_box_3d(frame: FrameView, params: dict) -> dict:
 
 
 def bounding_box_3d_360(frame: FrameView, params: dict) -> dict:
-    """As ``bounding_box_3d`` for every instance on the stage; occlusionRatio NaN outside the view."""
+    """As ``bounding_box_3d`` for every drawn instance on the stage; occlusionRatio NaN outside the view."""
     filt = semantic_filter(params)
     imap = frame.instance_map(filt)
-    return _boxes_3d(frame, filt, _by_instance_id(imap, np.arange(len(imap.paths))))
+    drawn = imap.geom_instance[frame.drawn_geoms()]
+    return _boxes_3d(frame, filt, _by_instance_id(imap, np.unique(drawn[drawn >= 0])))
 
 
 def occlusion(frame: FrameView, params: dict) -> dict:

@@ -714,3 +714,19 @@ def test_instances_that_cannot_overlap_share_an_isolated_render():
     ratios = dict(zip(loose.get_data()["info"]["primPaths"], loose.get_data()["data"]["occlusionRatio"]))
     assert ratios["/World/C2"] > 0.2 and ratios["/World/Front"] == 0
     assert all(ratios[f"/World/C{i}"] == 0 for i in (0, 1, 3))
+
+
+def test_bounding_box_3d_360_lists_drawn_instances_outside_the_view():
+    cam, rp = _scene(camera_position=(0.0, -5.0, 0.0))
+    rep.functional.create.cube(parent="/World", name="Seen", semantics={"class": "c"})
+    rep.functional.create.cube(position=(0.0, -10.0, 0.0), parent="/World", name="Behind", semantics={"class": "c"})
+    rep.functional.create.cube(position=(2.0, 0.0, 0.0), parent="/World", name="Hidden", semantics={"class": "c"},
+                               visible=False)
+    in_view, all_round = _attach(rp, "bounding_box_3d", "bounding_box_3d_360")
+    rep.orchestrator.step()
+    assert in_view.get_data()["info"]["primPaths"] == ["/World/Seen"]
+    d = all_round.get_data()
+    rows = dict(zip(d["info"]["primPaths"], d["data"]))
+    assert sorted(rows) == ["/World/Behind", "/World/Seen"]
+    assert np.isnan(rows["/World/Behind"]["occlusionRatio"]) and rows["/World/Seen"]["occlusionRatio"] == 0
+    np.testing.assert_allclose(rows["/World/Behind"]["transform"][3], [0, -10, 0, 1])

@@ -235,8 +235,8 @@ class FrameView:
             render = self.outputs.render_isolated if self.outputs is not None else None
             if render is None:
                 raise RuntimeError("isolated renders need the segmentation pass")
-            drawn = self.sim.model.geom_group
-            shown = (drawn != HIDDEN_GROUP) & (drawn != COLLISION_ONLY_GROUP)
+            shown = np.zeros(self.sim.model.ngeom, dtype=bool)
+            shown[self.drawn_geoms()] = True
             rects = self._geom_rects()
             members: list[tuple[int, np.ndarray, tuple[int, int, int, int]]] = []
             for k in range(n):
@@ -282,6 +282,11 @@ class FrameView:
             ratio[inview] = 1.0 - visible[inview] / fp.counts[inview]
             return np.clip(ratio, 0.0, 1.0).astype(np.float32)
         return self.cached(("occlusion", semantic_filter.text), build)
+
+    def drawn_geoms(self) -> np.ndarray:
+        """Ids of the geoms the rasteriser draws (not hidden, not collision-only)."""
+        group = self.sim.model.geom_group
+        return np.nonzero((group != HIDDEN_GROUP) & (group != COLLISION_ONLY_GROUP))[0]
 
     def _geom_rects(self) -> np.ndarray:
         """(ngeom, 4) conservative pixel rectangles of every geom's bounding sphere (NaN: behind)."""
