@@ -20,8 +20,8 @@ def local_boxes(stage: Usd.Stage, paths: Sequence[str]) -> tuple[np.ndarray, np.
     Example:
         >>> from graphsdg import stage as st
         >>> from pxr import UsdGeom
-        >>> s = st.new_stage(); c = UsdGeom.Cube.Define(s, "/C"); c.CreateSizeAttr(2.0)
-        >>> c.AddTranslateOp().Set((1.0, 0.0, 0.0))
+        >>> s = st.new_stage(); c = UsdGeom.Cube.Define(s, "/C"); _ = c.CreateSizeAttr(2.0)
+        >>> _ = c.AddTranslateOp().Set((1.0, 0.0, 0.0))
         >>> lo, hi, m = local_boxes(s, ["/C"])
         >>> lo[0].tolist(), hi[0].tolist(), m[0][3].tolist()
         ([-1.0, -1.0, -1.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0, 1.0])
