@@ -29,9 +29,13 @@ from graphsdg.io.backends import BackendDispatch  # noqa: E402
 from graphsdg.io.writer import Writer, WriterRegistry  # noqa: E402
 from graphsdg.rng import get_global_seed, set_global_seed  # noqa: E402
 from graphsdg import nodes  # noqa: E402,F401  (registers the node library)
+from graphsdg import (distribution, events, get, graph, modify, randomizer, trigger)  # noqa: E402
+from graphsdg import events as utils  # noqa: E402  (rep.utils.send_og_event)
+from graphsdg.graph import ReplicatorItem, new_layer  # noqa: E402
 
 __version__ = "0.1.0"
 
 __all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
-           "writers", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
+           "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
+           "new_layer", "ReplicatorItem", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
            "get_global_seed", "set_global_seed"]
