@@ -214,6 +214,7 @@ def seek(frame: int, restore_state: bool = True) -> None:
 
 def snapshot(graph: Graph) -> dict:
     """The scheduler state of ``graph`` (restored by :func:`restore`)."""
+    graph.order   # stable ids and effective triggers first: they are part of the state restored
     return {"nodes": {id(n): dict(n.__dict__) for n in graph}, "frame": graph.frame,
             "events": set(graph.pending_events), "prov": copy.deepcopy(getattr(graph, "provenance", {}))}
 
