@@ -37,5 +37,6 @@ __version__ = "0.1.0"
 
 __all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
            "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
-           "new_layer", "ReplicatorItem", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
+           "new_layer", "ReplicatorItem",
+           "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
            "get_global_seed", "set_global_seed"]

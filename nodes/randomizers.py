@@ -210,7 +210,8 @@ class Instantiate(Randomizer):
         base = self.user_name or "Instance"
         slots = []
         for _ in range(int(self.value_of("size"))):
-            prim = FC.xform(name=f"{base}_Xform", parent=Sdf.Path(REPLICATOR_ROOT), semantics=self.value_of("semantics"))
+            prim = FC.xform(name=f"{base}_Xform", parent=Sdf.Path(REPLICATOR_ROOT),
+                            semantics=self.value_of("semantics"))
             prim.SetInstanceable(self.value_of("mode") == "scene_instance")
             slots.append(prim)
         self.output_values = {"prims": slots}

@@ -6,7 +6,7 @@ Example:
     >>> with rep.trigger.on_frame(interval=2):
     ...     _ = rep.create.light(light_type="Sphere", intensity=rep.distribution.uniform(1e3, 2e3))
     >>> print(rep.graph.describe())   # doctest: +ELLIPSIS
-    graph: 3 nodes, 1 trigger, 2 edges
+    graph: 3 nodes, 1 trigger, 1 edge
     ...
 """
 from __future__ import annotations
@@ -81,7 +81,8 @@ def describe(graph: Graph | None = None) -> str:
     order = g.order
     data_edges = [(u, v, d) for u, v, d in g.dag.edges(data=True) if d["kind"] == "data"]
     n_trig = len(g.triggers)
-    lines = [f"graph: {len(order)} nodes, {n_trig} trigger{'s' if n_trig != 1 else ''}, {len(data_edges)} edges"]
+    lines = [f"graph: {len(order)} node{'s' if len(order) != 1 else ''}, {n_trig} trigger{'s' if n_trig != 1 else ''}, "
+             f"{len(data_edges)} edge{'s' if len(data_edges) != 1 else ''}"]
     from graphsdg.graph.graph import effective_triggers
     groups: dict[str, list] = {t.name: [] for t in g.triggers}
     groups["(runs once, at build)"] = []

@@ -5,7 +5,9 @@ Per frame ``n`` (zero-padded to ``frame_padding``) and per enabled flag:
 ``_prim_paths_{n}.json``; ``semantic_segmentation_{n}.png`` with
 ``semantic_segmentation_labels_{n}.json``; ... With several render products
 each file goes to ``<rp_name>/<annotator>/`` (or ``<annotator>/<rp_name>_`` with
-``use_common_output_dir=True``).
+``use_common_output_dir=True``). With ``provenance=True`` it also writes
+``provenance_{n}.json``: the values the graph sampled, by node name, with the
+frame each was drawn on and the ``trigger_outputs``.
 
 Example:
     >>> import graphsdg as rep, tempfile
