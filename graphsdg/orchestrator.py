@@ -111,8 +111,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     t = _timed("physics", t)
     subframes = rt_subframes if rt_subframes > 0 else max(int(settings.get("/omni/replicator/RTSubframes", 1)),
                                                           subframes_override, 1)
-    _capture(subframes, fired, trigger_outputs, provenance)
-    _timed("capture", t)
+    _capture(subframes, fired, trigger_outputs, provenance)   # times its render, annotate and write phases itself
     _state.frame_index += 1
     _state.set(Status.STEPPED)
 

@@ -30,7 +30,13 @@ def test_wheel_contains_nodes_and_imports(tmp_path):
     assert out.stdout.strip() == "ok"
 
 
-def test_plain_import_leaves_isaac_names_alone():
+def test_plain_import_leaves_isaac_names_alone(tmp_path):
     code = "import graphsdg, sys; bad = [m for m in sys.modules if m.split('.')[0] in ('omni', 'carb', 'isaacsim')]; " \
            "assert not bad, bad"
-    subprocess.run([sys.executable, "-c", code], check=True)
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=str(tmp_path))
+
+
+def test_source_checkout_imports_the_node_library():
+    code = "import graphsdg, sys; assert graphsdg.__file__.startswith(sys.argv[1]); " \
+           "assert 'rgb' in graphsdg.annotators.get_registered_annotators()"
+    subprocess.run([sys.executable, "-c", code, ROOT], check=True, cwd=ROOT)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
+from graphsdg import settings
 from graphsdg.functional.create_batch import per_prim
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -39,6 +40,15 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
         raise ValueError("size and scale are exclusive; pass one of them")
     targets = resolve_prims(prims)
     n = len(targets)
+    if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
+            and _write_to_fabric():
+        from graphsdg.runtime import runtime
+        from graphsdg.sim import direct_writes
+        arrays = [None if v is None else np.array(per_prim(v, n, name, width=np.shape(v)[-1] if np.ndim(v) else 3))
+                  for v, name in ((position_value, "position_value"), (rotation_value, "rotation_value"),
+                                  (scale_value, "scale_value"))]
+        if direct_writes.write_poses(runtime().sim, targets, *arrays):
+            return
     positions = per_prim(position_value, n, "position_value")
     rotations = per_prim(rotation_value, n, "rotation_value", width=4 if np.ndim(rotation_value) and
                          np.shape(rotation_value)[-1] == 4 else 3)
@@ -76,6 +86,10 @@ def _apply_pivot(prim: Usd.Prim, pivot: np.ndarray, position: Any) -> None:
     base = np.asarray(position, dtype=np.float64) if position is not None else t
     turned = r @ (s * pivot)
     set_local_pose(prim, position=base + pivot - turned)
+
+
+def _write_to_fabric() -> bool:
+    return bool(settings.get("/exts/omni.replicator.core/enableWriteToFabric", False))
 
 
 def position(prims: Any, value: Any) -> None:
@@ -173,6 +187,11 @@ def display_color(prims: Any, value: Any) -> None:
     """Set ``primvars:displayColor`` (one colour for all, or (N, 3))."""
     targets = resolve_prims(prims)
     colors = per_prim(value, len(targets), "display color")
+    if _write_to_fabric():
+        from graphsdg.runtime import runtime
+        from graphsdg.sim import direct_writes
+        if direct_writes.write_colors(runtime().sim, targets, np.array(colors)[:, :3]):
+            return
     for prim, c in zip(targets, colors):
         gprim = UsdGeom.Gprim(prim)
         if not gprim:
