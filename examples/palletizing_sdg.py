@@ -13,7 +13,8 @@ The tutorial's Replicator graphs, unchanged but for the import line:
 The UR10 simulation (which decides *when* to capture) is replaced by a built
 pallet-and-bins scene; Omniverse asset textures by generated wood textures; and
 ``DeletePrimsCommand(paths=["/Replicator"])`` by ``rep.graph.clear()``, which
-also releases the graph.
+also releases the graph. The pallet scenario's BasicWriter also writes
+``provenance_{n}.json`` (what the graph sampled for each frame).
 """
 import json
 import os

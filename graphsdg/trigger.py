@@ -42,7 +42,10 @@ def on_time(interval: float = 1, num: int = 0, name: str = "on_time", rt_subfram
 
 
 def on_custom_event(event_name: str) -> ReplicatorItem:
-    """Fire on the step after ``rep.utils.send_og_event(event_name)``."""
+    """Fire on the step after ``rep.utils.send_og_event(event_name)``.
+
+    The trigger is named after the event (its key in ``trigger_outputs``).
+    """
     return _add_trigger("trigger.on_custom_event", event_name, event_name=event_name)
 
 

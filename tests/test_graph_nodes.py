@@ -397,3 +397,20 @@ def test_new_layer_edits_are_released_with_the_graph():
     rep.graph.clear()
     assert str(matlib.bound_material(box).GetPath()) == "/Red"
     assert not rep.stage.get_stage().GetPrimAtPath("/Replicator").IsValid()
+
+
+def test_same_graph_same_samples_in_separate_processes():
+    import subprocess
+    import sys
+    code = ("import graphsdg as rep\n"
+            "rep.stage.new_stage(); rep.set_global_seed(5)\n"
+            "with rep.trigger.on_frame():\n"
+            "    l = rep.create.light(light_type='Sphere', intensity=rep.distribution.normal(45000, 15000), count=2)\n"
+            "    c = rep.create.cube(position=rep.distribution.uniform((-1, -1, 0), (1, 1, 1)))\n"
+            "for _ in range(3):\n"
+            "    rep.orchestrator.step()\n"
+            "    print([p.GetAttribute('inputs:intensity').Get() for p in l.get_output_prims()['prims']],\n"
+            "          tuple(c.get_output_prims()['prims'][0].GetAttribute('xformOp:translate').Get()))\n")
+    outs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                           env={**os.environ, "PYTHONHASHSEED": str(salt)}).stdout for salt in (1, 2)]
+    assert outs[0] == outs[1] and outs[0].count("\n") == 3
