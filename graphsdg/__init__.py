@@ -61,8 +61,14 @@ def _import_node_library():
 
 nodes = _import_node_library()
 
+from graphsdg import distribution, events, get, graph, modify, randomizer, trigger  # noqa: E402
+from graphsdg import events as utils  # noqa: E402  (rep.utils.send_og_event)
+from graphsdg.graph import ReplicatorItem, new_layer  # noqa: E402
+
 __version__ = "0.1.0"
 
 __all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
-           "writers", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
+           "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
+           "new_layer", "ReplicatorItem",
+           "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
            "get_global_seed", "set_global_seed"]

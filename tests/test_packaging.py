@@ -15,8 +15,16 @@ def test_wheel_contains_nodes_and_imports(tmp_path):
                     "-w", str(wheel_dir), ROOT], check=True)
     wheels = list(wheel_dir.glob("graphsdg-*.whl"))
     assert len(wheels) == 1
-    names = zipfile.ZipFile(wheels[0]).namelist()
+    names = set(zipfile.ZipFile(wheels[0]).namelist())
     assert "graphsdg/nodes/annotators.py" in names and "graphsdg/orchestrator.py" in names
+    # every module of the source tree ships (a package missing from pyproject's list would not)
+    for folder, sub in (("graphsdg", "graphsdg"), ("nodes", "graphsdg/nodes")):
+        for dirpath, _, files in os.walk(os.path.join(ROOT, folder)):
+            rel = os.path.relpath(dirpath, os.path.join(ROOT, folder))
+            for f in files:
+                if f.endswith(".py"):
+                    name = "/".join(p for p in (sub, rel if rel != "." else "", f) if p)
+                    assert name in names, f"{name} is missing from the wheel (pyproject packages list?)"
     target = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target),
                     str(wheels[0])], check=True)

@@ -398,6 +398,18 @@ class _Builder:
                                   builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb.tolist(), rgb2=rgb.tolist(),
                                   width=8, height=8)
 
+    def size_memory(self) -> None:
+        """Skip contact detection when nothing collides; give big scenes a big enough arena.
+
+        MuJoCo's broadphase scratch grows with the square of the body count, so
+        thousands of visual-only bodies would overflow the default arena for nothing.
+        """
+        colliding = any(g.contype or g.conaffinity for _, g, *_ in self.geom_records)
+        if not colliding:
+            self.spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        nbody = len(self.geom_records) + len(self.body_records) + 1
+        self.spec.memory = max(16 << 20, 16 * nbody * nbody + (8 << 20)) if colliding else -1
+
     # ---- top level -----------------------------------------------------
     def build(self) -> CompiledScene:
         self.configure()
@@ -414,6 +426,7 @@ class _Builder:
                 except Exception as exc:  # pxr / mujoco errors: say which prim
                     raise CompileError(f"cannot compile prim {prim.GetPath()} ({type_name}): {exc}") from exc
         self.finish_lighting()
+        self.size_memory()
         try:
             model = self.spec.compile()
         except Exception as exc:
