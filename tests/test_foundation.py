@@ -410,3 +410,18 @@ def test_pose_value_shapes():
     assert all(tuple(c.GetAttribute("xformOp:translate").Get()) == (1, 2, 3) for c in cubes)
     with pytest.raises(ValueError, match="4 rows but count/prims is 5"):
         rep.functional.modify.pose(cubes, position_value=np.zeros((4, 3)))
+
+
+def test_colour_and_depth_share_one_render_without_msaa():
+    from graphsdg.runtime import runtime
+    rep.settings.set("/graphsdg/render/msaaSamples", 0)
+    cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(W, H))
+    rgb, depth = rep.annotators.get("rgb"), rep.annotators.get("distance_to_image_plane")
+    rgb.attach(rp)
+    depth.attach(rp)
+    rep.orchestrator.step()
+    stats = dict(runtime().rasterizer.stats)
+    rep.orchestrator.step()
+    after = runtime().rasterizer.stats
+    assert after["color"] - stats["color"] == 1 and after.get("ids", 0) == stats.get("ids", 0)
+    assert abs(depth.get_data()[H // 2, W // 2] - 3.5) < 1e-3

@@ -167,19 +167,27 @@ class Rasterizer:
             raise ValueError(f"resolution {view.width}x{view.height} exceeds the offscreen buffer "
                              f"{model.vis.global_.offwidth}x{model.vis.global_.offheight}")
         out = RenderOutputs()
-        if "color" in passes or "hdr" in passes:
-            rgb, linear = self._render_color(sim, view, subframes, want_linear="hdr" in passes)
+        colour = "color" in passes or "hdr" in passes
+        # Without MSAA the colour pass's depth buffer is sampled at pixel centres, so colour and
+        # depth come from one render; with MSAA it holds an off-centre sample, so depth is read
+        # from the (single-sample) id render instead.
+        depth_with_colour = colour and "depth" in passes and "segmentation" not in passes and \
+            int(model.vis.quality.offsamples) == 0
+        if colour:
+            rgb, linear, depth = self._render_color(sim, view, subframes, want_linear="hdr" in passes,
+                                                    want_depth=depth_with_colour)
             out.color = rgb if "color" in passes else None
             out.hdr = linear
-        if "segmentation" in passes or "depth" in passes:
+            out.depth = depth
+        if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
             ids, depth = self._render_ids(sim, view, None, with_depth="depth" in passes)
             out.geom_ids = ids if "segmentation" in passes else None
             out.depth = depth
         out.render_isolated = lambda geoms, crop: self.render_isolated(sim, view, geoms, crop)
         return out
 
-    def _render_color(self, sim: SimScene, view: CameraView, subframes: int,
-                      want_linear: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    def _render_color(self, sim: SimScene, view: CameraView, subframes: int, want_linear: bool,
+                      want_depth: bool = False) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
         assert self._scene is not None and self._mjr is not None
         scene, ctx = self._scene, self._mjr
         w, h = view.width, view.height
@@ -190,10 +198,16 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
         rgb = np.empty((h, w, 3), dtype=np.uint8)
+        raw = np.empty((h, w), dtype=np.float32) if want_depth else None
         self._update_scene(sim, view, (0.0, 0.0))
         mujoco.mjr_render(rect, scene, ctx)
-        mujoco.mjr_readPixels(rgb, None, rect, ctx)
+        mujoco.mjr_readPixels(rgb, raw, rect, ctx)
         self.stats["color"] += 1
+        depth = None
+        if raw is not None:
+            far = effective_far(sim.model, view)
+            depth = _linearize_depth(raw[::-1], view.near, SKY_FAR_FACTOR * far, far,
+                                     orthographic=view.projection == "orthographic")
         linear = None
         if subframes > 1:
             acc = rgb.astype(np.float32)
@@ -209,7 +223,7 @@ class Rasterizer:
                 linear = np.ascontiguousarray(mean[::-1] / np.float32(255))
         elif want_linear:
             linear = np.ascontiguousarray(rgb[::-1].astype(np.float32) / np.float32(255))
-        return np.ascontiguousarray(rgb[::-1]), linear
+        return np.ascontiguousarray(rgb[::-1]), linear, depth
 
     def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None,
                     with_depth: bool) -> tuple[np.ndarray, np.ndarray | None]:

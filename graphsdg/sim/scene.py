@@ -387,6 +387,10 @@ class SimScene:
         n = max(1, int(round(seconds / c.model.opt.timestep)))
         for _ in range(n):
             mujoco.mj_step(c.model, c.data)
+        # mj_step leaves positions from before its integration: recompute them so renders,
+        # queries and the USD write-back all see the same, current poses.
+        mujoco.mj_kinematics(c.model, c.data)
+        mujoco.mj_camlight(c.model, c.data)
         self.write_back_rigid_bodies()
 
     def write_back_rigid_bodies(self) -> None:
