@@ -7,6 +7,7 @@ Replicator's OmniPBR inputs map onto UsdPreviewSurface inputs:
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -35,6 +36,10 @@ class MaterialDesc:
     texture: str | None = None
     texture_scale: tuple[float, float] = (1.0, 1.0)
     texture_rotate: float = 0.0
+    texture_primvar: str = "st"                          # the UV set the texture reads
+    uv_scale: tuple[float, float] = (1.0, 1.0)           # a UsdTransform2d between reader and texture
+    uv_rotation: float = 0.0
+    uv_translation: tuple[float, float] = (0.0, 0.0)
 
 
 def _color3(value: Sequence[float], what: str) -> Gf.Vec3f:
@@ -143,12 +148,11 @@ def describe(material: UsdShade.Material) -> MaterialDesc:
     metallic, _ = value("metallic", 0.0)
     emissive, _ = value("emissiveColor", Gf.Vec3f(0, 0, 0))
     texture, scale, rotate = None, (1.0, 1.0), 0.0
+    uv: dict = {}
     if diffuse_src is not None:
         tex = UsdShade.Shader(diffuse_src.GetPrim())
         file_in = tex.GetInput("file")
-        asset = file_in.Get() if file_in else None
-        if asset is not None and asset.path:
-            texture = asset.resolvedPath or asset.path
+        texture = texture_file_path(file_in) if file_in else None
         scale_in = tex.GetInput("scale")
         if scale_in and scale_in.Get() is not None:
             s = scale_in.Get()
@@ -156,11 +160,71 @@ def describe(material: UsdShade.Material) -> MaterialDesc:
         rot_attr = tex.GetPrim().GetAttribute("graphsdg:textureRotate")
         if rot_attr and rot_attr.Get() is not None:
             rotate = float(rot_attr.Get())
+        uv = _uv_source(tex)
         diffuse = Gf.Vec3f(1, 1, 1)
     emission = max(float(emissive[0]), float(emissive[1]), float(emissive[2]))
     return MaterialDesc(path=path, rgba=(float(diffuse[0]), float(diffuse[1]), float(diffuse[2]), float(opacity)),
                         roughness=float(roughness), metallic=float(metallic), emission=emission,
-                        texture=texture, texture_scale=scale, texture_rotate=rotate)
+                        texture=texture, texture_scale=scale, texture_rotate=rotate, **uv)
+
+
+def texture_file_path(file_input: UsdShade.Input) -> str | None:
+    """The file a ``UsdUVTexture`` reads: resolved, or anchored to the layer that authored it.
+
+    A relative path that does not resolve (the file is missing) is still made
+    absolute against its layer, so errors can say where the file was expected.
+    """
+    asset = file_input.Get()
+    if asset is None or not asset.path:
+        return None
+    if asset.resolvedPath:
+        return asset.resolvedPath
+    path = asset.path
+    if os.path.isabs(path) or "://" in path:
+        return path
+    for spec in file_input.GetAttr().GetPropertyStack(Usd.TimeCode.Default()):
+        if spec.HasDefaultValue():
+            return os.path.normpath(spec.layer.ComputeAbsolutePath(path))
+    return path
+
+
+def _input_value(inp: UsdShade.Input):
+    """An input's value, following a connection to a material interface input."""
+    if inp.HasConnectedSource():
+        for src in inp.GetConnectedSources()[0]:
+            if src.source.GetPrim().IsA(UsdShade.Material):
+                upstream = UsdShade.Material(src.source.GetPrim()).GetInput(src.sourceName)
+                return upstream.Get() if upstream else None
+        return None
+    return inp.Get()
+
+
+def _uv_source(texture: UsdShade.Shader) -> dict:
+    """UV set and 2D transform feeding a ``UsdUVTexture``'s ``st`` (reader, optionally via UsdTransform2d)."""
+    out: dict = {}
+    st = texture.GetInput("st")
+    node = None
+    if st and st.HasConnectedSource():
+        srcs = st.GetConnectedSources()[0]
+        node = UsdShade.Shader(srcs[0].source.GetPrim()) if srcs else None
+    if node and node.GetIdAttr().Get() == "UsdTransform2d":
+        for name, key in (("scale", "uv_scale"), ("translation", "uv_translation")):
+            inp = node.GetInput(name)
+            v = _input_value(inp) if inp else None
+            if v is not None:
+                out[key] = (float(v[0]), float(v[1]))
+        rot = node.GetInput("rotation")
+        if rot and _input_value(rot) is not None:
+            out["uv_rotation"] = float(_input_value(rot))
+        inp = node.GetInput("in")
+        srcs = inp.GetConnectedSources()[0] if inp and inp.HasConnectedSource() else []
+        node = UsdShade.Shader(srcs[0].source.GetPrim()) if srcs else None
+    if node and str(node.GetIdAttr().Get() or "").startswith("UsdPrimvarReader"):
+        var = node.GetInput("varname")
+        name = _input_value(var) if var else None
+        if name:
+            out["texture_primvar"] = str(name)
+    return out
 
 
 def bind(prim: Usd.Prim, material: UsdShade.Material) -> None:
