@@ -69,7 +69,7 @@ WOOD_STYLES: dict[str, WoodStyle] = {
     "Timber": WoodStyle(light=(0.80, 0.64, 0.43), dark=(0.55, 0.39, 0.22), rings=10, warp=1.5, fibre=0.12,
                         seed=41, knots=3),
     # sawn pallet pine: paler and greyer, with knots
-    "PalletPine": WoodStyle(light=(0.79, 0.69, 0.52), dark=(0.58, 0.47, 0.31), rings=11, warp=1.3, fibre=0.13,
+    "PalletPine": WoodStyle(light=(0.80, 0.70, 0.53), dark=(0.50, 0.38, 0.23), rings=11, warp=1.3, fibre=0.16,
                             seed=53, knots=2),
 }
 
