@@ -69,7 +69,7 @@ def _wood_builder(species: str) -> Callable[[str], list[str]]:
 
 
 # ---- skies ----------------------------------------------------------------------
-SKY_SIZE = (128, 256)
+SKY_SIZE = (256, 512)
 
 
 def _sky_builder(name: str) -> Callable[[str], list[str]]:

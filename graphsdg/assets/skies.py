@@ -92,8 +92,14 @@ def _surface_uv(points: np.ndarray, surface: np.ndarray) -> tuple[np.ndarray, np
 _SURFACES = {"floor": 0, "ceiling": 1, "+x": 2, "-x": 3, "+y": 4, "-y": 5}
 
 
-def render_room(room: Room, width: int = 256, height: int = 128) -> np.ndarray:
-    """The lat-long radiance map (H, W, 3) float32 of ``room``, normalised as the module says."""
+def render_room(room: Room, width: int = 512, height: int = 256, supersample: int = 2) -> np.ndarray:
+    """The lat-long radiance map (H, W, 3) float32 of ``room``, normalised as the module says.
+
+    Rendered ``supersample`` times larger and averaged down, so lamp and plank edges are anti-aliased.
+    """
+    if supersample > 1:
+        big = render_room(room, width * supersample, height * supersample, supersample=1)
+        return big.reshape(height, supersample, width, supersample, 3).mean(axis=(1, 3)).astype(np.float32)
     dirs = direction_grid(width, height)
     _, points, surface = _room_hits(room, dirs)
     u, v = _surface_uv(points, surface)
