@@ -313,3 +313,37 @@ def test_textured_dome_lights_like_the_plain_dome_it_averages_to(tmp_path):
     assert np.abs(plain - textured).max() <= 3, (plain, textured)
     r, g, b = _lit_white_top(warm, intensity=600.0)
     assert r > g > b and r > 1.7 * b
+
+
+def _omnipbr(stage, path, **inputs):
+    """An MDL-only OmniPBR material, as Isaac Sim's assets author them (no UsdPreviewSurface)."""
+    mat = UsdShade.Material.Define(stage, path)
+    sh = UsdShade.Shader.Define(stage, f"{path}/Shader")
+    sh.SetSourceAsset(Sdf.AssetPath("OmniPBR.mdl"), "mdl")
+    sh.GetPrim().CreateAttribute("info:mdl:sourceAsset:subIdentifier", Sdf.ValueTypeNames.Token).Set("OmniPBR")
+    types = {"diffuse_texture": Sdf.ValueTypeNames.Asset, "diffuse_color_constant": Sdf.ValueTypeNames.Color3f,
+             "texture_rotate": Sdf.ValueTypeNames.Float, "reflection_roughness_constant": Sdf.ValueTypeNames.Float}
+    for name, value in inputs.items():
+        sh.CreateInput(name, types[name]).Set(value)
+    mat.CreateSurfaceOutput("mdl").ConnectToSource(sh.ConnectableAPI(), "out")
+    return mat
+
+
+def test_isaac_omnipbr_mdl_materials_render_their_texture_and_colour(tmp_path):
+    cam, rgb = _top_down_scene()
+    stage = rep.stage.get_stage()
+    quad = _quad(stage, st=CORNERS)
+    tex = _quadrant_png(tmp_path / "q.png")
+    mat = _omnipbr(stage, "/World/Looks/OmniPBR", diffuse_texture=Sdf.AssetPath(tex), texture_rotate=180.0)
+    UsdShade.MaterialBindingAPI.Apply(quad).Bind(mat)
+    other = _quad(stage, "/World/Other", st=CORNERS)
+    rep.functional.modify.pose(other, position_value=(0, 0, -5))
+    flat = _omnipbr(stage, "/World/Looks/Flat", diffuse_color_constant=Gf.Vec3f(0.0, 0.8, 0.0))
+    UsdShade.MaterialBindingAPI.Apply(other).Bind(flat)
+    rep.orchestrator.step()
+    # rotated half a turn: each quadrant shows the opposite one
+    _assert_colours(_pixels_at(cam, rgb.get_data(), SAMPLES),
+                    [_expected_colour(-(x + 1) / 2, -(y + 1) / 2) for x, y in SAMPLES])
+    from graphsdg.stage import materials as matlib
+    d = matlib.describe(flat)
+    assert d.rgba[:3] == pytest.approx((0.0, 0.8, 0.0)) and d.texture is None

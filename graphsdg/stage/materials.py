@@ -126,11 +126,18 @@ def bound_material(prim: Usd.Prim) -> UsdShade.Material | None:
 
 
 def describe(material: UsdShade.Material) -> MaterialDesc:
-    """Read a material's colour, roughness, metallic and diffuse texture."""
+    """Read a material's colour, roughness, metallic and diffuse texture.
+
+    A UsdPreviewSurface network is read first; a material with only an MDL
+    surface (Isaac Sim's OmniPBR / OmniSurface assets) is read from the
+    OmniPBR inputs of that shader (see :func:`describe_omnipbr`).
+    """
     shader = surface_shader(material)
     path = str(material.GetPath())
     if shader is None:
-        return MaterialDesc(path=path)
+        mdl = material.ComputeSurfaceSource("mdl")
+        mdl_shader = mdl[0] if mdl and mdl[0] and mdl[0].GetPrim().IsValid() else None
+        return describe_omnipbr(path, mdl_shader) if mdl_shader is not None else MaterialDesc(path=path)
 
     def value(name: str, default):
         inp = shader.GetInput(name)
@@ -168,6 +175,36 @@ def describe(material: UsdShade.Material) -> MaterialDesc:
                         texture=texture, texture_scale=scale, texture_rotate=rotate, **uv)
 
 
+def describe_omnipbr(path: str, shader: UsdShade.Shader) -> MaterialDesc:
+    """Read the OmniPBR inputs of an MDL surface shader (unset inputs take OmniPBR's defaults).
+
+    ``diffuse_texture`` (tinted by ``diffuse_tint``) or ``diffuse_color_constant``,
+    ``reflection_roughness_constant``, ``metallic_constant``, ``emissive_color`` when
+    ``enable_emission``, and the UV controls ``texture_scale`` (repeats, as graphsdg's
+    own ``texture_scale``), ``texture_rotate`` (degrees) and ``texture_translate``.
+    """
+    def get(name: str, default):
+        inp = shader.GetInput(name)
+        v = _input_value(inp) if inp else None
+        return default if v is None else v
+
+    tex_in = shader.GetInput("diffuse_texture")
+    texture = texture_file_path(_interface_input(tex_in)) if tex_in else None
+    colour = get("diffuse_tint", Gf.Vec3f(1, 1, 1)) if texture else get("diffuse_color_constant",
+                                                                         Gf.Vec3f(0.2, 0.2, 0.2))
+    emissive = get("emissive_color", Gf.Vec3f(0, 0, 0)) if bool(get("enable_emission", False)) else (0, 0, 0)
+    scale = get("texture_scale", (1.0, 1.0))
+    translate = get("texture_translate", (0.0, 0.0))
+    return MaterialDesc(path=path, rgba=(float(colour[0]), float(colour[1]), float(colour[2]),
+                                         float(get("opacity_constant", 1.0))),
+                        roughness=float(get("reflection_roughness_constant", 0.5)),
+                        metallic=float(get("metallic_constant", 0.0)),
+                        emission=max(float(c) for c in emissive), texture=texture,
+                        texture_scale=(float(scale[0]), float(scale[1])),
+                        texture_rotate=float(get("texture_rotate", 0.0)),
+                        uv_translation=(float(translate[0]), float(translate[1])))
+
+
 def texture_file_path(file_input: UsdShade.Input) -> str | None:
     """The file a ``UsdUVTexture`` reads: resolved, or anchored to the layer that authored it.
 
@@ -188,15 +225,23 @@ def texture_file_path(file_input: UsdShade.Input) -> str | None:
     return path
 
 
-def _input_value(inp: UsdShade.Input):
-    """An input's value, following a connection to a material interface input."""
+def _interface_input(inp: UsdShade.Input) -> UsdShade.Input:
+    """``inp``, or the material interface input it is connected to."""
     if inp.HasConnectedSource():
         for src in inp.GetConnectedSources()[0]:
             if src.source.GetPrim().IsA(UsdShade.Material):
                 upstream = UsdShade.Material(src.source.GetPrim()).GetInput(src.sourceName)
-                return upstream.Get() if upstream else None
+                if upstream:
+                    return upstream
+    return inp
+
+
+def _input_value(inp: UsdShade.Input):
+    """An input's value, following a connection to a material interface input."""
+    source = _interface_input(inp)
+    if source.HasConnectedSource():
         return None
-    return inp.Get()
+    return source.Get()
 
 
 def _uv_source(texture: UsdShade.Shader) -> dict:
