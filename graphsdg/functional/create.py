@@ -185,6 +185,16 @@ def disk_light(intensity: float = 1000.0, exposure: float | None = None, color: 
                   position, rotation, scale, look_at, look_at_up_axis, Radius=float(radius))
 
 
+def cylinder_light(intensity: float = 1000.0, exposure: float | None = None, color: Vec3 | None = None,
+                   temperature: float | None = None, radius: float = 0.5, length: float = 1.0,
+                   name: str | None = None, parent: PrimLike | None = None, position: Vec3 | None = None,
+                   rotation: Vec3 | None = None, scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
+                   look_at_up_axis: Vec3 | None = None) -> Usd.Prim:
+    """Define a ``UsdLux.CylinderLight`` (a tube light along its local X)."""
+    return _light(UsdLux.CylinderLight, "CylinderLight", intensity, exposure, color, temperature, name, parent,
+                  position, rotation, scale, look_at, look_at_up_axis, Radius=float(radius), Length=float(length))
+
+
 def material(mdl: str = "OmniPBR.mdl", bind_prims: Sequence[PrimLike] | PrimLike | None = None,
              name: str | None = None, parent: PrimLike | None = None, **inputs: Any) -> Usd.Prim:
     """Define a material from OmniPBR-style inputs and optionally bind it to ``bind_prims``.

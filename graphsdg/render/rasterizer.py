@@ -98,6 +98,10 @@ class Rasterizer:
             for tid in sorted(sim.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
             sim.textures_to_upload.clear()
+        if sim.meshes_to_upload:
+            for mid in sorted(sim.meshes_to_upload):
+                mujoco.mjr_uploadMesh(model, self._mjr, mid)
+            sim.meshes_to_upload.clear()
 
     def close(self) -> None:
         if self._mjr is not None:

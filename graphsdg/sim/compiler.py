@@ -383,13 +383,13 @@ class _Builder:
     # ---- lights --------------------------------------------------------
     def add_light(self, prim: Usd.Prim) -> None:
         path = str(prim.GetPath())
+        self.has_lights = True   # even a hidden light means the user lights the stage
         if UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) == UsdGeom.Tokens.invisible:
             self.light_records.append((path, lightmap.LIGHT_KINDS[prim.GetTypeName()], []))
             return
         m = world_matrix(prim, self.cache)
         t, r, scale = decompose(m)
         params = lightmap.light_params(prim, scale)
-        self.has_lights = True
         wb = self.spec.worldbody
         made = []
         if params.kind == "dome":
@@ -420,14 +420,15 @@ class _Builder:
             _set_light_color(light, params.color)
             made.append(light)
         else:
-            spot = params.kind in ("rect", "disk")
-            light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_SPOT if spot
-                                 else mujoco.mjtLightType.mjLIGHT_POINT,
-                                 pos=t.tolist(), dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
+            # MuJoCo's rasteriser draws spot and directional lights only: a spot with a
+            # 180-degree cutoff is OpenGL's omnidirectional point light (sphere, cylinder);
+            # rect and disk lights emit into the hemisphere below them with cosine falloff.
+            area = params.kind in ("rect", "disk")
+            light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_SPOT, pos=t.tolist(),
+                                 dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
             light.attenuation = [0.0, 0.0, 1.0]
-            if spot:
-                light.cutoff = 85.0
-                light.exponent = 1.0
+            light.cutoff = 90.0 if area else 180.0
+            light.exponent = 1.0 if area else 0.0
             _set_light_color(light, params.color)
             made.append(light)
         self.light_records.append((path, params.kind, made))
@@ -463,6 +464,18 @@ class _Builder:
                                   builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb.tolist(), rgb2=rgb.tolist(),
                                   width=8, height=8)
 
+    def size_memory(self) -> None:
+        """Skip contact detection when nothing collides; give big scenes a big enough arena.
+
+        MuJoCo's broadphase scratch grows with the square of the body count, so
+        thousands of visual-only bodies would overflow the default arena for nothing.
+        """
+        colliding = any(g.contype or g.conaffinity for _, g, *_ in self.geom_records)
+        if not colliding:
+            self.spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        nbody = len(self.geom_records) + len(self.body_records) + 1
+        self.spec.memory = max(16 << 20, 16 * nbody * nbody + (8 << 20)) if colliding else -1
+
     # ---- top level -----------------------------------------------------
     def build(self) -> CompiledScene:
         self.configure()
@@ -479,6 +492,7 @@ class _Builder:
                 except Exception as exc:  # pxr / mujoco errors: say which prim
                     raise CompileError(f"cannot compile prim {prim.GetPath()} ({type_name}): {exc}") from exc
         self.finish_lighting()
+        self.size_memory()
         try:
             model = self.spec.compile()
         except Exception as exc:

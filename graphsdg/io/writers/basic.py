@@ -5,7 +5,9 @@ Per frame ``n`` (zero-padded to ``frame_padding``) and per enabled flag:
 ``_prim_paths_{n}.json``; ``semantic_segmentation_{n}.png`` with
 ``semantic_segmentation_labels_{n}.json``; ... With several render products
 each file goes to ``<rp_name>/<annotator>/`` (or ``<annotator>/<rp_name>_`` with
-``use_common_output_dir=True``).
+``use_common_output_dir=True``). With ``provenance=True`` it also writes
+``provenance_{n}.json``: the values the graph sampled, by node name, with the
+frame each was drawn on and the ``trigger_outputs``.
 
 Example:
     >>> import graphsdg as rep, tempfile
@@ -80,7 +82,7 @@ class BasicWriter(Writer):
                  colorize_instance_id_segmentation: bool = True, colorize_instance_segmentation: bool = True,
                  colorize_depth: bool = False, skeleton_data: bool = False, frame_padding: int = 4,
                  semantic_filter_predicate: str | None = None, use_common_output_dir: bool = False,
-                 backend: BaseBackend | None = None) -> None:
+                 backend: BaseBackend | None = None, provenance: bool = False) -> None:
         if s3_bucket or s3_region or s3_endpoint:
             raise ValueError("BasicWriter: S3 output is not available in graphsdg; pass output_dir or backend")
         if output_dir is None and backend is None:
@@ -110,6 +112,7 @@ class BasicWriter(Writer):
                           "instance_id_segmentation": colorize_instance_id_segmentation,
                           "instance_segmentation": colorize_instance_segmentation}
         self._colorize_depth = colorize_depth
+        self._provenance = bool(provenance)
         flags = {"rgb": rgb, "bounding_box_2d_tight": bounding_box_2d_tight,
                  "bounding_box_2d_loose": bounding_box_2d_loose, "semantic_segmentation": semantic_segmentation,
                  "instance_id_segmentation": instance_id_segmentation,
@@ -160,6 +163,11 @@ class BasicWriter(Writer):
             stem = self._stems.get(anno_name, anno_name[:-5] if anno_name.endswith("_fast") else anno_name)
             for rp_name, payload in per_rp.items():
                 self._write_one(stem, rp_name, multi, payload)
+        if self._provenance:
+            record = dict(data.get("provenance") or {})
+            record["trigger_outputs"] = dict(data.get("trigger_outputs", {}))
+            self.backend.schedule(iof.write_json, data=record,
+                                  path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
         self.num_written += 1
 
