@@ -93,3 +93,12 @@ def test_assets_in_stage_units_get_no_correction(tmp_path):
     same = _asset(tmp_path / "m.usda", meters_per_unit=1.0, up_axis="Z")
     prim = rep.functional.create.reference(usd_path=same, name="M")
     assert not any("unitsResolve" in n for n in UsdGeom.Xformable(prim).GetXformOpOrderAttr().Get() or [])
+
+
+def test_a_file_the_asset_references_that_is_missing_is_named(tmp_path):
+    inner = tmp_path / "outer.usda"
+    inner.write_text('#usda 1.0\n(\n    defaultPrim = "A"\n)\ndef Xform "A"\n{\n'
+                     '    def Xform "Part" (\n        references = @./parts/wheel.usd@\n    )\n    {\n    }\n}\n')
+    with pytest.raises(FileNotFoundError, match=r"parts/wheel\.usd"):
+        rep.functional.create.reference(usd_path=str(inner), name="Car")
+    assert not rep.stage.get_stage().GetPrimAtPath("/Car")

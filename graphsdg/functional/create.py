@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 from typing import Any, Sequence
 
-from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux
+from pxr import Gf, Pcp, Sdf, Usd, UsdGeom, UsdLux
 
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -299,10 +299,18 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
         raise ValueError(f"reference usd_path {path_str!r} does not parse as USD")
     target = _reference_target(layer, path_str)
     default = os.path.splitext(os.path.basename(path_str))[0]
-    prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, default, parent)).GetPrim()
+    stage = get_stage()
+    known_errors = {str(e) for e in stage.GetCompositionErrors()}
+    prim = UsdGeom.Xform.Define(stage, _new_path(name, default, parent)).GetPrim()
     if target is None:
         prim.GetReferences().AddReference(path_str)
     else:
         prim.GetReferences().AddReference(path_str, target)
+    missing = [str(e) for e in stage.GetCompositionErrors()
+               if isinstance(e, Pcp.ErrorInvalidAssetPath) and str(e) not in known_errors]
+    if missing:
+        stage.RemovePrim(prim.GetPath())
+        raise FileNotFoundError(f"reference usd_path {path_str!r} names files that do not exist: "
+                                + "; ".join(missing))
     _resolve_units(prim, layer)
     return _finish(prim, position, rotation, scale, None, None, semantics, visible)
