@@ -102,3 +102,20 @@ def test_a_file_the_asset_references_that_is_missing_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match=r"parts/wheel\.usd"):
         rep.functional.create.reference(usd_path=str(inner), name="Car")
     assert not rep.stage.get_stage().GetPrimAtPath("/Car")
+
+
+def test_pose_edit_on_a_prim_with_pivots_keeps_the_units_correction():
+    """Non-canonical ops are folded into translate/rotate/scale; unitsResolve ops stay last, unchanged."""
+    from pxr import Gf
+    stage = rep.stage.get_stage()
+    x = UsdGeom.Xform.Define(stage, "/X")
+    x.AddTranslateOp(opSuffix="pivot").Set(Gf.Vec3d(1, 2, 3))
+    x.AddRotateZOp().Set(30.0)
+    x.AddScaleOp().Set(Gf.Vec3f(2, 2, 2))                     # float precision, as many files have
+    x.AddRotateXOp(UsdGeom.XformOp.PrecisionDouble, "unitsResolve").Set(90.0)
+    x.AddScaleOp(UsdGeom.XformOp.PrecisionDouble, "unitsResolve").Set(Gf.Vec3d(0.01, 0.01, 0.01))
+    before = np.array(x.GetLocalTransformation())
+    rep.functional.modify.pose(x.GetPrim(), position_value=(1, 2, 3))
+    np.testing.assert_allclose(np.array(x.GetLocalTransformation()), before, atol=1e-12)
+    assert list(x.GetXformOpOrderAttr().Get()) == ["xformOp:translate", "xformOp:rotateXYZ", "xformOp:scale",
+                                                   "xformOp:rotateX:unitsResolve", "xformOp:scale:unitsResolve"]

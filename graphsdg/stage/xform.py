@@ -195,15 +195,23 @@ class _OpStack:
         self.set_rotation_matrix(r)
         self.set_scale(s)
 
+    def _existing_op(self, name: str) -> UsdGeom.XformOp | None:
+        """An op attribute left out of the order by a rebuild, reused as is (its precision may be float)."""
+        attr = self.xf.GetPrim().GetAttribute(name)
+        return UsdGeom.XformOp(attr) if attr and attr.IsValid() else None
+
     def _write_order(self) -> None:
         self.xf.SetXformOpOrder([op for op in (self.translate, self.rotate, self.scale) if op is not None]
                                 + self.tail)
 
     def set_translate(self, v: Sequence[float]) -> None:
         if self.translate is None:
-            self.translate = self.xf.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble)
+            self.translate = self._existing_op("xformOp:translate") or \
+                self.xf.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble)
             self._write_order()
-        self.translate.Set(Gf.Vec3d(*(float(x) for x in v)))
+        value = Gf.Vec3d(*(float(x) for x in v))
+        self.translate.Set(Gf.Vec3f(value) if self.translate.GetPrecision() == UsdGeom.XformOp.PrecisionFloat
+                           else value)
 
     def set_euler(self, angles: Sequence[float], order: str = "XYZ") -> None:
         order = order.upper()
@@ -241,7 +249,7 @@ class _OpStack:
 
     def set_scale(self, v: Sequence[float]) -> None:
         if self.scale is None:
-            self.scale = self.xf.AddScaleOp(UsdGeom.XformOp.PrecisionDouble)
+            self.scale = self._existing_op("xformOp:scale") or self.xf.AddScaleOp(UsdGeom.XformOp.PrecisionDouble)
             self._write_order()
         value = Gf.Vec3d(*(float(x) for x in v))
         if self.scale.GetPrecision() == UsdGeom.XformOp.PrecisionFloat:
