@@ -193,9 +193,13 @@ def test_pack_regenerates_identically(tmp_path):
         if rel.endswith(".usd"):
             a, b = Usd.Stage.Open(new), Usd.Stage.Open(old)      # keep the stages: they own the layers
             assert a.GetRootLayer().ExportToString() == b.GetRootLayer().ExportToString(), rel
+        elif rel.endswith(".hdr"):
+            a, b = (cv2.imread(p, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_COLOR) for p in (new, old))
+            np.testing.assert_allclose(a, b, rtol=0.02, atol=1e-3, err_msg=rel)
         else:
-            flags = cv2.IMREAD_ANYDEPTH | cv2.IMREAD_COLOR if rel.endswith(".hdr") else cv2.IMREAD_UNCHANGED
-            assert np.array_equal(cv2.imread(new, flags), cv2.imread(old, flags)), rel
+            # Same pixels; another CPU's float rounding may move a rare value by one level.
+            a, b = (cv2.imread(p, cv2.IMREAD_UNCHANGED).astype(int) for p in (new, old))
+            assert a.shape == b.shape and np.abs(a - b).max() <= 1 and (a != b).mean() < 1e-3, rel
 
 
 def test_materials_bind_through_references():
