@@ -29,10 +29,47 @@ from graphsdg.io.backends import BackendDispatch  # noqa: E402
 from graphsdg.io.writer import Writer, WriterRegistry  # noqa: E402
 from graphsdg.rng import get_global_seed, set_global_seed  # noqa: E402
 from graphsdg.sim import timeline  # noqa: E402
-from graphsdg import nodes  # noqa: E402,F401  (registers the node library)
+
+
+def _import_node_library():
+    """Import ``graphsdg.nodes`` (registering every node type).
+
+    Installed, the build maps the repository's top-level ``nodes/`` to
+    ``graphsdg.nodes``. Run straight from a source checkout (the repo root on
+    ``sys.path``) that mapping does not exist, so the folder beside the package is
+    loaded under the same name.
+    """
+    import importlib
+    import importlib.util
+    import os
+    import sys
+
+    try:
+        return importlib.import_module("graphsdg.nodes")
+    except ModuleNotFoundError as exc:
+        if exc.name != "graphsdg.nodes":
+            raise
+    folder = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "nodes")
+    spec = importlib.util.spec_from_file_location("graphsdg.nodes", os.path.join(folder, "__init__.py"),
+                                                  submodule_search_locations=[folder])
+    if spec is None or spec.loader is None:
+        raise ModuleNotFoundError("graphsdg.nodes: the node library is missing from this installation")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["graphsdg.nodes"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+nodes = _import_node_library()
+
+from graphsdg import distribution, events, get, graph, modify, randomizer, trigger  # noqa: E402
+from graphsdg import events as utils  # noqa: E402  (rep.utils.send_og_event)
+from graphsdg.graph import ReplicatorItem, new_layer  # noqa: E402
 
 __version__ = "0.1.0"
 
 __all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
-           "writers", "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
+           "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
+           "new_layer", "ReplicatorItem",
+           "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
            "get_global_seed", "set_global_seed", "timeline"]

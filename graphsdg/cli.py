@@ -7,6 +7,7 @@ boxes, depth) with BasicWriter.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 
@@ -52,6 +53,65 @@ def run_demo(out: str, frames: int, resolution: tuple[int, int], seed: int) -> d
     return {"frames": frames, "output_dir": writer.output_dir, "seconds": time.perf_counter() - start}
 
 
+def run_bench(args: argparse.Namespace) -> None:
+    """``graphsdg bench``: print (and optionally record) the benchmark table."""
+    import platform
+
+    from graphsdg import benchmark
+
+    annotators = tuple(benchmark.ANNOTATOR_FLAGS) if args.annotators == ["all"] else tuple(args.annotators)
+    unknown = [a for a in annotators if a not in benchmark.ANNOTATOR_FLAGS]
+    if unknown:
+        raise ValueError(f"unknown benchmark annotator(s) {unknown}; known: {sorted(benchmark.ANNOTATOR_FLAGS)}")
+    config = benchmark.BenchConfig(
+        frames=args.num_frames, warmup=args.warmup, num_cameras=args.num_cameras, resolution=tuple(args.resolution),
+        asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
+        rt_subframes=args.rt_subframes, wait_for_render=not args.no_wait_for_render,
+        write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads)
+    settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}, "
+                     f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
+                     f"{'skip-write' if args.skip_write else 'written'}")
+    machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}"
+    if args.processes:
+        row = benchmark.run_processes(config, args.processes)
+        table = benchmark.format_table([row])
+    else:
+        rows = [benchmark.run_graphsdg(config)]
+        if not args.no_baseline:
+            rows.append(benchmark.run_handwritten(config))
+        summaries = [r.summary() for r in rows]
+        if len(rows) == 2:
+            ratio = rows[0].fps / rows[1].fps if rows[1].fps else float("nan")
+            for s in summaries:
+                s["ratio to hand-written"] = round(ratio, 2) if s["run"] == "graphsdg" else 1.0
+        table = benchmark.format_table(summaries)
+        if args.profile:
+            prof = rows[0].profile
+            total = sum(prof.values()) or 1.0
+            table += "\n\n" + benchmark.format_table(
+                [{"phase": k, "ms/frame": round(v / config.frames * 1000, 2), "share": f"{v / total:.0%}"}
+                 for k, v in sorted(prof.items(), key=lambda kv: -kv[1])])
+    text = f"### {settings_line}\n\nMachine: {machine}\n\n{table}\n"
+    print(text)
+    if args.report:
+        with open(args.report, "a", encoding="utf-8") as f:
+            f.write("\n" + text)
+
+
+def _gl_renderer() -> str:
+    try:
+        from mujoco.rendering.classic import gl_context
+        from OpenGL import GL
+
+        ctx = gl_context.GLContext(16, 16)
+        ctx.make_current()
+        name = GL.glGetString(GL.GL_RENDERER).decode()
+        ctx.free()
+        return name
+    except Exception as exc:  # noqa: BLE001 - informational only
+        return f"unknown ({exc})"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="graphsdg", description="Synthetic data generation on MuJoCo + OpenUSD")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
@@ -61,6 +121,31 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--frames", type=int, default=10, help="frames to capture (default: 10)")
     demo.add_argument("--resolution", type=int, nargs=2, default=(512, 512), metavar=("W", "H"))
     demo.add_argument("--seed", type=int, default=0)
+    bench = sub.add_parser("bench", help="Isaac Sim's SDG benchmark scene vs a hand-written MuJoCo loop")
+    bench.add_argument("--num-frames", type=int, default=600)
+    bench.add_argument("--warmup", type=int, default=10)
+    bench.add_argument("--num-cameras", type=int, default=1)
+    bench.add_argument("--resolution", type=int, nargs=2, default=(1280, 720), metavar=("W", "H"))
+    bench.add_argument("--asset-count", type=int, default=10, help="assets per shape type (5 types)")
+    bench.add_argument("--annotators", nargs="+", default=["rgb"],
+                       help="annotator names as in benchmark_sdg.py, or 'all'")
+    bench.add_argument("--skip-write", action="store_true", help="compute annotators but write nothing")
+    bench.add_argument("--rt-subframes", type=int, default=-1)
+    bench.add_argument("--no-wait-for-render", action="store_true")
+    bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
+    bench.add_argument("--write-threads", type=int, default=4)
+    bench.add_argument("--processes", type=int, default=0,
+                       help="run this many graphsdg processes at once and report the aggregate (no baseline)")
+    bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
+    bench.add_argument("--profile", action="store_true", help="print where each frame's time goes")
+    bench.add_argument("--report", metavar="MD", help="append the result table to this Markdown file")
+    view = sub.add_parser("view", help="contact sheet (and HTML gallery) of a dataset, with statistics")
+    view.add_argument("dir")
+    view.add_argument("--html", action="store_true", help="also write an HTML gallery")
+    view.add_argument("--max", type=int, default=16, help="frames to show (default 16)")
+    view.add_argument("--out", help="output folder (default: DIR.view next to the dataset)")
+    validate = sub.add_parser("validate", help="check a dataset's consistency; exit 1 on any violation")
+    validate.add_argument("dir")
     args = parser.parse_args(argv)
     try:
         if args.command == "demo":
@@ -68,7 +153,23 @@ def main(argv: list[str] | None = None) -> int:
                 parser.error(f"--frames must be >= 1, got {args.frames}")
             summary = run_demo(args.out, args.frames, tuple(args.resolution), args.seed)
             print(f"wrote {summary['frames']} frames to {summary['output_dir']} in {summary['seconds']:.1f} s")
+        elif args.command == "bench":
+            run_bench(args)
+        elif args.command == "view":
+            from graphsdg.dataset.view import write_view
+            result = write_view(args.dir, args.out, args.max, args.html)
+            for key, value in result.items():
+                print(f"{key}: {value}")
+        elif args.command == "validate":
+            from graphsdg.dataset.validate import validate
+            violations = validate(args.dir)
+            for v in violations:
+                print(v)
+            print(f"{len(violations)} violation(s) in {args.dir}")
+            return 1 if violations else 0
         return 0
+    except SystemExit:
+        raise
     except Exception as exc:  # one clear line unless --debug
         if args.debug:
             raise

@@ -47,6 +47,8 @@ class _State:
         self.callbacks: dict[int, Callable[[Status], None]] = {}
         self.profile: dict[str, float] = {}
         self.stop_requested = False
+        self.pause_requested = False
+        self.remaining: int | None = None
 
     def set(self, status: Status) -> None:
         if status != self.status:
@@ -93,6 +95,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     t = time.perf_counter()
     fired: set = set()
     trigger_outputs: dict[str, int] = {}
+    provenance: dict[str, Any] = {}
     subframes_override = 0
     for hook in list(rt.graph_hooks):
         result = hook()
@@ -100,6 +103,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
             fired |= set(result.get("fired", ()))
             trigger_outputs.update(result.get("trigger_outputs", {}))
             subframes_override = max(subframes_override, int(result.get("rt_subframes", 0)))
+            provenance.update(result.get("provenance", {}))
     t = _timed("graph", t)
     sim = rt.sim
     sim.sync_dirty_prims()
@@ -110,8 +114,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     t = _timed("physics", t)
     subframes = rt_subframes if rt_subframes > 0 else max(int(settings.get("/omni/replicator/RTSubframes", 1)),
                                                           subframes_override, 1)
-    _capture(subframes, fired, trigger_outputs)
-    _timed("capture", t)
+    _capture(subframes, fired, trigger_outputs, provenance)   # times its render, annotate and write phases itself
     _state.frame_index += 1
     _state.set(Status.STEPPED)
 
@@ -136,7 +139,7 @@ def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
     return products
 
 
-def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int]) -> None:
+def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], provenance: dict | None = None) -> None:
     rt = runtime()
     sim = rt.sim
     stage = rt.stage
@@ -161,7 +164,8 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int]) -> Non
     for writer in rt.writers:
         if not writer.wants_frame(fired):
             continue
-        data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator))
+        data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
+                                    extra={"provenance": provenance} if provenance else None)
         writer.write(data)
     _timed("write", t)
 
@@ -262,11 +266,121 @@ def unregister_status_callback(handle: int) -> None:
 
 def stop() -> None:
     """Stop generation: writers' ``on_final_frame`` runs, then pending writes are flushed."""
+    _state.stop_requested = True
+    _state.pause_requested = False
     _state.set(Status.STOPPING)
     for writer in runtime().writers:
         writer.on_final_frame()
     wait_until_complete()
+    _state.remaining = None
     _state.set(Status.STOPPED)
+
+
+def _graph_scheduler():
+    from graphsdg.graph import scheduler
+    return scheduler
+
+
+def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
+    """Generate frames until ``num_frames`` were captured or every trigger reached its ``max_execs``.
+
+    graphsdg has no UI loop to return to, so ``run`` works through the frames
+    before it returns (as ``run_until_complete`` does) and ends with :func:`stop`
+    (writers' ``on_final_frame``). :func:`pause` from a writer or status callback
+    returns early; :func:`resume` carries on with the frames left.
+    """
+    if num_frames is not None and (isinstance(num_frames, bool) or not isinstance(num_frames, int)
+                                   or num_frames < 0):
+        raise ValueError(f"num_frames must be None or a non-negative integer, got {num_frames!r}")
+    sched = _graph_scheduler()
+    if num_frames is None:
+        unlimited = sched.unlimited_triggers()
+        if sched.active_graph() is None or not any(t.counts_toward_completion for t in sched.active_graph().triggers):
+            raise OrchestratorError("run() without num_frames needs a graph whose on_frame/on_time triggers set "
+                                    "max_execs; pass num_frames=N")
+        if unlimited:
+            raise OrchestratorError(f"run() without num_frames would never stop: trigger(s) {unlimited} have no "
+                                    f"max_execs; pass num_frames=N or set max_execs")
+    if start_timeline:
+        runtime().timeline.play()
+    _state.remaining = num_frames
+    _state.stop_requested = False
+    _state.pause_requested = False
+    _state.set(Status.STARTED)
+    _run_loop()
+
+
+def _run_loop() -> None:
+    sched = _graph_scheduler()
+    try:
+        while not _state.stop_requested:
+            if _state.pause_requested:
+                _state.set(Status.PAUSED)
+                return
+            if _state.remaining is not None and _state.remaining <= 0:
+                break
+            if _state.remaining is None and sched.all_exhausted():
+                break
+            step(pause_timeline=False)
+            if _state.remaining is not None:
+                _state.remaining -= 1
+            _state.set(Status.STARTED)
+    except BaseException:
+        _state.set(Status.STOPPED)
+        raise
+    if not _state.stop_requested:
+        stop()
+
+
+def run_until_complete(num_frames: int | None = None, start_timeline: bool = False) -> None:
+    """Like :func:`run`, then wait until every file is written."""
+    run(num_frames=num_frames, start_timeline=start_timeline)
+    wait_until_complete()
+
+
+async def run_async(num_frames: int | None = None, start_timeline: bool = False) -> None:
+    run(num_frames=num_frames, start_timeline=start_timeline)
+
+
+async def run_until_complete_async(num_frames: int | None = None, start_timeline: bool = False) -> None:
+    run_until_complete(num_frames=num_frames, start_timeline=start_timeline)
+
+
+def pause() -> None:
+    """Pause a running :func:`run` after the current frame (call from a writer or status callback)."""
+    if _state.status in (Status.STARTED, Status.STEPPING, Status.STEPPED):
+        _state.pause_requested = True
+
+
+def resume() -> None:
+    """Continue a paused :func:`run` with the frames it had left."""
+    if _state.status != Status.PAUSED:
+        return
+    _state.pause_requested = False
+    _state.set(Status.STARTED)
+    _run_loop()
+
+
+def preview() -> None:
+    """Run every trigger's subgraph once with writers off; the next step still produces frame 0's values.
+
+    The stage shows what the next captured frame will randomize to (the
+    scheduler's counters are not advanced) and MuJoCo is synced to it.
+    """
+    sched = _graph_scheduler()
+    graph = sched.active_graph()
+    if graph is not None:
+        snap = sched.snapshot(graph)
+        try:
+            sched.run_subgraphs(graph, [t for t in graph.triggers if not getattr(t, "exhausted", lambda: 0)()],
+                                graph.frame)
+        finally:
+            sched.restore(graph, snap)
+    runtime().sim.sync_dirty_prims()
+
+
+async def preview_async() -> None:
+    preview()
 
 
 async def stop_async() -> None:

@@ -32,6 +32,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/graphsdg/render/msaaSamples": (4, "multisample anti-aliasing samples of the colour pass"),
     "/graphsdg/render/exposure": (1.0, "scale from photometric light units to display values"),
     "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
+    "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
+                                             "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
                         "rasteriser settings (more MSAA samples and larger shadow maps)"),
 }

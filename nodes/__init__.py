@@ -4,3 +4,4 @@ Importing this package registers the node types with the runtime's registries;
 ``import graphsdg`` does so. The runtime itself never imports a concrete node.
 """
 from . import annotators  # noqa: F401  (registers annotator types)
+from . import create, distributions, get, modify, randomizers, triggers  # noqa: F401  (register node types)

@@ -1,34 +1,57 @@
 """Annotator node types: labels computed from render passes, in Replicator's formats.
 
-Formats follow Replicator (see docs/annotators.md): ``rgb`` is uint8 (H, W, 4);
-id images are uint32 with 0 = background and 1 = unlabelled; 2D boxes are
-structured arrays with inclusive pixel bounds; several labels of one type are
-joined with "," where Replicator's format needs one string.
+Formats follow Replicator (see docs/annotators.md, which also says what is
+exact): colour is uint8 (H, W, 4) (``HdrColor`` float16); depth float32 (H, W)
+with ``inf`` on background; id images uint32 with 0 = background and 1 =
+unlabelled; boxes are structured arrays (inclusive pixel bounds for 2D boxes);
+several labels of one type are joined with "," where Replicator's format needs
+one string, and kept as lists in graphsdg's own ``*Lists`` info keys.
+
+Every annotator that takes semantics accepts ``semanticTypes`` (a list of
+types) or ``semanticFilter`` (a predicate, see
+:mod:`graphsdg.annotate.semantic_filter`), not both; neither means every type.
 """
 from __future__ import annotations
 
-import numpy as np
+from fractions import Fraction
 
-from graphsdg.annotate.annotator import AnnotatorRegistry, AnnotatorSpec
-from graphsdg.annotate.frame import FrameView, parse_semantic_types
+import numpy as np
+from pxr import Usd, UsdGeom
+
+from graphsdg.annotate.annotator import AnnotatorRegistry, AnnotatorSpec, AovSource
+from graphsdg.annotate.bounds import local_boxes
+from graphsdg.annotate.frame import ALL_LABELS, FrameView
 from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, color_of
+from graphsdg.annotate.motion import motion_vectors as motion_between
+from graphsdg.annotate.semantic_filter import SemanticFilter
+from graphsdg.annotate.skeletons import skeleton_data as skeletons_seen
 
 BBOX_2D_DTYPE = np.dtype([("semanticId", "<u4"), ("x_min", "<i4"), ("y_min", "<i4"), ("x_max", "<i4"),
                           ("y_max", "<i4"), ("occlusionRatio", "<f4")])
-SEMANTIC_DEFAULTS = {"semanticTypes": ["class"], "semanticFilter": None}
+BBOX_3D_DTYPE = np.dtype([("semanticId", "<u4"), ("x_min", "<f4"), ("y_min", "<f4"), ("z_min", "<f4"),
+                          ("x_max", "<f4"), ("y_max", "<f4"), ("z_max", "<f4"), ("transform", "<f4", (4, 4)),
+                          ("occlusionRatio", "<f4")])
+OCCLUSION_DTYPE = np.dtype([("instanceId", "<u4"), ("semanticId", "<u4"), ("occlusionRatio", "<f4")])
+SEMANTIC_DEFAULTS = {"semanticTypes": None, "semanticFilter": None}
+RESERVED_TYPE = "class"    # Replicator labels BACKGROUND / UNLABELLED under "class" whatever the filter
 
 
-def _types(params: dict) -> tuple[str, ...] | None:
-    if params.get("semanticFilter") is not None:
-        from graphsdg.io.writers.basic import semantic_types_from_predicate
-        return parse_semantic_types(semantic_types_from_predicate(params["semanticFilter"]))
-    return parse_semantic_types(params.get("semanticTypes"))
+# ---- semantics --------------------------------------------------------------
+def semantic_filter(params: dict) -> SemanticFilter:
+    """The filter an annotator's ``semanticTypes`` / ``semanticFilter`` init params select."""
+    types, predicate = params.get("semanticTypes"), params.get("semanticFilter")
+    if types is not None and predicate is not None:
+        raise ValueError(f"pass semanticTypes or semanticFilter, not both (got semanticTypes={types!r} and "
+                         f"semanticFilter={predicate!r}); semanticTypes=['a', 'b'] means the filter 'a:*; b:*'")
+    if predicate is not None:
+        return SemanticFilter.parse(predicate)
+    if types is not None:
+        return SemanticFilter.from_types(types)
+    return ALL_LABELS
 
 
 def _validate_semantics(params: dict) -> None:
-    if params.get("semanticFilter") is not None and params.get("semanticTypes") not in (None, ["class"]):
-        raise ValueError("pass semanticTypes or semanticFilter, not both")
-    _types(params)
+    semantic_filter(params)
 
 
 def joined(labels: dict[str, list[str]]) -> dict[str, str]:
@@ -36,26 +59,23 @@ def joined(labels: dict[str, list[str]]) -> dict[str, str]:
     return {t: ",".join(v) for t, v in labels.items()}
 
 
-def _reserved(types: tuple[str, ...] | None) -> dict[int, dict[str, str]]:
-    key = types[0] if types else "class"
-    return {BACKGROUND_ID: {key: "BACKGROUND"}, UNLABELLED_ID: {key: "UNLABELLED"}}
+RESERVED = {BACKGROUND_ID: "BACKGROUND", UNLABELLED_ID: "UNLABELLED"}
 
 
-def _colorize(ids: np.ndarray) -> tuple[np.ndarray, dict[int, tuple[int, int, int, int]]]:
+def _colorize(ids: np.ndarray) -> np.ndarray:
     present = np.unique(ids)
-    colors = {int(i): color_of(int(i)) for i in present}
-    lut_keys = np.array(sorted(colors), dtype=np.int64)
-    lut_vals = np.array([colors[int(k)] for k in lut_keys], dtype=np.uint8)
-    out = lut_vals[np.searchsorted(lut_keys, ids)]
-    return out, colors
+    lut_vals = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
+    return lut_vals[np.searchsorted(present, ids)]
 
 
-def _color_key(c: tuple[int, int, int, int]) -> str:
+def _color_key(id_: int) -> str:
+    c = color_of(id_)
     return f"({c[0]}, {c[1]}, {c[2]}, {c[3]})"
 
 
 # ---- colour and depth -------------------------------------------------------
 def rgb(frame: FrameView, params: dict) -> dict:
+    """uint8 (H, W, 4) RGBA colour; alpha 255."""
     color = frame.require("color")
     out = np.empty((frame.height, frame.width, 4), dtype=np.uint8)
     out[..., :3] = color
@@ -63,101 +83,288 @@ def rgb(frame: FrameView, params: dict) -> dict:
     return {"data": out}
 
 
+def hdr_color(frame: FrameView, params: dict) -> dict:
+    """float16 (H, W, 4) linear colour (mean of the subframes, not rounded to 8 bits); alpha 1."""
+    linear = frame.require("hdr")
+    out = np.empty((frame.height, frame.width, 4), dtype=np.float16)
+    out[..., :3] = linear
+    out[..., 3] = 1.0
+    return {"data": out}
+
+
 def distance_to_image_plane(frame: FrameView, params: dict) -> dict:
+    """float32 (H, W) depth along the optical axis in stage units; inf where nothing was hit."""
     return {"data": frame.require("depth").astype(np.float32, copy=True)}
 
 
-def distance_to_camera(frame: FrameView, params: dict) -> dict:
+def _distance_to_camera(frame: FrameView) -> np.ndarray:
     z = frame.require("depth")
-    return {"data": (z / frame.cached("ray_cos", frame.camera.ray_cosines)).astype(np.float32)}
+    return (z / frame.cached("ray_cos", frame.camera.ray_cosines)).astype(np.float32)
+
+
+def distance_to_camera(frame: FrameView, params: dict) -> dict:
+    """float32 (H, W) distance from the camera centre in stage units; inf where nothing was hit."""
+    return {"data": _distance_to_camera(frame)}
 
 
 # ---- segmentation -----------------------------------------------------------
 def semantic_segmentation(frame: FrameView, params: dict) -> dict:
-    types = _types(params)
-    sem = frame.semantic_image(types)
-    imap = frame.instance_map(types)
-    names = {**_reserved(types), **{i: joined(lab) for i, lab in imap.semantic_labels.items()}}
-    present = sorted(set(int(i) for i in np.unique(sem)) | {BACKGROUND_ID, UNLABELLED_ID})
-    if params.get("colorize"):
-        img, colors = _colorize(sem)
-        labels = {_color_key(color_of(i)): names[i] for i in present}
-        return {"data": img, "info": {"idToLabels": labels}}
-    return {"data": sem.copy(), "info": {"idToLabels": {str(i): names[i] for i in present}}}
+    """uint32 (H, W) semantic ids (uint8 (H, W, 4) with ``colorize``); ``idToLabels``."""
+    filt = semantic_filter(params)
+    sem = frame.semantic_image(filt)
+    imap = frame.instance_map(filt)
+    lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
+    present = sorted(set(int(i) for i in np.unique(sem)) | set(RESERVED))
+    key = _color_key if params.get("colorize") else str
+    data = _colorize(sem) if params.get("colorize") else sem.copy()
+    return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},
+                                   "idToLabelLists": {key(i): lists[i] for i in present}}}
 
 
 def instance_segmentation(frame: FrameView, params: dict) -> dict:
-    types = _types(params)
-    inst = frame.instance_image(types)
-    imap = frame.instance_map(types)
-    geom_ids = frame.require("geom_ids")
-    ids = np.where(geom_ids < 0, BACKGROUND_ID, UNLABELLED_ID).astype(np.uint32)
-    has = inst >= 0
-    ids[has] = imap.instance_ids[inst[has]]
-    reserved = {BACKGROUND_ID: "BACKGROUND", UNLABELLED_ID: "UNLABELLED"}
-    present = sorted(set(int(i) for i in np.unique(ids)) | set(reserved))
+    """uint32 (H, W) one id per labelled prim; ``idToLabels`` (prim path), ``idToSemantics``."""
+    filt = semantic_filter(params)
+    ids = frame.instance_id_image(filt)
+    imap = frame.instance_map(filt)
+    present = sorted(set(int(i) for i in np.unique(ids)) | set(RESERVED))
     by_id = {int(i): k for k, i in enumerate(imap.instance_ids)}
-    paths = {i: (reserved[i] if i in reserved else imap.paths[by_id[i]]) for i in present}
-    sem_key = types[0] if types else "class"
-    semantics = {i: ({sem_key: reserved[i]} if i in reserved else joined(imap.labels[by_id[i]])) for i in present}
-    if params.get("colorize"):
-        img, _ = _colorize(ids)
-        keys = {i: _color_key(color_of(i)) for i in present}
-        return {"data": img, "info": {"idToLabels": {keys[i]: paths[i] for i in present},
-                                      "idToSemantics": {keys[i]: semantics[i] for i in present}}}
-    return {"data": ids, "info": {"idToLabels": {str(i): paths[i] for i in present},
-                                  "idToSemantics": {str(i): semantics[i] for i in present}}}
+    paths = {i: RESERVED[i] if i in RESERVED else imap.paths[by_id[i]] for i in present}
+    lists = {i: {RESERVED_TYPE: [RESERVED[i]]} if i in RESERVED else imap.labels[by_id[i]] for i in present}
+    key = _color_key if params.get("colorize") else str
+    data = _colorize(ids) if params.get("colorize") else ids.copy()
+    return {"data": data, "info": {"idToLabels": {key(i): paths[i] for i in present},
+                                   "idToSemantics": {key(i): joined(lists[i]) for i in present},
+                                   "idToSemanticLists": {key(i): lists[i] for i in present}}}
 
 
-def instance_id_segmentation(frame: FrameView, params: dict) -> dict:
+def _mesh_ids(frame: FrameView) -> tuple[np.ndarray, dict[int, str]]:
     geom_ids = frame.require("geom_ids")
     paths = frame.sim.ensure_compiled().geom_paths
     table = frame.labels.ids.mesh
     lut = np.array([table.id_of(p) if p else UNLABELLED_ID for p in paths] + [BACKGROUND_ID], dtype=np.uint32)
-    ids = lut[geom_ids]
+    names = {table.id_of(p): p for p in paths if p}
+    return lut[geom_ids], names
+
+
+def instance_id_segmentation(frame: FrameView, params: dict) -> dict:
+    """uint32 (H, W) one id per rendered gprim (finer than instances); ``idToLabels`` (prim path)."""
+    ids, names = _mesh_ids(frame)
+    names = {**RESERVED, **names}
     present = sorted(set(int(i) for i in np.unique(ids)))
-    names = {BACKGROUND_ID: "BACKGROUND", UNLABELLED_ID: "UNLABELLED"}
-    names.update({table.id_of(p): p for p in paths if p and table.id_of(p) in present})
-    if params.get("colorize"):
-        img, _ = _colorize(ids)
-        return {"data": img, "info": {"idToLabels": {_color_key(color_of(i)): names[i] for i in present}}}
-    return {"data": ids, "info": {"idToLabels": {str(i): names[i] for i in present}}}
+    key = _color_key if params.get("colorize") else str
+    data = _colorize(ids) if params.get("colorize") else ids
+    return {"data": data, "info": {"idToLabels": {key(i): names[i] for i in present}}}
 
 
-# ---- boxes ------------------------------------------------------------------
+# ---- boxes and occlusion ----------------------------------------------------
+def _box_info(imap, rows_sem: np.ndarray, idx: np.ndarray) -> dict:
+    ids = np.unique(rows_sem)
+    return {"idToLabels": {str(int(s)): joined(imap.semantic_labels[int(s)]) for s in ids},
+            "idToLabelLists": {str(int(s)): imap.semantic_labels[int(s)] for s in ids},
+            "bboxIds": imap.instance_ids[idx].astype(np.uint32),
+            "primPaths": [imap.paths[i] for i in idx]}
+
+
+def _by_instance_id(imap, idx: np.ndarray) -> np.ndarray:
+    return idx[np.argsort(imap.instance_ids[idx], kind="stable")]
+
+
 def bounding_box_2d_tight(frame: FrameView, params: dict) -> dict:
-    """Boxes of visible pixels only; an object with no visible pixel has no row."""
-    types = _types(params)
-    imap = frame.instance_map(types)
-    present, boxes, _ = frame.tight_boxes(types)
+    """Boxes of visible pixels only (inclusive bounds); an object with no visible pixel has no row."""
+    filt = semantic_filter(params)
+    imap = frame.instance_map(filt)
+    present, boxes, _ = frame.tight_boxes(filt)
     order = np.argsort(imap.instance_ids[present], kind="stable")
-    present, boxes = present[order], boxes[order]
-    rows = np.zeros(len(present), dtype=BBOX_2D_DTYPE)
-    rows["semanticId"] = imap.semantic_ids[present]
-    rows["x_min"], rows["y_min"], rows["x_max"], rows["y_max"] = boxes.T if len(boxes) else ([], [], [], [])
-    rows["occlusionRatio"] = -1.0   # not computed by this annotator; see the occlusion annotator
-    id_to_labels = {str(int(s)): joined(imap.semantic_labels[int(s)]) for s in np.unique(rows["semanticId"])}
-    return {"data": rows, "info": {"idToLabels": id_to_labels,
-                                   "bboxIds": imap.instance_ids[present].astype(np.uint32),
-                                   "primPaths": [imap.paths[i] for i in present]}}
+    idx, boxes = present[order], boxes[order]
+    rows = np.zeros(len(idx), dtype=BBOX_2D_DTYPE)
+    rows["semanticId"] = imap.semantic_ids[idx]
+    if len(idx):
+        rows["x_min"], rows["y_min"], rows["x_max"], rows["y_max"] = boxes.T
+    rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
+    return {"data": rows, "info": _box_info(imap, rows["semanticId"], idx)}
 
 
-def _spec(name: str, passes: set[str], fn, defaults: dict | None = None, aliases=(), doc: str = "",
-          validate=None) -> None:
+def bounding_box_2d_loose(frame: FrameView, params: dict) -> dict:
+    """Boxes of the whole unoccluded projection, clipped to the image; every instance in view has a row."""
+    filt = semantic_filter(params)
+    imap = frame.instance_map(filt)
+    fp = frame.footprints(filt)
+    idx = _by_instance_id(imap, np.nonzero(fp.counts)[0])
+    rows = np.zeros(len(idx), dtype=BBOX_2D_DTYPE)
+    rows["semanticId"] = imap.semantic_ids[idx]
+    if len(idx):
+        rows["x_min"], rows["y_min"], rows["x_max"], rows["y_max"] = fp.boxes[idx].T
+    rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
+    return {"data": rows, "info": _box_info(imap, rows["semanticId"], idx)}
+
+
+def _boxes_3d(frame: FrameView, filt: SemanticFilter, idx: np.ndarray) -> dict:
+    imap = frame.instance_map(filt)
+    rows = np.zeros(len(idx), dtype=BBOX_3D_DTYPE)
+    rows["semanticId"] = imap.semantic_ids[idx]
+    if len(idx):
+        lo, hi, m = local_boxes(frame.stage, [imap.paths[i] for i in idx])
+        rows["x_min"], rows["y_min"], rows["z_min"] = lo.T
+        rows["x_max"], rows["y_max"], rows["z_max"] = hi.T
+        rows["transform"] = m
+    rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
+    return {"data": rows, "info": _box_info(imap, rows["semanticId"], idx)}
+
+
+def bounding_box_3d(frame: FrameView, params: dict) -> dict:
+    """Local-frame extents + local-to-world transform (row-vector) of every instance in view."""
+    filt = semantic_filter(params)
+    idx = _by_instance_id(frame.instance_map(filt), np.nonzero(frame.footprints(filt).counts)[0])
+    return _boxes_3d(frame, filt, idx)
+
+
+def bounding_box_3d_360(frame: FrameView, params: dict) -> dict:
+    """As ``bounding_box_3d`` for every drawn instance on the stage; occlusionRatio NaN outside the view."""
+    filt = semantic_filter(params)
+    imap = frame.instance_map(filt)
+    drawn = imap.geom_instance[frame.drawn_geoms()]
+    return _boxes_3d(frame, filt, _by_instance_id(imap, np.unique(drawn[drawn >= 0])))
+
+
+def occlusion(frame: FrameView, params: dict) -> dict:
+    """Per instance in view: occluded / unoccluded pixels, from an isolated render of the instance."""
+    filt = semantic_filter(params)
+    imap = frame.instance_map(filt)
+    idx = _by_instance_id(imap, np.nonzero(frame.footprints(filt).counts)[0])
+    rows = np.zeros(len(idx), dtype=OCCLUSION_DTYPE)
+    rows["instanceId"] = imap.instance_ids[idx]
+    rows["semanticId"] = imap.semantic_ids[idx]
+    rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
+    return {"data": rows}
+
+
+# ---- camera, geometry, motion -----------------------------------------------
+def camera_params(frame: FrameView, params: dict) -> dict:
+    """Every key of Replicator's ``CameraParams`` (view/projection flat, USD row-vector layout)."""
+    view = frame.camera
+    prim = frame.stage.GetPrimAtPath(view.path)
+    v_ap = UsdGeom.Camera(prim).GetVerticalApertureAttr().Get() if prim else None
+    return {"info": {
+        "cameraAperture": np.array([view.horizontal_aperture, v_ap if v_ap is not None else view.vertical_aperture],
+                                   dtype=np.float32),
+        "cameraApertureOffset": np.array([view.horizontal_aperture_offset, view.vertical_aperture_offset],
+                                         dtype=np.float32),
+        "cameraFisheyeLensP": np.zeros(0, dtype=np.float32),
+        "cameraFisheyeLensS": np.zeros(0, dtype=np.float32),
+        "cameraFisheyeMaxFOV": 0.0,
+        "cameraFisheyeNominalHeight": 0,
+        "cameraFisheyeNominalWidth": 0,
+        "cameraFisheyeOpticalCentre": np.zeros(2, dtype=np.float32),
+        "cameraFisheyePolynomial": np.zeros(5, dtype=np.float32),
+        "cameraFocalLength": float(view.focal_length),
+        "cameraFocusDistance": float(view.focus_distance),
+        "cameraFStop": float(view.f_stop),
+        "cameraModel": "orthographic" if view.projection == "orthographic" else "pinhole",
+        "cameraNearFar": np.array([view.near, view.far], dtype=np.float32),
+        "cameraProjection": view.projection_matrix().reshape(16),
+        "cameraViewTransform": view.view_matrix().reshape(16),
+        "metersPerSceneUnit": float(view.meters_per_unit),
+        "renderProductResolution": np.array([view.width, view.height], dtype=np.int32),
+    }}
+
+
+def _normals4(frame: FrameView) -> np.ndarray:
+    n = frame.normals()
+    out = np.zeros((frame.height, frame.width, 4), dtype=np.float32)
+    out[..., :3] = n
+    out[..., 3] = (frame.require("geom_ids") >= 0).astype(np.float32)
+    return out
+
+
+def normals(frame: FrameView, params: dict) -> dict:
+    """float32 (H, W, 4): world-space unit normal of the surface at each pixel centre; w 1 on geometry."""
+    return {"data": frame.cached("normals4", lambda: _normals4(frame))}
+
+
+def _motion(frame: FrameView) -> np.ndarray:
+    return motion_between(frame.poses, frame.previous, frame.require("geom_ids"), frame.world_points())
+
+
+def motion_vectors(frame: FrameView, params: dict) -> dict:
+    """float32 (H, W, 4): previous minus current pixel position of each pixel's surface point."""
+    return {"data": frame.cached("motion", lambda: _motion(frame))}
+
+
+def pointcloud(frame: FrameView, params: dict) -> dict:
+    """World points of labelled pixels with their colour, normal, semantic and instance ids."""
+    filt = semantic_filter(params)
+    geom_ids = frame.require("geom_ids")
+    mask = geom_ids >= 0 if params.get("includeUnlabelled") else frame.instance_image(filt) >= 0
+    color = rgb(frame, {})["data"]
+    return {"data": frame.world_points()[mask].astype(np.float32),
+            "info": {"pointRgb": np.ascontiguousarray(color[mask]).reshape(-1),
+                     "pointNormals": np.ascontiguousarray(frame.cached("normals4", lambda: _normals4(frame))[mask])
+                     .reshape(-1),
+                     "pointSemantic": frame.semantic_image(filt)[mask],
+                     "pointInstance": frame.instance_id_image(filt)[mask]}}
+
+
+def skeleton_data(frame: FrameView, params: dict) -> dict:
+    """Joints of every ``UsdSkel.Skeleton`` (rest and animated pose, pixels, occlusion), at the capture's time.
+
+    Joints are always reported in the Skeleton's own joint order (``useSkelJoints``
+    is accepted for Replicator scripts; both of its values give that order here).
+    """
+    time = Usd.TimeCode(frame.sim_time * (frame.stage.GetTimeCodesPerSecond() or 60.0))
+    return {"info": skeletons_seen(frame.stage, frame.camera, time, frame.require("geom_ids"),
+                                   frame.sim.ensure_compiled().geom_paths)}
+
+
+def reference_time(frame: FrameView, params: dict) -> dict:
+    """The simulation time of the capture as a fraction."""
+    t = Fraction(frame.sim_time).limit_denominator(1_000_000)
+    return {"info": {"referenceTimeNumerator": t.numerator, "referenceTimeDenominator": t.denominator}}
+
+
+# ---- registration -----------------------------------------------------------
+def _spec(name: str, passes: set[str], fn, defaults: dict | None = None, aliases=(), validate=None) -> None:
     AnnotatorRegistry.register_spec(AnnotatorSpec(name=name, passes=frozenset(passes), compute=fn,
-                                                  defaults=dict(defaults or {}), doc=doc or (fn.__doc__ or ""),
+                                                  defaults=dict(defaults or {}), doc=fn.__doc__ or "",
                                                   validate=validate), aliases=aliases)
 
 
-_spec("rgb", {"color"}, rgb, aliases=("LdrColor", "LdrColorSD"), doc="uint8 (H, W, 4) RGBA colour")
-_spec("distance_to_image_plane", {"depth"}, distance_to_image_plane,
-      doc="float32 (H, W) z-depth in stage units; inf where nothing was hit")
-_spec("distance_to_camera", {"depth"}, distance_to_camera,
-      doc="float32 (H, W) distance from the camera centre; inf where nothing was hit")
-_spec("semantic_segmentation", {"segmentation"}, semantic_segmentation,
-      {**SEMANTIC_DEFAULTS, "colorize": False}, validate=_validate_semantics)
-_spec("instance_segmentation", {"segmentation"}, instance_segmentation,
-      {**SEMANTIC_DEFAULTS, "colorize": False}, validate=_validate_semantics)
-_spec("instance_id_segmentation", {"segmentation"}, instance_id_segmentation, {"colorize": False})
-_spec("bounding_box_2d_tight", {"segmentation"}, bounding_box_2d_tight, SEMANTIC_DEFAULTS,
+SEG = {"segmentation"}
+_spec("rgb", {"color"}, rgb, aliases=("LdrColor", "LdrColorSD"))
+_spec("HdrColor", {"hdr"}, hdr_color, aliases=("HdrColorSD",))
+_spec("distance_to_image_plane", {"depth"}, distance_to_image_plane)
+_spec("distance_to_camera", {"depth"}, distance_to_camera)
+_spec("semantic_segmentation", SEG, semantic_segmentation, {**SEMANTIC_DEFAULTS, "colorize": False},
       validate=_validate_semantics)
+_spec("instance_segmentation", SEG, instance_segmentation, {**SEMANTIC_DEFAULTS, "colorize": False},
+      validate=_validate_semantics)
+_spec("instance_id_segmentation", SEG, instance_id_segmentation, {"colorize": False})
+_spec("bounding_box_2d_tight", SEG, bounding_box_2d_tight, SEMANTIC_DEFAULTS, validate=_validate_semantics)
+_spec("bounding_box_2d_loose", SEG, bounding_box_2d_loose, SEMANTIC_DEFAULTS, validate=_validate_semantics)
+_spec("bounding_box_3d", SEG, bounding_box_3d, SEMANTIC_DEFAULTS, validate=_validate_semantics)
+_spec("bounding_box_3d_360", SEG, bounding_box_3d_360, SEMANTIC_DEFAULTS, validate=_validate_semantics)
+_spec("occlusion", SEG, occlusion, SEMANTIC_DEFAULTS, aliases=("Occlusion",), validate=_validate_semantics)
+_spec("camera_params", set(), camera_params, aliases=("CameraParams",))
+_spec("normals", SEG, normals)
+_spec("motion_vectors", SEG | {"depth"}, motion_vectors, aliases=("MotionVectors",))
+_spec("pointcloud", SEG | {"depth", "color"}, pointcloud, {**SEMANTIC_DEFAULTS, "includeUnlabelled": False},
+      validate=_validate_semantics)
+_spec("skeleton_data", SEG, skeleton_data, {"useSkelJoints": False})
+_spec("ReferenceTime", set(), reference_time)
+
+# Raw outputs users can register annotators from (AnnotatorRegistry.register_annotator_from_aov).
+for _source, _aliases in [
+    (AovSource("LdrColor", frozenset({"color"}), lambda f: rgb(f, {})["data"], "uint8 (H, W, 4) colour"),
+     ("LdrColorSD",)),
+    (AovSource("HdrColor", frozenset({"hdr"}), lambda f: hdr_color(f, {})["data"], "float16 (H, W, 4) linear"),
+     ("HdrColorSD",)),
+    (AovSource("DepthLinearized", frozenset({"depth"}), lambda f: f.require("depth"), "float32 (H, W) z-depth"),
+     ("DistanceToImagePlaneSD",)),
+    (AovSource("DistanceToCameraSD", frozenset({"depth"}), _distance_to_camera, "float32 (H, W) distance"), ()),
+    (AovSource("NormalSD", frozenset(SEG), lambda f: normals(f, {})["data"], "float32 (H, W, 4) world normals"),
+     ("SmoothNormal",)),
+    (AovSource("MotionVectorsSD", frozenset(SEG | {"depth"}), lambda f: motion_vectors(f, {})["data"],
+               "float32 (H, W, 4) motion"), ("Motion2d", "TargetMotionSD")),
+    (AovSource("Camera3dPositionSD", frozenset({"depth"}), lambda f: f.world_points().astype(np.float32),
+               "float32 (H, W, 3) world position of each pixel"), ()),
+]:
+    AnnotatorRegistry.register_aov(_source, _aliases)

@@ -301,3 +301,127 @@ def test_hydra_texture_updates_disabled_skips_render():
     rp.hydra_texture.set_updates_enabled(True)
     rep.orchestrator.step()
     assert not np.array_equal(ann.get_data(), first)
+
+
+def test_attribute_edits_sync_without_recompiling():
+    from graphsdg.runtime import runtime
+    cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(W, H))
+    ann, _ = _step_boxes(rp)
+    sim = runtime().sim
+    compiles = sim.stats["compiles"]
+    rep.functional.modify.pose(cube, position_value=(0.5, 0, 0), scale_value=(0.5, 0.5, 0.5))
+    rep.functional.modify.display_color(cube, (0.2, 0.9, 0.2))
+    UsdGeom.Imageable(cube).MakeInvisible()
+    rep.orchestrator.step()
+    UsdGeom.Imageable(cube).MakeVisible()
+    rep.orchestrator.step()
+    assert sim.stats["compiles"] == compiles
+    lo, hi = project_box(cam, W, H, cube_corners((0.5, 0, 0), half=0.25))
+    row = ann.get_data()["data"][0]
+    assert abs(row["x_min"] - lo[0]) <= 2 and abs(row["x_max"] + 1 - hi[0]) <= 2
+    rep.functional.create.sphere(parent="/World")      # structural: one recompile, state kept
+    rep.orchestrator.step()
+    assert sim.stats["compiles"] == compiles + 1
+
+
+@pytest.mark.parametrize("shape", ["cone", "torus"])
+def test_mesh_rescale_is_live_and_exact(shape):
+    from graphsdg.runtime import runtime
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=600, parent="/World")
+    prim = getattr(rep.functional.create, shape)(parent="/World", name="Shape", semantics={"class": shape},
+                                                 rotation=(30, 10, 0))
+    cam = rep.functional.create.camera(position=(0, -5, 0.5), look_at=(0, 0, 0), parent="/World")
+    rp = rep.create.render_product(cam, (W, H))
+    ann, _ = _step_boxes(rp)
+    sim = runtime().sim
+    compiles = sim.stats["compiles"]
+    rep.functional.modify.pose(prim, scale_value=(1.6, 0.7, 1.2), rotation_value=(0, 40, 20))
+    rep.orchestrator.step()
+    assert sim.stats["compiles"] == compiles
+    live = ann.get_data()["data"][0]
+    sim.recompile()                        # the same scale compiled from scratch
+    rep.orchestrator.step()
+    fresh = ann.get_data()["data"][0]
+    assert all(abs(int(live[k]) - int(fresh[k])) <= 1 for k in ("x_min", "y_min", "x_max", "y_max"))
+
+
+def test_write_to_fabric_matches_usd_authoring():
+    """The direct MuJoCo write path renders exactly what authoring USD renders."""
+    def capture(fabric):
+        rep.stage.new_stage()
+        rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", fabric)
+        rep.functional.create.xform(name="World")
+        rep.functional.create.dome_light(intensity=600, parent="/World")
+        prims = [rep.functional.create.cube(parent="/World", semantics={"class": "a"}),
+                 rep.functional.create.sphere(parent="/World", semantics={"class": "b"}),
+                 rep.functional.create.torus(parent="/World", semantics={"class": "c"})]
+        cam = rep.functional.create.camera(position=(5, -5, 4), look_at=(0, 0, 0), parent="/World")
+        rp = rep.create.render_product(cam, (W, H))
+        rgb, box = rep.annotators.get("rgb"), rep.annotators.get("bounding_box_2d_tight")
+        rgb.attach(rp)
+        box.attach(rp)
+        rep.orchestrator.step()
+        rng = np.random.default_rng(4)
+        for _ in range(2):
+            rep.functional.modify.pose(prims, position_value=rng.uniform(-1.5, 1.5, (3, 3)),
+                                       rotation_value=rng.uniform(0, 360, (3, 3)),
+                                       scale_value=rng.uniform(0.3, 1.0, (3, 1)).repeat(3, 1))
+            rep.functional.modify.display_color(prims, rng.uniform(0, 1, (3, 3)))
+            rep.orchestrator.step()
+        authored = prims[0].GetAttribute("xformOp:translate").Get()
+        return rgb.get_data().copy(), box.get_data()["data"].copy(), authored
+
+    usd_rgb, usd_box, usd_t = capture(False)
+    fab_rgb, fab_box, fab_t = capture(True)
+    assert np.array_equal(usd_box, fab_box)
+    assert np.abs(usd_rgb.astype(int) - fab_rgb).max() <= 2
+    assert usd_t is not None and fab_t is None       # the fast path leaves the stage unauthored
+
+
+def test_vectorized_quaternions_match_mujoco():
+    import mujoco
+    from graphsdg.sim.direct_writes import euler_xyz_to_matrices, matrices_to_quats
+    from graphsdg.stage.xform import euler_to_matrix
+    angles = np.random.default_rng(0).uniform(-360, 360, (200, 3))
+    angles[:4] = [[0, 0, 0], [180, 0, 0], [0, 180, 0], [0, 0, 180]]
+    mats = euler_xyz_to_matrices(angles)
+    assert np.allclose(mats, [euler_to_matrix(a, "XYZ") for a in angles], atol=1e-12)
+    quats = matrices_to_quats(mats)
+    for m, q in zip(mats, quats):
+        ref = np.empty(4)
+        mujoco.mju_mat2Quat(ref, m.ravel())
+        assert np.allclose(q, ref if ref[0] >= 0 else -ref, atol=1e-9) or np.allclose(q, -ref, atol=1e-9)
+
+
+def test_euler_convention_matches_usd_rotate_xyz():
+    from graphsdg.stage.xform import euler_to_matrix, matrix_to_euler_xyz
+    cube = rep.functional.create.cube(rotation=(30, -50, 110))
+    usd = np.array(UsdGeom.Xformable(cube).GetLocalTransformation())[:3, :3].T   # row-vector -> column
+    assert np.allclose(usd, euler_to_matrix((30, -50, 110), "XYZ"), atol=1e-9)
+    assert np.allclose(matrix_to_euler_xyz(usd), (30, -50, 110), atol=1e-9)
+
+
+def test_pose_value_shapes():
+    cubes = rep.functional.create_batch.cube(count=5)
+    rep.functional.modify.pose(cubes, scale_value=[0.1, 0.2, 0.3, 0.4, 0.5])       # one scalar per prim
+    assert tuple(cubes[3].GetAttribute("xformOp:scale").Get()) == (0.4, 0.4, 0.4)
+    rep.functional.modify.pose(cubes, position_value=(1, 2, 3))                   # one vector for all
+    assert all(tuple(c.GetAttribute("xformOp:translate").Get()) == (1, 2, 3) for c in cubes)
+    with pytest.raises(ValueError, match="4 rows but count/prims is 5"):
+        rep.functional.modify.pose(cubes, position_value=np.zeros((4, 3)))
+
+
+def test_colour_and_depth_share_one_render_without_msaa():
+    from graphsdg.runtime import runtime
+    rep.settings.set("/graphsdg/render/msaaSamples", 0)
+    cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(W, H))
+    rgb, depth = rep.annotators.get("rgb"), rep.annotators.get("distance_to_image_plane")
+    rgb.attach(rp)
+    depth.attach(rp)
+    rep.orchestrator.step()
+    stats = dict(runtime().rasterizer.stats)
+    rep.orchestrator.step()
+    after = runtime().rasterizer.stats
+    assert after["color"] - stats["color"] == 1 and after.get("ids", 0) == stats.get("ids", 0)
+    assert abs(depth.get_data()[H // 2, W // 2] - 3.5) < 1e-3

@@ -110,3 +110,42 @@ def test_backend_registry():
     b.schedule(rep.functional.write_json, data={"a": np.int64(1)}, path="x.json")
     rep.orchestrator.wait_until_complete()
     assert b.blobs == {"x.json": b'{"a": 1}'}
+
+
+def test_full_queue_throttles_the_producer():
+    import threading
+    import time
+
+    from graphsdg.io.write_queue import WriteQueue
+
+    q = WriteQueue(num_threads=1, max_size=2)
+    gate = threading.Event()
+    q.schedule(gate.wait)                     # occupies the only worker
+    q.schedule(lambda: None)
+    q.schedule(lambda: None)                  # queue now full (2 waiting)
+    blocked = threading.Thread(target=q.schedule, args=(lambda: None,))
+    blocked.start()
+    time.sleep(0.2)
+    assert blocked.is_alive()                 # backpressure: the producer waits instead of growing memory
+    assert q.pending() <= 4
+    gate.set()
+    blocked.join(5)
+    q.wait_until_done()
+    assert q.completed == 4 and q.throttled_seconds > 0.1
+    q.shutdown()
+
+
+@pytest.mark.parametrize("threads", [1, 3])
+def test_bytes_do_not_depend_on_writer_threads(tmp_path, threads):
+    from test_foundation import _capture
+    from graphsdg.io.write_queue import reset_write_queue
+
+    reference = _capture(str(tmp_path / "ref"))
+    rep.settings.set("/omni/replicator/backend/writeThreads", threads)
+    reset_write_queue()
+    try:
+        other = _capture(str(tmp_path / f"t{threads}"))
+    finally:
+        rep.settings.reset()
+        reset_write_queue()
+    assert reference == other

@@ -15,14 +15,28 @@ def test_wheel_contains_nodes_and_imports(tmp_path):
                     "-w", str(wheel_dir), ROOT], check=True)
     wheels = list(wheel_dir.glob("graphsdg-*.whl"))
     assert len(wheels) == 1
-    names = zipfile.ZipFile(wheels[0]).namelist()
+    names = set(zipfile.ZipFile(wheels[0]).namelist())
     assert "graphsdg/nodes/annotators.py" in names and "graphsdg/orchestrator.py" in names
+    # every module of the source tree ships (a package missing from pyproject's list would not)
+    for folder, sub in (("graphsdg", "graphsdg"), ("nodes", "graphsdg/nodes")):
+        for dirpath, _, files in os.walk(os.path.join(ROOT, folder)):
+            rel = os.path.relpath(dirpath, os.path.join(ROOT, folder))
+            for f in files:
+                if f.endswith(".py"):
+                    name = "/".join(p for p in (sub, rel if rel != "." else "", f) if p)
+                    assert name in names, f"{name} is missing from the wheel (pyproject packages list?)"
+    pack = "graphsdg/assets/pack/Isaac/Environments/Simple_Warehouse/Props/"
+    assert pack + "SM_PaletteA_01.usd" in names and pack + "Textures/SM_PaletteA_01_BaseColor.png" in names
+    assert "graphsdg/assets/pack/NVIDIA/Assets/Skies/Indoor/autoshop_01_4k.hdr" in names
     target = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target),
                     str(wheels[0])], check=True)
     code = ("import graphsdg, graphsdg.nodes, sys; "
             "assert graphsdg.__file__.startswith(sys.argv[1]), graphsdg.__file__; "
-            "assert 'rgb' in graphsdg.annotators.get_registered_annotators(); print('ok')")
+            "assert 'rgb' in graphsdg.annotators.get_registered_annotators(); "
+            "from graphsdg.assets import get_assets_root_path as r; import os; "
+            "assert r().startswith(sys.argv[1]) and os.path.isfile(r() + '/Isaac/Environments/Grid/"
+            "default_environment.usd'), r(); print('ok')")
     env = {**os.environ, "PYTHONPATH": str(target)}
     out = subprocess.run([sys.executable, "-c", code, str(target)], cwd=str(tmp_path), env=env,
                          capture_output=True, text=True)
@@ -30,7 +44,13 @@ def test_wheel_contains_nodes_and_imports(tmp_path):
     assert out.stdout.strip() == "ok"
 
 
-def test_plain_import_leaves_isaac_names_alone():
+def test_plain_import_leaves_isaac_names_alone(tmp_path):
     code = "import graphsdg, sys; bad = [m for m in sys.modules if m.split('.')[0] in ('omni', 'carb', 'isaacsim')]; " \
            "assert not bad, bad"
-    subprocess.run([sys.executable, "-c", code], check=True)
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=str(tmp_path))
+
+
+def test_source_checkout_imports_the_node_library():
+    code = "import graphsdg, sys; assert graphsdg.__file__.startswith(sys.argv[1]); " \
+           "assert 'rgb' in graphsdg.annotators.get_registered_annotators()"
+    subprocess.run([sys.executable, "-c", code, ROOT], check=True, cwd=ROOT)

@@ -137,17 +137,20 @@ def test_scatter_onto_prims_without_a_surface_is_a_clear_error():
         scatter_3d(cube, rep.functional.create.plane(name="Flat"))
     with pytest.raises(ValueError, match="offset must be a finite number"):
         scatter_2d(cube, rep.functional.create.plane(name="P"), offset=float("nan"))
-    with pytest.raises(ValueError, match="extents must be sizes"):
+    with pytest.raises(ValueError, match="extents must be"):
         scatter_2d(cube, "/P", extents=[[1, 2]])
 
 
-def test_extents_replace_the_real_bounds():
-    floor = rep.functional.create.plane(scale=(2, 2, 1))
-    points = rep.functional.create_batch.cube(count=5, scale=0.01)
-    scatter_2d(points, floor, extents=(0.5, 0.5, 0.5), check_for_collisions=True, rng=rng(6))
-    origins = np.array([transforms.get_world_position(p) for p in points])
-    d = np.abs(origins[:, None, :2] - origins[None, :, :2]).max(-1) + np.eye(len(origins))
-    assert d.min() >= 0.5 - 1e-9               # 0.5 m boxes around each origin do not overlap
+def test_extents_limit_where_origins_land():
+    floor = rep.functional.create.plane(scale=(4, 4, 1))
+    cubes = rep.functional.create_batch.cube(count=20, scale=0.05)
+    scatter_2d(cubes, floor, extents=((0.5, None, None), (1.5, -1.0, None)), rng=rng(6))   # Replicator's min/max_samp
+    origins = np.array([transforms.get_world_position(c) for c in cubes])
+    assert np.all((origins[:, 0] >= 0.5) & (origins[:, 0] <= 1.5) & (origins[:, 1] <= -1.0))
+    with pytest.raises(ValueError, match="extents need min <= max"):
+        scatter_2d(cubes, floor, extents=((1, 0, 0), (0, 1, 1)))
+    with pytest.raises(ValueError, match="could fit only 0 of 20"):
+        scatter_2d(cubes, floor, extents=((10, 10, None), (11, 11, None)), rng=rng(1))   # off the surface
 
 
 def test_scatter_3d_samples_inside_minus_excluded_and_keeps_bounds_inside():

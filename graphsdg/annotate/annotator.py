@@ -36,20 +36,34 @@ class AnnotatorSpec:
     validate: Callable[[dict], None] | None = None
 
 
+@dataclass(frozen=True)
+class AovSource:
+    """A raw render output (Replicator's AOV) that annotators can be registered from."""
+
+    name: str
+    passes: frozenset[str]
+    read: Callable[["FrameView"], np.ndarray]   # noqa: F821  (H, W) or (H, W, C)
+    doc: str = ""
+
+
 class AnnotatorRegistry:
     """Registry of annotator specs (``rep.AnnotatorRegistry``)."""
 
     _specs: dict[str, AnnotatorSpec] = {}
     _aliases: dict[str, str] = {}
+    _aovs: dict[str, AovSource] = {}
 
     @classmethod
     def register_spec(cls, spec: AnnotatorSpec, aliases: Iterable[str] = ()) -> None:
+        """Register ``spec`` under its name, its ``aliases`` and ``<name>_fast``."""
         cls._specs[spec.name] = spec
-        for alias in aliases:
-            cls._aliases[alias] = spec.name
+        for alias in (*aliases, f"{spec.name}_fast"):
+            if alias not in cls._specs:
+                cls._aliases[alias] = spec.name
 
     @classmethod
     def resolve(cls, name: str) -> AnnotatorSpec:
+        """The spec registered as ``name`` (an alias or a ``_fast`` variant included)."""
         if not isinstance(name, str):
             raise TypeError(f"annotator name must be a string, got {type(name).__name__}")
         key = cls._aliases.get(name, name)
@@ -57,7 +71,7 @@ class AnnotatorRegistry:
             key = cls._aliases.get(key[:-5], key[:-5])
         spec = cls._specs.get(key)
         if spec is None:
-            raise unknown_name("annotator", name, list(cls._specs) + list(cls._aliases))
+            raise unknown_name("annotator", name, cls.get_registered_annotators())
         return spec
 
     @classmethod
@@ -65,27 +79,131 @@ class AnnotatorRegistry:
                       device: str | None = None, do_array_copy: bool = True) -> "Annotator":
         """A new :class:`Annotator` of type ``name`` with ``init_params``."""
         spec = cls.resolve(name)
+        if init_params is not None and not isinstance(init_params, dict):
+            raise TypeError(f"init_params of annotator {name!r} must be a dict, got {init_params!r}")
         return Annotator(name, spec, init_params or {}, device=device, do_array_copy=do_array_copy)
 
     @classmethod
     def get_registered_annotators(cls) -> list[str]:
+        """Every name ``get_annotator`` accepts."""
         return sorted(set(cls._specs) | set(cls._aliases))
 
     @classmethod
-    def register_annotator_from_function(cls, name: str, fn: Callable[..., Any], inputs: Iterable[str],
-                                         init_params: dict | None = None, doc: str = "") -> None:
-        """Register ``fn(**{input: data}, **params)`` over other annotators' outputs as annotator ``name``."""
-        deps = [cls.resolve(i) for i in inputs]
-        inputs = list(inputs)
+    def get_aovs(cls) -> list[str]:
+        """The raw outputs :meth:`register_annotator_from_aov` accepts."""
+        return sorted(cls._aovs)
+
+    @classmethod
+    def register_aov(cls, source: AovSource, aliases: Iterable[str] = ()) -> None:
+        """Make a raw render output available to :meth:`register_annotator_from_aov`."""
+        for name in (source.name, *aliases):
+            cls._aovs[name] = source
+
+    @classmethod
+    def register_annotator_from_aov(cls, aov: str, output_data_type: Any = None, output_channels: int = 1,
+                                    name: str | None = None, documentation: str | None = None) -> str:
+        """Register an annotator that returns the raw output ``aov`` (see :meth:`get_aovs`).
+
+        ``output_data_type`` converts the array (default: the AOV's own dtype);
+        ``output_channels`` keeps that many channels (1 gives (H, W)). Returns the
+        annotator's name (``name`` or ``aov``).
+
+        Example:
+            >>> import graphsdg as rep
+            >>> rep.AnnotatorRegistry.register_annotator_from_aov("DepthLinearized", name="my_depth")
+            'my_depth'
+        """
+        source = cls._aovs.get(aov) if isinstance(aov, str) else None
+        if source is None:
+            raise unknown_name("AOV", aov, cls._aovs)
+        channels = int(output_channels)
+        if channels < 1:
+            raise ValueError(f"output_channels must be >= 1, got {output_channels!r}")
+        dtype = np.dtype(output_data_type) if output_data_type is not None else None
+        label = name or aov
 
         def compute(frame, params):
-            args = {i: get_output(frame, d, _params(d, {})) for i, d in zip(inputs, deps)}
-            result = fn(**{k: (v["data"] if "data" in v else v) for k, v in args.items()}, **params)
-            return result if isinstance(result, dict) and "data" in result else {"data": result}
+            arr = np.asarray(source.read(frame))
+            have = 1 if arr.ndim == 2 else arr.shape[2]
+            if channels > have:
+                raise ValueError(f"annotator {label!r}: AOV {aov!r} has {have} channel(s), "
+                                 f"output_channels={channels} asked for more")
+            out = arr if arr.ndim == 2 else (arr[..., 0] if channels == 1 else arr[..., :channels])
+            return {"data": np.ascontiguousarray(out.astype(dtype) if dtype is not None else out)}
 
-        passes = frozenset().union(*[d.passes for d in deps]) if deps else frozenset()
+        cls.register_spec(AnnotatorSpec(name=label, passes=source.passes, compute=compute,
+                                        doc=documentation or source.doc))
+        return label
+
+    @classmethod
+    def register_annotator_from_node(cls, name: str, *args: Any, **kwargs: Any) -> None:
+        """Replicator builds annotators from OmniGraph node types, which graphsdg does not have."""
+        raise NotImplementedError(
+            f"register_annotator_from_node({name!r}, ...) needs an OmniGraph node type; graphsdg has none. "
+            f"Use AnnotatorRegistry.register_annotator_from_function(name, fn, inputs=[...]) to compute an "
+            f"annotator in Python from other annotators, or register_annotator_from_aov(aov) for a raw output")
+
+    @classmethod
+    def register_annotator_from_function(cls, name: str, fn: Callable[..., Any],
+                                         inputs: Iterable["str | Annotator"], init_params: dict | None = None,
+                                         doc: str = "") -> str:
+        """Register ``fn(**{input: data}, **params)`` over other annotators' outputs as annotator ``name``.
+
+        ``inputs`` are annotator names (default init params) or
+        ``rep.annotators.get(...)`` objects (their init params); ``fn`` receives each
+        input's ``data`` (or its whole dict when it has no array), keyed by the input's
+        name, plus this annotator's init params. It may return an array or a
+        ``{"data": ..., "info": {...}}`` dict.
+
+        Example:
+            >>> import numpy as np, graphsdg as rep
+            >>> rep.AnnotatorRegistry.register_annotator_from_function(
+            ...     "box_count", lambda bounding_box_2d_tight: np.array([len(bounding_box_2d_tight)]),
+            ...     inputs=["bounding_box_2d_tight"])
+            'box_count'
+        """
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"annotator name must be a non-empty string, got {name!r}")
+        if not callable(fn):
+            raise TypeError(f"annotator {name!r}: fn must be callable, got {fn!r}")
+        deps: list[tuple[str, AnnotatorSpec, dict]] = []
+        for entry in inputs:
+            if isinstance(entry, Annotator):
+                deps.append((entry.name, entry.spec, dict(entry.init_params)))
+            else:
+                spec = cls.resolve(entry)
+                deps.append((entry, spec, _params(spec, {})))
+        if not deps:
+            raise ValueError(f"annotator {name!r} needs at least one input annotator")
+
+        def compute(frame, params):
+            args = {}
+            for key, spec, dep_params in deps:
+                out = get_output(frame, spec, dep_params)
+                args[key] = out["data"] if out.get("data") is not None else {**out.get("info", {})}
+            result = fn(**args, **params)
+            if isinstance(result, dict) and ("data" in result or "info" in result):
+                return result
+            return {"data": result}
+
+        passes = frozenset().union(*[spec.passes for _, spec, _ in deps])
         cls.register_spec(AnnotatorSpec(name=name, passes=passes, compute=compute,
-                                        defaults=dict(init_params or {}), doc=doc))
+                                        defaults=dict(init_params or {}), doc=doc or (fn.__doc__ or "")))
+        return name
+
+    @classmethod
+    def detach(cls, annotator: "Annotator | str", render_products=None) -> None:
+        """Detach ``annotator`` (an object, or the name of attached ones) from ``render_products`` (default all)."""
+        from graphsdg.runtime import runtime
+        if isinstance(annotator, Annotator):
+            annotator.detach(render_products)
+            return
+        found = [a for a in runtime().annotators if a.name == annotator]
+        if not found:
+            raise ValueError(f"no attached annotator named {annotator!r}; attached: "
+                             f"{sorted({a.name for a in runtime().annotators})}")
+        for a in found:
+            a.detach(render_products)
 
     @classmethod
     def unregister(cls, name: str) -> None:

@@ -3,51 +3,66 @@
 A :class:`FrameView` holds the render passes of one product for one step and
 derives, lazily and once, what several annotators share: which labelled prim
 (the *semantic instance*) each pixel belongs to, their semantic and instance
-ids. Because every id annotator reads these same tables, segmentation images,
-box rows and mapping files always agree.
+ids, tight boxes, the unoccluded footprint of every instance in view (loose
+boxes and occlusion ratios), world points and normals. Because every id
+annotator reads these same tables, segmentation images, box rows and mapping
+files always agree.
+
+Semantic instances: a gprim belongs to its nearest ancestor-or-self that has
+labels of its own, passes the semantic filter with its inherited labels, and
+contributes at least one of the matching labels. Its labels are the matching
+ones (Replicator's ``matchingLabels``), several per type kept as a list.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 from pxr import Usd
 
 from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, labels_key
+from graphsdg.annotate.motion import PoseSnapshot, history
+from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.render.camera import CameraView
 from graphsdg.render.rasterizer import RenderOutputs
+from graphsdg.render.raycast import surface_normals
 from graphsdg.render.render_product import RenderProduct
+from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage import semantics as semlib
+
+ALL_LABELS = SemanticFilter.parse("*:*")
 
 
 @dataclass
 class InstanceMap:
-    """Semantic instances of the model for one semantic-type filter.
+    """Semantic instances of the model for one semantic filter.
 
     ``geom_instance[g]`` is the index into ``paths`` of the instance that geom ``g``
-    belongs to, or -1 if the geom has no label of the filtered types.
+    belongs to, or -1 if the geom belongs to no instance passing the filter.
     """
 
     paths: list[str]                       # labelled prim path per instance
-    labels: list[dict[str, list[str]]]     # filtered labels per instance
+    labels: list[dict[str, list[str]]]     # matching labels per instance
     instance_ids: np.ndarray               # uint32 stable id per instance
     semantic_ids: np.ndarray               # uint32 semantic id per instance
     geom_instance: np.ndarray              # int32 per geom
     semantic_labels: dict[int, dict[str, list[str]]]   # semantic id -> labels
 
+    def geoms_of(self, index: int) -> np.ndarray:
+        return np.nonzero(self.geom_instance == index)[0]
 
-def parse_semantic_types(types: Iterable[str] | None) -> tuple[str, ...] | None:
-    """``None`` means every type."""
-    if types is None:
-        return None
-    if isinstance(types, str):
-        types = [types]
-    out = tuple(str(t) for t in types)
-    if not out or any(not t for t in out):
-        raise ValueError(f"semanticTypes must be a non-empty list of type names, got {types!r}")
-    return out
+
+@dataclass
+class Footprints:
+    """Unoccluded (isolated) renders of the instances of one filter, by instance index.
+
+    ``counts[k]`` pixels of instance ``k`` in view with nothing in front;
+    ``boxes[k]`` their inclusive pixel bounds (-1 when not in view).
+    """
+
+    counts: np.ndarray     # int64 (n,)
+    boxes: np.ndarray      # int32 (n, 4) x_min y_min x_max y_max
 
 
 class SceneLabels:
@@ -56,33 +71,27 @@ class SceneLabels:
     def __init__(self, ids: IdTables) -> None:
         self.ids = ids
         self._key: tuple[int, int] | None = None
-        self._maps: dict[tuple[str, ...] | None, InstanceMap] = {}
+        self._maps: dict[str, InstanceMap] = {}
 
-    def instance_map(self, sim: SimScene, stage: Usd.Stage, types: tuple[str, ...] | None) -> InstanceMap:
+    def instance_map(self, sim: SimScene, stage: Usd.Stage, semantic_filter: SemanticFilter) -> InstanceMap:
         key = (sim.model_version, sim.labels_version)
         if key != self._key:
             self._maps.clear()
             self._key = key
-        found = self._maps.get(types)
+        found = self._maps.get(semantic_filter.text)
         if found is None:
-            found = self._maps[types] = self._build(sim, stage, types)
+            found = self._maps[semantic_filter.text] = self._build(sim, stage, semantic_filter)
         return found
 
-    def _build(self, sim: SimScene, stage: Usd.Stage, types: tuple[str, ...] | None) -> InstanceMap:
+    def _build(self, sim: SimScene, stage: Usd.Stage, semantic_filter: SemanticFilter) -> InstanceMap:
         compiled = sim.ensure_compiled()
-        owner_of_geom: list[str | None] = []
         owners: dict[str, dict[str, list[str]]] = {}
+        owner_of_prim: dict[str, str | None] = {}
+        owner_of_geom: list[str | None] = []
         for path in compiled.geom_paths:
             prim = stage.GetPrimAtPath(path) if path else None
-            owner = semlib.labelled_ancestor(prim, types) if prim else None
-            if owner is None:
-                owner_of_geom.append(None)
-                continue
-            opath = str(owner.GetPath())
-            if opath not in owners:
-                labels = semlib.labels(owner)
-                owners[opath] = {t: v for t, v in labels.items() if types is None or t in types}
-            owner_of_geom.append(opath)
+            owner = _owner(prim, semantic_filter, owner_of_prim, owners) if prim else None
+            owner_of_geom.append(owner)
         paths = sorted(owners)
         index = {p: i for i, p in enumerate(paths)}
         labels = [owners[p] for p in paths]
@@ -94,10 +103,30 @@ class SceneLabels:
                            geom_instance=geom_instance, semantic_labels=sem_labels)
 
 
+def _owner(prim: Usd.Prim, semantic_filter: SemanticFilter, memo: dict[str, str | None],
+           owners: dict[str, dict[str, list[str]]]) -> str | None:
+    """Path of the semantic instance ``prim`` belongs to (see the module docstring), or None."""
+    path = str(prim.GetPath())
+    if path in memo:
+        return memo[path]
+    found: str | None = None
+    direct = semlib.direct_labels(prim)
+    if direct:
+        matched = semantic_filter.match(semlib.labels(prim))
+        if matched and any(v in matched.get(t, ()) for t, vals in direct.items() for v in vals):
+            found = path
+            owners[path] = matched
+    if found is None:
+        parent = prim.GetParent()
+        found = _owner(parent, semantic_filter, memo, owners) if parent and not parent.IsPseudoRoot() else None
+    memo[path] = found
+    return found
+
+
 class FrameView:
     """The passes of one render product at one step, plus shared derived maps."""
 
-    def __init__(self, rp: RenderProduct, view: CameraView, outputs: RenderOutputs, sim: SimScene,
+    def __init__(self, rp: RenderProduct, view: CameraView, outputs: RenderOutputs | None, sim: SimScene,
                  stage: Usd.Stage, labels: SceneLabels, frame_index: int, sim_time: float) -> None:
         self.render_product = rp
         self.camera = view
@@ -108,6 +137,9 @@ class FrameView:
         self.frame_index = frame_index
         self.sim_time = sim_time
         self._cache: dict[object, object] = {}
+        # The poses of this capture become the next capture's "previous" (motion vectors).
+        self.poses = PoseSnapshot.capture(sim, view, frame_index)
+        self.previous: PoseSnapshot | None = history.swap(rp, self.poses)
 
     @property
     def width(self) -> int:
@@ -118,9 +150,10 @@ class FrameView:
         return self.camera.height
 
     def require(self, name: str) -> np.ndarray:
-        value = getattr(self.outputs, name)
+        value = getattr(self.outputs, name) if self.outputs is not None else None
         if value is None:
-            raise RuntimeError(f"render pass {name!r} was not rendered for {self.render_product.name}")
+            raise RuntimeError(f"render pass {name!r} was not rendered for {self.render_product.name}; the "
+                               f"annotator spec must list it in its passes")
         return value
 
     def cached(self, key: object, build):
@@ -129,51 +162,196 @@ class FrameView:
             self._cache[key] = build()
         return self._cache[key]
 
-    def instance_map(self, types: tuple[str, ...] | None) -> InstanceMap:
-        return self.labels.instance_map(self.sim, self.stage, types)
+    # ---- instances -----------------------------------------------------
+    def instance_map(self, semantic_filter: SemanticFilter = ALL_LABELS) -> InstanceMap:
+        return self.labels.instance_map(self.sim, self.stage, semantic_filter)
 
-    def instance_image(self, types: tuple[str, ...] | None) -> np.ndarray:
-        """int32 (H, W): instance index into ``instance_map(types).paths`` per pixel, -1 if none."""
+    def instance_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
+        """int32 (H, W): instance index into ``instance_map(f).paths`` per pixel, -1 if none."""
         def build():
             geom_ids = self.require("geom_ids")
-            imap = self.instance_map(types)
+            imap = self.instance_map(semantic_filter)
             lut = np.append(imap.geom_instance, -1).astype(np.int32)   # index -1 -> -1
             return lut[geom_ids]
-        return self.cached(("instance_image", types), build)
+        return self.cached(("instance_image", semantic_filter.text), build)
 
-    def semantic_image(self, types: tuple[str, ...] | None) -> np.ndarray:
+    def semantic_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """uint32 (H, W): semantic id per pixel; 0 background, 1 unlabelled geometry."""
         def build():
-            geom_ids = self.require("geom_ids")
-            imap = self.instance_map(types)
-            inst = self.instance_image(types)
-            sem = np.where(geom_ids < 0, BACKGROUND_ID, UNLABELLED_ID).astype(np.uint32)
-            has = inst >= 0
-            sem[has] = imap.semantic_ids[inst[has]]
-            return sem
-        return self.cached(("semantic_image", types), build)
+            imap = self.instance_map(semantic_filter)
+            return self._id_image(semantic_filter, imap.semantic_ids)
+        return self.cached(("semantic_image", semantic_filter.text), build)
 
-    def tight_boxes(self, types: tuple[str, ...] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def instance_id_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
+        """uint32 (H, W): instance id per pixel; 0 background, 1 unlabelled geometry."""
+        def build():
+            imap = self.instance_map(semantic_filter)
+            return self._id_image(semantic_filter, imap.instance_ids)
+        return self.cached(("instance_id_image", semantic_filter.text), build)
+
+    def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
+        geom_ids = self.require("geom_ids")
+        inst = self.instance_image(semantic_filter)
+        out = np.where(geom_ids < 0, BACKGROUND_ID, UNLABELLED_ID).astype(np.uint32)
+        has = inst >= 0
+        out[has] = per_instance[inst[has]]
+        return out
+
+    # ---- boxes and occlusion -------------------------------------------
+    def visible_counts(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
+        """int64 (n,): visible pixels per instance."""
+        def build():
+            inst = self.instance_image(semantic_filter)
+            n = len(self.instance_map(semantic_filter).paths)
+            return np.bincount(inst[inst >= 0].ravel(), minlength=n)
+        return self.cached(("visible_counts", semantic_filter.text), build)
+
+    def tight_boxes(self, semantic_filter: SemanticFilter = ALL_LABELS
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(instance indices, boxes (K, 4) inclusive x_min y_min x_max y_max, pixel counts) of visible instances."""
         def build():
-            inst = self.instance_image(types)
-            flat = inst.ravel()
-            sel = np.nonzero(flat >= 0)[0]
-            if sel.size == 0:
-                return np.zeros(0, np.int64), np.zeros((0, 4), np.int32), np.zeros(0, np.int64)
-            k = flat[sel]
-            ys, xs = np.divmod(sel, self.width)
-            n = len(self.instance_map(types).paths)
-            xmin = np.full(n, np.iinfo(np.int64).max)
-            ymin = np.full(n, np.iinfo(np.int64).max)
-            xmax = np.full(n, -1)
-            ymax = np.full(n, -1)
-            np.minimum.at(xmin, k, xs)
-            np.minimum.at(ymin, k, ys)
-            np.maximum.at(xmax, k, xs)
-            np.maximum.at(ymax, k, ys)
-            counts = np.bincount(k, minlength=n)
+            inst = self.instance_image(semantic_filter)
+            n = len(self.instance_map(semantic_filter).paths)
+            boxes = _mask_boxes(inst, n)
+            counts = self.visible_counts(semantic_filter)
             present = np.nonzero(counts)[0]
-            boxes = np.stack([xmin[present], ymin[present], xmax[present], ymax[present]], 1).astype(np.int32)
-            return present, boxes, counts[present]
-        return self.cached(("tight_boxes", types), build)
+            return present, boxes[present], counts[present]
+        return self.cached(("tight_boxes", semantic_filter.text), build)
+
+    def footprints(self, semantic_filter: SemanticFilter = ALL_LABELS) -> Footprints:
+        """Unoccluded footprint of every instance in view, from isolated id renders.
+
+        Each instance is drawn with every other geom hidden, cropped to a
+        conservative pixel rectangle of its geoms' bounding spheres. Instances
+        whose rectangles do not overlap share one render (their footprints cannot
+        touch), so the number of renders is the number of overlap groups, not of
+        instances. Instances whose rectangle misses the image are not in view.
+        """
+        def build():
+            imap = self.instance_map(semantic_filter)
+            n = len(imap.paths)
+            counts = np.zeros(n, dtype=np.int64)
+            boxes = np.full((n, 4), -1, dtype=np.int32)
+            render = self.outputs.render_isolated if self.outputs is not None else None
+            if render is None:
+                raise RuntimeError("isolated renders need the segmentation pass")
+            shown = np.zeros(self.sim.model.ngeom, dtype=bool)
+            shown[self.drawn_geoms()] = True
+            rects = self._geom_rects()
+            members: list[tuple[int, np.ndarray, tuple[int, int, int, int]]] = []
+            for k in range(n):
+                geoms = imap.geoms_of(k)
+                geoms = geoms[shown[geoms]]
+                crop = _union_crop(rects[geoms], self.width, self.height) if geoms.size else None
+                if crop is not None:
+                    members.append((k, geoms, crop))
+            for group in _disjoint_groups(members):
+                crops = np.array([c for _, _, c in group])
+                x0, y0 = crops[:, :2].min(0)
+                x1, y1 = crops[:, 2:].max(0)
+                ids = render(np.concatenate([g for _, g, _ in group]), (int(x0), int(y0), int(x1), int(y1)))
+                for k, geoms, crop in group:
+                    part = ids[crop[1] - y0:crop[3] - y0, crop[0] - x0:crop[2] - x0]
+                    mask = np.isin(part, geoms)
+                    counts[k] = int(mask.sum())
+                    if counts[k]:
+                        ys, xs = np.nonzero(mask)
+                        boxes[k] = (xs.min() + crop[0], ys.min() + crop[1], xs.max() + crop[0], ys.max() + crop[1])
+            # Guard against a pixel drawn in the full render but not the isolated one (the two
+            # frusta differ in the last float bit): the footprint always covers the visible part.
+            visible = self.visible_counts(semantic_filter)
+            _, tight, _ = self.tight_boxes(semantic_filter)
+            present = np.nonzero(visible)[0]
+            counts = np.maximum(counts, visible)
+            for k, box in zip(present, tight):
+                if boxes[k, 0] < 0:
+                    boxes[k] = box
+                else:
+                    boxes[k, :2] = np.minimum(boxes[k, :2], box[:2])
+                    boxes[k, 2:] = np.maximum(boxes[k, 2:], box[2:])
+            return Footprints(counts=counts, boxes=boxes)
+        return self.cached(("footprints", semantic_filter.text), build)
+
+    def occlusion_ratios(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
+        """float32 (n,): occluded / unoccluded pixels per instance in view; NaN when not in view."""
+        def build():
+            fp = self.footprints(semantic_filter)
+            visible = self.visible_counts(semantic_filter)
+            ratio = np.full(len(fp.counts), np.nan, dtype=np.float64)
+            inview = fp.counts > 0
+            ratio[inview] = 1.0 - visible[inview] / fp.counts[inview]
+            return np.clip(ratio, 0.0, 1.0).astype(np.float32)
+        return self.cached(("occlusion", semantic_filter.text), build)
+
+    def drawn_geoms(self) -> np.ndarray:
+        """Ids of the geoms the rasteriser draws (not hidden, not collision-only)."""
+        group = self.sim.model.geom_group
+        return np.nonzero((group != HIDDEN_GROUP) & (group != COLLISION_ONLY_GROUP))[0]
+
+    def _geom_rects(self) -> np.ndarray:
+        """(ngeom, 4) conservative pixel rectangles of every geom's bounding sphere (NaN: behind)."""
+        def build():
+            m, d = self.sim.model, self.sim.data
+            radii = np.asarray(m.geom_rbound, dtype=np.float64).copy()
+            rects = self.camera.sphere_pixel_bounds(d.geom_xpos, radii)
+            rects[radii <= 0] = (0, 0, self.width, self.height)   # rbound 0: unbounded geom
+            return rects
+        return self.cached("geom_rects", build)
+
+    # ---- geometry ------------------------------------------------------
+    def world_points(self) -> np.ndarray:
+        """float64 (H, W, 3): world position of each pixel centre's surface (inf on background)."""
+        return self.cached("world_points", lambda: self.camera.unproject(self.require("depth")))
+
+    def normals(self) -> np.ndarray:
+        """float32 (H, W, 3): world-space unit surface normals facing the camera; 0 on background."""
+        return self.cached("normals", lambda: surface_normals(self.sim, self.camera, self.require("geom_ids")))
+
+
+def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
+    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels)."""
+    flat = inst.ravel()
+    sel = np.nonzero(flat >= 0)[0]
+    boxes = np.full((n, 4), -1, dtype=np.int64)
+    if sel.size == 0:
+        return boxes.astype(np.int32)
+    k = flat[sel]
+    ys, xs = np.divmod(sel, inst.shape[1])
+    big = np.iinfo(np.int64).max
+    lo_x, lo_y = np.full(n, big), np.full(n, big)
+    hi_x, hi_y = np.full(n, -1), np.full(n, -1)
+    np.minimum.at(lo_x, k, xs)
+    np.minimum.at(lo_y, k, ys)
+    np.maximum.at(hi_x, k, xs)
+    np.maximum.at(hi_y, k, ys)
+    present = hi_x >= 0
+    boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
+    return boxes.astype(np.int32)
+
+
+def _disjoint_groups(members: list) -> list[list]:
+    """Greedy packing of ``(index, geoms, crop)`` members into groups of pairwise disjoint crops."""
+    groups: list[list] = []
+    for member in members:
+        x0, y0, x1, y1 = member[2]
+        for group in groups:
+            if all(x1 <= c[0] or c[2] <= x0 or y1 <= c[1] or c[3] <= y0 for _, _, c in group):
+                group.append(member)
+                break
+        else:
+            groups.append([member])
+    return groups
+
+
+def _union_crop(rects: np.ndarray, width: int, height: int) -> tuple[int, int, int, int] | None:
+    """Integer pixel rectangle covering ``rects`` (float x0 y0 x1 y1), clipped to the image; None if empty."""
+    rects = rects[~np.isnan(rects).any(axis=1)]
+    if rects.size == 0:
+        return None
+    x0 = max(int(np.floor(rects[:, 0].min())), 0)
+    y0 = max(int(np.floor(rects[:, 1].min())), 0)
+    x1 = min(int(np.ceil(rects[:, 2].max())) + 1, width)
+    y1 = min(int(np.ceil(rects[:, 3].max())) + 1, height)
+    if x0 >= x1 or y0 >= y1:
+        return None
+    return x0, y0, x1, y1

@@ -27,10 +27,12 @@ def per_prim(value: Any, count: int, what: str, width: int = 3) -> list:
         if arr.shape[0] != count:
             raise ValueError(f"{what} has {arr.shape[0]} rows but count/prims is {count}")
         return [row for row in arr]
-    if arr.ndim == 0 and what.startswith("scale"):
+    is_scale = what.startswith("scale")
+    if arr.ndim == 0 and is_scale:
         return [np.full(3, float(arr))] * count
-    if arr.ndim == 1 and what.startswith("scale") and arr.shape[0] == count and count != 3:
-        return [np.full(3, float(v)) for v in arr]      # one uniform scale per prim
+    if arr.ndim == 1 and is_scale and arr.shape[0] == count:
+        # one uniform scale per prim (as the seed's Workflow 1 passes them)
+        return [np.full(3, float(v)) for v in arr]
     if arr.ndim == 1 and arr.shape[0] in (3, 4):
         return [arr] * count
     raise ValueError(f"{what} must be one {width}-vector or an (N, {width}) array, got shape {arr.shape}")

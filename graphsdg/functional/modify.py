@@ -12,11 +12,13 @@ Example:
 """
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
+from graphsdg import settings
 from graphsdg.functional.create_batch import per_prim
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -34,23 +36,71 @@ def _look_at_point(value: Any) -> Any:
 
 def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, scale_value: Any = None,
          look_at_value: Any = None, look_at_up_axis: Any = None, rotation_order: str = "XYZ",
-         write_to_usd: bool = True) -> None:
+         size_value: Any = None, pivot_value: Any = None, write_to_usd: bool = True) -> None:
     """Set position, rotation (Euler degrees or a (w, x, y, z) quaternion), scale, or aim with ``look_at``.
 
-    ``look_at_value`` is a world point or a prim (aim at its origin).
-    ``write_to_usd`` is accepted for Replicator scripts; graphsdg always authors the stage.
+    ``size_value`` scales each prim so its local bounding box spans that size
+    (exclusive with ``scale_value``); ``pivot_value`` is a local point that the
+    rotation and scale turn about (the translation compensates, so the pivot
+    stays where ``position`` puts it). ``look_at_value`` is a world point or a prim
+    (aim at its origin). ``write_to_usd`` is accepted for Replicator scripts; poses
+    are authored on the stage (or, with write-to-fabric on, written to MuJoCo).
     """
+    if size_value is not None and scale_value is not None:
+        raise ValueError("size and scale are exclusive; pass one of them")
     targets = resolve_prims(prims)
     look_at_value = _look_at_point(look_at_value)
     n = len(targets)
+    if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
+            and _write_to_fabric():
+        from graphsdg.runtime import runtime
+        from graphsdg.sim import direct_writes
+        arrays = [None if v is None else np.array(per_prim(v, n, name, width=np.shape(v)[-1] if np.ndim(v) else 3))
+                  for v, name in ((position_value, "position_value"), (rotation_value, "rotation_value"),
+                                  (scale_value, "scale_value"))]
+        if direct_writes.write_poses(runtime().sim, targets, *arrays):
+            return
     positions = per_prim(position_value, n, "position_value")
     rotations = per_prim(rotation_value, n, "rotation_value", width=4 if np.ndim(rotation_value) and
                          np.shape(rotation_value)[-1] == 4 else 3)
     scales = per_prim(scale_value, n, "scale_value")
+    sizes = per_prim(size_value, n, "scale_value (size)")
+    pivots = per_prim(pivot_value, n, "pivot_value")
     looks = per_prim(look_at_value, n, "look_at_value")
     for i, prim in enumerate(targets):
-        set_local_pose(prim, position=positions[i], rotation=rotations[i], scale=scales[i], look_at=looks[i],
+        scale_i = scales[i] if sizes[i] is None else size_to_scale(prim, sizes[i])
+        set_local_pose(prim, position=positions[i], rotation=rotations[i], scale=scale_i, look_at=looks[i],
                        look_at_up_axis=look_at_up_axis, rotation_order=rotation_order)
+        if pivots[i] is not None:
+            _apply_pivot(prim, np.asarray(pivots[i], dtype=np.float64), positions[i])
+
+
+def size_to_scale(prim: Usd.Prim, size: Any) -> np.ndarray:
+    """The scale that makes ``prim``'s untransformed bounding box ``size`` across (a number or 3 sizes)."""
+    target = np.broadcast_to(np.asarray(size, dtype=np.float64), (3,))
+    if np.any(target <= 0):
+        raise ValueError(f"size must be positive, got {size!r}")
+    cache = UsdGeom.BBoxCache(Usd.TimeCode.Default(), [UsdGeom.Tokens.default_, UsdGeom.Tokens.render])
+    extent = np.array(cache.ComputeUntransformedBound(prim).ComputeAlignedRange().GetSize(), dtype=np.float64)
+    if not np.all(np.isfinite(extent)) or np.any(extent <= 0):
+        raise ValueError(f"prim {prim.GetPath()} has no bounding box to size")
+    if np.ndim(size) == 0:
+        return np.full(3, float(target[0]) / float(extent.max()))   # uniform: the longest side gets the size
+    return target / extent
+
+
+def _apply_pivot(prim: Usd.Prim, pivot: np.ndarray, position: Any) -> None:
+    from graphsdg.stage.xform import decompose
+    xf = UsdGeom.Xformable(prim)
+    m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
+    t, r, s = decompose(m)
+    base = np.asarray(position, dtype=np.float64) if position is not None else t
+    turned = r @ (s * pivot)
+    set_local_pose(prim, position=base + pivot - turned)
+
+
+def _write_to_fabric() -> bool:
+    return bool(settings.get("/exts/omni.replicator.core/enableWriteToFabric", False))
 
 
 def position(prims: Any, value: Any) -> None:
@@ -148,6 +198,11 @@ def display_color(prims: Any, value: Any) -> None:
     """Set ``primvars:displayColor`` (one colour for all, or (N, 3))."""
     targets = resolve_prims(prims)
     colors = per_prim(value, len(targets), "display color")
+    if _write_to_fabric():
+        from graphsdg.runtime import runtime
+        from graphsdg.sim import direct_writes
+        if direct_writes.write_colors(runtime().sim, targets, np.array(colors)[:, :3]):
+            return
     for prim, c in zip(targets, colors):
         gprim = UsdGeom.Gprim(prim)
         if not gprim:
@@ -155,5 +210,80 @@ def display_color(prims: Any, value: Any) -> None:
         gprim.CreateDisplayColorAttr().Set(Vt.Vec3fArray([Gf.Vec3f(*(float(x) for x in c[:3]))]))
 
 
+def material_inputs(materials: Any, **inputs: Any) -> None:
+    """Set OmniPBR-style inputs of materials (one value for all, or one row per material).
+
+    Names: ``diffuse_color_constant``, ``reflection_roughness_constant``,
+    ``metallic_constant``, ``diffuse_texture``, ``texture_scale``,
+    ``texture_rotate``, ``emissive_color``, ``emissive_intensity``.
+    """
+    names = {"diffuse_color_constant": "diffuse", "reflection_roughness_constant": "roughness",
+             "metallic_constant": "metallic", "diffuse_texture": "diffuse_texture",
+             "texture_scale": "texture_scale", "texture_rotate": "texture_rotate",
+             "emissive_color": "emissive_color", "emissive_intensity": "emissive_intensity"}
+    unknown = sorted(set(inputs) - set(names))
+    if unknown:
+        raise ValueError(f"unknown material input(s) {unknown}; known: {sorted(names)}")
+    prims = resolve_prims(materials)
+    for p in prims:
+        if not p.IsA(UsdShade.Material):
+            raise TypeError(f"{p.GetPath()} is a {p.GetTypeName()!r} prim, not a Material")
+    mats = [UsdShade.Material(p) for p in prims]
+    rows = {key: _material_rows(key, value, len(mats)) for key, value in inputs.items() if value is not None}
+    for i, m in enumerate(mats):
+        kwargs = {names[k]: v[i] for k, v in rows.items()}
+        tex = kwargs.get("diffuse_texture")
+        if tex is not None:
+            if not os.path.isfile(os.fspath(tex)):
+                raise FileNotFoundError(f"diffuse_texture {os.fspath(tex)!r} does not exist")
+            kwargs["diffuse_texture"] = os.fspath(tex)
+        matlib.set_inputs(m, **kwargs)
+
+
+_VECTOR_INPUTS = {"diffuse_color_constant": 3, "emissive_color": 3, "texture_scale": 2}
+
+
+def _material_rows(key: str, value: Any, n: int) -> list:
+    """One value per material: ``value`` shared, or its rows (one per material)."""
+    if key == "diffuse_texture":
+        if isinstance(value, (str, os.PathLike)):
+            return [value] * n
+        values = list(value)
+    elif key in _VECTOR_INPUTS:
+        arr = np.asarray(value, dtype=np.float64)
+        if arr.ndim == 0:
+            arr = np.full(_VECTOR_INPUTS[key], float(arr))
+        if arr.ndim == 1:
+            return [arr.tolist()] * n
+        values = [row.tolist() for row in arr]
+    else:
+        arr = np.asarray(value, dtype=np.float64)
+        if arr.ndim == 0:
+            return [float(arr)] * n
+        values = [float(v) for v in arr.ravel()]
+    if len(values) != n:
+        raise ValueError(f"material input {key} has {len(values)} values for {n} materials")
+    return values
+
+
+def reference(prims: Any, usd_paths: Any) -> None:
+    """Make each prim reference ``usd_paths`` (one path for all, or one per prim), replacing its references."""
+    targets = resolve_prims(prims)
+    paths = [usd_paths] * len(targets) if isinstance(usd_paths, (str, os.PathLike)) else list(usd_paths)
+    if len(paths) != len(targets):
+        raise ValueError(f"reference got {len(paths)} paths for {len(targets)} prims")
+    for prim, path in zip(targets, paths):
+        path = os.fspath(path)
+        if "://" not in path and not os.path.isfile(path):
+            raise FileNotFoundError(f"reference usd_path {path!r} does not exist")
+        refs = prim.GetReferences()
+        current = [r.assetPath for r in prim.GetMetadata("references").GetAddedOrExplicitItems()] \
+            if prim.HasMetadata("references") else []
+        if current == [path]:
+            continue   # already referencing it: no structural change
+        refs.ClearReferences()
+        refs.AddReference(path)
+
+
 __all__ = ["pose", "position", "rotation", "scale", "look_at", "attribute", "semantics", "material",
-           "visibility", "display_color"]
+           "visibility", "display_color", "material_inputs", "reference", "size_to_scale"]

@@ -1,8 +1,10 @@
 """``rep.functional.randomizer``: randomize prims now, from an explicit ``rng``.
 
-``display_color`` recolours; ``scatter_2d`` and ``scatter_3d`` place prims on
-surfaces or in volumes, optionally without overlaps (the graph API's
-``rep.randomizer.scatter_2d/3d`` nodes call these).
+``scatter_2d`` and ``scatter_3d`` place prims on surfaces or in volumes,
+optionally without overlaps.
+
+These are also what the graph's randomizer nodes call (one implementation per
+operation): a node passes its per-execution stream as ``rng``.
 
 Example:
     >>> import graphsdg as rep
@@ -12,16 +14,21 @@ Example:
 """
 from __future__ import annotations
 
+import math
+import os
 from typing import Any, Sequence
 
 import numpy as np
-from pxr import UsdGeom
+from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from graphsdg.functional import modify
 from graphsdg.rng import ReplicatorRNG, as_generator
 from graphsdg.sim import bounds, placement, transforms
-from graphsdg.stage.prims import resolve_prims
-from graphsdg.stage.xform import set_local_pose, world_matrix
+from graphsdg.stage import materials as matlib
+from graphsdg.stage.prims import resolve_prims, sanitize_name
+from graphsdg.stage.xform import matrix_to_euler_xyz, quat_wxyz_to_matrix, set_local_pose, world_matrix
+
+LOOKS = "/Replicator/Looks"
 
 
 def display_color(prims: Any, rng: ReplicatorRNG | np.random.Generator | None = None,
@@ -36,34 +43,184 @@ def display_color(prims: Any, rng: ReplicatorRNG | np.random.Generator | None = 
     modify.display_color(targets, gen.uniform(lo, hi, size=(len(targets), 3)))
 
 
-def _bounds_offsets(targets: list, extents: Any) -> np.ndarray:
-    """Each prim's box relative to its world origin, (N, 6): from ``extents`` or the prims' real bounds."""
-    n = len(targets)
-    if extents is not None:
-        arr = np.asarray(extents, dtype=np.float64)
+def _own_material(prim: Usd.Prim, kind: str, looks: str) -> UsdShade.Material:
+    """The material graphsdg made for ``prim`` (one per prim and kind), made and bound on first use."""
+    stage = prim.GetStage()
+    name = sanitize_name(f"{kind}_{str(prim.GetPath()).strip('/').replace('/', '_')}")
+    path = Sdf.Path(looks).AppendChild(name)
+    mat = UsdShade.Material(stage.GetPrimAtPath(path))
+    if not mat:
+        _ensure_scope(stage, Sdf.Path(looks))
+        mat = matlib.define_preview_material(stage, path)
+        mat.GetPrim().CreateAttribute("info:mdl:sourceAsset", Sdf.ValueTypeNames.Asset).Set(
+            Sdf.AssetPath("OmniPBR.mdl"))
+    bound = matlib.bound_material(prim)
+    if bound is None or bound.GetPath() != path:
+        matlib.bind(prim, mat)
+    return mat
+
+
+def _ensure_scope(stage: Usd.Stage, path: Sdf.Path) -> None:
+    for prefix in path.GetPrefixes():
+        if not stage.GetPrimAtPath(prefix).IsValid():
+            UsdGeom.Scope.Define(stage, prefix) if prefix == path else UsdGeom.Xform.Define(stage, prefix)
+
+
+def color(prims: Any, colors: Any = None, rng: ReplicatorRNG | np.random.Generator | None = None,
+          looks: str = LOOKS) -> np.ndarray:
+    """Bind each prim its own OmniPBR-style material and set its diffuse colour.
+
+    ``colors``: one RGB for all, an ``(N, 3)`` array (one per prim), or None for a
+    uniform random colour per prim from ``rng``. Returns the colours applied.
+    The material is made once per prim; later calls only edit its colour.
+    """
+    targets = resolve_prims(prims)
+    if colors is None:
+        values = as_generator(rng, "color").uniform(0.0, 1.0, size=(len(targets), 3))
+    else:
+        arr = np.asarray(colors, dtype=np.float64)
         if arr.ndim == 1:
-            arr = np.tile(arr, (n, 1))
-        if arr.ndim != 2 or arr.shape[0] != n or arr.shape[1] not in (3, 6) or not np.all(np.isfinite(arr)):
-            raise ValueError(f"extents must be sizes (3,) / (N, 3) or bounds (xmin, ymin, zmin, xmax, ymax, zmax) "
-                             f"(6,) / (N, 6) relative to each prim's origin, for N={n} prims; got shape "
-                             f"{np.shape(extents)}")
-        if arr.shape[1] == 3:
-            if np.any(arr < 0):
-                raise ValueError(f"extents sizes must be >= 0, got {arr.tolist()}")
-            return np.c_[-arr / 2, arr / 2]
-        if np.any(arr[:, 3:] < arr[:, :3]):
-            raise ValueError(f"extents bounds need min <= max on every axis, got {arr.tolist()}")
-        return arr
+            arr = np.broadcast_to(arr, (len(targets), arr.shape[0]))
+        if arr.ndim != 2 or arr.shape[0] != len(targets) or arr.shape[1] not in (3, 4):
+            raise ValueError(f"colors must be one (r, g, b) or {len(targets)} rows of them, got shape "
+                             f"{np.shape(colors)}")
+        values = arr[:, :3]
+    for prim, c in zip(targets, values):
+        matlib.set_inputs(_own_material(prim, "Color", looks), diffuse=c)
+    return np.asarray(values)
+
+
+def materials(prims: Any, materials: Any, rng: ReplicatorRNG | np.random.Generator | None = None) -> list[str]:
+    """Bind each prim a material drawn uniformly from ``materials`` (prims or paths); returns the paths bound."""
+    mats = resolve_prims(materials)
+    if not mats:
+        raise ValueError("materials() needs at least one material to choose from, got none")
+    for m in mats:
+        if not m.IsA(UsdShade.Material):
+            raise TypeError(f"materials(): {m.GetPath()} is a {m.GetTypeName()!r} prim, not a Material")
+    targets = resolve_prims(prims)
+    picks = as_generator(rng, "materials").integers(0, len(mats), size=len(targets))
+    chosen = []
+    for prim, k in zip(targets, picks):
+        matlib.bind(prim, UsdShade.Material(mats[int(k)]))
+        chosen.append(str(mats[int(k)].GetPath()))
+    return chosen
+
+
+def texture(prims: Any, textures: Sequence[str], texture_scale: Any = None, texture_rotate: Any = None,
+            rng: ReplicatorRNG | np.random.Generator | None = None, looks: str = LOOKS) -> list[str]:
+    """Give each prim a material textured with a file drawn uniformly from ``textures``.
+
+    ``texture_scale`` ((su, sv), or one row per prim) and ``texture_rotate``
+    (degrees, or one per prim) set the UV transform. Returns the files applied.
+    """
+    files = [os.fspath(t) for t in ([textures] if isinstance(textures, (str, os.PathLike)) else textures)]
+    if not files:
+        raise ValueError("texture() needs at least one texture file, got none")
+    missing = [f for f in files if not os.path.isfile(f)]
+    if missing:
+        raise FileNotFoundError(f"texture file(s) not found: {missing}")
+    targets = resolve_prims(prims)
+    picks = as_generator(rng, "texture").integers(0, len(files), size=len(targets))
+    scales = _per_prim_rows(texture_scale, len(targets), 2, "texture_scale")
+    rotates = _per_prim_rows(texture_rotate, len(targets), 1, "texture_rotate")
+    chosen = []
+    for i, prim in enumerate(targets):
+        mat = _own_material(prim, "Texture", looks)
+        matlib.set_inputs(mat, diffuse_texture=files[int(picks[i])],
+                          texture_scale=None if scales[i] is None else tuple(scales[i]),
+                          texture_rotate=None if rotates[i] is None else float(rotates[i][0]))
+        chosen.append(files[int(picks[i])])
+    return chosen
+
+
+def _per_prim_rows(value: Any, n: int, width: int, what: str) -> list:
+    if value is None:
+        return [None] * n
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim == 0:
+        return [np.full(width, float(arr))] * n
+    if arr.ndim == 1 and arr.shape[0] == width:
+        return [arr] * n
+    if arr.ndim == 1 and width == 1 and arr.shape[0] == n:
+        return [np.array([v]) for v in arr]
+    if arr.ndim == 2 and arr.shape[0] == n and arr.shape[1] in (1, width):
+        return [np.broadcast_to(row, (width,)) for row in arr]
+    raise ValueError(f"{what} must be one value, one {width}-vector or one per prim ({n}), got shape {arr.shape}")
+
+
+def uniform_quaternions(gen: np.random.Generator, n: int) -> np.ndarray:
+    """``n`` quaternions (w, x, y, z) uniform on SO(3) (Shoemake's method)."""
+    u1, u2, u3 = gen.random((3, n))
+    a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
+    q = np.stack([a * np.sin(2 * math.pi * u2), a * np.cos(2 * math.pi * u2),
+                  b * np.sin(2 * math.pi * u3), b * np.cos(2 * math.pi * u3)], axis=1)   # (x, y, z, w)
+    return q[:, [3, 0, 1, 2]]
+
+
+def rotation(prims: Any, min_angle: Sequence[float] = (-180.0, -180.0, -180.0),
+             max_angle: Sequence[float] = (180.0, 180.0, 180.0),
+             rng: ReplicatorRNG | np.random.Generator | None = None, max_tries: int = 10000) -> np.ndarray:
+    """Rotate each prim by a rotation uniform on SO(3) (restricted to XYZ Euler limits if given).
+
+    With the default limits every orientation is equally likely (not uniform
+    Euler angles, which crowd the poles). Narrower limits keep the uniform law
+    restricted to the box, by rejection. Returns the Euler XYZ angles applied.
+    """
+    lo, hi = np.asarray(min_angle, dtype=np.float64), np.asarray(max_angle, dtype=np.float64)
+    if lo.shape != (3,) or hi.shape != (3,) or np.any(lo > hi):
+        raise ValueError(f"rotation limits must be two XYZ triples with min <= max, got {min_angle}, {max_angle}")
+    targets = resolve_prims(prims)
+    gen = as_generator(rng, "rotation")
+    full = bool(np.all(lo <= -180.0) and np.all(hi >= 180.0))
+    angles = np.zeros((len(targets), 3))
+    for i in range(len(targets)):
+        for _ in range(max_tries):
+            e = np.array(matrix_to_euler_xyz(quat_wxyz_to_matrix(uniform_quaternions(gen, 1)[0])))
+            if full or (np.all(e >= lo) and np.all(e <= hi)):
+                angles[i] = e
+                break
+        else:
+            raise ValueError(f"rotation limits {tuple(lo)}..{tuple(hi)} are too narrow: no uniform rotation "
+                             f"fell inside them in {max_tries} tries")
+    modify.pose(targets, rotation_value=angles)
+    return angles
+
+
+def _bounds_offsets(targets: list) -> np.ndarray:
+    """Each prim's world box relative to its world origin, (N, 6) (a point for prims without geometry)."""
     cache = bounds.create_bbox_cache()
-    out = np.zeros((n, 6))
+    out = np.zeros((len(targets), 6))
     for i, prim in enumerate(targets):
         origin = transforms.get_world_position(prim)
         try:
             box = bounds.compute_aabb(prim, cache)
         except ValueError:
-            continue                       # no geometry: a point at its origin
+            continue
         out[i] = np.r_[box[:3] - origin, box[3:] - origin]
     return out
+
+
+def _sample_limits(extents: Any) -> tuple[np.ndarray, np.ndarray]:
+    """World (min, max) corners that sampled origins must lie within (Replicator's min_samp / max_samp)."""
+    lo, hi = np.full(3, -np.inf), np.full(3, np.inf)
+    if extents is None:
+        return lo, hi
+    try:
+        pair = [None if e is None else list(e) for e in extents]
+        ok = len(pair) == 2 and all(e is None or len(e) == 3 for e in pair)
+    except TypeError:
+        ok = False
+    if not ok:
+        raise ValueError(f"extents must be (min, max) world corners, each 3 numbers or None "
+                         f"(None for an unbounded axis), got {extents!r}")
+    for out, corner in ((lo, pair[0]), (hi, pair[1])):
+        for axis, v in enumerate(corner or ()):
+            if v is not None:
+                out[axis] = float(v)
+    if np.any(lo > hi):
+        raise ValueError(f"extents need min <= max on every axis, got min {lo.tolist()} and max {hi.tolist()}")
+    return lo, hi
 
 
 def _obstacles(no_collision_prims: Any) -> np.ndarray:
@@ -102,10 +259,11 @@ def scatter_2d(prims: Any, surface_prims: Any, no_collision_prims: Any = None, e
 
     Surfaces are every Plane, Mesh or other shape at or below ``surface_prims``,
     hidden ones included; the origin goes ``offset`` along the surface normal
-    there; rotations are kept. With ``check_for_collisions`` each prim's real
-    world bounds (or ``extents``: sizes (N, 3) or bounds (N, 6) relative to the
-    origin) may not overlap those already placed nor ``no_collision_prims``. A
-    prim that finds no spot in 10 000 attempts raises ``ValueError`` saying how
+    there; rotations are kept. ``extents`` = (min, max) world corners (None or
+    None entries: unbounded) limits where origins may land (Replicator's
+    ``min_samp`` / ``max_samp``). With ``check_for_collisions`` each prim's real
+    world bounds may not overlap those already placed nor ``no_collision_prims``.
+    A prim that finds no spot in 10 000 attempts raises ``ValueError`` saying how
     many fit; the stage is then left unchanged.
 
     Example:
@@ -120,15 +278,17 @@ def scatter_2d(prims: Any, surface_prims: Any, no_collision_prims: Any = None, e
     """
     targets = resolve_prims(prims)
     surfaces = resolve_prims(surface_prims)
+    lo, hi = _sample_limits(extents)
     if isinstance(offset, bool) or not isinstance(offset, (int, float, np.floating)) or not np.isfinite(offset):
         raise ValueError(f"offset must be a finite number, got {offset!r}")
     surface = placement.surface_of(surfaces)
     gen = as_generator(rng, "scatter_2d")
-    offsets = _bounds_offsets(targets, extents)
+    offsets = _bounds_offsets(targets)
 
     def propose(k: int) -> np.ndarray:
         points, normals = placement.sample_surface(surface, k, gen)
-        return points + float(offset) * normals
+        points = points + float(offset) * normals
+        return points[np.all((points >= lo) & (points <= hi), axis=1)]
 
     positions, placed, attempts = placement.place(len(targets), propose, offsets, _obstacles(no_collision_prims),
                                                   bool(check_for_collisions))
@@ -147,7 +307,7 @@ def scatter_3d(prims: Any, volume_prims: Any, no_collision_prims: Any = None, vo
     cylinders, cones, capsules exactly; meshes by winding number), minus those
     under ``volume_excl_prims``. With ``prevent_vol_overlap`` the prim's bounds
     must lie inside the volume and outside the excluded ones; collisions work as
-    in :func:`scatter_2d`. Sampling is continuous, so Replicator's voxel settings
+    in :func:`scatter_2d`, and so do ``extents``. Sampling is continuous, so Replicator's voxel settings
     (``resolution_scaling``, ``input_voxel_size``, ``viz_sampled_voxels``) are
     validated but change nothing.
 
@@ -170,12 +330,14 @@ def scatter_3d(prims: Any, volume_prims: Any, no_collision_prims: Any = None, vo
                 (name == "resolution_scaling" and value == 0):
             raise ValueError(f"{name} must be a {'positive' if name == 'resolution_scaling' else 'non-negative'} "
                              f"number, got {value!r}")
+    lo, hi = _sample_limits(extents)
     gen = as_generator(rng, "scatter_3d")
-    offsets = _bounds_offsets(targets, extents)
+    offsets = _bounds_offsets(targets)
     signs = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=bool)
 
     def propose(k: int) -> np.ndarray:
-        return placement.sample_volumes(volumes, k, gen, excluded)
+        points = placement.sample_volumes(volumes, k, gen, excluded)
+        return points[np.all((points >= lo) & (points <= hi), axis=1)]
 
     def accept(i: int, cand: np.ndarray) -> np.ndarray:
         if not prevent_vol_overlap or not np.any(offsets[i]):
@@ -194,3 +356,7 @@ def scatter_3d(prims: Any, volume_prims: Any, no_collision_prims: Any = None, vo
     if placed < len(targets):
         raise _fail("scatter_3d", placed, targets, [v.prim for v in volumes], attempts, "volume")
     _move_to(targets, positions)
+
+
+__all__ = ["display_color", "color", "materials", "texture", "rotation", "uniform_quaternions", "scatter_2d",
+           "scatter_3d"]

@@ -4,6 +4,11 @@ The projection follows Omniverse's horizontal fit: the horizontal aperture and
 focal length fix the horizontal field of view; the vertical extent follows the
 render product's aspect ratio (square pixels). Pixel ``(u, v)`` has its origin at
 the top-left corner of the image; pixel ``i`` spans ``[i, i + 1)``.
+
+Aperture offsets follow ``Gf.Camera``: a positive offset moves the film window
+right (up), so the optical axis lands left of (below) the image centre.
+Orthographic cameras use USD's convention that their aperture is in tenths of a
+stage unit.
 """
 from __future__ import annotations
 
@@ -39,19 +44,40 @@ class CameraView:
 
     @property
     def fx(self) -> float:
+        """Pixels per unit of x/depth (perspective) or per stage unit (orthographic)."""
+        if self.projection == "orthographic":
+            return self.width / (self.horizontal_aperture / 10.0)
         return self.width * self.focal_length / self.horizontal_aperture
 
     @property
     def fy(self) -> float:
+        if self.projection == "orthographic":
+            return self.fx
         return self.height * self.focal_length / self.vertical_aperture
 
     @property
     def cx(self) -> float:
-        return self.width / 2 + self.horizontal_aperture_offset * self.width / self.horizontal_aperture
+        return self.width / 2 - self.horizontal_aperture_offset * self.width / self.horizontal_aperture
 
     @property
     def cy(self) -> float:
-        return self.height / 2 - self.vertical_aperture_offset * self.height / self.vertical_aperture
+        return self.height / 2 + self.vertical_aperture_offset * self.height / self.vertical_aperture
+
+    def frustum_window(self, crop: tuple[int, int, int, int] | None = None,
+                       jitter: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float, float]:
+        """(left, right, bottom, top) of the pixel rectangle ``crop`` on the near plane.
+
+        Perspective: in camera units at distance ``near``; orthographic: in stage
+        units. ``jitter`` moves every sample by that fraction of a pixel (x right,
+        y down). The rasteriser draws exactly this window, so its pixel centres and
+        :meth:`project` agree.
+        """
+        x0, y0, x1, y1 = crop if crop is not None else (0, 0, self.width, self.height)
+        kx = self.near / self.fx if self.projection != "orthographic" else 1.0 / self.fx
+        ky = self.near / self.fy if self.projection != "orthographic" else 1.0 / self.fy
+        jx, jy = jitter
+        return ((x0 + jx - self.cx) * kx, (x1 + jx - self.cx) * kx,
+                (self.cy - y1 - jy) * ky, (self.cy - y0 - jy) * ky)
 
     def intrinsics(self) -> np.ndarray:
         """OpenCV-style K (y down)."""
@@ -63,8 +89,10 @@ class CameraView:
 
     def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixel coordinates (N, 2) and z-depth (N,) of world points."""
-        pc = self.world_to_camera(points)
+        pc = self.world_to_camera(np.asarray(points, dtype=np.float64).reshape(-1, 3))
         depth = -pc[:, 2]
+        if self.projection == "orthographic":
+            return np.stack([self.cx + self.fx * pc[:, 0], self.cy - self.fy * pc[:, 1]], 1), depth
         with np.errstate(divide="ignore", invalid="ignore"):
             u = self.cx + self.fx * pc[:, 0] / depth
             v = self.cy - self.fy * pc[:, 1] / depth
@@ -78,22 +106,80 @@ class CameraView:
         return np.linalg.inv(cam_to_world)
 
     def projection_matrix(self) -> np.ndarray:
-        """Camera -> clip, row-vector layout (``cameraProjection``; OpenGL depth range)."""
-        n, f = self.near, self.far
+        """Camera -> clip, row-vector layout, as Replicator's ``cameraProjection``.
+
+        Replicator reports a reversed-Z projection with an infinite far plane:
+        ``p_clip = p_cam @ P`` gives ``ndc_z = near / depth`` (1 at the near plane,
+        0 at infinity) and ``ndc_x, ndc_y`` in [-1, 1] with y up. Orthographic
+        cameras get the matching orthographic matrix (``ndc_z`` linear in depth).
+        """
+        n = self.near
         sx = 2 * self.fx / self.width
         sy = 2 * self.fy / self.height
-        ox = 1 - 2 * self.cx / self.width
-        oy = 2 * self.cy / self.height - 1
-        p = np.array([[sx, 0, 0, 0], [0, sy, 0, 0], [-ox, -oy, -(f + n) / (f - n), -1],
-                      [0, 0, -2 * f * n / (f - n), 0]], dtype=np.float64)
-        return p
+        ox = 2 * self.cx / self.width - 1          # principal point in NDC (x right)
+        oy = 1 - 2 * self.cy / self.height         # (y up)
+        if self.projection == "orthographic":
+            f = self.far
+            return np.array([[sx, 0, 0, 0], [0, sy, 0, 0], [0, 0, 1 / (f - n), 0],
+                             [ox, oy, f / (f - n), 1]], dtype=np.float64)
+        return np.array([[sx, 0, 0, 0], [0, sy, 0, 0], [-ox, -oy, 0, -1], [0, 0, n, 0]], dtype=np.float64)
 
-    def ray_cosines(self) -> np.ndarray:
-        """Per-pixel cos(angle to the optical axis) at pixel centres, (H, W)."""
+    def pixel_directions(self) -> np.ndarray:
+        """(H, W, 3) camera-frame directions through pixel centres, scaled to z = -1 (perspective)."""
         u = (np.arange(self.width) + 0.5 - self.cx) / self.fx
         v = (np.arange(self.height) + 0.5 - self.cy) / self.fy
         uu, vv = np.meshgrid(u, v)
-        return 1.0 / np.sqrt(1.0 + uu ** 2 + vv ** 2)
+        return np.stack([uu, -vv, -np.ones_like(uu)], axis=-1)
+
+    def ray_cosines(self) -> np.ndarray:
+        """Per-pixel cos(angle to the optical axis) at pixel centres, (H, W); 1 for orthographic rays."""
+        if self.projection == "orthographic":
+            return np.ones((self.height, self.width))
+        d = self.pixel_directions()
+        return 1.0 / np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + 1.0)
+
+    def unproject(self, depth: np.ndarray) -> np.ndarray:
+        """World points (H, W, 3) of planar ``depth`` (H, W) at pixel centres (inf where depth is inf)."""
+        depth = np.asarray(depth, dtype=np.float64)
+        finite = np.isfinite(depth)
+        z = np.where(finite, depth, 0.0)
+        if self.projection == "orthographic":
+            xs = (np.arange(self.width) + 0.5 - self.cx) / self.fx
+            ys = -(np.arange(self.height) + 0.5 - self.cy) / self.fy
+            xx, yy = np.meshgrid(xs, ys)
+            cam = np.stack([xx, yy, -z], axis=-1)
+        else:
+            cam = self.pixel_directions() * z[..., None]
+        world = cam @ self.rotation.T + self.position
+        world[~finite] = np.inf
+        return world
+
+    def sphere_pixel_bounds(self, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
+        """Conservative pixel rectangles (N, 4: x0, y0, x1, y1, floats) of world spheres.
+
+        The rectangle holds the projection of the sphere's camera-aligned bounding
+        cube, which contains the sphere's; a sphere reaching the near plane gets the
+        whole image (its projection is unbounded).
+        """
+        pc = self.world_to_camera(np.asarray(centers, dtype=np.float64).reshape(-1, 3))
+        r = np.asarray(radii, dtype=np.float64).reshape(-1)
+        full = np.array([0.0, 0.0, float(self.width), float(self.height)])
+        out = np.tile(full, (len(pc), 1))
+        if self.projection == "orthographic":
+            u, v = self.cx + pc[:, 0] * self.fx, self.cy - pc[:, 1] * self.fy
+            out = np.stack([u - r * self.fx, v - r * self.fy, u + r * self.fx, v + r * self.fy], 1)
+            out[-pc[:, 2] + r <= self.near] = np.nan
+            return out
+        front = -pc[:, 2] - r > self.near
+        for k in np.nonzero(front)[0]:
+            corners = pc[k] + r[k] * np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+            depth = -corners[:, 2]
+            u = self.cx + self.fx * corners[:, 0] / depth
+            v = self.cy - self.fy * corners[:, 1] / depth
+            out[k] = (u.min(), v.min(), u.max(), v.max())
+        behind = -pc[:, 2] + r <= self.near
+        out[behind] = np.nan      # entirely behind the near plane: never drawn
+        return out
 
 
 def _attr(prim: Usd.Prim, name: str, default):

@@ -8,19 +8,30 @@ offset is honoured exactly.
 
 Passes:
 
-* ``color`` + ``depth``: one ``mjr_render``, one ``mjr_readPixels`` of both
-  buffers; depth is linearised to planar z in stage units (background ``inf``).
-* ``segmentation``: a second render with MuJoCo's id colours, decoded to geom
-  ids (background -1). MSAA does not blend ids.
+* ``color`` (uint8) and ``hdr`` (the same colour as linear float, before 8-bit
+  rounding): one lit, shadowed, multisampled ``mjr_render``.
+* ``segmentation`` and ``depth``: one render with MuJoCo's id colours, read
+  back with its depth buffer. MuJoCo draws ids without multisampling, so ids and
+  depth are both sampled exactly at pixel centres and agree with each other
+  (a multisampled colour pass resolves depth from an off-centre sample, which
+  is off by up to a quarter pixel of depth slope). Depth is linearised to
+  planar z in stage units (background ``inf``); ids are geom ids (background -1).
 
 ``subframes`` > 1 renders the colour that many times with sub-pixel jitter
 (a Halton(2, 3) pattern) and averages: anti-aliasing on a rasteriser, which is
 what Replicator's ``rt_subframes`` buys. Depth and ids come from the unjittered
 sample so labels stay crisp.
+
+:meth:`Rasterizer.render_isolated` draws the ids of a chosen set of geoms
+alone (every other geom hidden), cropped to a pixel rectangle of the same
+image: the unoccluded footprint of an object, which exact occlusion ratios and
+loose boxes are measured from.
 """
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
+from typing import Callable, Sequence
 
 import mujoco
 import numpy as np
@@ -29,7 +40,8 @@ from graphsdg.render.camera import CameraView
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
 from graphsdg.sim.scene import SimScene
 
-PASSES = ("color", "depth", "segmentation")
+PASSES = ("color", "hdr", "depth", "segmentation")
+Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)
 SKY_FAR_FACTOR = 2.0
 
 
@@ -38,8 +50,11 @@ class RenderOutputs:
     """What one render of one camera produced (each ``None`` if not requested)."""
 
     color: np.ndarray | None = None          # uint8 (H, W, 3)
+    hdr: np.ndarray | None = None            # float32 (H, W, 3), linear colour in [0, 1]
     depth: np.ndarray | None = None          # float32 (H, W), planar z, inf on background
     geom_ids: np.ndarray | None = None       # int32 (H, W), -1 on background
+    # Follow-up renders of the same view and state: (geom ids, crop) -> int32 ids of the crop
+    render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
 
 
 def halton(index: int, base: int) -> float:
@@ -70,6 +85,7 @@ class Rasterizer:
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FREE
         self._version = -1
         self._model: mujoco.MjModel | None = None
+        self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
 
     # ---- contexts ------------------------------------------------------
     def _ensure_gl(self) -> None:
@@ -98,6 +114,10 @@ class Rasterizer:
             for tid in sorted(sim.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
             sim.textures_to_upload.clear()
+        if sim.meshes_to_upload:
+            for mid in sorted(sim.meshes_to_upload):
+                mujoco.mjr_uploadMesh(model, self._mjr, mid)
+            sim.meshes_to_upload.clear()
 
     def close(self) -> None:
         if self._mjr is not None:
@@ -110,18 +130,14 @@ class Rasterizer:
             self._gl = None
 
     # ---- one render ----------------------------------------------------
-    def _update_scene(self, sim: SimScene, view: CameraView, jitter: tuple[float, float]) -> None:
+    def _update_scene(self, sim: SimScene, view: CameraView, jitter: tuple[float, float],
+                      crop: Crop | None = None) -> None:
         scene = self._scene
         assert scene is not None
         far = effective_far(sim.model, view)
         mujoco.mjv_updateScene(sim.model, sim.data, self._option, None, self._camera,
                                mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
-        near = view.near
-        half_w = near * view.horizontal_aperture / (2 * view.focal_length)
-        half_h = half_w * view.height / view.width
-        # Aperture offsets move the principal point; jitter moves it by a sub-pixel.
-        cx_shift = near * view.horizontal_aperture_offset / view.focal_length + jitter[0] * 2 * half_w / view.width
-        cy_shift = near * view.vertical_aperture_offset / view.focal_length - jitter[1] * 2 * half_h / view.height
+        left, right, bottom, top = view.frustum_window(crop, jitter)
         forward = -view.rotation[:, 2]
         up = view.rotation[:, 1]
         for i in range(2):
@@ -129,17 +145,17 @@ class Rasterizer:
             cam.pos[:] = view.position
             cam.forward[:] = forward
             cam.up[:] = up
-            cam.frustum_center = cx_shift
-            cam.frustum_width = half_w
-            cam.frustum_bottom = cy_shift - half_h
-            cam.frustum_top = cy_shift + half_h
-            cam.frustum_near = near
+            cam.frustum_center = 0.5 * (left + right)
+            cam.frustum_width = 0.5 * (right - left)
+            cam.frustum_bottom = bottom
+            cam.frustum_top = top
+            cam.frustum_near = view.near
             cam.frustum_far = SKY_FAR_FACTOR * far
             cam.orthographic = 1 if view.projection == "orthographic" else 0
         scene.enabletransform = 0
 
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1) -> RenderOutputs:
-        """Render the requested ``passes`` of ``view``."""
+        """Render the requested ``passes`` of ``view`` (only those: each pass costs a render)."""
         unknown = set(passes) - set(PASSES)
         if unknown:
             raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
@@ -150,48 +166,118 @@ class Rasterizer:
         if view.width > model.vis.global_.offwidth or view.height > model.vis.global_.offheight:
             raise ValueError(f"resolution {view.width}x{view.height} exceeds the offscreen buffer "
                              f"{model.vis.global_.offwidth}x{model.vis.global_.offheight}")
+        out = RenderOutputs()
+        colour = "color" in passes or "hdr" in passes
+        # Without MSAA the colour pass's depth buffer is sampled at pixel centres, so colour and
+        # depth come from one render; with MSAA it holds an off-centre sample, so depth is read
+        # from the (single-sample) id render instead.
+        depth_with_colour = colour and "depth" in passes and "segmentation" not in passes and \
+            int(model.vis.quality.offsamples) == 0
+        if colour:
+            rgb, linear, depth = self._render_color(sim, view, subframes, want_linear="hdr" in passes,
+                                                    want_depth=depth_with_colour)
+            out.color = rgb if "color" in passes else None
+            out.hdr = linear
+            out.depth = depth
+        if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
+            ids, depth = self._render_ids(sim, view, None, with_depth="depth" in passes)
+            out.geom_ids = ids if "segmentation" in passes else None
+            out.depth = depth
+        out.render_isolated = lambda geoms, crop: self.render_isolated(sim, view, geoms, crop)
+        return out
+
+    def _render_color(self, sim: SimScene, view: CameraView, subframes: int, want_linear: bool,
+                      want_depth: bool = False) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
         assert self._scene is not None and self._mjr is not None
         scene, ctx = self._scene, self._mjr
         w, h = view.width, view.height
         rect = mujoco.MjrRect(0, 0, w, h)
-        out = RenderOutputs()
         flags = scene.flags
-        if "color" in passes or "depth" in passes:
-            flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
-            flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
-            flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
-            flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
-            rgb = np.empty((h, w, 3), dtype=np.uint8)
-            depth = np.empty((h, w), dtype=np.float32)
-            self._update_scene(sim, view, (0.0, 0.0))
-            mujoco.mjr_render(rect, scene, ctx)
-            mujoco.mjr_readPixels(rgb, depth, rect, ctx)
-            if "color" in passes:
-                if subframes > 1:
-                    acc = rgb.astype(np.float32)
-                    for jit in jitter_offsets(subframes)[1:]:
-                        self._update_scene(sim, view, jit)
-                        mujoco.mjr_render(rect, scene, ctx)
-                        mujoco.mjr_readPixels(rgb, None, rect, ctx)
-                        acc += rgb
-                    rgb = np.rint(acc / subframes).astype(np.uint8)
-                out.color = np.ascontiguousarray(rgb[::-1])
-            if "depth" in passes:
-                far = effective_far(model, view)
-                out.depth = _linearize_depth(depth[::-1], view.near, SKY_FAR_FACTOR * far, far)
-        if "segmentation" in passes:
-            flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 1
-            flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 1
-            flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
-            flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
-            self._update_scene(sim, view, (0.0, 0.0))
+        flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
+        flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
+        flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
+        flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
+        rgb = np.empty((h, w, 3), dtype=np.uint8)
+        raw = np.empty((h, w), dtype=np.float32) if want_depth else None
+        self._update_scene(sim, view, (0.0, 0.0))
+        mujoco.mjr_render(rect, scene, ctx)
+        mujoco.mjr_readPixels(rgb, raw, rect, ctx)
+        self.stats["color"] += 1
+        depth = None
+        if raw is not None:
+            far = effective_far(sim.model, view)
+            depth = _linearize_depth(raw[::-1], view.near, SKY_FAR_FACTOR * far, far,
+                                     orthographic=view.projection == "orthographic")
+        linear = None
+        if subframes > 1:
+            acc = rgb.astype(np.float32)
+            for jit in jitter_offsets(subframes)[1:]:
+                self._update_scene(sim, view, jit)
+                mujoco.mjr_render(rect, scene, ctx)
+                mujoco.mjr_readPixels(rgb, None, rect, ctx)
+                self.stats["color"] += 1
+                acc += rgb
+            mean = acc / subframes
+            rgb = np.rint(mean).astype(np.uint8)
+            if want_linear:
+                linear = np.ascontiguousarray(mean[::-1] / np.float32(255))
+        elif want_linear:
+            linear = np.ascontiguousarray(rgb[::-1].astype(np.float32) / np.float32(255))
+        return np.ascontiguousarray(rgb[::-1]), linear, depth
+
+    def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None,
+                    with_depth: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        """Geom ids (and planar depth) of the view, or of a crop of it, top row first."""
+        assert self._scene is not None and self._mjr is not None
+        scene, ctx = self._scene, self._mjr
+        x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
+        w, h = x1 - x0, y1 - y0
+        rect = mujoco.MjrRect(0, 0, w, h)
+        flags = scene.flags
+        flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 1
+        flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 1
+        flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
+        flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+        try:
+            self._update_scene(sim, view, (0.0, 0.0), crop)
             mujoco.mjr_render(rect, scene, ctx)
             ids = np.empty((h, w, 3), dtype=np.uint8)
-            mujoco.mjr_readPixels(ids, None, rect, ctx)
-            out.geom_ids = _decode_segmentation(ids[::-1], scene)
+            raw = np.empty((h, w), dtype=np.float32) if with_depth else None
+            mujoco.mjr_readPixels(ids, raw, rect, ctx)
+        finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
-        return out
+        self.stats["ids" if crop is None else "isolated"] += 1
+        geom_ids = _decode_segmentation(ids[::-1], scene)
+        depth = None
+        if raw is not None:
+            far = effective_far(sim.model, view)
+            depth = _linearize_depth(raw[::-1], view.near, SKY_FAR_FACTOR * far, far,
+                                     orthographic=view.projection == "orthographic")
+        return geom_ids, depth
+
+    def render_isolated(self, sim: SimScene, view: CameraView, geoms: Sequence[int], crop: Crop) -> np.ndarray:
+        """Geom ids (H', W') of the ``crop`` of ``view`` with only ``geoms`` drawn (-1 elsewhere).
+
+        Every other geom is moved to the hidden group for this one render and put
+        back afterwards, so the result is the unoccluded footprint of ``geoms``.
+        """
+        x0, y0, x1, y1 = (int(c) for c in crop)
+        if not (0 <= x0 < x1 <= view.width and 0 <= y0 < y1 <= view.height):
+            raise ValueError(f"crop {crop} is not a non-empty rectangle inside {view.width}x{view.height}")
+        if self._model is not sim.model or self._version != sim.model_version:
+            self.bind(sim)   # normally bound (and current) already: this follows render() of the same view
+        model = sim.model
+        group = model.geom_group
+        saved = group.copy()
+        keep = np.zeros(model.ngeom, dtype=bool)
+        keep[np.asarray(list(geoms), dtype=np.int64)] = True
+        try:
+            group[~keep] = HIDDEN_GROUP
+            ids, _ = self._render_ids(sim, view, (x0, y0, x1, y1), with_depth=False)
+        finally:
+            group[:] = saved
+        return ids
 
 
 def effective_far(model: mujoco.MjModel, view: CameraView) -> float:
@@ -205,8 +291,13 @@ def effective_far(model: mujoco.MjModel, view: CameraView) -> float:
     return max(min(view.far, reach), view.near * 10)
 
 
-def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float) -> np.ndarray:
+def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
+                     orthographic: bool = False) -> np.ndarray:
     """Reversed-Z window depth -> planar z (the algebra of ``mujoco.Renderer``); beyond ``clip`` -> inf."""
+    if orthographic:   # window depth is linear: 1 at near, 0 at far
+        lin = (far - raw.astype(np.float64) * (far - near)).astype(np.float32)
+        lin[(raw <= 0.0) | (lin > clip)] = np.inf
+        return lin
     zfar, znear = np.float32(far), np.float32(near)
     c = -(zfar + znear) / (zfar - znear)
     d = -(np.float32(2) * zfar * znear) / (zfar - znear)

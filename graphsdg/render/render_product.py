@@ -86,6 +86,7 @@ class RenderProductRegistry:
 
     def __init__(self) -> None:
         self._products: list[RenderProduct] = []
+        self._destroyed: dict[str, RenderProduct] = {}   # path and name -> last destroyed product
 
     def __iter__(self):
         return iter(list(self._products))
@@ -109,6 +110,7 @@ class RenderProductRegistry:
     def remove(self, rp: RenderProduct) -> None:
         if rp in self._products:
             self._products.remove(rp)
+            self._destroyed[rp.path] = self._destroyed[rp.name] = rp
 
     def find(self, value: "RenderProduct | str") -> RenderProduct:
         if isinstance(value, RenderProduct):
@@ -117,6 +119,9 @@ class RenderProductRegistry:
         for rp in self._products:
             if value in (rp.path, rp.name):
                 return rp
+        gone = self._destroyed.get(value) if isinstance(value, str) else None
+        if gone is not None:
+            gone.check_alive()
         raise ValueError(f"no render product named or at path {value!r}; live products: "
                          f"{[p.path for p in self._products]}")
 

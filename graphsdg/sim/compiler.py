@@ -21,9 +21,15 @@ Mapping (USD -> MuJoCo):
   ``physxScene:timeStepsPerSecond`` the physics step; a ``PhysicsMaterialAPI``
   bound with the ``physics`` purpose sets friction.
 * ``UsdShade`` materials become MuJoCo materials; ``primvars:displayColor``
-  becomes the geom colour when no material is bound.
+  becomes the geom colour when no material is bound. A ``UsdUVTexture`` on
+  ``diffuseColor`` becomes a MuJoCo texture (decoded by
+  :mod:`graphsdg.sim.texture_images`, shared by every material naming the same
+  file), and a mesh's UV primvar becomes its texture coordinates
+  (:mod:`graphsdg.sim.texcoords`).
 * UsdLux lights become MuJoCo lights (see :mod:`graphsdg.sim.lights`); a dome
-  light becomes ambient light plus a soft sky light from above, and a skybox.
+  light becomes ambient light plus a soft sky light, and a skybox. A dome
+  texture (a lat-long HDR) is the skybox and sets the colour, strength and main
+  direction of that light (:mod:`graphsdg.sim.environment_map`).
 * cameras are not compiled: render products read USD cameras directly.
 
 The result, :class:`CompiledScene`, remembers which MuJoCo elements each prim
@@ -32,7 +38,6 @@ model.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import mujoco
@@ -40,8 +45,10 @@ import numpy as np
 from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
-from graphsdg.sim import colliders
+from graphsdg.sim import colliders, environment_map
 from graphsdg.sim import lights as lightmap
+from graphsdg.sim import texture_images
+from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import shapes
 from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
@@ -118,6 +125,7 @@ class CompiledScene:
     compile_seconds: float = 0.0
     collider_owner: dict[int, str] = field(default_factory=dict)   # colliding geom id -> body or prim path
     collider_prim: dict[int, str] = field(default_factory=dict)    # colliding geom id -> collider prim path
+    collider_paths: set[str] = field(default_factory=set)          # gprims that collide (own geom or proxies)
     probe_box: int = -1              # geom ids of the query probes
     probe_sphere: int = -1
 
@@ -289,10 +297,14 @@ class _Builder:
         self.body_mass: dict[str, tuple[float, float]] = {}
         self.mass_records: list[tuple] = []
         self.collider_records: list[tuple] = []
+        self.material_descs: dict[str, matlib.MaterialDesc] = {}
+        self.texture_names: dict[str, str] = {}       # texture file -> MuJoCo texture name
         self.mesh_count = 0
         self.has_lights = False
         self.ambient = np.zeros(3)
         self.sky_rgb: np.ndarray | None = None
+        self.sky_maps: list[tuple[environment_map.EnvironmentMap, np.ndarray, np.ndarray]] = []
+        self.sky_flat = np.zeros(3)                      # untextured domes' share of the background
 
     # ---- options -------------------------------------------------------
     def configure(self) -> None:
@@ -359,15 +371,41 @@ class _Builder:
         m.reflectance = 0.0
         m.emission = desc.emission
         if desc.texture:
-            if not os.path.isfile(desc.texture):
-                raise CompileError(f"material {path}: texture file {desc.texture!r} does not exist")
-            tex_name = f"tex:{path}"
-            self.spec.add_texture(name=tex_name, type=mujoco.mjtTexture.mjTEXTURE_2D, file=desc.texture)
-            m.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex_name
+            m.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = self.texture(desc.texture, path)
             m.texrepeat = [desc.texture_scale[0], desc.texture_scale[1]]
             m.texuniform = False
         self.material_names[path] = path
+        self.material_descs[path] = desc
         return path
+
+    def texture(self, file: str, material_path: str) -> str:
+        """The MuJoCo texture holding image ``file`` (added once, however many materials use it)."""
+        name = self.texture_names.get(file)
+        if name is not None:
+            return name
+        try:
+            rgb = texture_images.load_rgb(file)
+        except texture_images.TextureFileError as exc:
+            raise CompileError(f"material {material_path}: {exc}") from None
+        name = f"tex:{file}"
+        tex = self.spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, width=rgb.shape[1],
+                                    height=rgb.shape[0], nchannel=3)
+        tex.data = rgb.tobytes()
+        self.texture_names[file] = name
+        return name
+
+    def mesh_uvs(self, prim: Usd.Prim, material: str | None):
+        """Texture coordinates of Mesh ``prim`` for its bound material (UV set and transform), or None."""
+        desc = self.material_descs.get(material) if material else None
+        name, transform = None, None
+        if desc is not None and desc.texture:
+            name = desc.texture_primvar
+            transform = UvTransform(scale=desc.uv_scale, rotation=desc.uv_rotation + desc.texture_rotate,
+                                    translation=desc.uv_translation)
+        try:
+            return mesh_texcoords(prim, name, transform)
+        except TexcoordError as exc:
+            raise CompileError(str(exc)) from None
 
     # ---- geometry ------------------------------------------------------
     def body_for_rigid(self, root: Usd.Prim):
@@ -415,6 +453,10 @@ class _Builder:
             mesh_name = f"mesh:{path}"
             mesh = self.spec.add_mesh(name=mesh_name, uservert=(verts @ r.T + t).ravel().tolist(),
                                       userface=tris.ravel().tolist())
+            uvs = self.mesh_uvs(prim, material) if type_name == "Mesh" else None
+            if uvs is not None and len(uvs.face_texcoord) == len(tris):
+                mesh.usertexcoord = uvs.texcoord.ravel().tolist()
+                mesh.userfacetexcoord = uvs.face_texcoord.ravel().tolist()
             solid = dynamic and collides and not colliders.is_flat(verts)
             mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX if solid else \
                 mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
@@ -522,36 +564,52 @@ class _Builder:
     # ---- lights --------------------------------------------------------
     def add_light(self, prim: Usd.Prim) -> None:
         path = str(prim.GetPath())
+        self.has_lights = True   # even a hidden light means the user lights the stage
         if UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) == UsdGeom.Tokens.invisible:
             self.light_records.append((path, lightmap.LIGHT_KINDS[prim.GetTypeName()], []))
             return
         m = world_matrix(prim, self.cache)
         t, r, scale = decompose(m)
         params = lightmap.light_params(prim, scale)
-        self.has_lights = True
         wb = self.spec.worldbody
         made = []
         if params.kind == "dome":
-            self.ambient += 0.5 * params.color
+            color, direction = params.color, np.array([0.0, 0.0, -1.0])
+            if params.texture:
+                try:
+                    env = environment_map.load(params.texture)
+                except environment_map.EnvironmentMapError as exc:
+                    raise CompileError(f"dome light {path}: {exc}") from None
+                # The map tints and scales the dome: irradiance relative to a uniform sky of radiance 1.
+                color = params.color * env.up_irradiance / np.pi
+                self.sky_maps.append((env, r, params.color))     # display value of radiance 1
+                # Light mostly arrives from the map's bright side; keep it from grazing the floor.
+                d = r @ env.dominant_direction
+                d[2] = max(d[2], 0.5)
+                direction = -d / np.linalg.norm(d)
+            else:
+                self.sky_flat = self.sky_flat + params.color
+            self.ambient += 0.5 * color
             sky = wb.add_light(name=f"{path}#sky", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-                               pos=[0, 0, 10], dir=[0, 0, -1], castshadow=False)
-            _set_light_color(sky, 0.5 * params.color)
+                               pos=[0, 0, 10], dir=direction.tolist(), castshadow=False)
+            _set_light_color(sky, 0.5 * color)
             made.append(sky)
-            self.sky_rgb = params.color if self.sky_rgb is None else self.sky_rgb + params.color
+            self.sky_rgb = color if self.sky_rgb is None else self.sky_rgb + color
         elif params.kind == "distant":
             light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=t.tolist(),
                                  dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
             _set_light_color(light, params.color)
             made.append(light)
         else:
-            spot = params.kind in ("rect", "disk")
-            light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_SPOT if spot
-                                 else mujoco.mjtLightType.mjLIGHT_POINT,
-                                 pos=t.tolist(), dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
+            # MuJoCo's rasteriser draws spot and directional lights only: a spot with a
+            # 180-degree cutoff is OpenGL's omnidirectional point light (sphere, cylinder);
+            # rect and disk lights emit into the hemisphere below them with cosine falloff.
+            area = params.kind in ("rect", "disk")
+            light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_SPOT, pos=t.tolist(),
+                                 dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
             light.attenuation = [0.0, 0.0, 1.0]
-            if spot:
-                light.cutoff = 85.0
-                light.exponent = 1.0
+            light.cutoff = 90.0 if area else 180.0
+            light.exponent = 1.0 if area else 0.0
             _set_light_color(light, params.color)
             made.append(light)
         self.light_records.append((path, params.kind, made))
@@ -572,11 +630,32 @@ class _Builder:
         head.ambient = np.minimum(self.ambient, 10.0).tolist()
         head.diffuse = [0, 0, 0]
         head.specular = [0, 0, 0]
-        if self.sky_rgb is not None:
+        if self.sky_maps:
+            # Textured domes: the background is their maps (summed if several), in display units.
+            n = environment_map.FACE_SIZE
+            display = np.zeros((6 * n, n, 3), dtype=np.float32) + self.sky_flat.astype(np.float32)
+            for env, rotation, scale in self.sky_maps:
+                display += environment_map.skybox_faces(env, rotation, n) * scale.astype(np.float32)
+            tex = self.spec.add_texture(name=SKY_TEXTURE, type=mujoco.mjtTexture.mjTEXTURE_SKYBOX, width=n,
+                                        height=6 * n, nchannel=3)
+            tex.data = environment_map.tonemap(display).tobytes()
+        elif self.sky_rgb is not None:
             rgb = np.clip(self.sky_rgb, 0, 1)
             self.spec.add_texture(name=SKY_TEXTURE, type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
                                   builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb.tolist(), rgb2=rgb.tolist(),
                                   width=8, height=8)
+
+    def size_memory(self) -> None:
+        """Skip contact detection when nothing collides; give big scenes a big enough arena.
+
+        MuJoCo's broadphase scratch grows with the square of the body count, so
+        thousands of visual-only bodies would overflow the default arena for nothing.
+        """
+        colliding = bool(self.collider_records)     # proxy shapes collide for their visual geoms
+        if not colliding:
+            self.spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        nbody = len(self.geom_records) + len(self.body_records) + 1
+        self.spec.memory = max(16 << 20, 16 * nbody * nbody + (8 << 20)) if colliding else -1
 
     # ---- top level -----------------------------------------------------
     def build(self) -> CompiledScene:
@@ -596,6 +675,7 @@ class _Builder:
         self.finish_lighting()
         self.assign_masses()
         self.add_probes()
+        self.size_memory()
         try:
             model = self.spec.compile()
         except Exception as exc:
@@ -635,6 +715,7 @@ class _Builder:
             gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, shape.name)
             scene.collider_owner[gid] = owner
             scene.collider_prim[gid] = prim_path
+            scene.collider_paths.add(prim_path)
         scene.probe_box = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, PROBE_BOX)
         scene.probe_sphere = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, PROBE_SPHERE)
         if rescaled:

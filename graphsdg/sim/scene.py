@@ -30,6 +30,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size)
+from graphsdg.sim.mesh_scaling import rescale_mesh_geom
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
@@ -38,6 +39,34 @@ from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat
 
 class NeedsRecompile(Exception):
     """An edit that cannot be applied to compiled fields."""
+
+
+ALL_ASPECTS = frozenset({"pose", "shape", "visibility", "material", "color"})
+# Aspects an ancestor's edit passes down to the gprims below it.
+INHERITED_ASPECTS = frozenset({"pose", "visibility", "material"})
+_SHAPE_ATTRS = {"size", "radius", "height", "width", "length", "axis", "points", "faceVertexCounts",
+                "faceVertexIndices", "extent", "orientation", "primvars:st"}
+
+
+def edit_aspects(names: set[str]) -> set[str]:
+    """What a set of changed property names means for compiled geoms."""
+    aspects: set[str] = set()
+    for name in names:
+        if name.startswith("xformOp") or name == "xformOpOrder":
+            aspects.add("pose")
+        elif name == "visibility" or name == "purpose":
+            aspects.add("visibility")
+        elif name.startswith("material:binding"):
+            aspects.add("material")
+        elif name in ("primvars:displayColor", "primvars:displayOpacity"):
+            aspects.add("color")
+        elif name in _SHAPE_ATTRS:
+            aspects.add("shape")
+        elif name.startswith("semantic"):
+            continue   # labels are read by annotators, not compiled
+        else:
+            return set(ALL_ASPECTS)
+    return aspects
 
 
 class SimScene:
@@ -51,6 +80,7 @@ class SimScene:
         self.model_version = 0              # bumps on every recompile (renderers rebuild contexts)
         self.labels_version = 0             # bumps when semantic labels may have changed
         self.textures_to_upload: set[int] = set()
+        self.meshes_to_upload: set[int] = set()
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
@@ -98,6 +128,7 @@ class SimScene:
         self.model_version += 1
         self.labels_version += 1
         self.textures_to_upload.clear()
+        self.meshes_to_upload.clear()
         self.stats["compiles"] += 1
         self.stats["compile_s"] += time.perf_counter() - start
         for cb in list(self._on_recompile):
@@ -134,18 +165,27 @@ class SimScene:
         # Any prim added, removed, re-typed or given a new schema changes the model's shape.
         return bool(changes.structural)
 
-    def _affected(self, edited: set[Sdf.Path]) -> tuple[set[str], set[str], set[str], set[str]]:
-        """Split edited prim paths into affected geoms, lights, rigid bodies and materials."""
+    def _affected(self, edited: dict[Sdf.Path, set[str]]) -> tuple[dict, set[str], set[str], set[str]]:
+        """Which bound elements the edits touch: geoms (with the aspects to refresh), lights,
+        rigid bodies and materials."""
         c = self.compiled
         assert c is not None
-        geoms, lights, bodies, mats = set(), set(), set(), set()
-        edited_str = {str(p) for p in edited}
+        geoms: dict[str, set[str]] = {}
+        lights, bodies, mats = set(), set(), set()
         index = self._subtree_index()
-        for p in edited_str:
-            for key in index.get(p, ()):
-                kind, path = key
-                {"g": geoms, "l": lights, "b": bodies}[kind].add(path)
-            q = Sdf.Path(p)
+        for path, names in edited.items():
+            p = str(path)
+            aspects = edit_aspects(names)
+            inherited = aspects & INHERITED_ASPECTS
+            for kind, bound in index.get(p, ()):
+                own = bound == p
+                if kind == "g" and (own or inherited):
+                    geoms.setdefault(bound, set()).update(aspects if own else inherited)
+                elif kind == "l" and (own or inherited):
+                    lights.add(bound)
+                elif kind == "b" and "pose" in inherited:
+                    bodies.add(bound)
+            q = path
             while q != Sdf.Path.absoluteRootPath and not q.isEmpty:
                 if str(q) in c.materials:
                     mats.add(str(q))
@@ -177,8 +217,8 @@ class SimScene:
         cache = UsdGeom.XformCache(Usd.TimeCode.Default())
         for path in bodies:
             self._refresh_body(path, cache)
-        for path in geoms:
-            self._refresh_geom(path, cache)
+        for path, aspects in geoms.items():
+            self._refresh_geom(path, cache, aspects)
         for path in lights:
             self._refresh_light(path, cache)
         for path in mats:
@@ -208,7 +248,7 @@ class SimScene:
             c.data.qpos[b.qpos_adr + 3:b.qpos_adr + 7] = q
             c.data.qvel[b.qvel_adr:b.qvel_adr + 6] = 0.0   # a teleport, as in PhysX
 
-    def _refresh_geom(self, path: str, cache: UsdGeom.XformCache) -> None:
+    def _refresh_geom(self, path: str, cache: UsdGeom.XformCache, aspects: set[str] = ALL_ASPECTS) -> None:
         c = self.compiled
         assert c is not None
         prim = self.stage.GetPrimAtPath(path)
@@ -216,52 +256,57 @@ class SimScene:
             raise NeedsRecompile
         g = c.geoms[path]
         m, d = c.model, c.data
-        m_world = world_matrix(prim, cache)
-        if g.rigid_root is None:
-            t, r, scale = decompose(m_world)
-            d.mocap_pos[g.mocap_id] = t
-            d.mocap_quat[g.mocap_id] = matrix_to_quat_wxyz(r)
-        else:
-            root = self.stage.GetPrimAtPath(g.rigid_root)
-            t_root, r_root, _ = decompose(world_matrix(root, cache))
-            m_root = np.eye(4)
-            m_root[:3, :3] = r_root.T
-            m_root[3, :3] = t_root
-            t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
-        if g.relative is not None:
-            relative = np.eye(4)
-            relative[:3, :3] = r.T
-            relative[3, :3] = t
-            if not np.allclose(relative, g.relative, atol=1e-9):
-                raise NeedsRecompile   # a shape moved inside its rigid body: new mass distribution
-        if not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12) or g.rigid_root is not None:
-            if g.type_name in ("Mesh", "Cone") or g.rigid_root is not None:
-                if not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12):
-                    raise NeedsRecompile
+        if aspects & {"pose", "shape"}:
+            m_world = world_matrix(prim, cache)
+            if g.rigid_root is None:
+                t, r, scale = decompose(m_world)
+                d.mocap_pos[g.mocap_id] = t
+                d.mocap_quat[g.mocap_id] = matrix_to_quat_wxyz(r)
             else:
-                self._resize(prim, g)
-        elif g.type_name not in ("Mesh", "Cone"):
-            self._resize(prim, g)   # size/radius attribute edits
-        visible = UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible
-        m.geom_group[g.geom_id] = 0 if visible else HIDDEN_GROUP
-        g.visible = visible
-        material = matlib.bound_material(prim)
-        mat_path = str(material.GetPath()) if material is not None else None
-        if mat_path is not None:
-            if mat_path not in c.materials:
-                raise NeedsRecompile
-            m.geom_matid[g.geom_id] = c.materials[mat_path]
-            m.geom_rgba[g.geom_id] = MUJOCO_DEFAULT_RGBA
-        else:
-            m.geom_matid[g.geom_id] = -1
-            m.geom_rgba[g.geom_id] = display_rgba(prim)
-        g.material = mat_path
+                root = self.stage.GetPrimAtPath(g.rigid_root)
+                t_root, r_root, _ = decompose(world_matrix(root, cache))
+                m_root = np.eye(4)
+                m_root[:3, :3] = r_root.T
+                m_root[3, :3] = t_root
+                t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
+                relative = np.eye(4)
+                relative[:3, :3] = r.T
+                relative[3, :3] = t
+                if g.relative is not None and not np.allclose(relative, g.relative, atol=1e-9):
+                    raise NeedsRecompile   # a shape moved inside its rigid body: new mass distribution
+            rescaled = not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12)
+            if g.type_name in ("Mesh", "Cone") and g.rigid_root is None and "shape" not in aspects:
+                if rescaled:
+                    if np.any(np.abs(scale) < 1e-9) or path in c.collider_paths:
+                        raise NeedsRecompile   # colliding meshes carry hulls and inertia
+                    self.meshes_to_upload.add(rescale_mesh_geom(m, g.geom_id, g.scale, scale))
+                    g.scale = scale
+            elif g.type_name in ("Mesh", "Cone") or g.rigid_root is not None:
+                if "shape" in aspects or rescaled:
+                    raise NeedsRecompile   # vertices (or the body's inertia) change
+            elif "shape" in aspects or not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12):
+                self._resize(prim, g, scale)
+        if "visibility" in aspects:
+            visible = UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible
+            m.geom_group[g.geom_id] = 0 if visible else HIDDEN_GROUP
+            g.visible = visible
+        if aspects & {"material", "color"}:
+            material = matlib.bound_material(prim) if "material" in aspects or g.material else None
+            mat_path = str(material.GetPath()) if material is not None else None
+            if mat_path is not None:
+                if mat_path not in c.materials:
+                    raise NeedsRecompile
+                m.geom_matid[g.geom_id] = c.materials[mat_path]
+                m.geom_rgba[g.geom_id] = MUJOCO_DEFAULT_RGBA
+            else:
+                m.geom_matid[g.geom_id] = -1
+                m.geom_rgba[g.geom_id] = display_rgba(prim)
+            g.material = mat_path
 
-    def _resize(self, prim: Usd.Prim, g) -> None:
+    def _resize(self, prim: Usd.Prim, g, scale: np.ndarray) -> None:
         c = self.compiled
         assert c is not None
         m = c.model
-        _, r, scale = decompose(world_matrix(prim))
         kind, size, _ = primitive_size(prim, scale)
         kind = int(kind)
         if kind != int(m.geom_type[g.geom_id]):
@@ -354,7 +399,7 @@ class SimScene:
             mujoco.mj_step(m, d)
             steps += 1
         # mj_step leaves positions-derived quantities one step behind; renders,
-        # queries and contacts need them for the new state.
+        # queries and contacts need them (and the contacts) for the new state.
         mujoco.mj_forward(m, d)
         self.write_back_rigid_bodies()
 

@@ -23,11 +23,12 @@ class ChangeSet:
     """What changed on the stage since the last drain.
 
     ``structural``: prim paths whose subtree changed shape (needs a recompile).
-    ``edited``: prim paths whose attribute or relationship values changed.
+    ``edited``: prim path -> names of the properties whose values changed (``"*"``: the
+    prim itself changed in a way no property name describes).
     """
 
     structural: set[Sdf.Path] = field(default_factory=set)
-    edited: set[Sdf.Path] = field(default_factory=set)
+    edited: dict[Sdf.Path, set[str]] = field(default_factory=dict)
     semantics_changed: bool = False   # a semantics:* property changed (labels are re-read)
 
     def __bool__(self) -> bool:
@@ -47,22 +48,25 @@ class ChangeTracker:
         if self._muted:
             return
         for path in notice.GetResyncedPaths():
-            if path.IsPropertyPath() and path.name.startswith("semantic"):
-                self._pending.semantics_changed = True
-            if path.IsPropertyPath() and path.name.startswith(PHYSICS_PROPERTY_PREFIXES):
-                self._pending.structural.add(path.GetPrimPath())
-            elif path.IsPropertyPath():
+            if path.IsPropertyPath():
                 # A property that came into existence is a value edit of its prim.
-                self._pending.edited.add(path.GetPrimPath())
+                self._edit(path)
             else:
                 self._pending.structural.add(path)
         for path in notice.GetChangedInfoOnlyPaths():
-            if path.IsPropertyPath() and path.name.startswith("semantic"):
+            self._edit(path)
+
+    def _edit(self, path: Sdf.Path) -> None:
+        if path.IsPropertyPath():
+            name = path.name
+            if name.startswith("semantic"):
                 self._pending.semantics_changed = True
-            if path.IsPropertyPath() and path.name.startswith(PHYSICS_PROPERTY_PREFIXES):
+            if name.startswith(PHYSICS_PROPERTY_PREFIXES):
                 self._pending.structural.add(path.GetPrimPath())
-            else:
-                self._pending.edited.add(path.GetPrimPath() if path.IsPropertyPath() else path)
+                return
+            self._pending.edited.setdefault(path.GetPrimPath(), set()).add(name)
+        else:
+            self._pending.edited.setdefault(path, set()).add("*")
 
     @contextlib.contextmanager
     def muted(self) -> Iterator[None]:

@@ -5,7 +5,9 @@ Per frame ``n`` (zero-padded to ``frame_padding``) and per enabled flag:
 ``_prim_paths_{n}.json``; ``semantic_segmentation_{n}.png`` with
 ``semantic_segmentation_labels_{n}.json``; ... With several render products
 each file goes to ``<rp_name>/<annotator>/`` (or ``<annotator>/<rp_name>_`` with
-``use_common_output_dir=True``).
+``use_common_output_dir=True``). With ``provenance=True`` it also writes
+``provenance_{n}.json``: the values the graph sampled, by node name, with the
+frame each was drawn on and the ``trigger_outputs``.
 
 Example:
     >>> import graphsdg as rep, tempfile
@@ -19,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from graphsdg.annotate.annotator import AnnotatorRegistry
+from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
 from graphsdg.io.backends import BackendDispatch, BackendGroup, BaseBackend
 from graphsdg.io.writer import Writer
@@ -46,25 +49,6 @@ _SEMANTIC = {"bounding_box_2d_tight", "bounding_box_2d_loose", "semantic_segment
 IMAGE_FORMATS = ("png", "jpg", "jpeg")
 
 
-def semantic_types_from_predicate(predicate: str) -> list[str]:
-    """The types of a ``"class:*; foo:*"`` filter predicate (label-level filters are not parsed)."""
-    types = []
-    for clause in str(predicate).split(";"):
-        clause = clause.strip()
-        if not clause:
-            continue
-        if ":" not in clause:
-            raise ValueError(f"semantic_filter_predicate clause {clause!r} must look like 'type:*'")
-        sem_type, labels = (s.strip() for s in clause.split(":", 1))
-        if labels != "*" or not sem_type or sem_type == "*":
-            raise ValueError(f"semantic_filter_predicate clause {clause!r}: only 'type:*' clauses are "
-                             f"supported by graphsdg's BasicWriter")
-        types.append(sem_type)
-    if not types:
-        raise ValueError(f"semantic_filter_predicate {predicate!r} names no semantic type")
-    return types
-
-
 class BasicWriter(Writer):
     """Replicator's BasicWriter (see the module docstring for the files it writes)."""
 
@@ -80,7 +64,7 @@ class BasicWriter(Writer):
                  colorize_instance_id_segmentation: bool = True, colorize_instance_segmentation: bool = True,
                  colorize_depth: bool = False, skeleton_data: bool = False, frame_padding: int = 4,
                  semantic_filter_predicate: str | None = None, use_common_output_dir: bool = False,
-                 backend: BaseBackend | None = None) -> None:
+                 backend: BaseBackend | None = None, provenance: bool = False) -> None:
         if s3_bucket or s3_region or s3_endpoint:
             raise ValueError("BasicWriter: S3 output is not available in graphsdg; pass output_dir or backend")
         if output_dir is None and backend is None:
@@ -91,9 +75,15 @@ class BasicWriter(Writer):
         if isinstance(frame_padding, bool) or not isinstance(frame_padding, int) or frame_padding < 0:
             raise ValueError(f"frame_padding must be a non-negative integer, got {frame_padding!r}")
         if semantic_types is not None and semantic_filter_predicate is not None:
-            raise ValueError("BasicWriter: pass semantic_types or semantic_filter_predicate, not both")
-        types = list(semantic_types) if semantic_types is not None else (
-            semantic_types_from_predicate(semantic_filter_predicate) if semantic_filter_predicate else ["class"])
+            raise ValueError(f"BasicWriter: `semantic_types` ({semantic_types!r}) and `semantic_filter_predicate` "
+                             f"({semantic_filter_predicate!r}) are mutually exclusive; pass one")
+        if semantic_filter_predicate is not None:
+            semantic_filter = SemanticFilter.parse(semantic_filter_predicate)
+        elif semantic_types is not None:
+            semantic_filter = SemanticFilter.from_types(semantic_types)
+        else:
+            semantic_filter = SemanticFilter.parse("class:*")
+        self.semantic_filter_predicate = semantic_filter.text
         self.version = "0.0.2"
         self.data_structure = "annotator"
         backends = [backend] if backend is not None else []
@@ -110,6 +100,7 @@ class BasicWriter(Writer):
                           "instance_id_segmentation": colorize_instance_id_segmentation,
                           "instance_segmentation": colorize_instance_segmentation}
         self._colorize_depth = colorize_depth
+        self._provenance = bool(provenance)
         flags = {"rgb": rgb, "bounding_box_2d_tight": bounding_box_2d_tight,
                  "bounding_box_2d_loose": bounding_box_2d_loose, "semantic_segmentation": semantic_segmentation,
                  "instance_id_segmentation": instance_id_segmentation,
@@ -125,8 +116,8 @@ class BasicWriter(Writer):
             anno_name, stem = _FLAGS[flag]
             spec = AnnotatorRegistry.resolve(anno_name)   # clear error if not available
             params: dict[str, Any] = {}
-            if flag in _SEMANTIC and "semanticTypes" in spec.defaults:
-                params["semanticTypes"] = types
+            if flag in _SEMANTIC and "semanticFilter" in spec.defaults:
+                params["semanticFilter"] = semantic_filter.text
             if flag in self._colorize and "colorize" in spec.defaults:
                 params["colorize"] = self._colorize[flag]
             if flag == "pointcloud" and "includeUnlabelled" in spec.defaults:
@@ -160,6 +151,11 @@ class BasicWriter(Writer):
             stem = self._stems.get(anno_name, anno_name[:-5] if anno_name.endswith("_fast") else anno_name)
             for rp_name, payload in per_rp.items():
                 self._write_one(stem, rp_name, multi, payload)
+        if self._provenance:
+            record = dict(data.get("provenance") or {})
+            record["trigger_outputs"] = dict(data.get("trigger_outputs", {}))
+            self.backend.schedule(iof.write_json, data=record,
+                                  path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
         self.num_written += 1
 
@@ -193,15 +189,38 @@ class BasicWriter(Writer):
             b.schedule(iof.write_image, data=colorize_normals(arr), path=f"{path()}.png")
         elif stem == "pointcloud":
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
-            for key, suffix in (("pointRgb", "_rgb"), ("pointNormals", "_normals"),
-                                ("pointSemantic", "_semantic"), ("pointInstance", "_instance")):
-                if key in payload:
-                    b.schedule(iof.write_np, data=payload[key], path=f"{path(suffix)}.npy")
+            b.schedule(iof.write_np, data=np.asarray(payload["pointRgb"]).reshape(-1, 4), path=f"{path('_rgb')}.npy")
+            b.schedule(iof.write_np, data=np.asarray(payload["pointNormals"]).reshape(-1, 4),
+                       path=f"{path('_normals')}.npy")
+            b.schedule(iof.write_np, data=payload["pointSemantic"], path=f"{path('_semantic')}.npy")
+            b.schedule(iof.write_np, data=payload["pointInstance"], path=f"{path('_instance')}.npy")
         elif stem == "skeleton":
-            b.schedule(iof.write_json, data={k: v for k, v in payload.items() if k != "data"},
-                       path=f"{path()}.json")
+            b.schedule(iof.write_json, data=skeleton_json(payload), path=f"{path()}.json")
         else:
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+
+
+def skeleton_json(payload: dict) -> dict:
+    """Replicator's ``skeleton_{n}.json``: ``{"skeleton_<i>": {snake_case fields}}`` split per skeleton."""
+    out = {}
+    sizes = np.asarray(payload["skeletonParentsSizes"], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    per_joint = {"skeleton_parents": "skeletonParents", "rest_global_translations": "restGlobalTranslations",
+                 "rest_local_translations": "restLocalTranslations", "rest_local_rotations": "restLocalRotations",
+                 "global_translations": "globalTranslations", "local_rotations": "localRotations",
+                 "translations_2d": "translations2d", "skeleton_joints": "skeletonJoints",
+                 "joint_occlusions": "jointOcclusions"}
+    for i in range(int(payload["numSkeletons"])):
+        lo, hi = int(starts[i]), int(starts[i + 1])
+        entry = {"skel_name": payload["skelName"][i], "skel_path": payload["skelPath"][i],
+                 "asset_path": payload["assetPath"][i], "animation_variant": payload["animationVariant"][i]}
+        for key, src in per_joint.items():
+            entry[key] = np.asarray(payload[src][lo:hi]).tolist() if key != "skeleton_joints" \
+                else list(payload[src][lo:hi])
+        entry["occlusion_types"] = payload["occlusionTypes"][i]
+        entry["in_view"] = bool(payload["inView"][i])
+        out[f"skeleton_{i}"] = entry
+    return out
 
 
 def colorize_depth(depth: np.ndarray) -> np.ndarray:

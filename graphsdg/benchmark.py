@@ -1,0 +1,354 @@
+"""The SDG throughput benchmark: Isaac Sim's ``benchmark_sdg.py`` scene, and the floor to beat.
+
+Scene (Isaac Sim 6.0's benchmark, rebuilt): ``asset_count`` each of cube, cone,
+cylinder, sphere and torus (1 m primitives, ``class=<shape>``), a distant light
+(2000) and a dome light (400), no floor; per frame every asset gets a uniform
+position in [-3, 3]^3, Euler rotation in [0, 360)^3, one uniform scale in
+[0.1, 1] and a random display colour, and every camera a position in [5, 10]^3
+looking at the origin. ``frames`` timed captures follow ``warmup`` untimed ones.
+
+The *hand-written loop* is what a user would write with MuJoCo alone over the
+same compiled model: set the arrays, ``mujoco.Renderer`` colour / depth /
+segmentation renders per camera, tight boxes from the ids, and PNG/NPY writes
+with OpenCV on a thread pool of the same size. Both run in one process, one
+after the other, and the report gives their ratio.
+
+Example:
+    >>> from graphsdg.benchmark import BenchConfig, run_graphsdg
+    >>> result = run_graphsdg(BenchConfig(frames=2, warmup=1, asset_count=1, resolution=(64, 48),
+    ...                                   skip_write=True))
+    >>> result.frames
+    2
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import os
+import resource
+import tempfile
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+SHAPES = ("cube", "cone", "cylinder", "sphere", "torus")
+# benchmark_sdg.py annotator names -> BasicWriter flags
+ANNOTATOR_FLAGS = {
+    "rgb": "rgb", "bounding_box_2d_tight_fast": "bounding_box_2d_tight",
+    "bounding_box_2d_tight": "bounding_box_2d_tight", "bounding_box_2d_loose_fast": "bounding_box_2d_loose",
+    "bounding_box_2d_loose": "bounding_box_2d_loose", "semantic_segmentation": "semantic_segmentation",
+    "instance_id_segmentation_fast": "instance_id_segmentation",
+    "instance_id_segmentation": "instance_id_segmentation",
+    "instance_segmentation_fast": "instance_segmentation", "instance_segmentation": "instance_segmentation",
+    "distance_to_camera": "distance_to_camera", "distance_to_image_plane": "distance_to_image_plane",
+    "bounding_box_3d_fast": "bounding_box_3d", "bounding_box_3d": "bounding_box_3d", "occlusion": "occlusion",
+    "normals": "normals", "motion_vectors": "motion_vectors", "camera_params": "camera_params",
+    "pointcloud": "pointcloud",
+}
+
+
+@dataclass
+class BenchConfig:
+    """The benchmark's knobs, mirroring ``benchmark_sdg.py`` flags."""
+
+    frames: int = 600
+    warmup: int = 10
+    num_cameras: int = 1
+    resolution: tuple[int, int] = (1280, 720)
+    asset_count: int = 10
+    annotators: tuple[str, ...] = ("rgb",)
+    skip_write: bool = False
+    rt_subframes: int = -1
+    wait_for_render: bool = True
+    write_to_fabric: bool = True
+    seed: int = 11
+    out_dir: str | None = None
+    write_threads: int = 4
+
+
+@dataclass
+class BenchResult:
+    """Timing of one run."""
+
+    label: str
+    frames: int
+    cameras: int
+    frame_times: list[float] = field(default_factory=list)
+    wall_seconds: float = 0.0
+    drain_seconds: float = 0.0
+    peak_rss_mb: float = 0.0
+    profile: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def fps(self) -> float:
+        return self.frames / self.wall_seconds if self.wall_seconds else 0.0
+
+    @property
+    def fps_with_drain(self) -> float:
+        total = self.wall_seconds + self.drain_seconds
+        return self.frames / total if total else 0.0
+
+    @property
+    def images_per_second(self) -> float:
+        return self.fps * self.cameras
+
+    def summary(self) -> dict[str, float | str]:
+        ft = np.array(self.frame_times) * 1000 if self.frame_times else np.zeros(1)
+        return {"run": self.label, "frames/s": round(self.fps, 2), "images/s": round(self.images_per_second, 2),
+                "frames/s incl. drain": round(self.fps_with_drain, 2), "min ms": round(float(ft.min()), 2),
+                "mean ms": round(float(ft.mean()), 2), "max ms": round(float(ft.max()), 2),
+                "peak RSS MB": round(self.peak_rss_mb, 1)}
+
+
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+class Randomization:
+    """The per-frame draws, shared by both loops so they render the same frames."""
+
+    def __init__(self, config: BenchConfig) -> None:
+        self.n = config.asset_count * len(SHAPES)
+        self.cameras = config.num_cameras
+        self.rng = np.random.default_rng(config.seed)
+
+    def draw(self) -> dict[str, np.ndarray]:
+        g, n = self.rng, self.n
+        return {"position": g.uniform(-3, 3, (n, 3)), "rotation": g.uniform(0, 360, (n, 3)),
+                "scale": g.uniform(0.1, 1.0, (n, 1)).repeat(3, 1), "color": g.uniform(0, 1, (n, 3)),
+                "camera": g.uniform(5, 10, (self.cameras, 3))}
+
+
+def build_scene(config: BenchConfig):
+    """The benchmark stage; returns (asset prims, camera prims, render products)."""
+    import graphsdg as rep
+
+    rep.stage.new_stage()
+    rep.set_global_seed(config.seed)
+    rep.orchestrator.set_capture_on_play(False)
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", config.write_to_fabric)
+    rep.functional.create.xform(name="World")
+    rep.functional.create.distant_light(intensity=2000, parent="/World", name="DistantLight", rotation=(315, 0, 0))
+    rep.functional.create.dome_light(intensity=400, parent="/World", name="DomeLight")
+    assets = []
+    for shape in SHAPES:
+        assets += getattr(rep.functional.create_batch, shape)(count=config.asset_count, parent="/World",
+                                                               name=shape.capitalize(),
+                                                               semantics={"class": shape})
+    cams = [rep.functional.create.camera(position=(7.5, 7.5, 7.5), look_at=(0, 0, 0), parent="/World",
+                                         name=f"Camera_{i}") for i in range(config.num_cameras)]
+    rps = [rep.create.render_product(c, config.resolution, name=f"rp_{i}") for i, c in enumerate(cams)]
+    return assets, cams, rps
+
+
+def _apply(draw: dict[str, np.ndarray], assets, cams) -> None:
+    import graphsdg as rep
+
+    rep.functional.modify.pose(assets, position_value=draw["position"], rotation_value=draw["rotation"],
+                               scale_value=draw["scale"])
+    rep.functional.modify.display_color(assets, draw["color"])
+    for cam, pos in zip(cams, draw["camera"]):
+        rep.functional.modify.pose(cam, position_value=pos, look_at_value=(0.0, 0.0, 0.0),
+                                   look_at_up_axis=(0.0, 0.0, 1.0))
+
+
+def run_graphsdg(config: BenchConfig) -> BenchResult:
+    """Time graphsdg on the benchmark scene."""
+    import graphsdg as rep
+    from graphsdg.io.write_queue import reset_write_queue
+
+    rep.settings.set("/omni/replicator/backend/writeThreads", config.write_threads)
+    reset_write_queue()
+    assets, cams, rps = build_scene(config)
+    flags = {ANNOTATOR_FLAGS[a]: True for a in config.annotators}
+    tmp = None
+    if config.skip_write:
+        annotators = [rep.annotators.get(a) for a in config.annotators]
+        for a in annotators:
+            a.attach(rps)
+        writer = None
+    else:
+        out = config.out_dir or (tmp := tempfile.mkdtemp(prefix="graphsdg_bench_"))
+        writer = rep.writers.get("BasicWriter")
+        writer.initialize(output_dir=out, **flags)
+        writer.attach(rps)
+    draws = Randomization(config)
+    result = BenchResult(label="graphsdg", frames=config.frames, cameras=config.num_cameras)
+    for _ in range(config.warmup):
+        _apply(draws.draw(), assets, cams)
+        rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
+    rep.orchestrator.wait_until_complete()
+    rep.orchestrator.reset_profile()
+    start = last = time.perf_counter()
+    for _ in range(config.frames):
+        _apply(draws.draw(), assets, cams)
+        rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
+        now = time.perf_counter()
+        result.frame_times.append(now - last)
+        last = now
+    result.wall_seconds = time.perf_counter() - start
+    t = time.perf_counter()
+    rep.orchestrator.wait_until_complete()
+    result.drain_seconds = time.perf_counter() - t
+    result.profile = rep.orchestrator.get_profile()
+    result.peak_rss_mb = _peak_rss_mb()
+    if writer is not None:
+        writer.detach()
+    for rp in rps:
+        rp.destroy()
+    if tmp:
+        import shutil
+        shutil.rmtree(tmp, ignore_errors=True)
+    return result
+
+
+def run_handwritten(config: BenchConfig) -> BenchResult:
+    """Time the plain MuJoCo loop a user would write, over graphsdg's compiled model of the same scene."""
+    import cv2
+    import mujoco
+
+    import graphsdg as rep  # noqa: F401  (EGL selection)
+    from graphsdg.runtime import runtime
+
+    assets, cams, rps = build_scene(config)
+    sim = runtime().sim
+    model = sim.ensure_compiled().model
+    data = sim.data
+    geoms = [sim.compiled.geoms[str(p.GetPath())] for p in assets]
+    mocap = np.array([g.mocap_id for g in geoms])
+    geom_ids = np.array([g.geom_id for g in geoms])
+    unit_size = model.geom_size[geom_ids].copy()
+    is_mesh = np.array([g.type_name in ("Mesh", "Cone") for g in geoms])
+    w, h = config.resolution
+    model.vis.global_.offwidth, model.vis.global_.offheight = max(w, 64), max(h, 64)
+    vfov = np.degrees(2 * np.arctan(20.955 / 24.0 / 2 * h / w))
+    model.vis.global_.fovy = vfov
+    renderer = mujoco.Renderer(model, h, w)
+    want = set(config.annotators)
+    need_depth = bool(want & {"distance_to_image_plane", "distance_to_camera"})
+    need_seg = bool(want - {"rgb", "distance_to_image_plane", "distance_to_camera"})
+    pool = concurrent.futures.ThreadPoolExecutor(config.write_threads)
+    tmp = tempfile.mkdtemp(prefix="mujoco_bench_")
+    pending: list[concurrent.futures.Future] = []
+    draws = Randomization(config)
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    labels = np.append(np.repeat(np.arange(len(SHAPES)), config.asset_count), -1)
+    geom_to_asset = np.full(model.ngeom + 1, -1)
+    geom_to_asset[geom_ids] = np.arange(len(assets))
+
+    def write(path, payload):
+        if path.endswith(".png"):
+            ok, buf = cv2.imencode(".png", payload)
+            open(path, "wb").write(buf.tobytes())
+        else:
+            np.save(path, payload)
+
+    def frame(draw, index):
+        data.mocap_pos[mocap] = draw["position"]
+        for mid, rot in zip(mocap, draw["rotation"]):
+            quat = np.empty(4)
+            mujoco.mju_euler2Quat(quat, np.radians(rot), "XYZ")
+            data.mocap_quat[mid] = quat
+        model.geom_size[geom_ids[~is_mesh]] = unit_size[~is_mesh] * draw["scale"][~is_mesh, :1]
+        model.geom_rgba[geom_ids, :3] = draw["color"]
+        mujoco.mj_kinematics(model, data)
+        for c, pos in enumerate(draw["camera"]):
+            d = np.linalg.norm(pos)
+            cam.lookat[:] = 0
+            cam.distance = d
+            cam.azimuth = np.degrees(np.arctan2(pos[1], pos[0])) + 180
+            cam.elevation = -np.degrees(np.arcsin(pos[2] / d))
+            renderer.disable_depth_rendering()
+            renderer.disable_segmentation_rendering()
+            renderer.update_scene(data, cam)
+            rgb = renderer.render()
+            if not config.skip_write:
+                pending.append(pool.submit(write, f"{tmp}/rgb_{c}_{index}.png", rgb[..., ::-1].copy()))
+            if need_depth:
+                renderer.enable_depth_rendering()
+                depth = renderer.render()
+                renderer.disable_depth_rendering()
+                if not config.skip_write:
+                    pending.append(pool.submit(write, f"{tmp}/depth_{c}_{index}.npy", depth))
+            if need_seg:
+                renderer.enable_segmentation_rendering()
+                seg = renderer.render()
+                renderer.disable_segmentation_rendering()
+                ids = np.where(seg[..., 1] == mujoco.mjtObj.mjOBJ_GEOM, seg[..., 0], -1)
+                inst = geom_to_asset[ids]
+                flat = inst.ravel()
+                sel = np.nonzero(flat >= 0)[0]
+                ys, xs = np.divmod(sel, w)
+                k = flat[sel]
+                n = len(assets)
+                boxes = np.stack([np.full(n, w), np.full(n, h), np.full(n, -1), np.full(n, -1)], 1)
+                np.minimum.at(boxes[:, 0], k, xs)
+                np.minimum.at(boxes[:, 1], k, ys)
+                np.maximum.at(boxes[:, 2], k, xs)
+                np.maximum.at(boxes[:, 3], k, ys)
+                if not config.skip_write:
+                    sem = (labels[inst] + 2).astype(np.uint16)
+                    pending.append(pool.submit(write, f"{tmp}/seg_{c}_{index}.png", sem))
+                    pending.append(pool.submit(write, f"{tmp}/boxes_{c}_{index}.npy", boxes))
+
+    result = BenchResult(label="hand-written MuJoCo loop", frames=config.frames, cameras=config.num_cameras)
+    for i in range(config.warmup):
+        frame(draws.draw(), -1 - i)
+    concurrent.futures.wait(pending)
+    pending.clear()
+    start = last = time.perf_counter()
+    for i in range(config.frames):
+        frame(draws.draw(), i)
+        while len(pending) > 1000:          # the same bounded queue as graphsdg's writer pool
+            pending.pop(0).result()
+        now = time.perf_counter()
+        result.frame_times.append(now - last)
+        last = now
+    result.wall_seconds = time.perf_counter() - start
+    t = time.perf_counter()
+    for f in pending:
+        f.result()
+    result.drain_seconds = time.perf_counter() - t
+    result.peak_rss_mb = _peak_rss_mb()
+    pool.shutdown()
+    renderer.close()
+    import shutil
+    shutil.rmtree(tmp, ignore_errors=True)
+    for rp in rps:
+        rp.destroy()
+    return result
+
+
+def run_pair(config: BenchConfig) -> tuple[BenchResult, BenchResult]:
+    """graphsdg, then the hand-written loop, in this process."""
+    return run_graphsdg(config), run_handwritten(config)
+
+
+def _worker(config_dict: dict) -> dict:
+    config = BenchConfig(**config_dict)
+    r = run_graphsdg(config)
+    return {"frames": r.frames, "wall": r.wall_seconds, "drain": r.drain_seconds}
+
+
+def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
+    """``processes`` independent graphsdg benchmark processes at once (seeds differ); aggregate frames/s."""
+    ctx = __import__("multiprocessing").get_context("spawn")
+    configs = [dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)) for i in range(processes)]
+    start = time.perf_counter()
+    with concurrent.futures.ProcessPoolExecutor(processes, mp_context=ctx) as ex:
+        results = list(ex.map(_worker, configs))
+    elapsed = time.perf_counter() - start
+    per_process = [r["frames"] / r["wall"] for r in results]
+    return {"processes": processes, "aggregate frames/s (sum of per-process)": round(sum(per_process), 1),
+            "slowest process frames/s": round(min(per_process), 1), "wall s (incl. start-up)": round(elapsed, 1),
+            "cpu count": os.cpu_count() or 0}
+
+
+def format_table(rows: list[dict]) -> str:
+    """A Markdown table of dict rows (same keys)."""
+    cols = list(rows[0])
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    lines += ["| " + " | ".join(str(r[c]) for c in cols) + " |" for r in rows]
+    return "\n".join(lines)

@@ -1,0 +1,1 @@
+"""Reading, checking and looking at datasets graphsdg wrote."""

@@ -1,0 +1,34 @@
+"""The node graph: Replicator's declarative graph API rebuilt on networkx.
+
+* :mod:`~graphsdg.graph.node`: :class:`Node`, typed :class:`Port` s, :class:`TriggerNode`;
+* :mod:`~graphsdg.graph.registry`: :class:`NodeRegistry` of node types (the library lives in ``nodes/``);
+* :mod:`~graphsdg.graph.graph`: the ``networkx.DiGraph`` of data dependencies, order and stable ids;
+* :mod:`~graphsdg.graph.builder`: items, ``with`` scopes, ``new_layer``;
+* :mod:`~graphsdg.graph.scheduler`: per-step trigger firing, execution, provenance, seek;
+* :mod:`~graphsdg.graph.export` and :mod:`~graphsdg.graph.dry_run`: seeing the graph.
+
+Example:
+    >>> import graphsdg as rep
+    >>> _ = rep.stage.new_stage()
+    >>> with rep.trigger.on_frame(max_execs=2):
+    ...     _ = rep.create.cube(position=rep.distribution.uniform((-1, -1, 0), (1, 1, 0)))
+    >>> rep.graph.current_graph().triggers[0].name
+    'on_frame'
+    >>> rep.graph.clear()
+"""
+from graphsdg.graph import scheduler
+from graphsdg.graph.builder import (GraphBuildError, ReplicatorItem, current_graph, new_layer,
+                                    remove_prim_specs)
+from graphsdg.graph.dry_run import DryRunReport, dry_run
+from graphsdg.graph.export import describe, to_dict, to_dot, to_json, to_networkx
+from graphsdg.graph.graph import REPLICATOR_ROOT, Graph
+from graphsdg.graph.node import ExecContext, Node, Port, TriggerNode
+from graphsdg.graph.registry import NodeRegistry, register_node
+from graphsdg.graph.scheduler import clear, seek
+
+scheduler.install()
+
+__all__ = ["Node", "Port", "TriggerNode", "ExecContext", "NodeRegistry", "register_node", "Graph", "ReplicatorItem",
+           "GraphBuildError", "current_graph", "new_layer", "describe", "to_dict", "to_dot", "to_json",
+           "to_networkx", "dry_run", "DryRunReport", "clear", "seek", "remove_prim_specs", "REPLICATOR_ROOT",
+           "scheduler"]

@@ -1,0 +1,208 @@
+"""The node model: typed ports, the :class:`Node` base class and its execution context.
+
+A node type declares its ``inputs`` and ``outputs`` as :class:`Port` s and
+implements :meth:`Node.compute`. An input holds either a plain value or a
+reference to another node's output (an :class:`~graphsdg.graph.builder.ReplicatorItem`);
+references become the data edges of the graph.
+
+Example:
+    >>> from graphsdg.graph import Node, Port, NodeRegistry
+    >>> class Double(Node):
+    ...     type_name = "example.double"
+    ...     inputs = {"x": Port(float, default=1.0)}
+    ...     outputs = {"y": Port(float)}
+    ...     def compute(self, ctx):
+    ...         return {"y": 2 * ctx.value("x")}
+    >>> Double(x=3.0).values
+    {'x': 3.0}
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+from pxr import Usd
+
+from graphsdg import rng as rnglib
+
+if TYPE_CHECKING:  # pragma: no cover
+    from graphsdg.graph.graph import Graph
+
+FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer")
+
+
+@dataclass(frozen=True)
+class Port:
+    """One typed input or output of a node type.
+
+    ``type`` is informative (``"prims"``, ``float``, ``"vec3"``, ``"samples"``, ...);
+    ``required`` inputs must be given; ``default`` applies otherwise.
+    """
+
+    type: Any = object
+    default: Any = None
+    required: bool = False
+    doc: str = ""
+
+
+class Node:
+    """Base class of every node type.
+
+    Subclasses set ``type_name`` (unique, e.g. ``"distribution.uniform"``),
+    ``family`` (one of :data:`FAMILIES`), ``inputs`` and ``outputs``, and implement
+    :meth:`compute`. :meth:`setup` runs once when the node is added to a graph
+    (create nodes make their prims there).
+    """
+
+    type_name: ClassVar[str] = ""
+    family: ClassVar[str] = ""
+    inputs: ClassVar[dict[str, Port]] = {}
+    outputs: ClassVar[dict[str, Port]] = {}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        unknown = sorted(set(values) - set(self.inputs))
+        if unknown:
+            raise TypeError(f"{self.type_name} got unknown input(s) {unknown}; its inputs are {sorted(self.inputs)}")
+        missing = [k for k, p in self.inputs.items() if p.required and values.get(k) is None]
+        if missing:
+            raise TypeError(f"{self.type_name} needs input(s) {missing}")
+        self.values: dict[str, Any] = {k: v for k, v in values.items()}
+        self.user_name = name
+        self.name: str = name or ""          # unique in its graph; set when added
+        self.graph: "Graph | None" = None
+        self.trigger: "Node | None" = None   # the trigger node gating this node (None: runs once)
+        self.layer = None                    # the Sdf.Layer its edits go to (rep.new_layer), if any
+        self.seq = -1                        # build order in its graph
+        self.stable_id = ""                  # set when the graph's order is computed
+        self.exec_count = 0                  # executions so far
+        self.last_frame = -1                 # the frame of the last execution
+        self.output_values: dict[str, Any] = {}
+        self.record: dict[str, Any] = {}     # values sampled in the last execution (provenance)
+
+    def value_of(self, port: str) -> Any:
+        """The raw value given for ``port`` (its default if not given)."""
+        if port in self.values and self.values[port] is not None:
+            return self.values[port]
+        return self.inputs[port].default
+
+    def setup(self, ctx: "ExecContext") -> None:
+        """Run once when the node joins a graph (before any execution)."""
+
+    def compute(self, ctx: "ExecContext") -> dict[str, Any] | None:
+        """Run one execution; return the output values by port name."""
+        return None
+
+    def summary(self) -> dict[str, Any]:
+        """The node's plain inputs, for describe() and exports."""
+        from graphsdg.graph.builder import describe_value
+        return {k: describe_value(v) for k, v in self.values.items() if v is not None}
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name or self.type_name}>"
+
+
+class ExecContext:
+    """What a node's ``compute`` sees for one execution.
+
+    ``exec_index`` counts the node's executions from 0; :attr:`rng` is the
+    counter-based stream keyed on (global seed, stable node id, exec_index), so
+    any execution can be reproduced on its own.
+    """
+
+    def __init__(self, node: Node, exec_index: int, frame: int, dry: bool = False) -> None:
+        self.node = node
+        self.exec_index = exec_index
+        self.frame = frame
+        self.dry = dry
+        self._rng: np.random.Generator | None = None
+
+    @property
+    def rng(self) -> np.random.Generator:
+        if self._rng is None:
+            self._rng = node_stream(self.node, self.exec_index)
+        return self._rng
+
+    def value(self, port: str) -> Any:
+        """The input ``port`` with upstream references replaced by their current outputs."""
+        from graphsdg.graph.builder import resolve_refs
+        return resolve_refs(self.node.value_of(port))
+
+    def given(self, port: str) -> bool:
+        return self.node.values.get(port) is not None
+
+    def prims(self, port: str = "input_prims") -> list[Usd.Prim]:
+        """The prims an input names (items, prims, paths, or lists of them), flattened."""
+        from graphsdg.graph.builder import flatten_prims
+        return flatten_prims(self.value(port), f"{self.node.type_name}.{port}")
+
+    def sample(self, port: str, n: int) -> Any:
+        """``n`` samples for ``port`` if it holds a distribution, else the plain value (or None)."""
+        from graphsdg.graph.samples import Samples
+        value = self.value(port)
+        if isinstance(value, Samples):
+            return value.take(n)
+        return value
+
+    def is_random(self, port: str) -> bool:
+        """Whether ``port`` is fed by a distribution (re-sampled each execution)."""
+        return is_random_value(self.node.values.get(port))
+
+    def record(self, key: str, value: Any) -> None:
+        """Keep ``value`` as sampled in this execution (provenance)."""
+        self.node.record[key] = value
+
+
+def is_random_value(value: Any) -> bool:
+    """True for a distribution item or node (checked without evaluating it)."""
+    node = getattr(value, "node", value)
+    return isinstance(node, Node) and node.family == "distribution"
+
+
+def node_stream(node: Node, exec_index: int) -> np.random.Generator:
+    """The generator of ``node``'s execution ``exec_index``.
+
+    A distribution given an explicit ``seed`` (not None and not -1) uses it
+    instead of the global seed, as Replicator does.
+    """
+    seed = node.values.get("seed")
+    if seed is not None and seed != -1:
+        return np.random.Generator(np.random.Philox(np.random.SeedSequence([int(seed), int(exec_index)])))
+    return rnglib.stream("graph-node", node.stable_id, int(exec_index))
+
+
+class TriggerNode(Node):
+    """Base class of trigger node types: decides, once per step, whether its subgraph runs.
+
+    ``exec_count`` counts the times it fired; ``max_execs`` 0 means unlimited.
+    """
+
+    family: ClassVar[str] = "trigger"
+    outputs: ClassVar[dict[str, Port]] = {"execs": Port(int)}
+    counts_toward_completion: ClassVar[bool] = True   # run() stops when all such triggers are exhausted
+
+    @property
+    def max_execs(self) -> int:
+        return int(self.value_of("max_execs") or 0) if "max_execs" in self.inputs else 0
+
+    @property
+    def rt_subframes(self) -> int:
+        return int(self.value_of("rt_subframes") or 1) if "rt_subframes" in self.inputs else 1
+
+    def exhausted(self) -> bool:
+        return self.max_execs > 0 and self.exec_count >= self.max_execs
+
+    def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
+        """Whether the trigger fires on this step (called exactly once per step)."""
+        raise NotImplementedError
+
+    def listens_to(self, event_name: str) -> bool:
+        return False
+
+    def execs_before(self, frame: int) -> int | None:
+        """How many times it fired on frames ``0..frame-1`` (None if that depends on the run's history)."""
+        return None
+
+    def seek(self, frame: int) -> None:
+        """Set the state it would have entering ``frame`` (only for frame-determined triggers)."""
+        raise NotImplementedError(f"{self.type_name} cannot seek: it depends on events or simulated time")

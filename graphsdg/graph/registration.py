@@ -1,0 +1,46 @@
+"""``register(fn)`` for the graph-API namespaces: a user function becomes ``rep.<namespace>.<name>``.
+
+Example:
+    >>> import graphsdg as rep
+    >>> def bright_lights():
+    ...     return rep.create.light(light_type="Sphere", intensity=rep.distribution.uniform(1e4, 2e4))
+    >>> rep.randomizer.register(bright_lights)
+    >>> callable(rep.randomizer.bright_lights)
+    True
+"""
+from __future__ import annotations
+
+import functools
+from types import ModuleType
+from typing import Any, Callable
+
+from graphsdg.graph.builder import GraphBuildError, ReplicatorItem
+from graphsdg.graph.node import Node
+
+
+def as_item(value: Any) -> Any:
+    """A Node becomes its item; items and lists of items pass through."""
+    return ReplicatorItem(value) if isinstance(value, Node) else value
+
+
+def register_function(namespace: ModuleType, fn: Callable[..., Any], override: bool = True,
+                      fn_name: str | None = None) -> None:
+    """Add ``fn`` to ``namespace`` as ``fn_name`` (default ``fn.__name__``)."""
+    if not callable(fn):
+        raise TypeError(f"register expects a function, got {fn!r}")
+    name = fn_name or getattr(fn, "__name__", None)
+    if not name or not name.isidentifier():
+        raise ValueError(f"register needs a valid function name, got {name!r}; pass fn_name=")
+    short = namespace.__name__.rsplit(".", 1)[-1]
+    if hasattr(namespace, name) and not override:
+        raise ValueError(f"rep.{short}.{name} already exists; pass override=True to replace it")
+
+    @functools.wraps(fn)
+    def call(*args: Any, **kwargs: Any) -> Any:
+        result = fn(*args, **kwargs)
+        if result is None:
+            raise GraphBuildError(f"registered {short} {name!r} returned nothing; it must return the item (or "
+                                  f"item.node) it built, e.g. 'return lights.node'")
+        return as_item(result)
+
+    setattr(namespace, name, call)

@@ -1,0 +1,39 @@
+"""Rescale a compiled mesh geom in place, so a scale edit of a mesh prim needs no recompile.
+
+The compiler bakes a mesh prim's world scale into its vertices, and MuJoCo stores
+them in the mesh's own frame (``geom_pos``/``geom_quat`` place that frame in the
+body). Going from scale ``s0`` to ``s`` is the linear map
+``v_mesh' = Rg^T diag(s / s0) Rg v_mesh`` with ``geom_pos' = (s / s0) * geom_pos``;
+normals take the inverse transpose. The renderer re-uploads the mesh afterwards.
+Only visual geoms are rescaled this way: colliding meshes (convex hulls, BVHs,
+inertia) recompile.
+"""
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from graphsdg.stage.xform import quat_wxyz_to_matrix
+
+
+def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> int:
+    """Apply ``new_scale / old_scale`` to mesh geom ``geom_id``; returns the mesh id to re-upload."""
+    mesh_id = int(model.geom_dataid[geom_id])
+    if mesh_id < 0:
+        raise ValueError(f"geom {geom_id} is not a mesh geom")
+    ratio = np.asarray(new_scale, dtype=np.float64) / np.asarray(old_scale, dtype=np.float64)
+    rg = quat_wxyz_to_matrix(model.geom_quat[geom_id])
+    linear = rg.T @ np.diag(ratio) @ rg
+    normal_map = rg.T @ np.diag(1.0 / ratio) @ rg
+    v0, nv = model.mesh_vertadr[mesh_id], model.mesh_vertnum[mesh_id]
+    verts = model.mesh_vert[v0:v0 + nv] @ linear.T
+    model.mesh_vert[v0:v0 + nv] = verts
+    n0, nn = model.mesh_normaladr[mesh_id], model.mesh_normalnum[mesh_id]
+    normals = model.mesh_normal[n0:n0 + nn] @ normal_map.T
+    norms = np.linalg.norm(normals, axis=1, keepdims=True)
+    model.mesh_normal[n0:n0 + nn] = normals / np.where(norms > 0, norms, 1.0)
+    model.geom_pos[geom_id] = model.geom_pos[geom_id] * ratio
+    half = np.abs(verts).max(axis=0) if nv else np.zeros(3)
+    model.geom_aabb[geom_id] = np.concatenate([np.zeros(3), half])
+    model.geom_rbound[geom_id] = float(np.linalg.norm(verts, axis=1).max()) if nv else 0.0
+    return mesh_id

@@ -1,0 +1,300 @@
+"""Create nodes: make prims under ``/Replicator`` when built, re-sample their distributions per execution.
+
+Each prim gets Replicator's layout: an Xform wrapper with the prim under it
+(``/Replicator/Cube_Xform/Cube``, ``/Replicator/Cube_Xform_01/Cube``, ...). The
+item's prims are the inner prims. Plain arguments are applied once, at creation;
+distribution arguments are sampled (one value per prim) each time the trigger
+fires. Prim creation itself goes through ``graphsdg.functional.create``.
+"""
+from __future__ import annotations
+
+import os
+from typing import Any, Callable
+
+import numpy as np
+from pxr import Sdf, Usd
+
+from graphsdg.functional import create as FC
+from graphsdg.functional import modify as FM
+from graphsdg.graph.builder import flatten_prims
+from graphsdg.graph.graph import REPLICATOR_ROOT
+from graphsdg.graph.node import ExecContext, Node, Port, is_random_value
+from graphsdg.graph.registry import register_node
+from graphsdg.stage import semantics as semlib
+from graphsdg.stage.context import get_stage
+
+from .modify import POSE_PORTS, apply_pose, sample_port
+
+POSE = {"position": Port("vec3"), "rotation": Port("vec3"), "scale": Port("vec3|float"),
+        "look_at": Port("vec3|prim"), "look_at_up_axis": Port("vec3")}
+COMMON = {"count": Port(int, 1), "parent": Port("prim")}
+LOOKS = REPLICATOR_ROOT + "/Looks"
+
+
+def _count(node: Node) -> int:
+    count = node.value_of("count")
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+        raise ValueError(f"{node.type_name}: count must be a positive integer, got {count!r}")
+    return int(count)
+
+
+def _plain(node: Node, port: str) -> Any:
+    """The port's plain value, or None when it is a distribution (sampled at execution)."""
+    value = node.value_of(port)
+    return None if is_random_value(value) else value
+
+
+class CreateNode(Node):
+    """Base of create nodes: ``make(ctx, name, parent)`` makes one prim; setup makes ``count``."""
+
+    family = "create"
+    outputs = {"prims": Port("prims")}
+    default_name = "Prim"
+    attribute_ports: dict[str, str] = {}   # port -> USD attribute re-sampled per execution
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        _count(self)
+
+    def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
+        raise NotImplementedError
+
+    def parent_path(self) -> Sdf.Path:
+        parent = self.value_of("parent")
+        if parent is None:
+            return Sdf.Path(REPLICATOR_ROOT)
+        prims = flatten_prims(parent, f"{self.type_name}.parent")
+        if len(prims) != 1:
+            raise ValueError(f"{self.type_name}: parent must name one prim, got {len(prims)}")
+        return prims[0].GetPath()
+
+    def setup(self, ctx: ExecContext) -> None:
+        base = self.user_name or self.default_name
+        prims = []
+        for _ in range(_count(self)):
+            wrapper = FC.xform(name=f"{base}_Xform", parent=self.parent_path())
+            prims.append(self.make(ctx, base, wrapper.GetPath()))
+            if self.graph is not None:
+                self.graph.created_prims.append(str(wrapper.GetPath()))
+        self.output_values = {"prims": prims}
+        if not any(is_random_value(self.values.get(p)) for p in POSE_PORTS):
+            apply_pose(ctx, prims)
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = list(self.output_values.get("prims") or [])
+        if any(is_random_value(self.values.get(p)) for p in POSE_PORTS):
+            apply_pose(ctx, prims)
+        for port, attr in self.attribute_ports.items():
+            if ctx.is_random(port):
+                for prim, v in zip(prims, sample_port(ctx, port, len(prims))):
+                    FM.attribute(prim, attr, self.convert(port, v))
+        return {"prims": prims}
+
+    def convert(self, port: str, value: Any) -> Any:
+        return value.tolist() if isinstance(value, np.ndarray) else value
+
+
+def _shape_node(shape: str) -> type[CreateNode]:
+    make_fn: Callable[..., Usd.Prim] = getattr(FC, shape)
+
+    class Shape(CreateNode):
+        __doc__ = f"``rep.create.{shape}``: unit {shape}s (count copies) with semantics, material, visibility."
+        type_name = f"create.{shape}"
+        default_name = shape.capitalize()
+        inputs = {**POSE, **COMMON, "pivot": Port("vec3"), "semantics": Port(list), "material": Port("material"),
+                  "visible": Port(bool, True), "as_mesh": Port(bool, True)}
+
+        def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
+            prim = make_fn(name=name, parent=parent, semantics=self.value_of("semantics"),
+                           visible=bool(self.value_of("visible")))
+            material = self.value_of("material")
+            if material is not None:
+                mats = flatten_prims(ctx.value("material"), f"{self.type_name}.material")
+                FM.material(prim, mats[0])
+            return prim
+
+    Shape.__name__ = Shape.__qualname__ = f"Create{shape.capitalize()}"
+    return register_node(Shape)
+
+
+SHAPES = ("cube", "sphere", "cylinder", "cone", "capsule", "torus", "disk", "plane")
+SHAPE_NODES = {s: _shape_node(s) for s in SHAPES}
+
+
+@register_node
+class CreateXform(CreateNode):
+    """``rep.create.xform``: empty transforms."""
+
+    type_name = "create.xform"
+    default_name = "Xform"
+    inputs = {**POSE, **COMMON, "semantics": Port(list), "visible": Port(bool, True)}
+
+    def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
+        return FC.xform(name=name, parent=parent, semantics=self.value_of("semantics"),
+                        visible=bool(self.value_of("visible")))
+
+
+LIGHT_TYPES = {"cylinder": FC.cylinder_light, "disk": FC.disk_light, "distant": FC.distant_light,
+               "dome": FC.dome_light, "rect": FC.rect_light, "sphere": FC.sphere_light}
+
+
+@register_node
+class CreateLight(CreateNode):
+    """``rep.create.light``: any UsdLux light; colour, intensity, exposure, temperature (K), dome texture.
+
+    ``temperature`` switches on ``enableColorTemperature``; the renderer turns
+    Kelvin into RGB with :func:`graphsdg.sim.lights.kelvin_to_rgb` and multiplies
+    it with ``color``.
+    """
+
+    type_name = "create.light"
+    inputs = {**POSE, **COMMON, "light_type": Port(str, "Distant"), "color": Port("rgb", (1.0, 1.0, 1.0)),
+              "intensity": Port(float, 1000.0), "exposure": Port(float), "temperature": Port(float, 6500.0),
+              "texture": Port(str)}
+    attribute_ports = {"color": "inputs:color", "intensity": "inputs:intensity", "exposure": "inputs:exposure",
+                       "temperature": "inputs:colorTemperature", "texture": "inputs:texture:file"}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        kind = self.value_of("light_type")
+        if not isinstance(kind, str) or kind.lower() not in LIGHT_TYPES:
+            raise ValueError(f"create.light: light_type {kind!r} is not one of {sorted(LIGHT_TYPES)} "
+                             f"(case-insensitive)")
+        if self.value_of("texture") is not None and kind.lower() != "dome":
+            raise ValueError(f"create.light: texture applies to Dome lights only, not {kind!r}")
+        tex = _plain(self, "texture")
+        if tex is not None and not os.path.isfile(os.fspath(tex)):
+            raise FileNotFoundError(f"create.light: texture {os.fspath(tex)!r} does not exist")
+
+    @property
+    def default_name(self) -> str:  # type: ignore[override]
+        return f"{self.value_of('light_type').capitalize()}Light"
+
+    def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
+        kind = self.value_of("light_type").lower()
+        kwargs: dict[str, Any] = {"name": name, "parent": parent}
+        for port in ("intensity", "exposure", "color", "temperature"):
+            plain = _plain(self, port)
+            if plain is not None:
+                kwargs[port] = plain
+        kwargs.setdefault("temperature", 6500.0)
+        if kind == "dome" and _plain(self, "texture") is not None:
+            kwargs["texture"] = _plain(self, "texture")
+        return LIGHT_TYPES[kind](**kwargs)
+
+    def convert(self, port: str, value: Any) -> Any:
+        if port == "texture":
+            return Sdf.AssetPath(os.fspath(value))
+        if port in ("intensity", "exposure", "temperature"):
+            return float(np.asarray(value).reshape(-1)[0])
+        return super().convert(port, value)
+
+
+@register_node
+class CreateCamera(CreateNode):
+    """``rep.create.camera``: a pinhole camera (focal length and apertures in tenths of a stage unit)."""
+
+    type_name = "create.camera"
+    default_name = "Camera"
+    inputs = {**POSE, **COMMON, "focal_length": Port(float, 24.0), "focus_distance": Port(float, 400.0),
+              "f_stop": Port(float, 0.0), "horizontal_aperture": Port(float, 20.955),
+              "horizontal_aperture_offset": Port(float, 0.0), "vertical_aperture_offset": Port(float, 0.0),
+              "clipping_range": Port("vec2", (0.01, 1000000.0)), "projection_type": Port(str, "pinhole")}
+    attribute_ports = {"focal_length": "focalLength", "focus_distance": "focusDistance", "f_stop": "fStop",
+                       "horizontal_aperture": "horizontalAperture"}
+
+    def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
+        kwargs = {k: _plain(self, k) for k in ("focal_length", "focus_distance", "f_stop", "horizontal_aperture",
+                                               "horizontal_aperture_offset", "vertical_aperture_offset",
+                                               "clipping_range", "projection_type")}
+        return FC.camera(name=name, parent=parent, **{k: v for k, v in kwargs.items() if v is not None})
+
+    def convert(self, port: str, value: Any) -> Any:
+        return float(np.asarray(value).reshape(-1)[0])
+
+
+MDL_INPUTS = {"diffuse": "diffuse_color_constant", "diffuse_texture": "diffuse_texture",
+              "roughness": "reflection_roughness_constant", "metallic": "metallic_constant",
+              "emissive_color": "emissive_color", "emissive_intensity": "emissive_intensity"}
+UNRENDERED_INPUTS = ("roughness_texture", "metallic_texture", "emissive_texture")
+
+
+@register_node
+class CreateMaterialOmniPBR(CreateNode):
+    """``rep.create.material_omnipbr``: ``count`` OmniPBR-style materials under ``/Replicator/Looks``."""
+
+    type_name = "create.material_omnipbr"
+    default_name = "OmniPBR"
+    inputs = {"diffuse": Port("rgb"), "diffuse_texture": Port(str), "roughness": Port(float),
+              "roughness_texture": Port(str), "metallic": Port(float), "metallic_texture": Port(str),
+              "specular": Port(float), "emissive_color": Port("rgb"), "emissive_texture": Port(str),
+              "emissive_intensity": Port(float, 0.0), "project_uvw": Port(bool, False), "semantics": Port(list),
+              "count": Port(int, 1)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        given = [k for k in UNRENDERED_INPUTS if values.get(k) is not None]
+        if given:
+            raise ValueError(f"material_omnipbr: {given} are not rendered by graphsdg (only diffuse_texture "
+                             f"is); remove them")
+
+    def setup(self, ctx: ExecContext) -> None:
+        stage = get_stage()
+        if not stage.GetPrimAtPath(LOOKS).IsValid():
+            FC.scope(name="Looks", parent=REPLICATOR_ROOT)
+        mats = []
+        for _ in range(_count(self)):
+            inputs = {mdl: _plain(self, port) for port, mdl in MDL_INPUTS.items()}
+            inputs = {k: v for k, v in inputs.items() if v is not None}
+            if self.value_of("emissive_intensity") and "emissive_color" not in inputs:
+                inputs["emissive_color"] = (1.0, 1.0, 1.0)
+            prim = FC.material(mdl="OmniPBR.mdl", name=self.user_name or "OmniPBR", parent=LOOKS, **inputs)
+            if self.value_of("semantics"):
+                semlib.apply(prim, self.value_of("semantics"))
+            mats.append(prim)
+        self.output_values = {"prims": mats}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        mats = list(self.output_values["prims"])
+        inputs = {}
+        for port, mdl in MDL_INPUTS.items():
+            if ctx.is_random(port):
+                inputs[mdl] = sample_port(ctx, port, len(mats))
+        if inputs:
+            FM.material_inputs(mats, **inputs)
+        return {"prims": mats}
+
+
+@register_node
+class CreateGroup(Node):
+    """``rep.create.group``: the union of items' prims, so ``with group:`` edits all of them."""
+
+    type_name = "create.group"
+    family = "create"
+    inputs = {"items": Port(list, required=True), "semantics": Port(list)}
+    outputs = {"prims": Port("prims")}
+
+    def setup(self, ctx: ExecContext) -> None:
+        prims = flatten_prims(ctx.value("items"), "create.group items")
+        if self.value_of("semantics"):
+            for prim in prims:
+                semlib.apply(prim, self.value_of("semantics"))
+        self.output_values = {"prims": prims}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        return {"prims": flatten_prims(ctx.value("items"), "create.group items")}
+
+
+@register_node
+class CreateFromUsd(CreateNode):
+    """``rep.create.from_usd``: the USD file as a reference, ``count`` times."""
+
+    type_name = "create.from_usd"
+    inputs = {**POSE, **COMMON, "usd": Port(str, required=True), "semantics": Port(list)}
+
+    @property
+    def default_name(self) -> str:  # type: ignore[override]
+        return os.path.splitext(os.path.basename(os.fspath(self.value_of("usd"))))[0] or "Asset"
+
+    def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
+        return FC.reference(self.value_of("usd"), name=name, parent=parent, semantics=self.value_of("semantics"))

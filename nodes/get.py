@@ -1,0 +1,55 @@
+"""Get nodes: select existing prims (``rep.get.prims``, ``rep.get.prim_at_path``)."""
+from __future__ import annotations
+
+import logging
+
+from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.registry import register_node
+from graphsdg.stage.prims import resolve_prims
+from graphsdg.stage.query import find_prims
+
+log = logging.getLogger("graphsdg.graph")
+
+
+@register_node
+class GetPrims(Node):
+    """Prims matching path patterns, types and semantics; evaluated once unless ``cache_result=False``."""
+
+    type_name = "get.prims"
+    family = "get"
+    inputs = {"path_pattern": Port(str), "path_match": Port(str), "path_pattern_exclusion": Port(str),
+              "prim_types": Port(list), "prim_types_exclusion": Port(list), "semantics": Port(list),
+              "semantics_exclusion": Port(list), "cache_result": Port(bool, True), "ignore_case": Port(bool, True)}
+    outputs = {"prims": Port("prims")}
+
+    def _query(self) -> dict:
+        kwargs = {k: self.value_of(k) for k in self.inputs if k != "cache_result"}
+        prims = find_prims(**kwargs)
+        if not prims:
+            given = {k: v for k, v in kwargs.items() if v is not None and k != "ignore_case"}
+            log.warning("rep.get.prims(%s) matched no prim", ", ".join(f"{k}={v!r}" for k, v in given.items()))
+        return {"prims": prims}
+
+    def setup(self, ctx: ExecContext) -> None:
+        self.output_values = self._query()
+
+    def compute(self, ctx: ExecContext) -> dict:
+        if self.value_of("cache_result") and ctx.exec_index > 0:
+            return {}
+        return self._query()
+
+
+@register_node
+class PrimAtPath(Node):
+    """The prims at the given path(s); an unknown path raises."""
+
+    type_name = "get.prim_at_path"
+    family = "get"
+    inputs = {"path": Port("str|list", required=True)}
+    outputs = {"prims": Port("prims")}
+
+    def setup(self, ctx: ExecContext) -> None:
+        self.output_values = {"prims": resolve_prims(self.value_of("path"))}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        return {"prims": resolve_prims(self.value_of("path"))}

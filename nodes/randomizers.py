@@ -1,0 +1,231 @@
+"""Randomizer nodes: each execution calls the matching ``graphsdg.functional.randomizer`` function
+with the node's per-execution stream as ``rng``."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pxr import Sdf, Usd
+
+from graphsdg.functional import create as FC
+from graphsdg.functional import modify as FM
+from graphsdg.functional import randomizer as FR
+from graphsdg.graph.builder import flatten_prims
+from graphsdg.graph.graph import REPLICATOR_ROOT
+from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.registry import register_node
+from graphsdg.graph.samples import Samples
+from graphsdg.stage import semantics as semlib
+
+from .modify import TARGET, sample_port
+
+
+class Randomizer(Node):
+    family = "randomizer"
+    outputs = {"prims": Port("prims")}
+
+
+@register_node
+class Color(Randomizer):
+    """``randomizer.color``: a material per prim with a diffuse colour from ``colors`` (one per prim)."""
+
+    type_name = "randomizer.color"
+    inputs = {**TARGET, "colors": Port("rgb", required=True), "per_sub_mesh": Port(bool, False),
+              "seed": Port(int)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        colors = sample_port(ctx, "colors", len(prims))
+        applied = FR.color(prims, colors=colors)
+        ctx.record("colors", applied)
+        return {"prims": prims}
+
+
+def _material_prims(value: Any, what: str) -> list[Usd.Prim]:
+    if isinstance(value, Samples):
+        raise TypeError(f"{what}: expected materials (a list, or a material_omnipbr item), got a distribution")
+    return flatten_prims(value, what)
+
+
+@register_node
+class Materials(Randomizer):
+    """``randomizer.materials``: bind each prim a material drawn from ``materials``."""
+
+    type_name = "randomizer.materials"
+    inputs = {**TARGET, "materials": Port("materials", required=True), "seed": Port(int),
+              "max_cached_materials": Port(int, 0)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        mats = _material_prims(ctx.value("materials"), "randomizer.materials materials")
+        ctx.record("materials", FR.materials(prims, mats, rng=ctx.rng))
+        return {"prims": prims}
+
+
+@register_node
+class Texture(Randomizer):
+    """``randomizer.texture``: a textured material per prim, file drawn from ``textures``; UV scale/rotation."""
+
+    type_name = "randomizer.texture"
+    inputs = {**TARGET, "textures": Port(list, required=True), "texture_scale": Port("vec2"),
+              "texture_rotate": Port(float), "per_sub_mesh": Port(bool, False), "project_uvw": Port(bool, False),
+              "seed": Port(int)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        n = len(prims)
+        scale = sample_port(ctx, "texture_scale", n)
+        rotate = sample_port(ctx, "texture_rotate", n)
+        textures = ctx.value("textures")
+        if isinstance(textures, Samples):   # a distribution of paths: one per prim
+            chosen = []
+            for i, (prim, file) in enumerate(zip(prims, textures.take(n))):
+                s_i = None if scale is None else (np.asarray(scale)[i] if np.ndim(scale) == 2 else scale)
+                r_i = None if rotate is None else (np.asarray(rotate).reshape(-1)[i] if np.size(rotate) == n
+                                                   else rotate)
+                chosen += FR.texture([prim], [file], texture_scale=s_i, texture_rotate=r_i, rng=ctx.rng)
+        else:
+            chosen = FR.texture(prims, list(textures), texture_scale=scale, texture_rotate=rotate, rng=ctx.rng)
+        ctx.record("textures", chosen)
+        return {"prims": prims}
+
+
+@register_node
+class Rotation(Randomizer):
+    """``randomizer.rotation``: rotations uniform on SO(3) (within XYZ Euler limits)."""
+
+    type_name = "randomizer.rotation"
+    inputs = {**TARGET, "min_angle": Port("vec3", (-180.0, -180.0, -180.0)),
+              "max_angle": Port("vec3", (180.0, 180.0, 180.0)), "seed": Port(int)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        angles = FR.rotation(prims, ctx.value("min_angle"), ctx.value("max_angle"), rng=ctx.rng)
+        ctx.record("rotation", angles)
+        return {"prims": prims}
+
+
+def _functional_scatter(name: str):
+    fn = getattr(FR, name, None)
+    if fn is None:
+        raise NotImplementedError(f"graphsdg.functional.randomizer.{name} is not available in this build; "
+                                  f"the scatter placement logic ships with the physics module")
+    return fn
+
+
+def _opt_prims(ctx: ExecContext, port: str) -> list[Usd.Prim] | None:
+    return ctx.prims(port) if ctx.given(port) else None
+
+
+@register_node
+class Scatter2D(Randomizer):
+    """``randomizer.scatter_2d``: place prims on surface meshes (``functional.randomizer.scatter_2d``)."""
+
+    type_name = "randomizer.scatter_2d"
+    inputs = {**TARGET, "surface_prims": Port("prims", required=True), "no_coll_prims": Port("prims"),
+              "min_samp": Port("vec3"), "max_samp": Port("vec3"), "seed": Port(int), "offset": Port(float, 0.0),
+              "check_for_collisions": Port(bool, False)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        kwargs: dict[str, Any] = {"no_collision_prims": _opt_prims(ctx, "no_coll_prims"),
+                                  "offset": float(ctx.value("offset")),
+                                  "check_for_collisions": bool(ctx.value("check_for_collisions")), "rng": ctx.rng}
+        extents = _extents(ctx)
+        if extents is not None:
+            kwargs["extents"] = extents
+        _functional_scatter("scatter_2d")(prims, ctx.prims("surface_prims"), **kwargs)
+        ctx.record("positions", [_translation(p) for p in prims])
+        return {"prims": prims}
+
+
+@register_node
+class Scatter3D(Randomizer):
+    """``randomizer.scatter_3d``: place prims inside volume meshes (``functional.randomizer.scatter_3d``)."""
+
+    type_name = "randomizer.scatter_3d"
+    inputs = {**TARGET, "volume_prims": Port("prims"), "no_coll_prims": Port("prims"),
+              "volume_excl_prims": Port("prims"), "min_samp": Port("vec3"), "max_samp": Port("vec3"),
+              "resolution_scaling": Port(float, 1.0), "voxel_size": Port(float, 0.0),
+              "check_for_collisions": Port(bool, False), "prevent_vol_overlap": Port(bool, True),
+              "viz_sampled_voxels": Port(bool, False), "seed": Port(int)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        kwargs: dict[str, Any] = {"no_collision_prims": _opt_prims(ctx, "no_coll_prims"),
+                                  "volume_excl_prims": _opt_prims(ctx, "volume_excl_prims"),
+                                  "check_for_collisions": bool(ctx.value("check_for_collisions")),
+                                  "prevent_vol_overlap": bool(ctx.value("prevent_vol_overlap")),
+                                  "viz_sampled_voxels": bool(ctx.value("viz_sampled_voxels")),
+                                  "resolution_scaling": float(ctx.value("resolution_scaling")),
+                                  "input_voxel_size": float(ctx.value("voxel_size")), "rng": ctx.rng}
+        extents = _extents(ctx)
+        if extents is not None:
+            kwargs["extents"] = extents
+        _functional_scatter("scatter_3d")(prims, _opt_prims(ctx, "volume_prims"), **kwargs)
+        ctx.record("positions", [_translation(p) for p in prims])
+        return {"prims": prims}
+
+
+def _extents(ctx: ExecContext) -> Any:
+    lo, hi = ctx.value("min_samp"), ctx.value("max_samp")
+    if lo is None and hi is None or (all(v is None for v in (lo or ())) and all(v is None for v in (hi or ()))):
+        return None
+    return (lo, hi)
+
+
+def _translation(prim: Usd.Prim) -> list[float]:
+    attr = prim.GetAttribute("xformOp:translate")
+    value = attr.Get() if attr else None
+    return [float(v) for v in value] if value is not None else [0.0, 0.0, 0.0]
+
+
+@register_node
+class Instantiate(Randomizer):
+    """``randomizer.instantiate``: ``size`` instances, each referencing an asset drawn from ``paths``."""
+
+    type_name = "randomizer.instantiate"
+    inputs = {"paths": Port(list, required=True), "size": Port(int, required=True), "weights": Port(list),
+              "mode": Port(str, "scene_instance"), "with_replacements": Port(bool, True), "seed": Port(int),
+              "use_cache": Port(bool, True), "semantics": Port(list)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        paths, size = self.value_of("paths"), self.value_of("size")
+        if isinstance(paths, str) or not paths:
+            raise ValueError(f"instantiate: paths must be a non-empty list of USD files, got {paths!r}")
+        if isinstance(size, bool) or not isinstance(size, int) or size < 1:
+            raise ValueError(f"instantiate: size must be a positive integer, got {size!r}")
+        if self.value_of("mode") not in ("scene_instance", "point_instance", "reference"):
+            raise ValueError(f"instantiate: mode must be 'scene_instance', 'point_instance' or 'reference', "
+                             f"got {self.value_of('mode')!r}")
+        weights = self.value_of("weights")
+        if weights is not None and (len(weights) != len(paths) or sum(weights) <= 0 or min(weights) < 0):
+            raise ValueError(f"instantiate: weights {weights!r} must be {len(paths)} non-negative numbers "
+                             f"with a positive sum")
+        if not self.value_of("with_replacements") and size > len(paths):
+            raise ValueError(f"instantiate: {size} instances without replacement from only {len(paths)} paths")
+
+    def setup(self, ctx: ExecContext) -> None:
+        base = self.user_name or "Instance"
+        slots = []
+        for _ in range(int(self.value_of("size"))):
+            prim = FC.xform(name=f"{base}_Xform", parent=Sdf.Path(REPLICATOR_ROOT),
+                            semantics=self.value_of("semantics"))
+            prim.SetInstanceable(self.value_of("mode") == "scene_instance")
+            slots.append(prim)
+        self.output_values = {"prims": slots}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        slots = list(self.output_values["prims"])
+        paths = list(self.value_of("paths"))
+        weights = self.value_of("weights")
+        p = None if weights is None else np.asarray(weights, dtype=np.float64) / float(sum(weights))
+        idx = ctx.rng.choice(len(paths), size=len(slots), replace=bool(self.value_of("with_replacements")), p=p)
+        chosen = [paths[int(i)] for i in idx]
+        FM.reference(slots, chosen)
+        if self.value_of("semantics"):
+            for prim in slots:
+                semlib.apply(prim, self.value_of("semantics"))
+        ctx.record("paths", chosen)
+        return {"prims": slots}

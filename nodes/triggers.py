@@ -1,0 +1,104 @@
+"""Trigger nodes: ``on_frame``, ``on_time``, ``on_custom_event``.
+
+Each polls once per ``orchestrator.step()``; when it fires, the nodes built in
+its ``with`` block run.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from graphsdg import settings
+from graphsdg.graph.node import Port, TriggerNode
+from graphsdg.graph.registry import register_node
+
+
+def _positive_int(value: Any, what: str, minimum: int = 1) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ValueError(f"{what} must be an integer >= {minimum}, got {value!r}")
+    return value
+
+
+@register_node
+class OnFrame(TriggerNode):
+    """Fires on the trigger's frames 0, interval, 2*interval, ... until ``max_execs`` fires."""
+
+    type_name = "trigger.on_frame"
+    inputs = {"interval": Port(int, 1), "max_execs": Port(int, 0), "rt_subframes": Port(int, 1)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        _positive_int(self.value_of("interval"), "on_frame interval")
+        _positive_int(self.value_of("max_execs"), "on_frame max_execs", 0)
+        _positive_int(self.value_of("rt_subframes"), "on_frame rt_subframes")
+        self.frames_seen = 0
+
+    @property
+    def interval(self) -> int:
+        return int(self.value_of("interval"))
+
+    def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
+        due = self.frames_seen % self.interval == 0
+        self.frames_seen += 1
+        return due and not self.exhausted()
+
+    def execs_before(self, frame: int) -> int:
+        n = math.ceil(frame / self.interval)
+        return min(n, self.max_execs) if self.max_execs else n
+
+    def seek(self, frame: int) -> None:
+        self.exec_count = self.execs_before(frame)
+        self.frames_seen = frame
+        self.last_frame = (self.exec_count - 1) * self.interval if self.exec_count else -1
+        self.output_values = {"execs": self.exec_count}
+
+
+@register_node
+class OnTime(TriggerNode):
+    """Fires at simulated time 0, then every ``interval`` seconds of simulated time."""
+
+    type_name = "trigger.on_time"
+    inputs = {"interval": Port(float, 1.0), "max_execs": Port(int, 0), "rt_subframes": Port(int, 32),
+              "enable_capture_on_play": Port(bool, True), "reset_physics": Port(bool, True)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        interval = self.value_of("interval")
+        if isinstance(interval, bool) or not isinstance(interval, (int, float)) or not interval > 0:
+            raise ValueError(f"on_time interval must be a positive number of seconds, got {interval!r}")
+        _positive_int(self.value_of("max_execs"), "on_time max_execs", 0)
+        _positive_int(self.value_of("rt_subframes"), "on_time rt_subframes")
+        self.next_time: float | None = None
+
+    def setup(self, ctx) -> None:
+        if self.value_of("enable_capture_on_play"):
+            settings.set("/omni/replicator/captureOnPlay", True)
+
+    def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
+        interval = float(self.value_of("interval"))
+        if self.next_time is not None and sim_time + 1e-9 < self.next_time:
+            return False
+        base = sim_time if self.next_time is None else self.next_time
+        self.next_time = base + interval * (math.floor((sim_time - base) / interval + 1e-9) + 1)
+        return not self.exhausted()
+
+
+@register_node
+class OnCustomEvent(TriggerNode):
+    """Fires on the step after ``rep.utils.send_og_event(event_name)``."""
+
+    type_name = "trigger.on_custom_event"
+    inputs = {"event_name": Port(str, required=True)}
+    counts_toward_completion = False
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        event = self.value_of("event_name")
+        if not isinstance(event, str) or not event:
+            raise ValueError(f"on_custom_event event_name must be a non-empty string, got {event!r}")
+
+    def listens_to(self, event_name: str) -> bool:
+        return event_name == self.value_of("event_name")
+
+    def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
+        return self.value_of("event_name") in events
