@@ -472,14 +472,14 @@ class _Builder:
             geom.rgba = list(MUJOCO_DEFAULT_RGBA)
         else:
             geom.rgba = list(display_rgba(prim))
-        shapes = [geom]
+        physical = [geom]
         if collides:
-            shapes = self.collision_shapes(prim, body, geom, mesh_data, t, r, dynamic, root is None)
-        for shape in shapes:
-            shape.contype = shape.conaffinity = 1 if collides else 0
-        if shapes and shapes[0] is not geom:
+            physical = self.collision_shapes(prim, body, geom, mesh_data, t, r, dynamic, root is None)
+        for part in physical:
+            part.contype = part.conaffinity = 1 if collides else 0
+        if physical and physical[0] is not geom:
             geom.contype = geom.conaffinity = 0
-        self.mass_records.append((str(root.GetPath()) if root else None, prim, geom, shapes, collides))
+        self.mass_records.append((str(root.GetPath()) if root else None, prim, geom, physical, collides))
         relative = None
         if root is not None:
             relative = np.eye(4)
@@ -489,7 +489,7 @@ class _Builder:
                                   relative))
         if collides:
             owner = str(root.GetPath()) if root is not None else path
-            self.collider_records += [(shape, owner, path) for shape in shapes]
+            self.collider_records += [(part, owner, path) for part in physical]
 
     def collision_shapes(self, prim: Usd.Prim, body, geom, mesh_data, t: np.ndarray, r: np.ndarray,
                          dynamic: bool, static: bool) -> list:
@@ -531,14 +531,14 @@ class _Builder:
     def assign_masses(self) -> None:
         """Densities and masses from ``MassAPI`` (see the module docstring)."""
         bodies_with_colliders = {root for root, _, _, _, collides in self.mass_records if collides and root}
-        for root, prim, geom, shapes, collides in self.mass_records:
+        for root, prim, geom, physical, collides in self.mass_records:
             if collides:
                 friction = _friction(prim)
-                for shape in shapes:
-                    shape.friction = [friction, 0.005, 0.0001]
+                for part in physical:
+                    part.friction = [friction, 0.005, 0.0001]
             if root is None:
-                for shape in shapes:
-                    shape.density = DEFAULT_DENSITY if collides else 0.0
+                for part in physical:
+                    part.density = DEFAULT_DENSITY if collides else 0.0
                 continue
             mass, density = _mass_api_values(prim)
             if not density:
@@ -547,12 +547,12 @@ class _Builder:
             if not carries_mass:
                 geom.density = 0.0
                 continue
-            if shapes[0] is not geom:
+            if physical[0] is not geom:
                 geom.density = 0.0
-            for shape in shapes:
-                shape.density = density
+            for part in physical:
+                part.density = density
                 if mass > 0:
-                    shape.mass = mass / len(shapes)
+                    part.mass = mass / len(physical)
 
     def add_probes(self) -> None:
         """Collision-free box and sphere that scene queries pose and size (never drawn)."""
