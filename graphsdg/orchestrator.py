@@ -18,6 +18,7 @@ from graphsdg import settings
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.io.write_queue import get_write_queue
+from graphsdg.progress import Progress
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
 
@@ -293,6 +294,8 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
                                    or num_frames < 0):
         raise ValueError(f"num_frames must be None or a non-negative integer, got {num_frames!r}")
     sched = _graph_scheduler()
+    if num_frames is None and settings.get("/graphsdg/run/numFrames") is not None:
+        num_frames = int(settings.get("/graphsdg/run/numFrames"))   # graphsdg run --frames N
     if num_frames is None:
         unlimited = sched.unlimited_triggers()
         if sched.active_graph() is None or not any(t.counts_toward_completion for t in sched.active_graph().triggers):
@@ -312,24 +315,34 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
 
 def _run_loop() -> None:
     sched = _graph_scheduler()
+    progress = Progress(_state.remaining, "run")
     try:
-        while not _state.stop_requested:
-            if _state.pause_requested:
-                _state.set(Status.PAUSED)
-                return
-            if _state.remaining is not None and _state.remaining <= 0:
-                break
-            if _state.remaining is None and sched.all_exhausted():
-                break
-            step(pause_timeline=False)
-            if _state.remaining is not None:
-                _state.remaining -= 1
-            _state.set(Status.STARTED)
+        with progress:
+            paused = _frames(sched, progress)
     except BaseException:
         _state.set(Status.STOPPED)
         raise
-    if not _state.stop_requested:
+    if not paused and not _state.stop_requested:
         stop()
+        log.info("run finished: %s", progress.summary())
+
+
+def _frames(sched, progress: Progress) -> bool:
+    """Capture until done, stopped or paused; returns whether it paused."""
+    while not _state.stop_requested:
+        if _state.pause_requested:
+            _state.set(Status.PAUSED)
+            return True
+        if _state.remaining is not None and _state.remaining <= 0:
+            break
+        if _state.remaining is None and sched.all_exhausted():
+            break
+        step(pause_timeline=False)
+        progress.advance()
+        if _state.remaining is not None:
+            _state.remaining -= 1
+        _state.set(Status.STARTED)
+    return False
 
 
 def run_until_complete(num_frames: int | None = None, start_timeline: bool = False) -> None:
