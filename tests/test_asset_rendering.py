@@ -113,9 +113,10 @@ def test_environment_renders_textured(key, view):
     depth.attach(rp)
     rep.orchestrator.step()
     from graphsdg.runtime import runtime
-    model = runtime().sim.model
+    compiled = runtime().sim.ensure_compiled()
     gprims = [p for p in Usd.PrimRange(env, Usd.TraverseInstanceProxies()) if p.IsA(UsdGeom.Mesh)]
-    assert model.ngeom == len(gprims)                      # every mesh, nested references included
+    # every mesh, nested references included (collider proxies and query probes draw no prim)
+    assert sorted(p for p in compiled.geom_paths if p) == sorted(str(p.GetPath()) for p in gprims)
     img = rgb.get_data()[..., :3].astype(np.float64)
     floor = depth.get_data()[H * 3 // 4:, :]
     assert np.isfinite(floor).all()                        # the lower image is floor
