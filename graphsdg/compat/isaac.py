@@ -17,9 +17,10 @@ import types
 import unittest
 
 from graphsdg.compat import isaac_core, kit
-from graphsdg.compat.modules import CompatModule, ForwardingModule
+from graphsdg.compat.modules import CompatFinder, CompatModule, ForwardingModule
 
 _installed: dict[str, types.ModuleType] = {}
+_finder: CompatFinder | None = None
 
 
 def _assets():
@@ -42,8 +43,9 @@ def _modules() -> dict[str, types.ModuleType]:
     rep.scripts = scripts  # type: ignore[attr-defined]
     rep.functional = rep_functional  # type: ignore[attr-defined]
 
+    from graphsdg.sim.timeline import TimelineEventType
     timeline = CompatModule("omni.timeline", get_timeline_interface=kit.get_timeline_interface,
-                            TimelineEventType=kit.TimelineEventType)
+                            TimelineEventType=TimelineEventType)
     app = CompatModule("omni.kit.app", get_app=kit.get_app)
     commands = CompatModule("omni.kit.commands", execute=kit.execute)
     kit_test = CompatModule("omni.kit.test", AsyncTestCase=unittest.IsolatedAsyncioTestCase)
@@ -125,14 +127,21 @@ def install() -> None:
         modules["isaacsim"].examples = modules["isaacsim.examples"]  # type: ignore[attr-defined]
     sys.modules.update(modules)
     _installed.update(modules)
+    global _finder
+    _finder = CompatFinder(_installed)
+    sys.meta_path.insert(0, _finder)
 
 
 def uninstall() -> None:
     """Remove the names :func:`install` added."""
+    global _finder
     for name in list(_installed):
         if sys.modules.get(name) is _installed[name]:
             del sys.modules[name]
     _installed.clear()
+    if _finder is not None and _finder in sys.meta_path:
+        sys.meta_path.remove(_finder)
+    _finder = None
 
 
 def installed_names() -> list[str]:
