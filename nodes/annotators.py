@@ -62,8 +62,15 @@ def joined(labels: dict[str, list[str]]) -> dict[str, str]:
 RESERVED = {BACKGROUND_ID: "BACKGROUND", UNLABELLED_ID: "UNLABELLED"}
 
 
+def present_ids(ids: np.ndarray) -> np.ndarray:
+    """Sorted distinct ids of an id image (a histogram when ids are small: much faster than unique)."""
+    if ids.size and int(ids.max()) < (1 << 20):
+        return np.flatnonzero(np.bincount(ids.ravel()))
+    return np.unique(ids)
+
+
 def _colorize(ids: np.ndarray) -> np.ndarray:
-    present = np.unique(ids)
+    present = present_ids(ids)
     lut_vals = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
     return lut_vals[np.searchsorted(present, ids)]
 
@@ -114,7 +121,7 @@ def semantic_segmentation(frame: FrameView, params: dict) -> dict:
     sem = frame.semantic_image(filt)
     imap = frame.instance_map(filt)
     lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
-    present = sorted(set(int(i) for i in np.unique(sem)) | set(RESERVED))
+    present = sorted(set(present_ids(sem).tolist()) | set(RESERVED))
     key = _color_key if params.get("colorize") else str
     data = _colorize(sem) if params.get("colorize") else sem.copy()
     return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},
@@ -126,7 +133,7 @@ def instance_segmentation(frame: FrameView, params: dict) -> dict:
     filt = semantic_filter(params)
     ids = frame.instance_id_image(filt)
     imap = frame.instance_map(filt)
-    present = sorted(set(int(i) for i in np.unique(ids)) | set(RESERVED))
+    present = sorted(set(present_ids(ids).tolist()) | set(RESERVED))
     by_id = {int(i): k for k, i in enumerate(imap.instance_ids)}
     paths = {i: RESERVED[i] if i in RESERVED else imap.paths[by_id[i]] for i in present}
     lists = {i: {RESERVED_TYPE: [RESERVED[i]]} if i in RESERVED else imap.labels[by_id[i]] for i in present}

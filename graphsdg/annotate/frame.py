@@ -193,11 +193,13 @@ class FrameView:
 
     def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
         geom_ids = self.require("geom_ids")
-        inst = self.instance_image(semantic_filter)
-        out = np.where(geom_ids < 0, BACKGROUND_ID, UNLABELLED_ID).astype(np.uint32)
-        has = inst >= 0
-        out[has] = per_instance[inst[has]]
-        return out
+        imap = self.instance_map(semantic_filter)
+        # one lookup per pixel: geom -> id (unlabelled geoms 1), and index -1 (background) -> 0
+        lut = np.full(len(imap.geom_instance) + 1, UNLABELLED_ID, dtype=np.uint32)
+        labelled = imap.geom_instance >= 0
+        lut[:-1][labelled] = per_instance[imap.geom_instance[labelled]]
+        lut[-1] = BACKGROUND_ID
+        return lut[geom_ids]
 
     # ---- boxes and occlusion -------------------------------------------
     def visible_counts(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:

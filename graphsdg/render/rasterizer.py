@@ -36,6 +36,7 @@ from typing import Callable, Sequence
 import mujoco
 import numpy as np
 
+from graphsdg import profiling
 from graphsdg.render.camera import CameraView
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
 from graphsdg.sim.scene import SimScene
@@ -200,8 +201,10 @@ class Rasterizer:
         rgb = np.empty((h, w, 3), dtype=np.uint8)
         raw = np.empty((h, w), dtype=np.float32) if want_depth else None
         self._update_scene(sim, view, (0.0, 0.0))
-        mujoco.mjr_render(rect, scene, ctx)
-        mujoco.mjr_readPixels(rgb, raw, rect, ctx)
+        with profiling.timed("render:color"):
+            mujoco.mjr_render(rect, scene, ctx)
+        with profiling.timed("readback:color"):
+            mujoco.mjr_readPixels(rgb, raw, rect, ctx)
         self.stats["color"] += 1
         depth = None
         if raw is not None:
@@ -240,10 +243,13 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
         try:
             self._update_scene(sim, view, (0.0, 0.0), crop)
-            mujoco.mjr_render(rect, scene, ctx)
+            kind = "ids" if crop is None else "isolated"
+            with profiling.timed(f"render:{kind}"):
+                mujoco.mjr_render(rect, scene, ctx)
             ids = np.empty((h, w, 3), dtype=np.uint8)
             raw = np.empty((h, w), dtype=np.float32) if with_depth else None
-            mujoco.mjr_readPixels(ids, raw, rect, ctx)
+            with profiling.timed(f"readback:{kind}"):
+                mujoco.mjr_readPixels(ids, raw, rect, ctx)
         finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
@@ -298,25 +304,28 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
         lin = (far - raw.astype(np.float64) * (far - near)).astype(np.float32)
         lin[(raw <= 0.0) | (lin > clip)] = np.inf
         return lin
-    zfar, znear = np.float32(far), np.float32(near)
-    c = -(zfar + znear) / (zfar - znear)
-    d = -(np.float32(2) * zfar * znear) / (zfar - znear)
-    c = np.float32(-0.5) * c - np.float32(0.5)
-    d = np.float32(-0.5) * d
-    z = raw.astype(np.float64)
+    # Reversed Z: window depth w = near * (far - z) / (z * (far - near)), so z = near * far / (w * (far - near) + near).
+    # float64 for the division: float32 loses millimetres at tens of metres.
+    w = raw.astype(np.float64)
     with np.errstate(divide="ignore"):
-        lin = d / (z + c)
-    lin = lin.astype(np.float32)
+        lin = (near * far / (w * (far - near) + near)).astype(np.float32)
     lin[(raw <= 0.0) | (lin > clip)] = np.inf   # nothing drawn, or the sky
     return lin
 
 
 def _decode_segmentation(rgb: np.ndarray, scene: mujoco.MjvScene) -> np.ndarray:
-    segid = rgb[..., 0].astype(np.int32) | (rgb[..., 1].astype(np.int32) << 8) | \
-        (rgb[..., 2].astype(np.int32) << 16)
-    lut = np.full(scene.ngeom + 2, -1, dtype=np.int32)
+    """MuJoCo's id colours (segid + 1 in 24-bit RGB) -> geom ids, -1 where no geom was drawn."""
+    if scene.ngeom + 1 < (1 << 16):
+        # Ids fit in red + green: read those two bytes as one little-endian uint16 (one pass).
+        segid = np.ascontiguousarray(rgb[..., :2]).view(np.uint16)[..., 0]
+        size = 1 << 16
+    else:
+        segid = rgb[..., 0].astype(np.int32) | (rgb[..., 1].astype(np.int32) << 8) | \
+            (rgb[..., 2].astype(np.int32) << 16)
+        size = scene.ngeom + 2
+        segid = np.clip(segid, 0, size - 1)
+    lut = np.full(size, -1, dtype=np.int32)
     for g in scene.geoms[:scene.ngeom]:
         if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
             lut[g.segid + 1] = g.objid
-    segid = np.clip(segid, 0, len(lut) - 1)
     return lut[segid]
