@@ -140,8 +140,7 @@ class BasicWriter(Writer):
         return f"{prefix}{stem}{suffix}_{self._sequence}{n}"
 
     def write(self, data: dict) -> None:
-        seq = "".join(f"{count}_" for name, count in sorted(data.get("trigger_outputs", {}).items())
-                      if "on_time" in name)
+        seq = sequence_prefix(data.get("trigger_outputs", {}))
         if seq != self._sequence:
             self._sequence = seq
             self._frame_id = 0
@@ -157,7 +156,6 @@ class BasicWriter(Writer):
             self.backend.schedule(iof.write_json, data=record,
                                   path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
-        self.num_written += 1
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
         b = self.backend
@@ -198,6 +196,18 @@ class BasicWriter(Writer):
             b.schedule(iof.write_json, data=skeleton_json(payload), path=f"{path()}.json")
         else:
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+
+
+def sequence_prefix(trigger_outputs: dict) -> str:
+    """Replicator's ``{seq}``: ``"<count>_"`` for each ``on_time`` trigger, the last one first.
+
+    ``{"on_time": 3}`` gives ``"3_"``; with no ``on_time`` trigger it is ``""``.
+    """
+    seq = ""
+    for name, count in trigger_outputs.items():
+        if "on_time" in name:
+            seq = f"{count}_{seq}"
+    return seq
 
 
 def skeleton_json(payload: dict) -> dict:
