@@ -1,7 +1,9 @@
 """Built-in writers; importing this package registers them."""
 from graphsdg.io.writer import WriterRegistry
 from graphsdg.io.writers.basic import BasicWriter
+from graphsdg.io.writers.coco import CocoWriter
 
-WriterRegistry.register(BasicWriter, category="default")
+for _writer in (BasicWriter, CocoWriter):
+    WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter"]
+__all__ = ["BasicWriter", "CocoWriter"]
