@@ -210,3 +210,119 @@ def test_coco_writer_flushes_on_stop(out_dir):
     colours = {tuple(c["color"]) for c in data["categories"]}
     assert {tuple(p) for p in panoptic.reshape(-1, 3)} - {(0, 0, 0)} == colours
     writer.detach()
+
+
+# ---- PoseWriter ----------------------------------------------------------------------------
+def _quat_matrix(q):
+    from graphsdg.stage.xform import quat_wxyz_to_matrix
+    return quat_wxyz_to_matrix(q)
+
+
+def test_pose_writer_pose_reprojects_onto_the_stored_corners(out_dir):
+    from conftest import project_box
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=600, parent="/World", name="Dome")
+    box = rep.functional.create.cube(position=(0.3, 0.2, 0.1), rotation=(10, 20, 35), scale=(1.5, 0.6, 0.8),
+                                     parent="/World", name="Box", semantics={"class": "box"})
+    rep.functional.create.sphere(position=(-1.2, -1.0, 0.0), scale=0.5, parent="/World", name="Ball",
+                                 semantics={"class": "ball"})
+    cam = rep.functional.create.camera(position=(2.0, -4.0, 1.5), look_at=(0, 0, 0), parent="/World", name="Cam")
+    rp = rep.create.render_product(cam, (W, H))
+    writer = rep.writers.get("PoseWriter")
+    writer.initialize(output_dir=out_dir, write_debug_images=True)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    assert _files(out_dir) == ["000000.json", "000000.png", "000000_overlay.png", "metadata.txt"]
+    frame = json.load(open(os.path.join(out_dir, "000000.json")))
+    k = frame["camera_data"]["intrinsics"]
+    assert frame["keypoint_order"] == ["Center", "LDB", "LDF", "LUB", "LUF", "RDB", "RDF", "RUB", "RUF"]
+    objects = {o["prim_path"]: o for o in frame["objects"]}
+    assert sorted(objects) == ["/World/Ball", "/World/Box"] and objects["/World/Box"]["label"] == "box"
+    for obj in objects.values():
+        r = _quat_matrix(obj["quat_wxyz_camera_frame"])
+        t = np.array(obj["location_camera_frame"])
+        (x0, y0, z0), (x1, y1, z1) = obj["local_bounds"]
+        local = np.array([[(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2]]
+                         + [[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)])
+        cam_pts = (r @ (local * obj["scale"]).T).T + t           # the 6-DoF pose (+ scale) in the camera frame
+        np.testing.assert_allclose(cam_pts, obj["cuboid_keypoints_camera_frame"], atol=1e-5)
+        uv = np.stack([k["cx"] + k["fx"] * cam_pts[:, 0] / -cam_pts[:, 2],
+                       k["cy"] - k["fy"] * cam_pts[:, 1] / -cam_pts[:, 2]], axis=1)
+        np.testing.assert_allclose(uv, obj["cuboid_keypoints_projected"], atol=1e-4)
+    # analytic truth: the box's world corners projected with the USD camera
+    from graphsdg.stage.xform import world_matrix
+    m = world_matrix(box)
+    corners = np.array([[x, y, z] for x in (-.5, .5) for y in (-.5, .5) for z in (-.5, .5)]) @ m[:3, :3] + m[3, :3]
+    lo, hi = project_box(cam, W, H, corners)
+    stored = np.array(objects["/World/Box"]["cuboid_keypoints_projected"][1:])
+    np.testing.assert_allclose(stored.min(0), lo, atol=1e-4)
+    np.testing.assert_allclose(stored.max(0), hi, atol=1e-4)
+    np.testing.assert_allclose(objects["/World/Box"]["size"], [1.5, 0.6, 0.8], atol=1e-5)
+    # the debug image is the rgb image with the cuboid edges drawn on it
+    rgb = np.array(Image.open(os.path.join(out_dir, "000000.png")))[..., :3].astype(int)
+    overlay = np.array(Image.open(os.path.join(out_dir, "000000_overlay.png"))).astype(int)
+    changed = np.any(overlay != rgb, axis=-1)
+    ys, xs = np.nonzero(changed)
+    assert changed.sum() > 100
+    assert xs.min() >= np.floor(min(lo[0], objects["/World/Ball"]["cuboid_keypoints_projected"][1][0])) - 3
+    assert not changed[0, 0] and not changed[-1, -1]
+
+
+def test_pose_writer_thresholds_empty_frames_and_subfolders(out_dir):
+    cube, (cam, rp), (top, rp_top) = _two_cameras()
+    writer = rep.writers.get("PoseWriter")
+    writer.initialize(output_dir=out_dir, use_subfolders=True, frame_padding=2)
+    writer.attach([rp, rp_top])
+    rep.orchestrator.step()
+    rep.functional.modify.position(cube, (0, 0, 50))                 # out of both views: empty frames are skipped
+    rep.orchestrator.step()
+    rep.functional.modify.position(cube, (0, 0, 0))
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    files = _files(out_dir)
+    for name in (rp.name, "top"):
+        assert f"{name}/00.json" in files and f"{name}/02.json" in files and f"{name}/01.json" not in files
+    frame = json.load(open(os.path.join(out_dir, "top", "02.json")))
+    centre = frame["objects"][0]["cuboid_keypoints_projected"][0]
+    np.testing.assert_allclose(centre, [32.0, 32.0], atol=1e-6)     # top camera looks straight at the centre
+    with pytest.raises(ValueError, match="format.*'yolo'"):
+        rep.writers.get("PoseWriter").initialize(output_dir=out_dir, format="yolo")
+    dope = rep.writers.get("PoseWriter")
+    dope.initialize(output_dir=os.path.join(out_dir, "dope"), format="dope")
+    writer.detach()
+    dope.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    obj = json.load(open(os.path.join(out_dir, "dope", "000000.json")))["objects"][0]
+    assert set(obj) == {"label", "prim_path", "visibility", "location", "quaternion_xyzw", "projected_cuboid",
+                        "truncation_ratio"}
+
+
+def test_getting_started_02_example_writes_pose_data(tmp_path):
+    import subprocess
+    import sys
+    example = os.path.join(os.path.dirname(__file__), os.pardir, "examples", "getting_started_02.py")
+    proc = subprocess.run([sys.executable, example], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout
+    assert out.count("[MyWriter]") == 3 and "'camera_params': {'cameraAperture'" in out
+    assert "'bounding_box_3d': {'data': array([(2, -0.5, -0.5, -0.5, 0.5, 0.5, 0.5" in out
+    assert "[Annotator][Top][2] rgb_data_top shape: (400, 400, 4)" in out
+    root = tmp_path / "_out_pose_writer"
+    files = sorted(os.listdir(root))
+    assert files == sorted(["metadata.txt"] + [f"{n:06d}{s}" for n in range(6)
+                                               for s in (".json", ".png", "_overlay.png")])
+    # frames alternate top_view (400 px) / persp_view (512 px); the top camera looks down on the unit cube
+    top = json.load(open(root / "000000.json"))
+    assert top["camera_data"]["resolution"] == [400, 400]
+    obj = top["objects"][0]
+    assert obj["label"] == "my_cube" and obj["prim_path"] == "/World/Cube"
+    f = top["camera_data"]["intrinsics"]["fx"]
+    corners = np.array(obj["cuboid_keypoints_projected"][1:])
+    # corners at depth 4.5 (top face) and 5.5 (bottom face), +-0.5 around the centre
+    expected = sorted({200 + s * f * 0.5 / d for s in (-1, 1) for d in (4.5, 5.5)})
+    np.testing.assert_allclose(sorted(set(np.round(corners[:, 0], 6))), expected, atol=1e-4)
+    overlay = np.array(Image.open(root / "000001_overlay.png"))
+    assert overlay.shape == (512, 512, 3)
+    assert np.any(np.all(overlay == (255, 0, 0), axis=-1))           # red front edges drawn

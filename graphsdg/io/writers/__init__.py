@@ -2,8 +2,9 @@
 from graphsdg.io.writer import WriterRegistry
 from graphsdg.io.writers.basic import BasicWriter
 from graphsdg.io.writers.coco import CocoWriter
+from graphsdg.io.writers.pose import PoseWriter
 
-for _writer in (BasicWriter, CocoWriter):
+for _writer in (BasicWriter, CocoWriter, PoseWriter):
     WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter", "CocoWriter"]
+__all__ = ["BasicWriter", "CocoWriter", "PoseWriter"]
