@@ -326,3 +326,84 @@ def test_getting_started_02_example_writes_pose_data(tmp_path):
     overlay = np.array(Image.open(root / "000001_overlay.png"))
     assert overlay.shape == (512, 512, 3)
     assert np.any(np.all(overlay == (255, 0, 0), axis=-1))           # red front edges drawn
+
+
+# ---- KittiWriter -------------------------------------------------------------------------
+def _read_kitti_labels(path):
+    rows = []
+    for line in open(path).read().splitlines():
+        f = line.split(" ")
+        assert len(f) == 15                                           # KITTI's 15 ground-truth fields
+        rows.append({"type": f[0], "truncated": float(f[1]), "occluded": int(f[2]), "alpha": float(f[3]),
+                     "bbox": [float(v) for v in f[4:8]], "dimensions": [float(v) for v in f[8:11]],
+                     "location": [float(v) for v in f[11:14]], "rotation_y": float(f[14])})
+    return rows
+
+
+def test_kitti_writer_labels_parse_back(out_dir):
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=600, parent="/World", name="Dome")
+    rep.functional.create.cube(position=(0, 0, 0.4), rotation=(0, 0, 30), scale=(2.0, 1.0, 0.8), parent="/World",
+                               name="Car", semantics={"class": "car"})
+    rep.functional.create.cube(position=(1.2, 3.0, 0.5), parent="/World", name="Crate",
+                               semantics={"class": "wooden crate"})
+    # a level camera 6 m in front of the car, looking along +y
+    cam = rep.functional.create.camera(position=(0, -6, 0.4), look_at=(0, 0, 0.4), parent="/World", name="Cam")
+    rp = rep.create.render_product(cam, (128, 96))
+    boxes = rep.annotators.get("bounding_box_2d_tight", init_params={"semanticTypes": ["class"]})
+    boxes.attach(rp)
+    distance = rep.annotators.get("distance_to_camera")
+    distance.attach(rp)
+    writer = rep.writers.get("KittiWriter")
+    writer.initialize(output_dir=out_dir, bbox_height_threshold=5)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    files = _files(out_dir)
+    for expected in ["rgb/0.png", "object_detection/0.txt", "semantic_segmentation/0.png", "semantic/0.png",
+                     "instance_segmentation/0.png", "depth/0.png"]:
+        assert expected in files
+    rows = {r["type"]: r for r in _read_kitti_labels(os.path.join(out_dir, "object_detection", "0.txt"))}
+    assert sorted(rows) == ["car", "wooden_crate"]
+    truth = {p: b for p, b in zip(boxes.get_data()["info"]["primPaths"], boxes.get_data()["data"])}
+    car, crate = rows["car"], rows["wooden_crate"]
+    b = truth["/World/Car"]
+    assert car["bbox"] == [b["x_min"], b["y_min"], b["x_max"], b["y_max"]]
+    assert car["occluded"] == 0 and crate["occluded"] in (1, 2)      # the crate is partly behind the car
+    assert car["truncated"] == 0.0
+    # 3D: h w l in metres, bottom-centre location in the camera frame (x right, y down, z forward)
+    np.testing.assert_allclose(car["dimensions"], [0.8, 1.0, 2.0], atol=0.01)
+    np.testing.assert_allclose(car["location"], [0.0, 0.4, 6.0], atol=0.01)
+    # local x (the car's length) is turned 30 degrees about world z: KITTI's rotation_y = -30 degrees
+    assert car["rotation_y"] == pytest.approx(-np.radians(30), abs=0.01)
+    assert car["alpha"] == pytest.approx(car["rotation_y"], abs=0.01)   # centred object: alpha == rotation_y
+    depth = np.array(Image.open(os.path.join(out_dir, "depth", "0.png")))
+    d = distance.get_data()
+    assert depth.dtype == np.uint16 and np.array_equal(depth, np.where(np.isfinite(d), np.round(d * 256), 0))
+    assert 5.4 < depth[48, 64] / 256 < 5.6
+    inst = np.array(Image.open(os.path.join(out_dir, "instance_segmentation", "0.png")))
+    semantic = np.array(Image.open(os.path.join(out_dir, "semantic", "0.png")))
+    car_index = list(writer.mapping).index("car")
+    assert semantic[48, 64] == car_index and inst[48, 64] == car_index * 256 + 1
+    crate_index = list(writer.mapping).index("wooden crate")           # appended to KITTI's classes
+    assert crate_index == len(writer.mapping) - 1 and (semantic == crate_index).any()
+
+
+def test_kitti_writer_dir_names_threshold_and_several_products(out_dir):
+    cube, (cam, rp), (top, rp_top) = _two_cameras()
+    writer = rep.writers.get("KittiWriter")
+    writer.initialize(output_dir=out_dir, use_kitti_dir_names=True, bbox_height_threshold=60,
+                      mapping_dict={"car": (0, 0, 142, 255)}, colorize_instance_segmentation=True)
+    writer.attach([rp, rp_top])
+    for _ in range(2):
+        rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    files = _files(out_dir)
+    for name in (rp.name, "top"):
+        for sub in ("image_02/1.png", "label_02/1.txt", "semantic_rgb/1.png", "semantic/1.png", "instance/1.png",
+                    "instance_rgb/1.png", "depth/1.png"):
+            assert f"{name}/{sub}" in files
+    # the cube is ~33 px tall in both views: under the 60 px threshold, no label lines
+    assert open(os.path.join(out_dir, "top", "label_02", "0.txt")).read() == ""
+    # "cube" is not in the user's mapping: unlabelled in the class image
+    assert not np.array(Image.open(os.path.join(out_dir, "top", "semantic", "0.png"))).any()

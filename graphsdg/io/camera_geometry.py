@@ -94,3 +94,15 @@ def box_corners(mins: np.ndarray, maxs: np.ndarray) -> np.ndarray:
 
 # Isaac's PoseWriter keypoint order: box centre, then Left/Right (x), Down/Up (y), Back/Front (z).
 CUBOID_KEYPOINTS = ["Center", "LDB", "LDF", "LUB", "LUF", "RDB", "RDF", "RUB", "RUF"]
+
+
+def truncation_ratio(projected: np.ndarray, camera_points: np.ndarray, width: int, height: int) -> float:
+    """Share of the projected box's 2D extent that lies outside the image (1 if any corner is behind the camera)."""
+    if np.any(camera_points[:, 2] >= 0) or not np.all(np.isfinite(projected)):
+        return 1.0
+    (x0, y0), (x1, y1) = projected.min(0), projected.max(0)
+    area = (x1 - x0) * (y1 - y0)
+    if area <= 0:
+        return 0.0
+    inside = max(0.0, min(x1, width) - max(x0, 0.0)) * max(0.0, min(y1, height) - max(y0, 0.0))
+    return float(round(1.0 - inside / area, 6))

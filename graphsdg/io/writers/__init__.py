@@ -2,9 +2,10 @@
 from graphsdg.io.writer import WriterRegistry
 from graphsdg.io.writers.basic import BasicWriter
 from graphsdg.io.writers.coco import CocoWriter
+from graphsdg.io.writers.kitti import KittiWriter
 from graphsdg.io.writers.pose import PoseWriter
 
-for _writer in (BasicWriter, CocoWriter, PoseWriter):
+for _writer in (BasicWriter, CocoWriter, KittiWriter, PoseWriter):
     WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter", "CocoWriter", "PoseWriter"]
+__all__ = ["BasicWriter", "CocoWriter", "KittiWriter", "PoseWriter"]

@@ -45,7 +45,7 @@ from PIL import Image, ImageDraw
 
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof
-from graphsdg.io.camera_geometry import CUBOID_KEYPOINTS, PinholeCamera, box_corners
+from graphsdg.io.camera_geometry import CUBOID_KEYPOINTS, PinholeCamera, box_corners, truncation_ratio
 from graphsdg.io.labels import class_name
 from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
@@ -183,18 +183,6 @@ class PoseWriter(Writer):
     def detach(self) -> None:
         super().detach()
         self._frame_id = 0
-
-
-def truncation_ratio(projected: np.ndarray, camera_points: np.ndarray, width: int, height: int) -> float:
-    """Share of the projected box's 2D extent that lies outside the image (1 if any corner is behind the camera)."""
-    if np.any(camera_points[:, 2] >= 0) or not np.all(np.isfinite(projected)):
-        return 1.0
-    (x0, y0), (x1, y1) = projected.min(0), projected.max(0)
-    area = (x1 - x0) * (y1 - y0)
-    if area <= 0:
-        return 0.0
-    inside = max(0.0, min(x1, width) - max(x0, 0.0)) * max(0.0, min(y1, height) - max(y0, 0.0))
-    return float(round(1.0 - inside / area, 6))
 
 
 def write_overlay(rgb: np.ndarray, objects: list[dict], camera: PinholeCamera, path: str,
