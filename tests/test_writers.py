@@ -407,3 +407,54 @@ def test_kitti_writer_dir_names_threshold_and_several_products(out_dir):
     assert open(os.path.join(out_dir, "top", "label_02", "0.txt")).read() == ""
     # "cube" is not in the user's mapping: unlabelled in the class image
     assert not np.array(Image.open(os.path.join(out_dir, "top", "semantic", "0.png"))).any()
+
+
+# ---- YoloWriter ------------------------------------------------------------------------------
+def test_yolo_writer_reads_back(out_dir):
+    import yaml
+    cam, rp = _occluding_scene()
+    boxes = rep.annotators.get("bounding_box_2d_tight", init_params={"semanticTypes": ["class"]})
+    boxes.attach(rp)
+    writer = rep.writers.get("YoloWriter")
+    writer.initialize(output_dir=out_dir, val_every=3)
+    writer.attach(rp)
+    truth = []
+    for i in range(3):
+        rep.functional.modify.position("/World/Ball", (0.6 - 0.4 * i, 2.0, 0.3))
+        rep.orchestrator.step()
+        truth.append(boxes.get_data())
+    rep.orchestrator.wait_until_complete()
+    meta = yaml.safe_load(open(os.path.join(out_dir, "data.yaml")))
+    assert meta["path"] == os.path.abspath(out_dir) and meta["train"] == "images/train" and meta["val"] == "images/val"
+    assert sorted(meta["names"].values()) == ["ball", "box"] and sorted(meta["names"]) == [0, 1] and meta["nc"] == 2
+    images = [f for f in _files(out_dir) if f.startswith("images/")]
+    assert images == ["images/train/000000.png", "images/train/000001.png", "images/val/000002.png"]
+    for n, image in enumerate(images):
+        label_path = os.path.join(out_dir, "/labels/".join(image.rsplit("images/", 1)).rsplit(".", 1)[0] + ".txt")
+        img = Image.open(os.path.join(out_dir, image))
+        w, h = img.size
+        rows = [line.split() for line in open(label_path).read().splitlines()]
+        got = []
+        for r in rows:
+            c, cx, cy, bw, bh = int(r[0]), *map(float, r[1:])
+            assert all(0.0 <= v <= 1.0 for v in (cx, cy, bw, bh))
+            x0, x1 = round(cx * w - bw * w / 2), round(cx * w + bw * w / 2) - 1
+            y0, y1 = round(cy * h - bh * h / 2), round(cy * h + bh * h / 2) - 1
+            got.append((meta["names"][c], x0, y0, x1, y1))
+        labels = truth[n]["info"]["idToLabels"]
+        expected = sorted((labels[str(t["semanticId"])]["class"], t["x_min"], t["y_min"], t["x_max"], t["y_max"])
+                          for t in truth[n]["data"])
+        assert sorted(got) == expected
+    writer.detach()
+
+
+def test_yolo_writer_fixed_classes_skip_others(out_dir):
+    cam, rp = _occluding_scene()
+    writer = rep.writers.get("YoloWriter")
+    writer.initialize(output_dir=out_dir, classes=["ball"], split="synthetic")
+    writer.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    lines = open(os.path.join(out_dir, "labels", "synthetic", "000000.txt")).read().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("0 ")
+    assert "val: \"images/synthetic\"" in open(os.path.join(out_dir, "data.yaml")).read()

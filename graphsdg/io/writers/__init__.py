@@ -4,8 +4,9 @@ from graphsdg.io.writers.basic import BasicWriter
 from graphsdg.io.writers.coco import CocoWriter
 from graphsdg.io.writers.kitti import KittiWriter
 from graphsdg.io.writers.pose import PoseWriter
+from graphsdg.io.writers.yolo import YoloWriter
 
-for _writer in (BasicWriter, CocoWriter, KittiWriter, PoseWriter):
+for _writer in (BasicWriter, CocoWriter, KittiWriter, PoseWriter, YoloWriter):
     WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter", "CocoWriter", "KittiWriter", "PoseWriter"]
+__all__ = ["BasicWriter", "CocoWriter", "KittiWriter", "PoseWriter", "YoloWriter"]
