@@ -430,8 +430,10 @@ def test_yolo_writer_reads_back(out_dir):
     images = [f for f in _files(out_dir) if f.startswith("images/")]
     assert images == ["images/train/000000.png", "images/train/000001.png", "images/val/000002.png"]
     for n, image in enumerate(images):
-        label_path = os.path.join(out_dir, "/labels/".join(image.rsplit("images/", 1)).rsplit(".", 1)[0] + ".txt")
-        img = Image.open(os.path.join(out_dir, image))
+        image_path = os.path.join(out_dir, image)
+        # Ultralytics' img2label_paths: the last /images/ becomes /labels/, the extension .txt
+        label_path = "/labels/".join(image_path.rsplit("/images/", 1)).rsplit(".", 1)[0] + ".txt"
+        img = Image.open(image_path)
         w, h = img.size
         rows = [line.split() for line in open(label_path).read().splitlines()]
         got = []
