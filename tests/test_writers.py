@@ -460,3 +460,58 @@ def test_yolo_writer_fixed_classes_skip_others(out_dir):
     lines = open(os.path.join(out_dir, "labels", "synthetic", "000000.txt")).read().splitlines()
     assert len(lines) == 1 and lines[0].startswith("0 ")
     assert "val: \"images/synthetic\"" in open(os.path.join(out_dir, "data.yaml")).read()
+
+
+# ---- BopWriter -----------------------------------------------------------------------------
+def test_bop_writer_reads_back(out_dir):
+    from conftest import project_box
+    cam, rp = _occluding_scene()
+    instances = rep.annotators.get("instance_segmentation", init_params={"semanticTypes": ["class"]})
+    depth = rep.annotators.get("distance_to_image_plane")
+    for a in (instances, depth):
+        a.attach(rp)
+    writer = rep.writers.get("BopWriter")
+    writer.initialize(output_dir=out_dir, obj_ids={"box": 1, "ball": 2}, scene_id=3)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    seg, z = instances.get_data(), depth.get_data()
+    rep.orchestrator.wait_until_complete()
+    scene = os.path.join(out_dir, "train_pbr", "000003")
+    gt = json.load(open(os.path.join(scene, "scene_gt.json")))["0"]
+    info = json.load(open(os.path.join(scene, "scene_gt_info.json")))["0"]
+    cam_info = json.load(open(os.path.join(scene, "scene_camera.json")))["0"]
+    assert sorted(g["obj_id"] for g in gt) == [1, 1, 2] and len(info) == 3
+    K = np.array(cam_info["cam_K"]).reshape(3, 3)
+    # depth png * depth_scale = z-depth in mm
+    png = np.array(Image.open(os.path.join(scene, "depth", "000000.png"))).astype(np.float64)
+    finite = np.isfinite(z)
+    assert np.all(png[~finite] == 0)
+    np.testing.assert_allclose(png[finite] * cam_info["depth_scale"], z[finite] * 1000, atol=0.501)
+    # world -> camera: the world origin (the front cube's centre) is 5.1 m in front of the camera
+    t_w2c = np.array(cam_info["cam_t_w2c"])
+    np.testing.assert_allclose(np.linalg.norm(t_w2c), np.hypot(5, 1) * 1000, rtol=1e-6)
+    paths = {v: int(k) for k, v in seg["info"]["idToLabels"].items()}
+    corners = np.array([[x, y, zz] for x in (-.5, .5) for y in (-.5, .5) for zz in (-.5, .5)])
+    for gt_id, (g, i) in enumerate(zip(gt, info)):
+        R, t = np.array(g["cam_R_m2c"]).reshape(3, 3), np.array(g["cam_t_m2c"])
+        assert np.allclose(R @ R.T, np.eye(3), atol=1e-9)
+        if g["obj_id"] == 2:
+            continue
+        pts = (R @ (corners * g["graphsdg_scale"] * 1000).T).T + t   # model (mm) -> camera, mm (OpenCV frame)
+        uv = (K @ pts.T).T
+        uv = uv[:, :2] / uv[:, 2:]
+        mask = np.array(Image.open(os.path.join(scene, "mask_visib", f"000000_{gt_id:06d}.png"))) > 0
+        iid = int(np.bincount(seg["data"][mask]).argmax())
+        truth = seg["data"] == iid
+        assert np.array_equal(mask, truth) and i["px_count_visib"] == truth.sum()
+        prim = seg["info"]["idToLabels"][str(iid)]
+        world = corners * (0.5 if prim == "/World/Side" else 1.0) + ((-1.6, 1.0, 0) if prim == "/World/Side" else 0)
+        lo, hi = project_box(cam, W, H, world)
+        np.testing.assert_allclose(uv.min(0), lo, atol=1e-4)
+        np.testing.assert_allclose(uv.max(0), hi, atol=1e-4)
+    ball = info[[g["obj_id"] for g in gt].index(2)]
+    assert 0 < ball["visib_fract"] < 1 and ball["px_count_all"] > ball["px_count_visib"]
+    assert ball["visib_fract"] == pytest.approx(ball["px_count_visib"] / ball["px_count_all"], abs=1e-3)
+    x, y, w, h = ball["bbox_visib"]
+    bx, by, bw, bh = ball["bbox_obj"]
+    assert bx <= x and by <= y and bx + bw >= x + w and by + bh >= y + h
