@@ -5,9 +5,11 @@ from graphsdg.io.writers.bop import BopWriter
 from graphsdg.io.writers.coco import CocoWriter
 from graphsdg.io.writers.kitti import KittiWriter
 from graphsdg.io.writers.pose import PoseWriter
+from graphsdg.io.writers.webdataset import WebDatasetWriter
 from graphsdg.io.writers.yolo import YoloWriter
 
-for _writer in (BasicWriter, BopWriter, CocoWriter, KittiWriter, PoseWriter, YoloWriter):
+for _writer in (BasicWriter, BopWriter, CocoWriter, KittiWriter, PoseWriter, WebDatasetWriter, YoloWriter):
     WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter", "BopWriter", "CocoWriter", "KittiWriter", "PoseWriter", "YoloWriter"]
+__all__ = ["BasicWriter", "BopWriter", "CocoWriter", "KittiWriter", "PoseWriter", "WebDatasetWriter",
+           "YoloWriter"]
