@@ -569,3 +569,215 @@ def test_webdataset_shards_are_deterministic(tmp_path):
         writer.detach()
         return open(path / "shard-000000.tar", "rb").read()
     assert capture(tmp_path / "a") == capture(tmp_path / "b")
+
+
+# ---- custom writers ---------------------------------------------------------------------------
+def test_custom_writer_schedule_on_final_frame_and_registered_backend(out_dir):
+    calls = []
+
+    class MemoryBackend(rep.backends.BaseBackend):
+        def __init__(self):
+            self.blobs = {}
+
+        def write_blob(self, path, data):
+            self.blobs[path] = data
+
+    rep.backends.register(MemoryBackend)
+
+    def write_mean(data=None, path="", scale=1.0, backend_instance=None):
+        calls.append(path)
+        backend_instance.write_blob(path, f"{float(np.mean(data)) * scale:.3f}".encode())
+
+    class MeanWriter(rep.Writer):
+        def __init__(self, output_dir):
+            self.version = "1.2.3"
+            self.data_structure = "annotator"
+            self.annotators = ["rgb"]
+            self.backend = rep.backends.get("DiskBackend")
+            self.backend.initialize(output_dir=output_dir)
+            self.memory = rep.backends.get("MemoryBackend", init_params={})
+            self.frames = 0
+            self.finals = 0
+
+        def write(self, data):
+            for rp_name, d in data["annotators"]["rgb"].items():
+                self.backend.schedule(rep.functional.write_image, data=d["data"], path=f"{rp_name}/{self.frames}.png")
+                self.memory.schedule(write_mean, data=d["data"], path=f"mean_{self.frames}", scale=2.0)
+            self.frames += 1
+
+        def on_final_frame(self):
+            self.finals += 1
+            self.backend.schedule(rep.functional.write_json, data={"frames": self.frames}, path="summary.json")
+
+    rep.WriterRegistry.register(MeanWriter)
+    cube, cam, rp = unit_cube_scene()
+    writer = rep.writers.get("MeanWriter", init_params={"output_dir": out_dir}, render_products=[rp])
+    rep.orchestrator.run(num_frames=2)
+    assert writer.finals == 1 and writer.num_written == 2
+    assert json.load(open(os.path.join(out_dir, "summary.json"))) == {"frames": 2}
+    assert json.load(open(os.path.join(out_dir, "metadata.txt")))["version"] == "1.2.3"
+    png = np.array(Image.open(os.path.join(out_dir, rp.name, "1.png")))
+    assert sorted(calls) == ["mean_0", "mean_1"]
+    assert float(writer.memory.blobs["mean_1"]) == pytest.approx(2 * png.mean(), abs=1e-3)
+    rep.orchestrator.stop()                                           # stop() runs on_final_frame again
+    assert writer.finals == 2
+    writer.detach()
+
+
+def test_basic_writer_writes_through_a_user_backend():
+    class MemoryBackend(rep.backends.BaseBackend):
+        def __init__(self):
+            self.blobs = {}
+
+        def write_blob(self, path, data):
+            self.blobs[path] = data
+
+    rep.backends.register(MemoryBackend)
+    backend = rep.backends.get("MemoryBackend", init_params={})
+    cube, cam, rp = unit_cube_scene()
+    writer = rep.writers.get("BasicWriter", init_params={"backend": backend, "rgb": True}, render_products=rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    assert sorted(backend.blobs) == ["metadata.txt", "rgb_0000.png"]
+    assert backend.blobs["rgb_0000.png"][:8] == b"\x89PNG\r\n\x1a\n"
+    writer.detach()
+
+
+def test_a_writer_that_raises_stops_the_script(out_dir):
+    class Broken(rep.Writer):
+        def __init__(self):
+            self.annotators = ["rgb"]
+            self.frames = 0
+
+        def write(self, data):
+            self.frames += 1
+            if self.frames == 2:
+                raise KeyError("no such annotator output: 'rbg'")
+
+        def on_final_frame(self):
+            raise RuntimeError("final flush failed")
+
+    rep.WriterRegistry.register(Broken)
+    cube, cam, rp = unit_cube_scene()
+    writer = rep.writers.get("Broken", init_params={}, render_products=rp)
+    rep.orchestrator.step()
+    with pytest.raises(KeyError, match="rbg"):
+        rep.orchestrator.step()
+    with pytest.raises(RuntimeError, match="final flush failed"):
+        rep.orchestrator.stop()
+    writer.detach()
+    rep.orchestrator.step()                                           # the script can go on without it
+
+
+# ---- bad input -------------------------------------------------------------------------------
+ALL_WRITERS = ["BasicWriter", "CocoWriter", "KittiWriter", "PoseWriter", "YoloWriter", "BopWriter",
+               "WebDatasetWriter"]
+FLAGS = {"BasicWriter": {"rgb": True}}
+
+
+@pytest.mark.parametrize("name", ALL_WRITERS)
+def test_writer_without_output_unknown_flag_and_file_as_dir(name, tmp_path):
+    with pytest.raises(ValueError, match=r"No `backend`, `output_dir` or `s3_` parameter specified"):
+        rep.writers.get(name).initialize(**FLAGS.get(name, {}))
+    with pytest.raises(TypeError, match=rf"{name}.initialize\(\) got unknown parameter\(s\) \['colorise'\]"):
+        rep.writers.get(name).initialize(output_dir=str(tmp_path / "o"), colorise=True, **FLAGS.get(name, {}))
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(NotADirectoryError, match="is a file"):
+        rep.writers.get(name).initialize(output_dir=str(blocker), **FLAGS.get(name, {}))
+    with pytest.raises(NotADirectoryError, match=r"'.*/file' is a file"):
+        rep.writers.get(name).initialize(output_dir=str(blocker / "sub"), **FLAGS.get(name, {}))
+    s3 = {"PoseWriter": {"use_s3": True}, "BasicWriter": {"s3_bucket": "b"}, "CocoWriter": {"s3_bucket": "b"},
+          "KittiWriter": {"s3_bucket": "b"}}
+    if name in s3:                                                    # Replicator's S3 arguments: a clear refusal
+        with pytest.raises(ValueError, match="S3"):
+            rep.writers.get(name).initialize(output_dir=str(tmp_path / "o"), **FLAGS.get(name, {}), **s3[name])
+    with pytest.raises(TypeError, match="backend must be a backend from rep.backends.get"):
+        rep.writers.get(name).initialize(backend="DiskBackend", **FLAGS.get(name, {}))
+
+
+def test_output_dir_that_is_not_writable(tmp_path, monkeypatch):
+    import errno
+    real_open = open
+
+    def read_only_open(path, mode="r", *args, **kwargs):
+        if "w" in mode and str(path).startswith(str(tmp_path)):
+            raise OSError(errno.EROFS, "Read-only file system", str(path))
+        return real_open(path, mode, *args, **kwargs)
+
+    import graphsdg.io.backends as backends
+    monkeypatch.setattr(backends, "open", read_only_open, raising=False)
+    with pytest.raises(PermissionError, match=r"output_dir '.*/ro' is not writable: Read-only file system"):
+        rep.writers.get("BasicWriter").initialize(output_dir=str(tmp_path / "ro"), rgb=True)
+    monkeypatch.undo()
+    if os.access("/sys", os.W_OK):                                    # a real read-only mount, when there is one
+        try:
+            open("/sys/.graphsdg-probe", "wb").close()
+        except OSError:
+            with pytest.raises(PermissionError, match="'/sys' is not writable"):
+                rep.writers.get("BasicWriter").initialize(output_dir="/sys", rgb=True)
+
+
+def _disk_full_open(monkeypatch, after_bytes=10):
+    """Make every file write through graphsdg's backends fail with ENOSPC after ``after_bytes`` bytes."""
+    import errno
+    import graphsdg.io.backends as backends
+    real_open = open
+
+    class FullDisk:
+        def __init__(self, f):
+            self.f, self.written = f, 0
+
+        def write(self, data):
+            room = max(0, after_bytes - self.written)
+            self.f.write(data[:room])                                 # a partial file really reaches the disk
+            self.written += min(room, len(data))
+            if len(data) > room:
+                raise OSError(errno.ENOSPC, "No space left on device")
+            return len(data)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.f.close()
+
+    def full_open(path, mode="r", *args, **kwargs):
+        f = real_open(path, mode, *args, **kwargs)
+        return FullDisk(f) if "w" in mode else f
+
+    monkeypatch.setattr(backends, "open", full_open, raising=False)
+
+
+def test_disk_full_during_a_write_leaves_no_truncated_file(out_dir, monkeypatch):
+    from graphsdg.errors import WriterError
+    cube, cam, rp = unit_cube_scene()
+    writer = rep.writers.get("CocoWriter")
+    writer.initialize(output_dir=out_dir, dataset_id="full", semantic_types=["class"])
+    writer.attach(rp)
+    rep.orchestrator.wait_until_complete()
+    good_json = open(os.path.join(out_dir, "coco_annotations_full.json"), "rb").read()
+    _disk_full_open(monkeypatch)
+    rep.orchestrator.step()
+    with pytest.raises(WriterError, match=r"disk full while writing '.*(\.png|\.json|metadata\.txt)'"):
+        rep.orchestrator.wait_until_complete()
+    monkeypatch.undo()
+    files = _files(out_dir)
+    assert not [f for f in files if ".tmp" in f]                      # partial temp files were removed
+    assert not [f for f in files if f.endswith(".png")]               # no image under its final name
+    # the aggregate json still holds its last complete version
+    assert open(os.path.join(out_dir, "coco_annotations_full.json"), "rb").read() == good_json
+    writer.detach()
+
+
+def test_missing_texture_paths_name_the_path(tmp_path):
+    missing = str(tmp_path / "nope" / "wood_BaseColor.png")
+    cube, cam, rp = unit_cube_scene()
+    with pytest.raises(FileNotFoundError, match="nope/wood_BaseColor.png"):
+        rep.functional.create.material(mdl="OmniPBR.mdl", diffuse_texture=missing)
+    with pytest.raises(FileNotFoundError, match="nope/wood_BaseColor.png"):
+        rep.functional.randomizer.texture(cube, [missing])
+    with pytest.raises(FileNotFoundError, match="nope/wood_BaseColor.png"):
+        with rep.trigger.on_frame():
+            rep.randomizer.texture([missing], input_prims=[cube])
+        rep.orchestrator.step()

@@ -23,8 +23,9 @@ import numpy as np
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
-from graphsdg.io.backends import BackendDispatch, BackendGroup, BaseBackend
+from graphsdg.io.backends import BaseBackend
 from graphsdg.io.writer import Writer
+from graphsdg.io.writers import arguments
 
 # flag -> (annotator name BasicWriter requests, file stem)
 _FLAGS = {
@@ -65,11 +66,6 @@ class BasicWriter(Writer):
                  colorize_depth: bool = False, skeleton_data: bool = False, frame_padding: int = 4,
                  semantic_filter_predicate: str | None = None, use_common_output_dir: bool = False,
                  backend: BaseBackend | None = None, provenance: bool = False) -> None:
-        if s3_bucket or s3_region or s3_endpoint:
-            raise ValueError("BasicWriter: S3 output is not available in graphsdg; pass output_dir or backend")
-        if output_dir is None and backend is None:
-            raise ValueError("No `backend`, `output_dir` or `s3_` parameter specified; BasicWriter needs "
-                             "somewhere to write (e.g. output_dir='_out')")
         if str(image_output_format).lower() not in IMAGE_FORMATS:
             raise ValueError(f"image_output_format must be one of {IMAGE_FORMATS}, got {image_output_format!r}")
         if isinstance(frame_padding, bool) or not isinstance(frame_padding, int) or frame_padding < 0:
@@ -86,10 +82,8 @@ class BasicWriter(Writer):
         self.semantic_filter_predicate = semantic_filter.text
         self.version = "0.0.2"
         self.data_structure = "annotator"
-        backends = [backend] if backend is not None else []
-        if output_dir is not None:
-            backends.append(BackendDispatch(output_dir=output_dir))
-        self.backend = backends[0] if len(backends) == 1 else BackendGroup(backends)
+        self.backend = arguments.output_backend("BasicWriter", output_dir, backend, s3_bucket=s3_bucket,
+                                                s3_region=s3_region, s3_endpoint=s3_endpoint)
         self.output_dir = getattr(self.backend, "output_dir", None)
         self._frame_id = 0
         self._sequence = ""
