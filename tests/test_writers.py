@@ -781,3 +781,15 @@ def test_missing_texture_paths_name_the_path(tmp_path):
         with rep.trigger.on_frame():
             rep.randomizer.texture([missing], input_prims=[cube])
         rep.orchestrator.step()
+
+
+@pytest.mark.parametrize("module", ["graphsdg.io.aggregate", "graphsdg.io.camera_geometry", "graphsdg.io.labels",
+                                    "graphsdg.io.writers.arguments", "graphsdg.io.writers.coco",
+                                    "graphsdg.io.writers.kitti", "graphsdg.io.writers.pose",
+                                    "graphsdg.io.writers.yolo", "graphsdg.io.writers.bop",
+                                    "graphsdg.io.writers.webdataset"])
+def test_writer_docstring_examples_run(module):
+    import doctest
+    import importlib
+    result = doctest.testmod(importlib.import_module(module), optionflags=doctest.ELLIPSIS)
+    assert result.failed == 0

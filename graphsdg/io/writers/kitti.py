@@ -211,28 +211,42 @@ class KittiWriter(Writer):
 
     def _write_segmentation(self, rp: dict, path) -> None:
         instances = rp["instance_segmentation_fast"]
-        ids = np.asarray(instances["data"])
-        semantic_index = np.zeros(ids.shape, dtype=np.uint8)
-        instance_image = np.zeros(ids.shape, dtype=np.uint16)
-        colours = np.zeros(ids.shape + (4,), dtype=np.uint8)
+        unlabelled = list(self.mapping).index("unlabelled")
+        plan = []                         # (instance id, class index, instance number in its class)
         per_class: dict[int, int] = {}
         for iid in sorted(int(k) for k in instances["idToSemantics"]):
             label = class_name(instances["idToSemantics"][str(iid)], self.semantic_types)
             index = self._class_index(label)
-            mask = ids == iid
             if index > 255:
                 raise ValueError(f"KittiWriter: more than 255 classes in the label mapping ({label!r} is {index})")
-            semantic_index[mask] = index
-            colours[mask] = self.mapping[list(self.mapping)[index]]
-            if iid >= 2 and index != list(self.mapping).index("unlabelled"):
-                per_class[index] = per_class.get(index, 0) + 1
-                instance_image[mask] = index * 256 + per_class[index]
-        self.backend.schedule(iof.write_image, data=colours, path=path("semantic_rgb"))
-        self.backend.schedule(iof.write_image, data=semantic_index, path=path("semantic"))
-        self.backend.schedule(iof.write_image, data=instance_image, path=path("instance"))
-        if self._colorize_instances:
-            rgba = np.zeros(ids.shape + (4,), dtype=np.uint8)
-            for iid in np.unique(ids):
-                if iid >= 2:
-                    rgba[ids == iid] = color_of(int(iid))
-            self.backend.schedule(iof.write_image, data=rgba, path=path("instance_rgb"))
+            number = 0
+            if iid >= 2 and index != unlabelled:
+                per_class[index] = number = per_class.get(index, 0) + 1
+            plan.append((iid, index, number))
+        colours = [self.mapping[name] for name in self.mapping]
+        # the per-pixel work runs on a write-queue worker
+        self.backend.schedule(write_kitti_segmentation, ids=np.asarray(instances["data"]), plan=plan,
+                              colours=colours, colorize_instances=self._colorize_instances,
+                              paths={k: path(k) for k in ("semantic_rgb", "semantic", "instance", "instance_rgb")})
+
+
+def write_kitti_segmentation(ids: np.ndarray, plan: list, colours: list, colorize_instances: bool, paths: dict,
+                             backend_instance=None) -> None:
+    """KITTI's class, colour and instance images from an instance-id image and a per-instance plan."""
+    semantic_index = np.zeros(ids.shape, dtype=np.uint8)
+    instance_image = np.zeros(ids.shape, dtype=np.uint16)
+    rgba = np.zeros(ids.shape + (4,), dtype=np.uint8)
+    instance_rgba = np.zeros(ids.shape + (4,), dtype=np.uint8)
+    for iid, index, number in plan:
+        mask = ids == iid
+        semantic_index[mask] = index
+        rgba[mask] = colours[index]
+        if number:
+            instance_image[mask] = index * 256 + number
+        if iid >= 2:
+            instance_rgba[mask] = color_of(iid)
+    iof.write_image(data=rgba, path=paths["semantic_rgb"], backend_instance=backend_instance)
+    iof.write_image(data=semantic_index, path=paths["semantic"], backend_instance=backend_instance)
+    iof.write_image(data=instance_image, path=paths["instance"], backend_instance=backend_instance)
+    if colorize_instances:
+        iof.write_image(data=instance_rgba, path=paths["instance_rgb"], backend_instance=backend_instance)
