@@ -100,6 +100,26 @@ def test_basic_writer_on_time_sequence_prefix(out_dir):
     assert names == ["rgb_1_0000.png", "rgb_1_0001.png", "rgb_1_0002.png", "rgb_2_0000.png", "rgb_2_0001.png"]
 
 
+def test_basic_writer_filter_predicate_and_raw_ids(out_dir):
+    cam, rp = _occluding_scene()
+    seg = rep.annotators.get("semantic_segmentation", init_params={"semanticFilter": "class:ball"})
+    seg.attach(rp)
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir=out_dir, semantic_filter_predicate="class:ball", bounding_box_2d_tight=True,
+                      semantic_segmentation=True, colorize_semantic_segmentation=False)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    assert json.load(open(os.path.join(out_dir, "bounding_box_2d_tight_prim_paths_0000.json"))) == ["/World/Ball"]
+    ids = np.array(Image.open(os.path.join(out_dir, "semantic_segmentation_0000.png")))
+    assert ids.dtype == np.uint16 and np.array_equal(ids, seg.get_data()["data"])   # raw ids, not colours
+    labels = json.load(open(os.path.join(out_dir, "semantic_segmentation_labels_0000.json")))
+    assert {v["class"] for v in labels.values()} == {"BACKGROUND", "UNLABELLED", "ball"}
+    with pytest.raises(ValueError, match="mutually exclusive"):
+        rep.writers.get("BasicWriter").initialize(output_dir=out_dir, rgb=True, semantic_types=["class"],
+                                                  semantic_filter_predicate="class:ball")
+
+
 def test_sequence_prefix_matches_replicator_order():
     from graphsdg.io.writers.basic import sequence_prefix
     assert sequence_prefix({}) == ""
