@@ -139,6 +139,13 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
     bench.add_argument("--profile", action="store_true", help="print where each frame's time goes")
     bench.add_argument("--report", metavar="MD", help="append the result table to this Markdown file")
+    run = sub.add_parser("run", help="run a graphsdg (or, with --compat isaac, an Isaac Sim Replicator) script",
+                         usage="graphsdg run SCRIPT [options] [-- SCRIPT_ARGS ...]")
+    run.add_argument("script")
+    run.add_argument("--compat", choices=["isaac"], help="provide Isaac Sim's module names to the script")
+    run.add_argument("--seed", type=int, help="global seed (unless the script sets its own)")
+    run.add_argument("--out", help="root for the script's relative output directories")
+    run.add_argument("--frames", type=int, help="frames for orchestrator.run() calls without num_frames")
     view = sub.add_parser("view", help="contact sheet (and HTML gallery) of a dataset, with statistics")
     view.add_argument("dir")
     view.add_argument("--html", action="store_true", help="also write an HTML gallery")
@@ -146,6 +153,11 @@ def main(argv: list[str] | None = None) -> int:
     view.add_argument("--out", help="output folder (default: DIR.view next to the dataset)")
     validate = sub.add_parser("validate", help="check a dataset's consistency; exit 1 on any violation")
     validate.add_argument("dir")
+    argv = list(sys.argv[1:] if argv is None else argv)
+    script_args: list[str] = []
+    if "--" in argv:   # everything after "--" belongs to the script (graphsdg run SCRIPT ... -- ARGS)
+        cut = argv.index("--")
+        argv, script_args = argv[:cut], argv[cut + 1:]
     args = parser.parse_args(argv)
     try:
         if args.command == "demo":
@@ -153,6 +165,10 @@ def main(argv: list[str] | None = None) -> int:
                 parser.error(f"--frames must be >= 1, got {args.frames}")
             summary = run_demo(args.out, args.frames, tuple(args.resolution), args.seed)
             print(f"wrote {summary['frames']} frames to {summary['output_dir']} in {summary['seconds']:.1f} s")
+        elif args.command == "run":
+            from graphsdg.script_runner import run_script
+            run_script(args.script, script_args, compat=args.compat, seed=args.seed, out_dir=args.out,
+                       frames=args.frames)
         elif args.command == "bench":
             run_bench(args)
         elif args.command == "view":

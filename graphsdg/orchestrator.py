@@ -18,6 +18,7 @@ from graphsdg import settings
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.io.write_queue import get_write_queue
+from graphsdg.progress import Progress
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
 
@@ -77,8 +78,11 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
          wait_for_render: bool = True) -> None:
     """Run one capture: fired graph triggers, stage sync, time advance, render, annotators, writers.
 
-    ``delta_time=None`` advances a playing timeline by one tick; ``0`` captures
-    without advancing; a positive value advances by that many seconds.
+    ``delta_time=None`` advances the timeline one frame (``1 / time codes per
+    second``); ``0`` captures without advancing; a positive value advances by that
+    many seconds. As in Replicator, a step that advances plays the timeline for the
+    step; ``pause_timeline=True`` leaves it paused afterwards (so a script that
+    wants it running again calls ``timeline.play()``).
     ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
     """
     rt_subframes = _validate_subframes(rt_subframes)
@@ -117,21 +121,13 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
 
 
 def advance_time(delta_time: float | None) -> None:
-    """Advance the simulation by ``delta_time`` (``None``: one tick if the timeline plays)."""
-    rt = runtime()
-    timeline = rt.timeline
-    if delta_time is None:
-        if not timeline.is_playing():
-            return
-        dt = timeline.frame_duration
-    else:
-        dt = float(delta_time)
+    """Play the timeline through ``delta_time`` seconds (``None``: one frame; ``0``: nothing)."""
+    timeline = runtime().timeline
+    dt = timeline.frame_duration if delta_time is None else float(delta_time)
     if dt <= 0:
         return
-    sim = rt.sim
-    sim.sync_dirty_prims()
-    sim.advance(dt)
-    timeline.advanced(dt)
+    timeline.play()
+    timeline.advance(dt)
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
@@ -206,13 +202,46 @@ def get_capture_on_play() -> bool:
     return bool(settings.get("/omni/replicator/captureOnPlay", True))
 
 
-def tick() -> None:
-    """One app update: advance a playing timeline one tick, capturing if capture-on-play is on."""
+def update() -> None:
+    """One app update: Isaac's ``simulation_app.update()`` / ``omni.kit.app.get_app().update()``.
+
+    While the timeline plays, advances it one frame (physics, tick events) and,
+    with capture-on-play on and a writer or annotator attached, captures that
+    frame. While paused or stopped it does nothing: stage edits reach the
+    simulation when something needs it (a step, a query, the next tick), so a
+    script that rebuilds its scene over many updates recompiles once.
+
+    Example:
+        >>> import graphsdg as rep
+        >>> _ = rep.stage.new_stage()
+        >>> cube = rep.functional.create.cube(position=(0, 0, 2))
+        >>> rep.functional.physics.apply_rigid_body(cube)
+        >>> rep.timeline.get_timeline_interface().play()
+        >>> for _ in range(30):
+        ...     rep.orchestrator.update()
+        >>> float(cube.GetAttribute("xformOp:translate").Get()[2]) < 2.0
+        True
+        >>> rep.timeline.get_timeline_interface().stop()
+    """
     rt = runtime()
-    if rt.timeline.is_playing() and get_capture_on_play() and (len(rt.writers) or len(rt.annotators)):
+    timeline = rt.timeline
+    if not timeline.is_playing():
+        return
+    if get_capture_on_play() and (len(rt.writers) or len(rt.annotators)):
         step(pause_timeline=False)
         return
-    advance_time(None)
+    timeline.advance()
+
+
+tick = update   # the earlier name of :func:`update`
+
+
+async def update_async() -> None:
+    """:func:`update` for asyncio scripts (``await omni.kit.app.get_app().next_update_async()``)."""
+    update()
+
+
+next_update_async = update_async
 
 
 def get_status() -> Status:
@@ -271,6 +300,8 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
                                    or num_frames < 0):
         raise ValueError(f"num_frames must be None or a non-negative integer, got {num_frames!r}")
     sched = _graph_scheduler()
+    if num_frames is None and settings.get("/graphsdg/run/numFrames") is not None:
+        num_frames = int(settings.get("/graphsdg/run/numFrames"))   # graphsdg run --frames N
     if num_frames is None:
         unlimited = sched.unlimited_triggers()
         if sched.active_graph() is None or not any(t.counts_toward_completion for t in sched.active_graph().triggers):
@@ -290,24 +321,34 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
 
 def _run_loop() -> None:
     sched = _graph_scheduler()
+    progress = Progress(_state.remaining, "run")
     try:
-        while not _state.stop_requested:
-            if _state.pause_requested:
-                _state.set(Status.PAUSED)
-                return
-            if _state.remaining is not None and _state.remaining <= 0:
-                break
-            if _state.remaining is None and sched.all_exhausted():
-                break
-            step(pause_timeline=False)
-            if _state.remaining is not None:
-                _state.remaining -= 1
-            _state.set(Status.STARTED)
+        with progress:
+            paused = _frames(sched, progress)
     except BaseException:
         _state.set(Status.STOPPED)
         raise
-    if not _state.stop_requested:
+    if not paused and not _state.stop_requested:
         stop()
+        log.info("run finished: %s", progress.summary())
+
+
+def _frames(sched, progress: Progress) -> bool:
+    """Capture until done, stopped or paused; returns whether it paused."""
+    while not _state.stop_requested:
+        if _state.pause_requested:
+            _state.set(Status.PAUSED)
+            return True
+        if _state.remaining is not None and _state.remaining <= 0:
+            break
+        if _state.remaining is None and sched.all_exhausted():
+            break
+        step(pause_timeline=False)
+        progress.advance()
+        if _state.remaining is not None:
+            _state.remaining -= 1
+        _state.set(Status.STARTED)
+    return False
 
 
 def run_until_complete(num_frames: int | None = None, start_timeline: bool = False) -> None:

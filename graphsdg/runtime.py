@@ -55,7 +55,7 @@ class Runtime:
         self._sim: SimScene | None = None
         self._sim_stage: Usd.Stage | None = None
         self.rasterizer = Rasterizer()
-        self.timeline = Timeline()
+        self.timeline = Timeline(simulation=lambda: self.sim)
         self.annotators: OrderedSet = OrderedSet()
         self.writers: OrderedSet = OrderedSet()
         self.ids = IdTables()
@@ -88,7 +88,7 @@ class Runtime:
         self._sim_stage = None
         self.ids.clear()
         self.labels = SceneLabels(self.ids)
-        self.timeline.stop()
+        self.timeline.forget_simulation_state()
 
     def check_attachments(self) -> None:
         """Raise if an attached annotator or writer still points at a destroyed render product."""

@@ -28,10 +28,13 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
     "/exts/omni.replicator.core/enableWriteToFabric": (
         False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
+    "/graphsdg/run/numFrames": (None, "frames for orchestrator.run() calls without num_frames (graphsdg run --frames)"),
     "/graphsdg/render/shadowSize": (1024, "shadow map size of shadow-casting lights"),
     "/graphsdg/render/msaaSamples": (4, "multisample anti-aliasing samples of the colour pass"),
     "/graphsdg/render/exposure": (1.0, "scale from photometric light units to display values"),
     "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
+    "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
+                                             "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
                         "rasteriser settings (more MSAA samples and larger shadow maps)"),
 }

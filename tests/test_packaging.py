@@ -25,12 +25,18 @@ def test_wheel_contains_nodes_and_imports(tmp_path):
                 if f.endswith(".py"):
                     name = "/".join(p for p in (sub, rel if rel != "." else "", f) if p)
                     assert name in names, f"{name} is missing from the wheel (pyproject packages list?)"
+    pack = "graphsdg/assets/pack/Isaac/Environments/Simple_Warehouse/Props/"
+    assert pack + "SM_PaletteA_01.usd" in names and pack + "Textures/SM_PaletteA_01_BaseColor.png" in names
+    assert "graphsdg/assets/pack/NVIDIA/Assets/Skies/Indoor/autoshop_01_4k.hdr" in names
     target = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target),
                     str(wheels[0])], check=True)
     code = ("import graphsdg, graphsdg.nodes, sys; "
             "assert graphsdg.__file__.startswith(sys.argv[1]), graphsdg.__file__; "
-            "assert 'rgb' in graphsdg.annotators.get_registered_annotators(); print('ok')")
+            "assert 'rgb' in graphsdg.annotators.get_registered_annotators(); "
+            "from graphsdg.assets import get_assets_root_path as r; import os; "
+            "assert r().startswith(sys.argv[1]) and os.path.isfile(r() + '/Isaac/Environments/Grid/"
+            "default_environment.usd'), r(); print('ok')")
     env = {**os.environ, "PYTHONPATH": str(target)}
     out = subprocess.run([sys.executable, "-c", code, str(target)], cwd=str(tmp_path), env=env,
                          capture_output=True, text=True)

@@ -119,3 +119,14 @@ def test_no_light_stage_gets_a_camera_light():
     rep.stage.get_stage().RemovePrim("/World/Dome")
     img = _rgb(rp)
     assert img[36, 48].sum() > 100
+
+
+def test_saving_over_the_builtin_pack_is_refused(tmp_path):
+    import os
+    from graphsdg.assets import get_assets_root_path
+    path = os.path.join(get_assets_root_path(), "Isaac/Environments/Simple_Warehouse/Props/SM_CardBoxD_04.usd")
+    rep.stage.open_stage(path)
+    with pytest.raises(PermissionError, match="built-in asset pack"):
+        rep.stage.save()
+    copy = rep.stage.save(str(tmp_path / "copy.usda"))
+    assert os.path.getsize(copy) > 100

@@ -71,76 +71,36 @@ class EventStream:
 
 
 # ---- timeline -------------------------------------------------------------------
-class TimelineEventType(enum.IntEnum):
-    PLAY = 0
-    PAUSE = 1
-    STOP = 2
-    CURRENT_TIME_CHANGED = 3
-    CURRENT_TIME_TICKED_PERMANENT = 4
-    CURRENT_TIME_TICKED = 5
+class TimelineEventStream:
+    """Kit's event-stream view of graphsdg's timeline events."""
+
+    def __init__(self, timeline) -> None:
+        self._timeline = timeline
+
+    def create_subscription_to_pop_by_type(self, event_type: int, fn: Callable[[Any], Any], name: str = ""):
+        return self._timeline.subscribe(fn, event_type)
+
+    def create_subscription_to_pop(self, fn: Callable[[Any], Any], name: str = ""):
+        return self._timeline.subscribe(fn)
 
 
 class TimelineInterface:
-    """omni.timeline's interface over graphsdg's timeline; ticks become CURRENT_TIME_TICKED events."""
+    """omni.timeline's interface: graphsdg's :class:`~graphsdg.sim.timeline.Timeline` plus the event stream."""
 
-    def __init__(self) -> None:
-        self._stream = EventStream()
-        self._hooked_timeline = None
+    def __getattr__(self, item: str) -> Any:
+        return getattr(runtime().timeline, item)
 
-    @property
-    def _timeline(self):
-        tl = runtime().timeline
-        if tl is not self._hooked_timeline:
-            tl.subscribe_ticks(lambda t, dt: self._stream.push(TimelineEventType.CURRENT_TIME_TICKED,
-                                                                 {"currentTime": t, "dt": dt}))
-            self._hooked_timeline = tl
-        return tl
-
-    def play(self) -> None:
-        self._timeline.play()
-        self._stream.push(TimelineEventType.PLAY)
-
-    def pause(self) -> None:
-        self._timeline.pause()
-        self._stream.push(TimelineEventType.PAUSE)
-
-    def stop(self) -> None:
-        self._timeline.stop()
-        self._stream.push(TimelineEventType.STOP)
-
-    def is_playing(self) -> bool:
-        return self._timeline.is_playing()
-
-    def is_stopped(self) -> bool:
-        return self._timeline.is_stopped()
-
-    def get_current_time(self) -> float:
-        return self._timeline.get_current_time()
-
-    def set_current_time(self, t: float) -> None:
-        self._timeline.set_current_time(t)
-
-    def get_time_codes_per_seconds(self) -> float:
-        return self._timeline.get_time_codes_per_seconds()
-
-    def set_time_codes_per_second(self, v: float) -> None:
-        self._timeline.set_time_codes_per_second(v)
-
-    def get_timeline_event_stream(self) -> EventStream:
-        _ = self._timeline
-        return self._stream
+    def get_timeline_event_stream(self) -> TimelineEventStream:
+        return TimelineEventStream(runtime().timeline)
 
     def commit(self) -> None:
         """Kit applies pending timeline changes here; graphsdg applies them at once."""
 
 
-_timeline_interface: TimelineInterface | None = None
+_timeline_interface = TimelineInterface()
 
 
 def get_timeline_interface() -> TimelineInterface:
-    global _timeline_interface
-    if _timeline_interface is None:
-        _timeline_interface = TimelineInterface()
     return _timeline_interface
 
 
@@ -149,10 +109,10 @@ class App:
     """omni.kit.app's application: an update is one timeline tick (and a capture if capture-on-play)."""
 
     def update(self) -> None:
-        orchestrator.tick()
+        orchestrator.update()
 
     async def next_update_async(self) -> None:
-        orchestrator.tick()
+        orchestrator.update()
         await asyncio.sleep(0)
 
     def is_running(self) -> bool:
@@ -344,5 +304,5 @@ def log_error(msg: str) -> None:
     log.error(msg)
 
 
-__all__ = ["SimulationApp", "App", "get_app", "get_timeline_interface", "TimelineEventType", "get_context",
+__all__ = ["SimulationApp", "App", "get_app", "get_timeline_interface", "get_context",
            "StageEventType", "get_world_transform_matrix", "execute", "get_settings", "Float3", "Float4"]

@@ -5,8 +5,42 @@ import types
 from typing import Any
 
 
-class CompatError(AttributeError, ImportError):
-    """A name an Isaac script uses that graphsdg's compat mode does not provide."""
+ROOTS = ("omni", "carb", "isaacsim")
+
+
+class CompatError(AttributeError):
+    """An attribute of an Isaac module that graphsdg's compat mode does not provide."""
+
+
+class CompatImportError(ImportError):
+    """An Isaac module (or a name imported from one) that graphsdg's compat mode does not provide."""
+
+
+class CompatFinder:
+    """A meta-path finder that answers imports of unknown ``omni``/``carb``/``isaacsim`` names.
+
+    ``from omni.usd import missing`` first asks ``omni.usd`` for the attribute, then
+    tries the submodule ``omni.usd.missing``: this finder turns that into one clear
+    error naming the symbol and what the parent module provides.
+    """
+
+    def __init__(self, provided: dict) -> None:
+        self.provided = provided
+
+    def find_spec(self, fullname: str, path=None, target=None):
+        if fullname.split(".")[0] not in ROOTS or fullname in self.provided:
+            return None
+        parent, _, leaf = fullname.rpartition(".")
+        owner = self.provided.get(parent)
+        if owner is not None:
+            available = sorted(k for k in owner.__dict__ if not k.startswith("_"))
+            raise CompatImportError(f"{fullname} is not available in graphsdg's compat mode; {parent} provides: "
+                                    f"{', '.join(available)}. See docs/porting.md.", name=fullname)
+        raise CompatImportError(f"module {fullname} is not available in graphsdg's compat mode; mapped modules: "
+                                f"{', '.join(sorted(self.provided))}. See docs/porting.md.", name=fullname)
+
+    def find_module(self, fullname, path=None):  # pragma: no cover - legacy protocol
+        return None
 
 
 class CompatModule(types.ModuleType):

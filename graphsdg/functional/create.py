@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 from typing import Any, Sequence
 
-from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux
+from pxr import Gf, Pcp, Sdf, Usd, UsdGeom, UsdLux
 
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -230,10 +230,64 @@ def material(mdl: str = "OmniPBR.mdl", bind_prims: Sequence[PrimLike] | PrimLike
     return mat.GetPrim()
 
 
+def _reference_target(layer: Sdf.Layer, path_str: str) -> Sdf.Path | None:
+    """The prim of ``layer`` a reference should target: None for its defaultPrim, else its only root prim."""
+    roots = [p.name for p in layer.rootPrims if p.specifier == Sdf.SpecifierDef]
+    default = layer.defaultPrim
+    if default:
+        if layer.GetPrimAtPath(Sdf.Path.absoluteRootPath.AppendChild(default)) is None:
+            raise ValueError(f"reference usd_path {path_str!r}: its defaultPrim {default!r} is not a root prim "
+                             f"of the file (root prims: {roots})")
+        return None
+    if len(roots) == 1:
+        return Sdf.Path.absoluteRootPath.AppendChild(roots[0])
+    if not roots:
+        raise ValueError(f"reference usd_path {path_str!r} defines no prims to reference")
+    raise ValueError(f"reference usd_path {path_str!r} has no defaultPrim and {len(roots)} root prims {roots}; "
+                     f"set its defaultPrim to say which one to reference")
+
+
+def _resolve_units(prim: Usd.Prim, layer: Sdf.Layer) -> None:
+    """Scale / turn a referenced asset authored in other units or another up axis into the stage's.
+
+    As Kit's metrics assembler does: ``xformOp:rotateX:unitsResolve`` and
+    ``xformOp:scale:unitsResolve`` after the prim's own ops, only when both the
+    asset and the stage author the metadata and it differs.
+    """
+    stage = prim.GetStage()
+    info = layer.pseudoRoot
+    ops = []
+    if info.HasInfo("upAxis") and stage.HasAuthoredMetadata("upAxis"):
+        asset_up, stage_up = str(info.GetInfo("upAxis")), str(UsdGeom.GetStageUpAxis(stage))
+        if asset_up != stage_up:
+            ops.append(("rotateX", 90.0 if asset_up == "Y" else -90.0))
+    if info.HasInfo("metersPerUnit") and UsdGeom.StageHasAuthoredMetersPerUnit(stage):
+        factor = float(info.GetInfo("metersPerUnit")) / UsdGeom.GetStageMetersPerUnit(stage)
+        if abs(factor - 1.0) > 1e-9:
+            ops.append(("scale", factor))
+    xf = UsdGeom.Xformable(prim)
+    for kind, value in ops:
+        if kind == "rotateX":
+            xf.AddRotateXOp(UsdGeom.XformOp.PrecisionDouble, "unitsResolve").Set(value)
+        else:
+            xf.AddScaleOp(UsdGeom.XformOp.PrecisionDouble, "unitsResolve").Set(Gf.Vec3d(value, value, value))
+
+
 def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = None,
               position: Vec3 | None = None, rotation: Vec3 | None = None, scale: Vec3 | float | None = None,
               semantics: Any = None, visible: bool = True) -> Usd.Prim:
-    """Add ``usd_path`` as a reference under a new Xform and return that prim."""
+    """Add ``usd_path`` as a reference under a new Xform and return that prim.
+
+    The file's ``defaultPrim`` is referenced (or its only root prim when it has
+    no default). An asset authored in other units (``metersPerUnit``) or with
+    another up axis is scaled / turned into the stage's by ``*:unitsResolve``
+    ops, as Isaac Sim does; ``position``, ``rotation`` and ``scale`` are then in
+    stage units. Meshes, UVs, materials and textures of the file render as
+    authored (see :mod:`graphsdg.sim.compiler`).
+
+    Raises ``FileNotFoundError`` naming a path that does not exist and
+    ``ValueError`` for a file that does not parse as USD.
+    """
     path_str = os.fspath(usd_path)
     if "://" not in path_str and not os.path.isfile(path_str):
         raise FileNotFoundError(f"reference usd_path {path_str!r} does not exist")
@@ -243,7 +297,20 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
         raise ValueError(f"reference usd_path {path_str!r} does not parse as USD: {exc}") from exc
     if layer is None:
         raise ValueError(f"reference usd_path {path_str!r} does not parse as USD")
+    target = _reference_target(layer, path_str)
     default = os.path.splitext(os.path.basename(path_str))[0]
-    prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, default, parent)).GetPrim()
-    prim.GetReferences().AddReference(path_str)
+    stage = get_stage()
+    known_errors = {str(e) for e in stage.GetCompositionErrors()}
+    prim = UsdGeom.Xform.Define(stage, _new_path(name, default, parent)).GetPrim()
+    if target is None:
+        prim.GetReferences().AddReference(path_str)
+    else:
+        prim.GetReferences().AddReference(path_str, target)
+    missing = [str(e) for e in stage.GetCompositionErrors()
+               if isinstance(e, Pcp.ErrorInvalidAssetPath) and str(e) not in known_errors]
+    if missing:
+        stage.RemovePrim(prim.GetPath())
+        raise FileNotFoundError(f"reference usd_path {path_str!r} names files that do not exist: "
+                                + "; ".join(missing))
+    _resolve_units(prim, layer)
     return _finish(prim, position, rotation, scale, None, None, semantics, visible)

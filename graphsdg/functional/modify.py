@@ -26,19 +26,30 @@ from graphsdg.stage.prims import resolve_prim, resolve_prims
 from graphsdg.stage.xform import set_local_pose
 
 
+def _look_at_point(value: Any) -> Any:
+    """A look-at target given as a prim (or prim path) becomes its world position."""
+    if isinstance(value, Usd.Prim) or (isinstance(value, str) and value.startswith("/")):
+        from graphsdg.stage.xform import world_matrix
+        return world_matrix(resolve_prim(value))[3, :3]
+    return value
+
+
 def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, scale_value: Any = None,
          look_at_value: Any = None, look_at_up_axis: Any = None, rotation_order: str = "XYZ",
-         size_value: Any = None, pivot_value: Any = None) -> None:
+         size_value: Any = None, pivot_value: Any = None, write_to_usd: bool = True) -> None:
     """Set position, rotation (Euler degrees or a (w, x, y, z) quaternion), scale, or aim with ``look_at``.
 
     ``size_value`` scales each prim so its local bounding box spans that size
     (exclusive with ``scale_value``); ``pivot_value`` is a local point that the
     rotation and scale turn about (the translation compensates, so the pivot
-    stays where ``position`` puts it).
+    stays where ``position`` puts it). ``look_at_value`` is a world point or a prim
+    (aim at its origin). ``write_to_usd`` is accepted for Replicator scripts; poses
+    are authored on the stage (or, with write-to-fabric on, written to MuJoCo).
     """
     if size_value is not None and scale_value is not None:
         raise ValueError("size and scale are exclusive; pass one of them")
     targets = resolve_prims(prims)
+    look_at_value = _look_at_point(look_at_value)
     n = len(targets)
     if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
             and _write_to_fabric():

@@ -1,5 +1,8 @@
 """``rep.functional.randomizer``: randomize prims now, from an explicit ``rng``.
 
+``scatter_2d`` and ``scatter_3d`` place prims on surfaces or in volumes,
+optionally without overlaps.
+
 These are also what the graph's randomizer nodes call (one implementation per
 operation): a node passes its per-execution stream as ``rng``.
 
@@ -20,9 +23,10 @@ from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from graphsdg.functional import modify
 from graphsdg.rng import ReplicatorRNG, as_generator
+from graphsdg.sim import bounds, placement, transforms
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.prims import resolve_prims, sanitize_name
-from graphsdg.stage.xform import matrix_to_euler_xyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import matrix_to_euler_xyz, quat_wxyz_to_matrix, set_local_pose, world_matrix
 
 LOOKS = "/Replicator/Looks"
 
@@ -183,4 +187,176 @@ def rotation(prims: Any, min_angle: Sequence[float] = (-180.0, -180.0, -180.0),
     return angles
 
 
-__all__ = ["display_color", "color", "materials", "texture", "rotation", "uniform_quaternions"]
+def _bounds_offsets(targets: list) -> np.ndarray:
+    """Each prim's world box relative to its world origin, (N, 6) (a point for prims without geometry)."""
+    cache = bounds.create_bbox_cache()
+    out = np.zeros((len(targets), 6))
+    for i, prim in enumerate(targets):
+        origin = transforms.get_world_position(prim)
+        try:
+            box = bounds.compute_aabb(prim, cache)
+        except ValueError:
+            continue
+        out[i] = np.r_[box[:3] - origin, box[3:] - origin]
+    return out
+
+
+def _sample_limits(extents: Any) -> tuple[np.ndarray, np.ndarray]:
+    """World (min, max) corners that sampled origins must lie within (Replicator's min_samp / max_samp)."""
+    lo, hi = np.full(3, -np.inf), np.full(3, np.inf)
+    if extents is None:
+        return lo, hi
+    try:
+        pair = [None if e is None else list(e) for e in extents]
+        ok = len(pair) == 2 and all(e is None or len(e) == 3 for e in pair)
+    except TypeError:
+        ok = False
+    if not ok:
+        raise ValueError(f"extents must be (min, max) world corners, each 3 numbers or None "
+                         f"(None for an unbounded axis), got {extents!r}")
+    for out, corner in ((lo, pair[0]), (hi, pair[1])):
+        for axis, v in enumerate(corner or ()):
+            if v is not None:
+                out[axis] = float(v)
+    if np.any(lo > hi):
+        raise ValueError(f"extents need min <= max on every axis, got min {lo.tolist()} and max {hi.tolist()}")
+    return lo, hi
+
+
+def _obstacles(no_collision_prims: Any) -> np.ndarray:
+    if no_collision_prims is None:
+        return np.zeros((0, 6))
+    cache = bounds.create_bbox_cache()
+    boxes = []
+    for prim in resolve_prims(no_collision_prims):
+        try:
+            boxes.append(bounds.compute_aabb(prim, cache))
+        except ValueError:
+            continue
+    return np.array(boxes).reshape(-1, 6)
+
+
+def _move_to(targets: list, world_positions: np.ndarray) -> None:
+    """Give each prim a local translation putting its origin at the world position (rotation kept)."""
+    for prim, p in zip(targets, world_positions):
+        parent = prim.GetParent()
+        parent_m = world_matrix(parent) if parent and parent.IsA(UsdGeom.Xformable) else np.eye(4)
+        local = np.append(p, 1.0) @ np.linalg.inv(parent_m)
+        set_local_pose(prim, position=local[:3])
+
+
+def _fail(kind: str, placed: int, targets: list, where: list, attempts: int, noun: str) -> ValueError:
+    paths = ", ".join(str(p.GetPath()) for p in where)
+    return ValueError(f"{kind} could fit only {placed} of {len(targets)} prims in {paths} without collisions: "
+                      f"{targets[placed].GetPath()} found no free spot in {attempts} attempts; the stage was left "
+                      f"unchanged (scatter fewer or smaller prims, or use a larger {noun})")
+
+
+def scatter_2d(prims: Any, surface_prims: Any, no_collision_prims: Any = None, extents: Any = None,
+               offset: float = 0.0, check_for_collisions: bool = False,
+               rng: ReplicatorRNG | np.random.Generator | None = None) -> None:
+    """Place each prim's origin at a point drawn uniformly by area on the surface prims.
+
+    Surfaces are every Plane, Mesh or other shape at or below ``surface_prims``,
+    hidden ones included; the origin goes ``offset`` along the surface normal
+    there; rotations are kept. ``extents`` = (min, max) world corners (None or
+    None entries: unbounded) limits where origins may land (Replicator's
+    ``min_samp`` / ``max_samp``). With ``check_for_collisions`` each prim's real
+    world bounds may not overlap those already placed nor ``no_collision_prims``.
+    A prim that finds no spot in 10 000 attempts raises ``ValueError`` saying how
+    many fit; the stage is then left unchanged.
+
+    Example:
+        >>> import graphsdg as rep
+        >>> _ = rep.stage.new_stage()
+        >>> floor = rep.functional.create.plane(scale=(4, 4, 1), visible=False)
+        >>> cubes = rep.functional.create_batch.cube(count=5, scale=0.3)
+        >>> rep.functional.randomizer.scatter_2d(cubes, floor, offset=0.15, check_for_collisions=True,
+        ...                                      rng=rep.rng.ReplicatorRNG(seed=3))
+        >>> sorted({round(float(c.GetAttribute("xformOp:translate").Get()[2]), 2) for c in cubes})
+        [0.15]
+    """
+    targets = resolve_prims(prims)
+    surfaces = resolve_prims(surface_prims)
+    lo, hi = _sample_limits(extents)
+    if isinstance(offset, bool) or not isinstance(offset, (int, float, np.floating)) or not np.isfinite(offset):
+        raise ValueError(f"offset must be a finite number, got {offset!r}")
+    surface = placement.surface_of(surfaces)
+    gen = as_generator(rng, "scatter_2d")
+    offsets = _bounds_offsets(targets)
+
+    def propose(k: int) -> np.ndarray:
+        points, normals = placement.sample_surface(surface, k, gen)
+        points = points + float(offset) * normals
+        return points[np.all((points >= lo) & (points <= hi), axis=1)]
+
+    positions, placed, attempts = placement.place(len(targets), propose, offsets, _obstacles(no_collision_prims),
+                                                  bool(check_for_collisions))
+    if placed < len(targets):
+        raise _fail("scatter_2d", placed, targets, surfaces, attempts, "surface")
+    _move_to(targets, positions)
+
+
+def scatter_3d(prims: Any, volume_prims: Any, no_collision_prims: Any = None, volume_excl_prims: Any = None,
+               extents: Any = None, check_for_collisions: bool = False, prevent_vol_overlap: bool = True,
+               viz_sampled_voxels: bool = False, resolution_scaling: float = 1.0, input_voxel_size: float = 0.0,
+               rng: ReplicatorRNG | np.random.Generator | None = None) -> None:
+    """Place each prim's origin at a point drawn uniformly by volume inside the volume prims.
+
+    Volumes are the closed shapes at or below ``volume_prims`` (cubes, spheres,
+    cylinders, cones, capsules exactly; meshes by winding number), minus those
+    under ``volume_excl_prims``. With ``prevent_vol_overlap`` the prim's bounds
+    must lie inside the volume and outside the excluded ones; collisions work as
+    in :func:`scatter_2d`, and so do ``extents``. Sampling is continuous, so Replicator's voxel settings
+    (``resolution_scaling``, ``input_voxel_size``, ``viz_sampled_voxels``) are
+    validated but change nothing.
+
+    Example:
+        >>> import graphsdg as rep
+        >>> _ = rep.stage.new_stage()
+        >>> box = rep.functional.create.cube(scale=2, visible=False)
+        >>> balls = rep.functional.create_batch.sphere(count=4, scale=0.2)
+        >>> rep.functional.randomizer.scatter_3d(balls, box, check_for_collisions=True,
+        ...                                      rng=rep.rng.ReplicatorRNG(seed=1))
+        >>> all(abs(v) <= 0.9 for b in balls for v in b.GetAttribute("xformOp:translate").Get())
+        True
+    """
+    targets = resolve_prims(prims)
+    volumes = [placement.Volume(p) for p in resolve_prims(volume_prims)]
+    excluded = [placement.Volume(p) for p in resolve_prims(volume_excl_prims)] if volume_excl_prims is not None \
+        else []
+    for name, value in (("resolution_scaling", resolution_scaling), ("input_voxel_size", input_voxel_size)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value < 0 or \
+                (name == "resolution_scaling" and value == 0):
+            raise ValueError(f"{name} must be a {'positive' if name == 'resolution_scaling' else 'non-negative'} "
+                             f"number, got {value!r}")
+    lo, hi = _sample_limits(extents)
+    gen = as_generator(rng, "scatter_3d")
+    offsets = _bounds_offsets(targets)
+    signs = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=bool)
+
+    def propose(k: int) -> np.ndarray:
+        points = placement.sample_volumes(volumes, k, gen, excluded)
+        return points[np.all((points >= lo) & (points <= hi), axis=1)]
+
+    def accept(i: int, cand: np.ndarray) -> np.ndarray:
+        if not prevent_vol_overlap or not np.any(offsets[i]):
+            return np.ones(len(cand), dtype=bool)
+        corner_offsets = np.where(signs, offsets[i, 3:], offsets[i, :3])          # (8, 3)
+        corners = (cand[:, None, :] + corner_offsets[None]).reshape(-1, 3)
+        inside = np.zeros(len(corners), dtype=bool)
+        for vol in volumes:
+            inside |= vol.contains(corners)
+        for vol in excluded:
+            inside &= ~vol.contains(corners)
+        return inside.reshape(len(cand), 8).all(1)
+
+    positions, placed, attempts = placement.place(len(targets), propose, offsets, _obstacles(no_collision_prims),
+                                                  bool(check_for_collisions), accept)
+    if placed < len(targets):
+        raise _fail("scatter_3d", placed, targets, [v.prim for v in volumes], attempts, "volume")
+    _move_to(targets, positions)
+
+
+__all__ = ["display_color", "color", "materials", "texture", "rotation", "uniform_quaternions", "scatter_2d",
+           "scatter_3d"]

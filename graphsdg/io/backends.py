@@ -11,6 +11,7 @@ from __future__ import annotations
 import errno
 import inspect
 import os
+import threading
 import uuid
 from typing import Any, Callable
 
@@ -133,6 +134,19 @@ def _check_writable(path: str) -> None:
         raise PermissionError(f"output_dir {path!r} is not writable: {exc.strerror or exc}") from exc
 
 
+_counter_lock = threading.Lock()
+_written = {"files": 0, "bytes": 0}
+
+
+def files_written() -> int:
+    """Files written by this process (all disk writes, for progress summaries)."""
+    return _written["files"]
+
+
+def bytes_written() -> int:
+    return _written["bytes"]
+
+
 def write_file_atomic(full_path: str, data: bytes) -> None:
     """Write ``data`` to ``full_path`` so that the file appears whole or not at all."""
     directory = os.path.dirname(full_path)
@@ -142,6 +156,9 @@ def write_file_atomic(full_path: str, data: bytes) -> None:
         with open(tmp, "wb") as f:
             f.write(data)
         os.replace(tmp, full_path)
+        with _counter_lock:
+            _written["files"] += 1
+            _written["bytes"] += len(data)
     except BaseException as exc:
         try:
             os.unlink(tmp)

@@ -9,10 +9,27 @@ Mapping (USD -> MuJoCo):
   ``mocap_pos``/``mocap_quat`` with no recompile.
 * the world scale of a gprim is baked into the geom size (primitives, editable
   live) or into the mesh vertices (meshes: a scale edit recompiles).
+* physics (``UsdPhysics``): a prim with ``RigidBodyAPI`` is a free body (a
+  mocap body when ``kinematicEnabled``); a rigid body nested in another moves
+  with the outermost one (graphsdg has no joints, so nesting cannot mean
+  anything else); ``CollisionAPI`` makes a gprim collide, with
+  ``MeshCollisionAPI`` approximations mapped by :mod:`graphsdg.sim.colliders`
+  (proxy shapes in group :data:`COLLISION_ONLY_GROUP`, never drawn); a static
+  or kinematic ``Plane`` collider is an infinite plane, as in PhysX;
+  ``MassAPI`` mass and density set masses (colliders carry a body's mass, at
+  1000 kg/m³ unless told otherwise); ``PhysicsScene`` sets gravity and
+  ``physxScene:timeStepsPerSecond`` the physics step; a ``PhysicsMaterialAPI``
+  bound with the ``physics`` purpose sets friction.
 * ``UsdShade`` materials become MuJoCo materials; ``primvars:displayColor``
-  becomes the geom colour when no material is bound.
+  becomes the geom colour when no material is bound. A ``UsdUVTexture`` on
+  ``diffuseColor`` becomes a MuJoCo texture (decoded by
+  :mod:`graphsdg.sim.texture_images`, shared by every material naming the same
+  file), and a mesh's UV primvar becomes its texture coordinates
+  (:mod:`graphsdg.sim.texcoords`).
 * UsdLux lights become MuJoCo lights (see :mod:`graphsdg.sim.lights`); a dome
-  light becomes ambient light plus a soft sky light from above, and a skybox.
+  light becomes ambient light plus a soft sky light, and a skybox. A dome
+  texture (a lat-long HDR) is the skybox and sets the colour, strength and main
+  direction of that light (:mod:`graphsdg.sim.environment_map`).
 * cameras are not compiled: render products read USD cameras directly.
 
 The result, :class:`CompiledScene`, remembers which MuJoCo elements each prim
@@ -21,15 +38,17 @@ model.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
-from pxr import Usd, UsdGeom, UsdPhysics
+from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
+from graphsdg.sim import colliders, environment_map
 from graphsdg.sim import lights as lightmap
+from graphsdg.sim import texture_images
+from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import shapes
 from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
@@ -40,6 +59,15 @@ DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
 MUJOCO_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)   # geom rgba that lets a bound material show through
 GPRIM_TYPES = ("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh")
 SKY_TEXTURE = "graphsdg:sky"
+PROBE_BOX = "graphsdg:probe_box"          # collision-free shapes posed by scene queries
+PROBE_SPHERE = "graphsdg:probe_sphere"
+DEFAULT_DENSITY = 1000.0                 # kg/m³, PhysX's default
+DEFAULT_FRICTION = 0.5                   # PhysX's default material (static = dynamic = 0.5)
+# MuJoCo's soft contacts need a shorter step than PhysX's 60 Hz (whose solver iterates
+# positions within a step) to keep dropped boxes within millimetres of each other and
+# to calm a pile within the 75 frames the SDG workflows settle for: two physics steps
+# per 60 Hz timeline frame, with elliptic friction cones (no creeping on slopes).
+PHYSICS_STEPS_PER_SECOND = 120.0
 
 
 class CompileError(ValueError):
@@ -59,6 +87,7 @@ class GeomBinding:
     scale: np.ndarray                # world scale baked into size or vertices
     material: str | None             # bound material path
     visible: bool = True
+    relative: np.ndarray | None = None   # pose in its rigid body's frame (row-vector 4x4)
 
 
 @dataclass
@@ -70,6 +99,7 @@ class BodyBinding:
     mocap_id: int                    # kinematic bodies are mocap bodies
     qpos_adr: int = -1               # free joint address (dynamic bodies)
     qvel_adr: int = -1
+    kinematic: bool = False
 
 
 @dataclass
@@ -93,6 +123,11 @@ class CompiledScene:
     sky_texture_id: int = -1
     has_scene_lights: bool = False
     compile_seconds: float = 0.0
+    collider_owner: dict[int, str] = field(default_factory=dict)   # colliding geom id -> body or prim path
+    collider_prim: dict[int, str] = field(default_factory=dict)    # colliding geom id -> collider prim path
+    collider_paths: set[str] = field(default_factory=set)          # gprims that collide (own geom or proxies)
+    probe_box: int = -1              # geom ids of the query probes
+    probe_sphere: int = -1
 
 
 def _is_renderable(prim: Usd.Prim) -> bool:
@@ -102,15 +137,62 @@ def _is_renderable(prim: Usd.Prim) -> bool:
     return purpose in (UsdGeom.Tokens.default_, UsdGeom.Tokens.render)
 
 
-def _rigid_root(prim: Usd.Prim) -> Usd.Prim | None:
+def rigid_root(prim: Usd.Prim) -> Usd.Prim | None:
+    """The outermost enabled ``RigidBodyAPI`` prim at or above ``prim`` (the body it moves with)."""
+    found = None
     p = prim
     while p and not p.IsPseudoRoot():
         if p.HasAPI(UsdPhysics.RigidBodyAPI):
             enabled = UsdPhysics.RigidBodyAPI(p).GetRigidBodyEnabledAttr().Get()
             if enabled is None or enabled:
-                return p
+                found = p
         p = p.GetParent()
-    return None
+    return found
+
+
+def _is_kinematic(root: Usd.Prim) -> bool:
+    return bool(UsdPhysics.RigidBodyAPI(root).GetKinematicEnabledAttr().Get())
+
+
+def _mass_api_values(prim: Usd.Prim) -> tuple[float, float]:
+    """(mass, density) authored by ``MassAPI`` on ``prim`` (0 where unset); negative values raise."""
+    if not prim.HasAPI(UsdPhysics.MassAPI):
+        return 0.0, 0.0
+    api = UsdPhysics.MassAPI(prim)
+    values = []
+    for name, attr in (("physics:mass", api.GetMassAttr()), ("physics:density", api.GetDensityAttr())):
+        v = attr.Get() if attr else None
+        v = 0.0 if v is None else float(v)
+        if v < 0 or not np.isfinite(v):
+            raise CompileError(f"{name} of {prim.GetPath()} is {v!r}; it must be >= 0 "
+                               f"(0 means computed from the colliders' volume and density)")
+        values.append(v)
+    return values[0], values[1]
+
+
+def _approximation(prim: Usd.Prim) -> str:
+    attr = UsdPhysics.MeshCollisionAPI(prim).GetApproximationAttr() if prim.HasAPI(
+        UsdPhysics.MeshCollisionAPI) else prim.GetAttribute("physics:approximation")
+    value = attr.Get() if attr and attr.IsValid() else None
+    if value is None:
+        return "none"
+    try:
+        return colliders.check_approximation(str(value), f"{prim.GetPath()} (physics:approximation)")
+    except colliders.ApproximationError as exc:
+        raise CompileError(str(exc)) from None
+
+
+def _friction(prim: Usd.Prim) -> float:
+    """Dynamic friction of the physics material bound to ``prim`` (PhysX's 0.5 when none)."""
+    binding = UsdShade.MaterialBindingAPI(prim)
+    material, _ = binding.ComputeBoundMaterial("physics")
+    if material and material.GetPrim().HasAPI(UsdPhysics.MaterialAPI):
+        api = UsdPhysics.MaterialAPI(material.GetPrim())
+        for attr in (api.GetDynamicFrictionAttr(), api.GetStaticFrictionAttr()):
+            v = attr.Get() if attr else None
+            if v is not None:
+                return max(float(v), 0.0)
+    return DEFAULT_FRICTION
 
 
 def _collides(prim: Usd.Prim) -> bool:
@@ -212,37 +294,30 @@ class _Builder:
         self.body_records: dict[str, object] = {}
         self.light_records: list[tuple[str, str, list[object]]] = []
         self.material_names: dict[str, str] = {}
+        self.body_mass: dict[str, tuple[float, float]] = {}
+        self.mass_records: list[tuple] = []
+        self.collider_records: list[tuple] = []
+        self.material_descs: dict[str, matlib.MaterialDesc] = {}
+        self.texture_names: dict[str, str] = {}       # texture file -> MuJoCo texture name
         self.mesh_count = 0
         self.has_lights = False
         self.ambient = np.zeros(3)
         self.sky_rgb: np.ndarray | None = None
+        self.sky_maps: list[tuple[environment_map.EnvironmentMap, np.ndarray, np.ndarray]] = []
+        self.sky_flat = np.zeros(3)                      # untextured domes' share of the background
 
     # ---- options -------------------------------------------------------
     def configure(self) -> None:
         spec = self.spec
         spec.compiler.boundmass = 1e-6
         spec.compiler.boundinertia = 1e-9
-        spec.option.timestep = 1.0 / 60.0
+        spec.option.timestep = 1.0 / PHYSICS_STEPS_PER_SECOND
         spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+        spec.option.impratio = 10.0
         up = UsdGeom.GetStageUpAxis(self.stage)
         spec.option.gravity = [0, -9.81, 0] if up == UsdGeom.Tokens.y else [0, 0, -9.81]
-        mpu = UsdGeom.GetStageMetersPerUnit(self.stage) or 1.0
-        for prim in self.stage.Traverse():
-            if prim.IsA(UsdPhysics.Scene):
-                scene = UsdPhysics.Scene(prim)
-                direction = scene.GetGravityDirectionAttr().Get()
-                magnitude = scene.GetGravityMagnitudeAttr().Get()
-                g = 9.81 / mpu if magnitude is None or magnitude < -1e30 else float(magnitude)
-                if direction is not None and np.linalg.norm(np.array(direction)) > 0:
-                    d = np.array(direction, dtype=np.float64)
-                    spec.option.gravity = (d / np.linalg.norm(d) * g).tolist()
-                else:
-                    spec.option.gravity = [0, -g, 0] if up == UsdGeom.Tokens.y else [0, 0, -g]
-                tps = prim.GetAttribute("physxScene:timeStepsPerSecond").Get() if \
-                    prim.GetAttribute("physxScene:timeStepsPerSecond") else None
-                if tps:
-                    spec.option.timestep = 1.0 / float(tps)
-                break
+        self.configure_physics_scene(up)
         vis = spec.visual
         vis.global_.offwidth, vis.global_.offheight = self.offscreen
         vis.quality.shadowsize = int(settings.get("/graphsdg/render/shadowSize", 1024))
@@ -253,6 +328,32 @@ class _Builder:
         # only bound MuJoCo's shadow-map depth range, so they are kept tight for precision.
         vis.map.znear = 0.01
         vis.map.zfar = 8.0
+
+    def configure_physics_scene(self, up: str) -> None:
+        """Gravity and physics step from the first ``UsdPhysics.Scene`` prim, if any."""
+        spec = self.spec
+        mpu = UsdGeom.GetStageMetersPerUnit(self.stage) or 1.0
+        for prim in self.stage.Traverse():
+            if not prim.IsA(UsdPhysics.Scene):
+                continue
+            scene = UsdPhysics.Scene(prim)
+            direction = scene.GetGravityDirectionAttr().Get()
+            magnitude = scene.GetGravityMagnitudeAttr().Get()
+            # USD's fallback magnitude (-inf) means "earth gravity in stage units".
+            g = 9.81 / mpu if magnitude is None or not np.isfinite(magnitude) or magnitude < 0 else float(magnitude)
+            if direction is not None and np.linalg.norm(np.array(direction)) > 0:
+                d = np.array(direction, dtype=np.float64)
+                spec.option.gravity = (d / np.linalg.norm(d) * g).tolist()
+            else:
+                spec.option.gravity = [0, -g, 0] if up == UsdGeom.Tokens.y else [0, 0, -g]
+            attr = prim.GetAttribute("physxScene:timeStepsPerSecond")
+            tps = attr.Get() if attr and attr.IsValid() else None
+            if tps is not None:
+                if not np.isfinite(tps) or tps <= 0:
+                    raise CompileError(f"physxScene:timeStepsPerSecond of {prim.GetPath()} is {tps!r}; "
+                                       f"it must be a positive number of physics steps per second")
+                spec.option.timestep = 1.0 / float(tps)
+            return
 
     # ---- materials -----------------------------------------------------
     def material(self, prim: Usd.Prim) -> str | None:
@@ -270,15 +371,41 @@ class _Builder:
         m.reflectance = 0.0
         m.emission = desc.emission
         if desc.texture:
-            if not os.path.isfile(desc.texture):
-                raise CompileError(f"material {path}: texture file {desc.texture!r} does not exist")
-            tex_name = f"tex:{path}"
-            self.spec.add_texture(name=tex_name, type=mujoco.mjtTexture.mjTEXTURE_2D, file=desc.texture)
-            m.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex_name
+            m.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = self.texture(desc.texture, path)
             m.texrepeat = [desc.texture_scale[0], desc.texture_scale[1]]
             m.texuniform = False
         self.material_names[path] = path
+        self.material_descs[path] = desc
         return path
+
+    def texture(self, file: str, material_path: str) -> str:
+        """The MuJoCo texture holding image ``file`` (added once, however many materials use it)."""
+        name = self.texture_names.get(file)
+        if name is not None:
+            return name
+        try:
+            rgb = texture_images.load_rgb(file)
+        except texture_images.TextureFileError as exc:
+            raise CompileError(f"material {material_path}: {exc}") from None
+        name = f"tex:{file}"
+        tex = self.spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, width=rgb.shape[1],
+                                    height=rgb.shape[0], nchannel=3)
+        tex.data = rgb.tobytes()
+        self.texture_names[file] = name
+        return name
+
+    def mesh_uvs(self, prim: Usd.Prim, material: str | None):
+        """Texture coordinates of Mesh ``prim`` for its bound material (UV set and transform), or None."""
+        desc = self.material_descs.get(material) if material else None
+        name, transform = None, None
+        if desc is not None and desc.texture:
+            name = desc.texture_primvar
+            transform = UvTransform(scale=desc.uv_scale, rotation=desc.uv_rotation + desc.texture_rotate,
+                                    translation=desc.uv_translation)
+        try:
+            return mesh_texcoords(prim, name, transform)
+        except TexcoordError as exc:
+            raise CompileError(str(exc)) from None
 
     # ---- geometry ------------------------------------------------------
     def body_for_rigid(self, root: Usd.Prim):
@@ -286,18 +413,22 @@ class _Builder:
         if path in self.body_records:
             return self.body_records[path]
         t, r, _ = decompose(world_matrix(root, self.cache))
-        kinematic = bool(UsdPhysics.RigidBodyAPI(root).GetKinematicEnabledAttr().Get())
+        kinematic = _is_kinematic(root)
         body = self.spec.worldbody.add_body(name=path, pos=t.tolist(), quat=matrix_to_quat_wxyz(r).tolist(),
                                             mocap=kinematic)
         if not kinematic:
             body.add_freejoint(name=f"{path}#free")
+            disable = root.GetAttribute("physxRigidBody:disableGravity")
+            if disable and disable.Get():
+                body.gravcomp = 1.0
         self.body_records[path] = body
+        self.body_mass[path] = _mass_api_values(root)
         return body
 
     def add_gprim(self, prim: Usd.Prim) -> None:
         path = str(prim.GetPath())
         m_world = world_matrix(prim, self.cache)
-        root = _rigid_root(prim)
+        root = rigid_root(prim)
         if root is not None:
             body = self.body_for_rigid(root)
             t_root, r_root, _ = decompose(world_matrix(root, self.cache))
@@ -311,32 +442,124 @@ class _Builder:
                                                 mocap=True)
             t, r = np.zeros(3), np.eye(3)
         collides = _collides(prim)
+        dynamic = root is not None and not _is_kinematic(root)
         visible = UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible
         material = self.material(prim)
         type_name = prim.GetTypeName()
+        mesh_data = None
         if type_name in ("Mesh", "Cone"):
             verts, tris = mesh_arrays(prim, scale)
-            verts = verts @ r.T + t
+            mesh_data = (verts, tris)
             mesh_name = f"mesh:{path}"
-            mesh = self.spec.add_mesh(name=mesh_name, uservert=verts.ravel().tolist(),
+            mesh = self.spec.add_mesh(name=mesh_name, uservert=(verts @ r.T + t).ravel().tolist(),
                                       userface=tris.ravel().tolist())
-            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+            uvs = self.mesh_uvs(prim, material) if type_name == "Mesh" else None
+            if uvs is not None and len(uvs.face_texcoord) == len(tris):
+                mesh.usertexcoord = uvs.texcoord.ravel().tolist()
+                mesh.userfacetexcoord = uvs.face_texcoord.ravel().tolist()
+            solid = dynamic and collides and not colliders.is_flat(verts)
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX if solid else \
+                mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
             geom = body.add_geom(name=path, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=mesh_name)
             self.mesh_count += 1
         else:
             kind, size, local_rot = primitive_size(prim, scale)
             geom = body.add_geom(name=path, type=kind, size=size.tolist(), pos=t.tolist(),
                                  quat=matrix_to_quat_wxyz(r @ local_rot).tolist())
-        geom.contype = geom.conaffinity = 1 if collides else 0
         geom.group = 0 if visible else HIDDEN_GROUP
         if material is not None:
             geom.material = material
             geom.rgba = list(MUJOCO_DEFAULT_RGBA)
         else:
             geom.rgba = list(display_rgba(prim))
-        if root is None:
-            geom.density = 0.0 if not collides else 1000.0
-        self.geom_records.append((path, geom, str(root.GetPath()) if root else None, scale, material, visible))
+        physical = [geom]
+        if collides:
+            physical = self.collision_shapes(prim, body, geom, mesh_data, t, r, dynamic, root is None)
+        for part in physical:
+            part.contype = part.conaffinity = 1 if collides else 0
+        if physical and physical[0] is not geom:
+            geom.contype = geom.conaffinity = 0
+        self.mass_records.append((str(root.GetPath()) if root else None, prim, geom, physical, collides))
+        relative = None
+        if root is not None:
+            relative = np.eye(4)
+            relative[:3, :3] = r.T
+            relative[3, :3] = t
+        self.geom_records.append((path, geom, str(root.GetPath()) if root else None, scale, material, visible,
+                                  relative))
+        if collides:
+            owner = str(root.GetPath()) if root is not None else path
+            self.collider_records += [(part, owner, path) for part in physical]
+
+    def collision_shapes(self, prim: Usd.Prim, body, geom, mesh_data, t: np.ndarray, r: np.ndarray,
+                         dynamic: bool, static: bool) -> list:
+        """The geoms that collide for ``prim``: its own geom, or proxies in :data:`COLLISION_ONLY_GROUP`."""
+        type_name = prim.GetTypeName()
+        if type_name == "Plane" and not dynamic:
+            # PhysX collides a UsdGeom.Plane as an infinite plane; so does MuJoCo's plane geom.
+            size = np.array(geom.size, dtype=np.float64)
+            plane = body.add_geom(name=f"{prim.GetPath()}#plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
+                                  size=[max(size[0], 1e-3), max(size[1], 1e-3), 1.0], pos=list(geom.pos),
+                                  quat=list(geom.quat), group=COLLISION_ONLY_GROUP)
+            return [plane]
+        if type_name != "Mesh":
+            return [geom]
+        verts, tris = mesh_data
+        approximation = _approximation(prim)
+        pieces = colliders.collision_pieces(verts, tris, approximation, dynamic)
+        if len(pieces) == 1 and pieces[0].kind == "hull" and len(pieces[0].vertices) == len(np.unique(tris)):
+            return [geom]      # the mesh itself is the hull MuJoCo collides with
+        made = []
+        q = matrix_to_quat_wxyz(r).tolist()
+        for i, piece in enumerate(pieces):
+            name = f"{prim.GetPath()}#collider{i}"
+            if piece.kind == "box":
+                made.append(body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, size=piece.half.tolist(),
+                                          pos=(r @ piece.center + t).tolist(), quat=q,
+                                          group=COLLISION_ONLY_GROUP))
+            elif piece.kind == "sphere":
+                made.append(body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_SPHERE,
+                                          size=[piece.radius, 0, 0], pos=(r @ piece.center + t).tolist(),
+                                          group=COLLISION_ONLY_GROUP))
+            else:
+                mesh = self.spec.add_mesh(name=f"mesh:{name}", uservert=(piece.vertices @ r.T + t).ravel().tolist())
+                mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+                made.append(body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"mesh:{name}",
+                                          group=COLLISION_ONLY_GROUP))
+        return made
+
+    def assign_masses(self) -> None:
+        """Densities and masses from ``MassAPI`` (see the module docstring)."""
+        bodies_with_colliders = {root for root, _, _, _, collides in self.mass_records if collides and root}
+        for root, prim, geom, physical, collides in self.mass_records:
+            if collides:
+                friction = _friction(prim)
+                for part in physical:
+                    part.friction = [friction, 0.005, 0.0001]
+            if root is None:
+                for part in physical:
+                    part.density = DEFAULT_DENSITY if collides else 0.0
+                continue
+            mass, density = _mass_api_values(prim)
+            if not density:
+                density = self.body_mass[root][1] or DEFAULT_DENSITY
+            carries_mass = collides or root not in bodies_with_colliders
+            if not carries_mass:
+                geom.density = 0.0
+                continue
+            if physical[0] is not geom:
+                geom.density = 0.0
+            for part in physical:
+                part.density = density
+                if mass > 0:
+                    part.mass = mass / len(physical)
+
+    def add_probes(self) -> None:
+        """Collision-free box and sphere that scene queries pose and size (never drawn)."""
+        probe = self.spec.worldbody.add_body(name="graphsdg:probe", mocap=True)
+        for name, kind in ((PROBE_BOX, mujoco.mjtGeom.mjGEOM_BOX), (PROBE_SPHERE, mujoco.mjtGeom.mjGEOM_SPHERE)):
+            probe.add_geom(name=name, type=kind, size=[1e-3, 1e-3, 1e-3], contype=0, conaffinity=0,
+                           group=HIDDEN_GROUP, density=0.0)
 
     # ---- lights --------------------------------------------------------
     def add_light(self, prim: Usd.Prim) -> None:
@@ -351,12 +574,27 @@ class _Builder:
         wb = self.spec.worldbody
         made = []
         if params.kind == "dome":
-            self.ambient += 0.5 * params.color
+            color, direction = params.color, np.array([0.0, 0.0, -1.0])
+            if params.texture:
+                try:
+                    env = environment_map.load(params.texture)
+                except environment_map.EnvironmentMapError as exc:
+                    raise CompileError(f"dome light {path}: {exc}") from None
+                # The map tints and scales the dome: irradiance relative to a uniform sky of radiance 1.
+                color = params.color * env.up_irradiance / np.pi
+                self.sky_maps.append((env, r, params.color))     # display value of radiance 1
+                # Light mostly arrives from the map's bright side; keep it from grazing the floor.
+                d = r @ env.dominant_direction
+                d[2] = max(d[2], 0.5)
+                direction = -d / np.linalg.norm(d)
+            else:
+                self.sky_flat = self.sky_flat + params.color
+            self.ambient += 0.5 * color
             sky = wb.add_light(name=f"{path}#sky", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-                               pos=[0, 0, 10], dir=[0, 0, -1], castshadow=False)
-            _set_light_color(sky, 0.5 * params.color)
+                               pos=[0, 0, 10], dir=direction.tolist(), castshadow=False)
+            _set_light_color(sky, 0.5 * color)
             made.append(sky)
-            self.sky_rgb = params.color if self.sky_rgb is None else self.sky_rgb + params.color
+            self.sky_rgb = color if self.sky_rgb is None else self.sky_rgb + color
         elif params.kind == "distant":
             light = wb.add_light(name=path, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=t.tolist(),
                                  dir=(-r[:, 2]).tolist(), castshadow=params.cast_shadow)
@@ -392,7 +630,16 @@ class _Builder:
         head.ambient = np.minimum(self.ambient, 10.0).tolist()
         head.diffuse = [0, 0, 0]
         head.specular = [0, 0, 0]
-        if self.sky_rgb is not None:
+        if self.sky_maps:
+            # Textured domes: the background is their maps (summed if several), in display units.
+            n = environment_map.FACE_SIZE
+            display = np.zeros((6 * n, n, 3), dtype=np.float32) + self.sky_flat.astype(np.float32)
+            for env, rotation, scale in self.sky_maps:
+                display += environment_map.skybox_faces(env, rotation, n) * scale.astype(np.float32)
+            tex = self.spec.add_texture(name=SKY_TEXTURE, type=mujoco.mjtTexture.mjTEXTURE_SKYBOX, width=n,
+                                        height=6 * n, nchannel=3)
+            tex.data = environment_map.tonemap(display).tobytes()
+        elif self.sky_rgb is not None:
             rgb = np.clip(self.sky_rgb, 0, 1)
             self.spec.add_texture(name=SKY_TEXTURE, type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
                                   builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb.tolist(), rgb2=rgb.tolist(),
@@ -404,7 +651,7 @@ class _Builder:
         MuJoCo's broadphase scratch grows with the square of the body count, so
         thousands of visual-only bodies would overflow the default arena for nothing.
         """
-        colliding = any(g.contype or g.conaffinity for _, g, *_ in self.geom_records)
+        colliding = bool(self.collider_records)     # proxy shapes collide for their visual geoms
         if not colliding:
             self.spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
         nbody = len(self.geom_records) + len(self.body_records) + 1
@@ -426,6 +673,8 @@ class _Builder:
                 except Exception as exc:  # pxr / mujoco errors: say which prim
                     raise CompileError(f"cannot compile prim {prim.GetPath()} ({type_name}): {exc}") from exc
         self.finish_lighting()
+        self.assign_masses()
+        self.add_probes()
         self.size_memory()
         try:
             model = self.spec.compile()
@@ -437,21 +686,40 @@ class _Builder:
     def _bind(self, model: mujoco.MjModel, data: mujoco.MjData) -> CompiledScene:
         scene = CompiledScene(model=model, data=data, has_scene_lights=self.has_lights)
         scene.geom_paths = [""] * model.ngeom
-        for path, geom, root, scale, material, visible in self.geom_records:
+        for path, geom, root, scale, material, visible, relative in self.geom_records:
             gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, path)
             bid = int(model.geom_bodyid[gid])
             mocap = int(model.body_mocapid[bid]) if root is None else -1
             scene.geoms[path] = GeomBinding(path=path, type_name=self.stage.GetPrimAtPath(path).GetTypeName(),
                                             geom_id=gid, body_id=bid, mocap_id=mocap, rigid_root=root,
-                                            scale=scale, material=material, visible=visible)
+                                            scale=scale, material=material, visible=visible,
+                                            relative=relative)
             scene.geom_paths[gid] = path
+        rescaled = False
         for path in self.body_records:
             bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, path)
             binding = BodyBinding(path=path, body_id=bid, mocap_id=int(model.body_mocapid[bid]))
+            binding.kinematic = binding.mocap_id >= 0
             if model.body_jntnum[bid] > 0:
                 jid = int(model.body_jntadr[bid])
                 binding.qpos_adr, binding.qvel_adr = int(model.jnt_qposadr[jid]), int(model.jnt_dofadr[jid])
             scene.bodies[path] = binding
+            mass = self.body_mass[path][0]
+            if mass > 0 and model.body_mass[bid] > 0:
+                # MassAPI mass on the body overrides the colliders' sum; the inertia keeps its shape.
+                factor = mass / model.body_mass[bid]
+                model.body_mass[bid] *= factor
+                model.body_inertia[bid] *= factor
+                rescaled = True
+        for shape, owner, prim_path in self.collider_records:
+            gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, shape.name)
+            scene.collider_owner[gid] = owner
+            scene.collider_prim[gid] = prim_path
+            scene.collider_paths.add(prim_path)
+        scene.probe_box = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, PROBE_BOX)
+        scene.probe_sphere = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, PROBE_SPHERE)
+        if rescaled:
+            mujoco.mj_setConst(model, data)
         for path, kind, made in self.light_records:
             ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_LIGHT, lt.name) for lt in made]
             scene.lights[path] = LightBinding(path=path, kind=kind, light_ids=ids)

@@ -7,12 +7,19 @@ tracker's :class:`~graphsdg.stage.changes.ChangeSet`:
 * value edits (poses, sizes, colours, visibility, material inputs, lights) are
   written straight into ``MjModel``/``MjData`` fields, then kinematics are
   recomputed: no recompile;
-* structural edits (prims added or removed, schemas applied, a mesh rescaled)
+* structural edits (prims added or removed, schemas applied, physics
+  properties edited, a mesh rescaled, a shape moved inside its rigid body)
   recompile the stage, carrying the simulation state (time, rigid-body poses and
   velocities) over by prim path.
+
+:meth:`SimScene.advance` steps physics and authors the rigid bodies' new poses
+on the stage; :meth:`SimScene.body_pose` and :meth:`SimScene.body_velocity`
+read a body's state; :meth:`SimScene.snapshot` / :meth:`SimScene.restore`
+implement the timeline's stop (bodies return to where they were at play).
 """
 from __future__ import annotations
 
+import math
 import time
 from typing import Callable
 
@@ -21,7 +28,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg.sim import lights as lightmap
-from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, CompiledScene, compile_stage,
+from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size)
 from graphsdg.sim.mesh_scaling import rescale_mesh_geom
 from graphsdg.stage import materials as matlib
@@ -76,6 +83,7 @@ class SimScene:
         self.meshes_to_upload: set[int] = set()
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
+        self._pose_writers: dict[str, PoseWriter] = {}
 
     # ---- compile -------------------------------------------------------
     @property
@@ -103,12 +111,12 @@ class SimScene:
                 self.compiled.model.vis.global_.offheight = h
                 self.model_version += 1
 
-    def recompile(self) -> CompiledScene:
-        """Compile the stage anew, keeping time and rigid-body state."""
+    def recompile(self, keep_state: bool = True) -> CompiledScene:
+        """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
         start = time.perf_counter()
         new = compile_stage(self.stage, self.offscreen)
-        if old is not None:
+        if old is not None and keep_state:
             new.data.time = old.data.time
             for path, body in new.bodies.items():
                 prev = old.bodies.get(path)
@@ -261,12 +269,15 @@ class SimScene:
                 m_root[:3, :3] = r_root.T
                 m_root[3, :3] = t_root
                 t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
-                if not np.allclose(t, self._geom_local_pos(g), atol=1e-9):
-                    raise NeedsRecompile   # a geom moved inside its rigid body
+                relative = np.eye(4)
+                relative[:3, :3] = r.T
+                relative[3, :3] = t
+                if g.relative is not None and not np.allclose(relative, g.relative, atol=1e-9):
+                    raise NeedsRecompile   # a shape moved inside its rigid body: new mass distribution
             rescaled = not np.allclose(scale, g.scale, rtol=1e-9, atol=1e-12)
             if g.type_name in ("Mesh", "Cone") and g.rigid_root is None and "shape" not in aspects:
                 if rescaled:
-                    if np.any(np.abs(scale) < 1e-9) or m.geom_contype[g.geom_id] or m.geom_conaffinity[g.geom_id]:
+                    if np.any(np.abs(scale) < 1e-9) or path in c.collider_paths:
                         raise NeedsRecompile   # colliding meshes carry hulls and inertia
                     self.meshes_to_upload.add(rescale_mesh_geom(m, g.geom_id, g.scale, scale))
                     g.scale = scale
@@ -291,13 +302,6 @@ class SimScene:
                 m.geom_matid[g.geom_id] = -1
                 m.geom_rgba[g.geom_id] = display_rgba(prim)
             g.material = mat_path
-
-    def _geom_local_pos(self, g) -> np.ndarray:
-        c = self.compiled
-        assert c is not None
-        if g.type_name in ("Mesh", "Cone"):
-            return np.zeros(3)   # mesh vertices carry the offset
-        return np.asarray(c.model.geom_pos[g.geom_id])
 
     def _resize(self, prim: Usd.Prim, g, scale: np.ndarray) -> None:
         c = self.compiled
@@ -380,17 +384,23 @@ class SimScene:
 
     # ---- physics -------------------------------------------------------
     def advance(self, seconds: float) -> None:
-        """Simulate ``seconds`` of physics and write rigid-body poses back to the stage."""
+        """Simulate ``seconds`` of physics and write rigid-body poses back to the stage.
+
+        Steps at the model's timestep until the simulated clock reaches its target,
+        so ticks that are not a multiple of the timestep do not drift.
+        """
         c = self.ensure_compiled()
         if seconds <= 0:
             return
-        n = max(1, int(round(seconds / c.model.opt.timestep)))
-        for _ in range(n):
-            mujoco.mj_step(c.model, c.data)
-        # mj_step leaves positions from before its integration: recompute them so renders,
-        # queries and the USD write-back all see the same, current poses.
-        mujoco.mj_kinematics(c.model, c.data)
-        mujoco.mj_camlight(c.model, c.data)
+        m, d = c.model, c.data
+        target = d.time + seconds
+        steps = 0
+        while d.time < target - 0.5 * m.opt.timestep or steps == 0:
+            mujoco.mj_step(m, d)
+            steps += 1
+        # mj_step leaves positions-derived quantities one step behind; renders,
+        # queries and contacts need them (and the contacts) for the new state.
+        mujoco.mj_forward(m, d)
         self.write_back_rigid_bodies()
 
     def write_back_rigid_bodies(self) -> None:
@@ -399,16 +409,117 @@ class SimScene:
         if c is None or not c.bodies:
             return
         cache = UsdGeom.XformCache(Usd.TimeCode.Default())
+        writers = self._pose_writers
         with self.tracker.muted(), Sdf.ChangeBlock():
             for path, b in c.bodies.items():
                 if b.qpos_adr < 0:
                     continue
+                writer = writers.get(path)
+                if writer is None or not writer.prim:
+                    prim = self.stage.GetPrimAtPath(path)
+                    if not prim:
+                        continue
+                    writer = writers[path] = PoseWriter(prim)
+                writer.write(c.data.qpos[b.qpos_adr:b.qpos_adr + 7], cache)
+
+    # ---- rigid-body state ----------------------------------------------
+    def body(self, path: str) -> BodyBinding:
+        """The compiled rigid body of ``path`` (a prim with ``RigidBodyAPI``)."""
+        self.sync_dirty_prims()
+        c = self.ensure_compiled()
+        binding = c.bodies.get(str(path))
+        if binding is None:
+            raise ValueError(f"prim {path} is not a simulated rigid body; apply "
+                             f"rep.functional.physics.apply_rigid_body to it (with geometry under it) first")
+        return binding
+
+    def body_pose(self, path: str) -> tuple[np.ndarray, np.ndarray]:
+        """World (position, quaternion w, x, y, z) of a rigid body's frame."""
+        b = self.body(path)
+        d = self.data
+        if b.mocap_id >= 0:
+            return d.mocap_pos[b.mocap_id].copy(), d.mocap_quat[b.mocap_id].copy()
+        q = d.qpos[b.qpos_adr:b.qpos_adr + 7]
+        return q[:3].copy(), q[3:].copy()
+
+    def body_velocity(self, path: str) -> tuple[np.ndarray, np.ndarray]:
+        """World-frame (linear m/s, angular rad/s) velocity of a rigid body's frame origin."""
+        b = self.body(path)
+        if b.qvel_adr < 0:
+            return np.zeros(3), np.zeros(3)
+        d = self.data
+        v = d.qvel[b.qvel_adr:b.qvel_adr + 6]
+        rot = quat_wxyz_to_matrix(d.qpos[b.qpos_adr + 3:b.qpos_adr + 7])
+        return v[:3].copy(), rot @ v[3:]      # MuJoCo's free-joint angular velocity is body-local
+
+    def set_body_pose(self, path: str, position: np.ndarray | None = None,
+                      orientation: np.ndarray | None = None) -> None:
+        """Move a rigid body to a world pose (quaternion w, x, y, z), keeping its velocity; authors the stage."""
+        b = self.body(path)
+        c = self.ensure_compiled()
+        d = c.data
+        pos, quat = self.body_pose(path)
+        if position is not None:
+            pos = np.asarray(position, dtype=np.float64)
+        if orientation is not None:
+            quat = np.asarray(orientation, dtype=np.float64)
+            quat = quat / np.linalg.norm(quat)
+        if b.mocap_id >= 0:
+            d.mocap_pos[b.mocap_id], d.mocap_quat[b.mocap_id] = pos, quat
+        else:
+            d.qpos[b.qpos_adr:b.qpos_adr + 3], d.qpos[b.qpos_adr + 3:b.qpos_adr + 7] = pos, quat
+        mujoco.mj_forward(c.model, d)
+        with self.tracker.muted(), Sdf.ChangeBlock():
+            _set_world_pose_sdf(self.stage.GetPrimAtPath(path), pos, quat, UsdGeom.XformCache(Usd.TimeCode.Default()))
+
+    def set_body_velocity(self, path: str, linear: np.ndarray | None = None,
+                          angular: np.ndarray | None = None) -> None:
+        """Set a dynamic body's world-frame linear (m/s) and angular (rad/s) velocity."""
+        b = self.body(path)
+        if b.qvel_adr < 0:
+            raise ValueError(f"rigid body {path} is kinematic; it has no simulated velocity to set")
+        d = self.data
+        if linear is not None:
+            d.qvel[b.qvel_adr:b.qvel_adr + 3] = linear
+        if angular is not None:
+            rot = quat_wxyz_to_matrix(d.qpos[b.qpos_adr + 3:b.qpos_adr + 7])
+            d.qvel[b.qvel_adr + 3:b.qvel_adr + 6] = rot.T @ np.asarray(angular, dtype=np.float64)
+
+    def forward(self) -> None:
+        """Recompute every derived quantity (contacts included) for the current state."""
+        c = self.ensure_compiled()
+        mujoco.mj_forward(c.model, c.data)
+
+    # ---- play / stop ---------------------------------------------------
+    def snapshot(self) -> dict[str, dict[str, object]]:
+        """The authored xform values of every rigid body, to restore on stop."""
+        self.sync_dirty_prims()
+        saved: dict[str, dict[str, object]] = {}
+        for path in self.ensure_compiled().bodies:
+            prim = self.stage.GetPrimAtPath(path)
+            if not prim:
+                continue
+            values = {}
+            for attr in prim.GetAttributes():
+                name = attr.GetName()
+                if name.startswith("xformOp") and attr.HasAuthoredValue():
+                    values[name] = attr.Get()
+            saved[path] = values
+        return saved
+
+    def restore(self, saved: dict[str, dict[str, object]]) -> None:
+        """Put rigid bodies back where :meth:`snapshot` found them; time back to 0, at rest."""
+        with Sdf.ChangeBlock():
+            for path, values in saved.items():
                 prim = self.stage.GetPrimAtPath(path)
                 if not prim:
                     continue
-                pos = c.data.qpos[b.qpos_adr:b.qpos_adr + 3]
-                quat = c.data.qpos[b.qpos_adr + 3:b.qpos_adr + 7]
-                _set_world_pose_sdf(prim, pos, quat, cache)
+                for name, value in values.items():
+                    attr = prim.GetAttribute(name)
+                    if attr:
+                        attr.Set(value)
+        self.tracker.drain()
+        self.recompile(keep_state=False)
 
 
 def _aabb_half(kind: int, size: np.ndarray) -> np.ndarray:
@@ -422,6 +533,84 @@ def _aabb_half(kind: int, size: np.ndarray) -> np.ndarray:
     if kind == int(g.mjGEOM_CAPSULE):
         return np.array([size[0], size[0], size[1] + size[0]])
     return np.asarray(size[:3], dtype=np.float64)
+
+
+_IDENTITY = Gf.Matrix4d(1.0)
+
+
+class PoseWriter:
+    """Authors a rigid body's simulated world pose on its prim, once per step.
+
+    The common case (a translate and an orient or rotateXYZ op, optionally a
+    scale, under a parent without a transform) is written straight into the two
+    attributes; anything else goes through the general path.
+    """
+
+    def __init__(self, prim: Usd.Prim) -> None:
+        self.prim = prim
+        self._order_attr = prim.GetAttribute("xformOpOrder")
+        self._order: tuple[str, ...] | None = None
+        self._last: np.ndarray | None = None
+        self._read_ops()
+
+    def _read_ops(self) -> None:
+        order = self._order_attr.Get() if self._order_attr else None
+        self._order = tuple(order) if order is not None else ()
+        self._translate = self._rotate = None
+        self._rotate_kind = ""
+        names = list(self._order)
+        if names[-1:] == ["xformOp:scale"]:
+            names = names[:-1]
+        if len(names) == 2 and names[0] == "xformOp:translate" and names[1] in ("xformOp:orient",
+                                                                                 "xformOp:rotateXYZ"):
+            self._translate = self.prim.GetAttribute(names[0])
+            self._rotate = self.prim.GetAttribute(names[1])
+            type_name = str(self._rotate.GetTypeName())
+            self._rotate_kind = {"quatd": "quatd", "quatf": "quatf", "double3": "eulerd",
+                                 "float3": "eulerf"}.get(type_name, "")
+            if str(self._translate.GetTypeName()) != "double3":
+                self._rotate_kind = ""
+
+    def write(self, qpos7: np.ndarray, cache: UsdGeom.XformCache) -> None:
+        """Author ``qpos7`` (position, quaternion w, x, y, z) as the prim's world pose."""
+        if self._last is not None and np.array_equal(qpos7, self._last):
+            return      # unchanged since the last write (a body at rest)
+        self._last = np.array(qpos7, dtype=np.float64)
+        order = self._order_attr.Get() if self._order_attr else None
+        if (tuple(order) if order is not None else ()) != self._order:
+            self._read_ops()
+        parent = self.prim.GetParent()
+        parent_identity = not parent or not parent.IsA(UsdGeom.Xformable) or \
+            cache.GetLocalToWorldTransform(parent) == _IDENTITY
+        if not (parent_identity and self._rotate_kind):
+            _set_world_pose_sdf(self.prim, qpos7[:3], qpos7[3:], cache)
+            return
+        x, y, z = (float(v) for v in qpos7[:3])
+        self._translate.Set(Gf.Vec3d(x, y, z))
+        w, qx, qy, qz = (float(v) for v in qpos7[3:])
+        if self._rotate_kind == "quatd":
+            self._rotate.Set(Gf.Quatd(w, qx, qy, qz))
+        elif self._rotate_kind == "quatf":
+            self._rotate.Set(Gf.Quatf(w, qx, qy, qz))
+        else:
+            euler = _quat_to_euler_xyz(w, qx, qy, qz)
+            self._rotate.Set(Gf.Vec3d(*euler) if self._rotate_kind == "eulerd" else Gf.Vec3f(*euler))
+
+
+def _quat_to_euler_xyz(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """USD rotateXYZ angles (degrees) of a unit quaternion; same convention as ``matrix_to_euler_xyz``."""
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    r20 = 2 * (x * z - y * w)
+    sy = -max(-1.0, min(1.0, r20))
+    b = math.asin(sy)
+    if abs(sy) < 1 - 1e-9:
+        a = math.atan2(2 * (y * z + x * w), 1 - 2 * (x * x + y * y))
+        c = math.atan2(2 * (x * y + z * w), 1 - 2 * (y * y + z * z))
+    else:
+        a = math.atan2(-2 * (y * z - x * w), 1 - 2 * (x * x + z * z))
+        c = 0.0
+    return (math.degrees(a), math.degrees(b), math.degrees(c))
 
 
 def _set_world_pose_sdf(prim: Usd.Prim, pos: np.ndarray, quat_wxyz: np.ndarray,

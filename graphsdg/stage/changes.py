@@ -13,6 +13,10 @@ from typing import Iterator
 
 from pxr import Sdf, Tf, Usd
 
+# Properties of these namespaces shape the physics model (masses, colliders, scene
+# settings): an edit recompiles, like a structural change.
+PHYSICS_PROPERTY_PREFIXES = ("physics:", "physx", "material:binding:physics")
+
 
 @dataclass
 class ChangeSet:
@@ -57,6 +61,9 @@ class ChangeTracker:
             name = path.name
             if name.startswith("semantic"):
                 self._pending.semantics_changed = True
+            if name.startswith(PHYSICS_PROPERTY_PREFIXES):
+                self._pending.structural.add(path.GetPrimPath())
+                return
             self._pending.edited.setdefault(path.GetPrimPath(), set()).add(name)
         else:
             self._pending.edited.setdefault(path, set()).add("*")

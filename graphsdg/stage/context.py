@@ -99,6 +99,11 @@ def save(path: str | os.PathLike | None = None) -> str:
         layer = stage.GetRootLayer()
         if layer.anonymous:
             raise ValueError("the stage is in memory only; pass save(path='scene.usda')")
+        from graphsdg.assets.root import builtin_pack_root
+        pack = os.path.realpath(builtin_pack_root())
+        if os.path.realpath(layer.realPath).startswith(pack + os.sep):
+            raise PermissionError(f"{layer.realPath} belongs to graphsdg's built-in asset pack; "
+                                  f"save a copy with save(path='my_scene.usda')")
         layer.Save()
         return layer.realPath
     path = os.fspath(path)

@@ -7,6 +7,7 @@ Replicator's OmniPBR inputs map onto UsdPreviewSurface inputs:
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -35,6 +36,10 @@ class MaterialDesc:
     texture: str | None = None
     texture_scale: tuple[float, float] = (1.0, 1.0)
     texture_rotate: float = 0.0
+    texture_primvar: str = "st"                          # the UV set the texture reads
+    uv_scale: tuple[float, float] = (1.0, 1.0)           # a UsdTransform2d between reader and texture
+    uv_rotation: float = 0.0
+    uv_translation: tuple[float, float] = (0.0, 0.0)
 
 
 def _color3(value: Sequence[float], what: str) -> Gf.Vec3f:
@@ -121,11 +126,18 @@ def bound_material(prim: Usd.Prim) -> UsdShade.Material | None:
 
 
 def describe(material: UsdShade.Material) -> MaterialDesc:
-    """Read a material's colour, roughness, metallic and diffuse texture."""
+    """Read a material's colour, roughness, metallic and diffuse texture.
+
+    A UsdPreviewSurface network is read first; a material with only an MDL
+    surface (Isaac Sim's OmniPBR / OmniSurface assets) is read from the
+    OmniPBR inputs of that shader (see :func:`describe_omnipbr`).
+    """
     shader = surface_shader(material)
     path = str(material.GetPath())
     if shader is None:
-        return MaterialDesc(path=path)
+        mdl = material.ComputeSurfaceSource("mdl")
+        mdl_shader = mdl[0] if mdl and mdl[0] and mdl[0].GetPrim().IsValid() else None
+        return describe_omnipbr(path, mdl_shader) if mdl_shader is not None else MaterialDesc(path=path)
 
     def value(name: str, default):
         inp = shader.GetInput(name)
@@ -143,12 +155,11 @@ def describe(material: UsdShade.Material) -> MaterialDesc:
     metallic, _ = value("metallic", 0.0)
     emissive, _ = value("emissiveColor", Gf.Vec3f(0, 0, 0))
     texture, scale, rotate = None, (1.0, 1.0), 0.0
+    uv: dict = {}
     if diffuse_src is not None:
         tex = UsdShade.Shader(diffuse_src.GetPrim())
         file_in = tex.GetInput("file")
-        asset = file_in.Get() if file_in else None
-        if asset is not None and asset.path:
-            texture = asset.resolvedPath or asset.path
+        texture = texture_file_path(file_in) if file_in else None
         scale_in = tex.GetInput("scale")
         if scale_in and scale_in.Get() is not None:
             s = scale_in.Get()
@@ -156,11 +167,109 @@ def describe(material: UsdShade.Material) -> MaterialDesc:
         rot_attr = tex.GetPrim().GetAttribute("graphsdg:textureRotate")
         if rot_attr and rot_attr.Get() is not None:
             rotate = float(rot_attr.Get())
+        uv = _uv_source(tex)
         diffuse = Gf.Vec3f(1, 1, 1)
     emission = max(float(emissive[0]), float(emissive[1]), float(emissive[2]))
     return MaterialDesc(path=path, rgba=(float(diffuse[0]), float(diffuse[1]), float(diffuse[2]), float(opacity)),
                         roughness=float(roughness), metallic=float(metallic), emission=emission,
-                        texture=texture, texture_scale=scale, texture_rotate=rotate)
+                        texture=texture, texture_scale=scale, texture_rotate=rotate, **uv)
+
+
+def describe_omnipbr(path: str, shader: UsdShade.Shader) -> MaterialDesc:
+    """Read the OmniPBR inputs of an MDL surface shader (unset inputs take OmniPBR's defaults).
+
+    ``diffuse_texture`` (tinted by ``diffuse_tint``) or ``diffuse_color_constant``,
+    ``reflection_roughness_constant``, ``metallic_constant``, ``emissive_color`` when
+    ``enable_emission``, and the UV controls ``texture_scale`` (repeats, as graphsdg's
+    own ``texture_scale``), ``texture_rotate`` (degrees) and ``texture_translate``.
+    """
+    def get(name: str, default):
+        inp = shader.GetInput(name)
+        v = _input_value(inp) if inp else None
+        return default if v is None else v
+
+    tex_in = shader.GetInput("diffuse_texture")
+    texture = texture_file_path(_interface_input(tex_in)) if tex_in else None
+    colour = get("diffuse_tint", Gf.Vec3f(1, 1, 1)) if texture else get("diffuse_color_constant",
+                                                                         Gf.Vec3f(0.2, 0.2, 0.2))
+    emissive = get("emissive_color", Gf.Vec3f(0, 0, 0)) if bool(get("enable_emission", False)) else (0, 0, 0)
+    scale = get("texture_scale", (1.0, 1.0))
+    translate = get("texture_translate", (0.0, 0.0))
+    return MaterialDesc(path=path, rgba=(float(colour[0]), float(colour[1]), float(colour[2]),
+                                         float(get("opacity_constant", 1.0))),
+                        roughness=float(get("reflection_roughness_constant", 0.5)),
+                        metallic=float(get("metallic_constant", 0.0)),
+                        emission=max(float(c) for c in emissive), texture=texture,
+                        texture_scale=(float(scale[0]), float(scale[1])),
+                        texture_rotate=float(get("texture_rotate", 0.0)),
+                        uv_translation=(float(translate[0]), float(translate[1])))
+
+
+def texture_file_path(file_input: UsdShade.Input) -> str | None:
+    """The file a ``UsdUVTexture`` reads: resolved, or anchored to the layer that authored it.
+
+    A relative path that does not resolve (the file is missing) is still made
+    absolute against its layer, so errors can say where the file was expected.
+    """
+    asset = file_input.Get()
+    if asset is None or not asset.path:
+        return None
+    if asset.resolvedPath:
+        return asset.resolvedPath
+    path = asset.path
+    if os.path.isabs(path) or "://" in path:
+        return path
+    for spec in file_input.GetAttr().GetPropertyStack(Usd.TimeCode.Default()):
+        if spec.HasDefaultValue():
+            return os.path.normpath(spec.layer.ComputeAbsolutePath(path))
+    return path
+
+
+def _interface_input(inp: UsdShade.Input) -> UsdShade.Input:
+    """``inp``, or the material interface input it is connected to."""
+    if inp.HasConnectedSource():
+        for src in inp.GetConnectedSources()[0]:
+            if src.source.GetPrim().IsA(UsdShade.Material):
+                upstream = UsdShade.Material(src.source.GetPrim()).GetInput(src.sourceName)
+                if upstream:
+                    return upstream
+    return inp
+
+
+def _input_value(inp: UsdShade.Input):
+    """An input's value, following a connection to a material interface input."""
+    source = _interface_input(inp)
+    if source.HasConnectedSource():
+        return None
+    return source.Get()
+
+
+def _uv_source(texture: UsdShade.Shader) -> dict:
+    """UV set and 2D transform feeding a ``UsdUVTexture``'s ``st`` (reader, optionally via UsdTransform2d)."""
+    out: dict = {}
+    st = texture.GetInput("st")
+    node = None
+    if st and st.HasConnectedSource():
+        srcs = st.GetConnectedSources()[0]
+        node = UsdShade.Shader(srcs[0].source.GetPrim()) if srcs else None
+    if node and node.GetIdAttr().Get() == "UsdTransform2d":
+        for name, key in (("scale", "uv_scale"), ("translation", "uv_translation")):
+            inp = node.GetInput(name)
+            v = _input_value(inp) if inp else None
+            if v is not None:
+                out[key] = (float(v[0]), float(v[1]))
+        rot = node.GetInput("rotation")
+        if rot and _input_value(rot) is not None:
+            out["uv_rotation"] = float(_input_value(rot))
+        inp = node.GetInput("in")
+        srcs = inp.GetConnectedSources()[0] if inp and inp.HasConnectedSource() else []
+        node = UsdShade.Shader(srcs[0].source.GetPrim()) if srcs else None
+    if node and str(node.GetIdAttr().Get() or "").startswith("UsdPrimvarReader"):
+        var = node.GetInput("varname")
+        name = _input_value(var) if var else None
+        if name:
+            out["texture_primvar"] = str(name)
+    return out
 
 
 def bind(prim: Usd.Prim, material: UsdShade.Material) -> None:

@@ -138,17 +138,34 @@ def decompose(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return m[3, :3].copy(), r, scale
 
 
-def _local_components(xf: UsdGeom.Xformable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
-    return decompose(m)
+UNITS_RESOLVE_SUFFIX = ":unitsResolve"
+
+
+def units_resolve_ops(xf: UsdGeom.Xformable) -> list[UsdGeom.XformOp]:
+    """The trailing ``*:unitsResolve`` ops of a prim (the unit / up-axis correction of a referenced asset)."""
+    ops = xf.GetOrderedXformOps()
+    tail: list[UsdGeom.XformOp] = []
+    for op in reversed(ops):
+        if not op.GetOpName().endswith(UNITS_RESOLVE_SUFFIX):
+            break
+        tail.insert(0, op)
+    return tail
 
 
 class _OpStack:
-    """The canonical op stack graphsdg authors: translate, one rotation op, scale."""
+    """The canonical op stack graphsdg authors: translate, one rotation op, scale.
+
+    Trailing ``*:unitsResolve`` ops (the correction Kit's metrics assembler, and
+    :func:`graphsdg.functional.create.reference`, add to a referenced asset in
+    other units or another up axis) are kept after the canonical ops, so a pose
+    set here is in the stage's units while the asset keeps its corrected size.
+    """
 
     def __init__(self, prim: Usd.Prim) -> None:
         self.xf = UsdGeom.Xformable(prim)
+        self.tail = units_resolve_ops(self.xf)
         ops = self.xf.GetOrderedXformOps()
+        ops = ops[:len(ops) - len(self.tail)]
         self.translate = self.rotate = self.scale = None
         canonical = True
         for op in ops:
@@ -167,21 +184,34 @@ class _OpStack:
             self._rebuild()
 
     def _rebuild(self) -> None:
-        t, r, s = _local_components(self.xf)
+        m = np.array(self.xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
+        tail = np.eye(4)
+        for op in self.tail:                      # later ops apply first (row vectors: p @ M_last @ ... )
+            tail = np.array(op.GetOpTransform(Usd.TimeCode.Default()), dtype=np.float64) @ tail
+        t, r, s = decompose(np.linalg.inv(tail) @ m)
         self.xf.ClearXformOpOrder()
         self.translate = self.rotate = self.scale = None
         self.set_translate(t)
         self.set_rotation_matrix(r)
         self.set_scale(s)
 
+    def _existing_op(self, name: str) -> UsdGeom.XformOp | None:
+        """An op attribute left out of the order by a rebuild, reused as is (its precision may be float)."""
+        attr = self.xf.GetPrim().GetAttribute(name)
+        return UsdGeom.XformOp(attr) if attr and attr.IsValid() else None
+
     def _write_order(self) -> None:
-        self.xf.SetXformOpOrder([op for op in (self.translate, self.rotate, self.scale) if op is not None])
+        self.xf.SetXformOpOrder([op for op in (self.translate, self.rotate, self.scale) if op is not None]
+                                + self.tail)
 
     def set_translate(self, v: Sequence[float]) -> None:
         if self.translate is None:
-            self.translate = self.xf.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble)
+            self.translate = self._existing_op("xformOp:translate") or \
+                self.xf.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble)
             self._write_order()
-        self.translate.Set(Gf.Vec3d(*(float(x) for x in v)))
+        value = Gf.Vec3d(*(float(x) for x in v))
+        self.translate.Set(Gf.Vec3f(value) if self.translate.GetPrecision() == UsdGeom.XformOp.PrecisionFloat
+                           else value)
 
     def set_euler(self, angles: Sequence[float], order: str = "XYZ") -> None:
         order = order.upper()
@@ -219,7 +249,7 @@ class _OpStack:
 
     def set_scale(self, v: Sequence[float]) -> None:
         if self.scale is None:
-            self.scale = self.xf.AddScaleOp(UsdGeom.XformOp.PrecisionDouble)
+            self.scale = self._existing_op("xformOp:scale") or self.xf.AddScaleOp(UsdGeom.XformOp.PrecisionDouble)
             self._write_order()
         value = Gf.Vec3d(*(float(x) for x in v))
         if self.scale.GetPrecision() == UsdGeom.XformOp.PrecisionFloat:

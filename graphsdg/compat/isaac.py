@@ -1,0 +1,148 @@
+"""Install Isaac Sim / Omniverse module names that map onto graphsdg.
+
+Example:
+    >>> from graphsdg.compat import isaac
+    >>> isaac.install()
+    >>> import omni.replicator.core as rep      # this is graphsdg
+    >>> isaac.uninstall()
+
+``graphsdg run --compat isaac script.py`` does this before running the script.
+Only names listed in docs/porting.md exist; any other attribute of these
+modules raises :class:`~graphsdg.compat.modules.CompatError` naming what is there.
+"""
+from __future__ import annotations
+
+import sys
+import types
+import unittest
+
+from graphsdg.compat import isaac_core, kit
+from graphsdg.compat.modules import CompatFinder, CompatModule, ForwardingModule
+
+_installed: dict[str, types.ModuleType] = {}
+_finder: CompatFinder | None = None
+
+
+def _assets():
+    from graphsdg import assets
+    return assets
+
+
+def _modules() -> dict[str, types.ModuleType]:
+    import graphsdg
+    from graphsdg import functional
+    from graphsdg.sim import transforms
+
+    rep = ForwardingModule("omni.replicator.core", graphsdg, BackendDispatch=graphsdg.BackendDispatch)
+    rep_functional = ForwardingModule("omni.replicator.core.functional", functional)
+    utils = CompatModule("omni.replicator.core.scripts.functional.utils",
+                         get_world_position=transforms.get_world_position,
+                         get_world_transform_matrix=transforms.get_world_transform_matrix)
+    scripts_functional = CompatModule("omni.replicator.core.scripts.functional", utils=utils)
+    scripts = CompatModule("omni.replicator.core.scripts", functional=scripts_functional)
+    rep.scripts = scripts  # type: ignore[attr-defined]
+    rep.functional = rep_functional  # type: ignore[attr-defined]
+
+    from graphsdg.sim.timeline import TimelineEventType
+    timeline = CompatModule("omni.timeline", get_timeline_interface=kit.get_timeline_interface,
+                            TimelineEventType=TimelineEventType)
+    app = CompatModule("omni.kit.app", get_app=kit.get_app)
+    commands = CompatModule("omni.kit.commands", execute=kit.execute)
+    kit_test = CompatModule("omni.kit.test", AsyncTestCase=unittest.IsolatedAsyncioTestCase)
+    omni_kit = CompatModule("omni.kit", app=app, commands=commands, test=kit_test)
+    usd = CompatModule("omni.usd", get_context=kit.get_context, StageEventType=kit.StageEventType,
+                       get_world_transform_matrix=kit.get_world_transform_matrix,
+                       get_local_transform_matrix=kit.get_local_transform_matrix)
+    physx = CompatModule("omni.physx", get_physx_scene_query_interface=isaac_core.get_physx_scene_query_interface)
+    replicator = CompatModule("omni.replicator", core=rep)
+    omni = CompatModule("omni", replicator=replicator, usd=usd, timeline=timeline, kit=omni_kit, physx=physx)
+
+    carb_settings = CompatModule("carb.settings", get_settings=kit.get_settings)
+    carb_events = CompatModule("carb.events", IEvent=kit.Event, IEventStream=kit.EventStream)
+    carb = CompatModule("carb", settings=carb_settings, events=carb_events, Float3=kit.Float3, Float4=kit.Float4,
+                        log_info=kit.log_info, log_warn=kit.log_warn, log_error=kit.log_error)
+
+    storage_native = CompatModule("isaacsim.storage.native",
+                                  get_assets_root_path=lambda *a, **k: _assets().get_assets_root_path(*a, **k),
+                                  get_assets_root_path_async=lambda *a, **k: _assets().get_assets_root_path_async(
+                                      *a, **k))
+    storage = CompatModule("isaacsim.storage", native=storage_native)
+    bounds = CompatModule("isaacsim.core.utils.bounds", create_bbox_cache=isaac_core.create_bbox_cache,
+                          compute_aabb=isaac_core.compute_aabb,
+                          compute_combined_aabb=isaac_core.compute_combined_aabb,
+                          compute_obb=isaac_core.compute_obb)
+    core_utils = CompatModule("isaacsim.core.utils", bounds=bounds)
+    exp_bounds = CompatModule("isaacsim.core.experimental.utils.bounds",
+                              create_bbox_cache=isaac_core.create_bbox_cache, compute_aabb=isaac_core.compute_aabb,
+                              compute_combined_aabb=isaac_core.compute_combined_aabb,
+                              compute_obb=isaac_core.compute_obb)
+    exp_stage = CompatModule("isaacsim.core.experimental.utils.stage", get_current_stage=isaac_core.get_current_stage)
+    exp_semantics = CompatModule("isaacsim.core.experimental.utils.semantics", add_labels=isaac_core.add_labels,
+                                 get_labels=isaac_core.get_labels, remove_labels=isaac_core.remove_labels)
+    exp_utils = CompatModule("isaacsim.core.experimental.utils", bounds=exp_bounds, stage=exp_stage,
+                             semantics=exp_semantics)
+    exp_prims = CompatModule("isaacsim.core.experimental.prims", RigidPrim=isaac_core.RigidPrim,
+                             XformPrim=isaac_core.XformPrim)
+    experimental = CompatModule("isaacsim.core.experimental", prims=exp_prims, utils=exp_utils)
+    core = CompatModule("isaacsim.core", utils=core_utils, experimental=experimental)
+    isaacsim = CompatModule("isaacsim", SimulationApp=kit.SimulationApp, storage=storage, core=core)
+
+    modules = [omni, replicator, rep, rep_functional, scripts, scripts_functional, utils, usd, timeline,
+               omni_kit, app, commands, kit_test, physx, carb, carb_settings, carb_events, isaacsim, storage,
+               storage_native, core, core_utils, bounds, experimental, exp_utils, exp_bounds, exp_stage,
+               exp_semantics, exp_prims]
+    scenario = _palletizing_module()
+    if scenario is not None:
+        modules += scenario
+    return {m.__name__: m for m in modules}
+
+
+def _palletizing_module() -> list[types.ModuleType] | None:
+    """``isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing`` when the scenario exists."""
+    try:
+        from graphsdg.scenarios import palletizing
+    except ImportError:
+        return None
+    leaf = CompatModule("isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing",
+                        BinStacking=palletizing.BinStacking)
+    pkg = CompatModule("isaacsim.examples.interactive.ur10_palletizing", ur10_palletizing=leaf)
+    interactive = CompatModule("isaacsim.examples.interactive", ur10_palletizing=pkg)
+    examples = CompatModule("isaacsim.examples", interactive=interactive)
+    return [leaf, pkg, interactive, examples]
+
+
+def install() -> None:
+    """Put the Isaac / Omniverse names into ``sys.modules`` (no-op if already installed)."""
+    if _installed:
+        return
+    modules = _modules()
+    clash = [n for n in modules if n in sys.modules and n not in _installed]
+    if clash:
+        raise RuntimeError(f"cannot install graphsdg's Isaac compat modules: {clash[0]!r} is already imported "
+                           f"(a real Omniverse install?)")
+    if "isaacsim.examples" not in modules:
+        isaacsim = modules["isaacsim"]
+        isaacsim.examples = CompatModule("isaacsim.examples")  # type: ignore[attr-defined]
+    else:
+        modules["isaacsim"].examples = modules["isaacsim.examples"]  # type: ignore[attr-defined]
+    sys.modules.update(modules)
+    _installed.update(modules)
+    global _finder
+    _finder = CompatFinder(_installed)
+    sys.meta_path.insert(0, _finder)
+
+
+def uninstall() -> None:
+    """Remove the names :func:`install` added."""
+    global _finder
+    for name in list(_installed):
+        if sys.modules.get(name) is _installed[name]:
+            del sys.modules[name]
+    _installed.clear()
+    if _finder is not None and _finder in sys.meta_path:
+        sys.meta_path.remove(_finder)
+    _finder = None
+
+
+def installed_names() -> list[str]:
+    return sorted(_installed)

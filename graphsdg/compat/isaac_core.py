@@ -1,0 +1,177 @@
+"""isaacsim.core / omni.physx helpers mapped onto graphsdg: bounds, rigid-body views, scene queries.
+
+Isaac's experimental prim wrappers return warp arrays; graphsdg returns numpy
+arrays that also answer ``.numpy()``, so ``poses[0].numpy()`` works unchanged.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Sequence
+
+import numpy as np
+from pxr import Usd, UsdGeom
+
+from graphsdg.stage import semantics as semlib
+from graphsdg.stage.context import get_stage
+from graphsdg.stage.prims import resolve_prim
+
+
+class WarpLikeArray(np.ndarray):
+    """A numpy array with warp's ``.numpy()`` (returns itself as a plain array)."""
+
+    def numpy(self) -> np.ndarray:
+        return np.asarray(self)
+
+
+def _warp(a: Any) -> WarpLikeArray:
+    return np.asarray(a).view(WarpLikeArray)
+
+
+# ---- bounds -----------------------------------------------------------------------
+def create_bbox_cache(time: Usd.TimeCode = Usd.TimeCode.Default(), use_extents_hint: bool = True
+                      ) -> UsdGeom.BBoxCache:
+    from graphsdg.sim.bounds import create_bbox_cache as make
+    return make(time, use_extents_hint)
+
+
+def compute_aabb(*args: Any, bbox_cache: UsdGeom.BBoxCache | None = None, prim: Any = None,
+                 include_children: bool = False) -> np.ndarray:
+    """``compute_aabb(bbox_cache, prim, ...)`` (isaacsim.core.utils.bounds) or
+    ``compute_aabb(prim, bbox_cache=..., include_children=...)`` (the experimental utils)."""
+    from graphsdg.sim.bounds import compute_aabb as aabb
+    positional = list(args)
+    if positional and isinstance(positional[0], UsdGeom.BBoxCache):
+        bbox_cache = positional.pop(0)
+    if positional:
+        prim = positional.pop(0)
+    if positional:
+        bbox_cache = positional.pop(0)
+    if prim is None:
+        raise TypeError("compute_aabb needs a prim")
+    return aabb(prim, bbox_cache, include_children=include_children)
+
+
+def compute_combined_aabb(bbox_cache: UsdGeom.BBoxCache, prim_paths: Iterable[str]) -> np.ndarray:
+    from graphsdg.sim.bounds import compute_combined_aabb as combined
+    return combined(list(prim_paths), bbox_cache)
+
+
+def compute_obb(bbox_cache: UsdGeom.BBoxCache, prim_path: str):
+    from graphsdg.sim.bounds import compute_obb as obb
+    return obb(prim_path, bbox_cache)
+
+
+# ---- prims --------------------------------------------------------------------------
+class XformPrim:
+    """isaacsim.core.experimental.prims.XformPrim: world poses of prims matched by path(s)."""
+
+    def __init__(self, paths: str | Sequence[str], **_: Any) -> None:
+        self.paths = [paths] if isinstance(paths, str) else list(paths)
+        for p in self.paths:
+            resolve_prim(p)
+
+    def _selected(self, indices: Sequence[int] | None) -> list[str]:
+        return self.paths if indices is None else [self.paths[int(i)] for i in indices]
+
+    def get_world_poses(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
+        from graphsdg.sim.transforms import get_world_pose
+        poses = [get_world_pose(p) for p in self._selected(indices)]
+        return _warp([p[0] for p in poses]), _warp([p[1] for p in poses])
+
+    def set_world_poses(self, positions: Any = None, orientations: Any = None,
+                        indices: Sequence[int] | None = None) -> None:
+        from graphsdg.functional import modify
+        from graphsdg.stage.xform import decompose, quat_wxyz_to_matrix, world_matrix
+        for i, path in enumerate(self._selected(indices)):
+            prim = resolve_prim(path)
+            parent = prim.GetParent()
+            parent_m = world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
+            world = world_matrix(prim)
+            if positions is not None:
+                world[3, :3] = np.asarray(positions, dtype=np.float64).reshape(-1, 3)[i]
+            if orientations is not None:
+                _, _, scale = decompose(world)
+                r = quat_wxyz_to_matrix(np.asarray(orientations, dtype=np.float64).reshape(-1, 4)[i])
+                world[:3, :3] = (r * scale).T
+            t, r, _ = decompose(world @ np.linalg.inv(parent_m))
+            from graphsdg.stage.xform import matrix_to_quat_wxyz
+            modify.pose(prim, position_value=t, rotation_value=matrix_to_quat_wxyz(r))
+
+
+class RigidPrim(XformPrim):
+    """isaacsim.core.experimental.prims.RigidPrim over graphsdg's rigid-body view."""
+
+    def __init__(self, paths: str | Sequence[str], **kwargs: Any) -> None:
+        super().__init__(paths, **kwargs)
+        from graphsdg.sim.bodies import RigidBodyView
+        self._view = RigidBodyView(self.paths)
+
+    def get_world_poses(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
+        pos, quat = self._view.get_world_poses(indices)
+        return _warp(pos), _warp(quat)
+
+    def set_world_poses(self, positions: Any = None, orientations: Any = None,
+                        indices: Sequence[int] | None = None) -> None:
+        self._view.set_world_poses(positions, orientations, indices)
+
+    def get_velocities(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
+        lin, ang = self._view.get_velocities(indices)
+        return _warp(lin), _warp(ang)
+
+    def set_velocities(self, linear_velocities: Any = None, angular_velocities: Any = None,
+                       indices: Sequence[int] | None = None) -> None:
+        self._view.set_velocities(linear_velocities, angular_velocities, indices)
+
+    def get_masses(self, indices: Sequence[int] | None = None) -> WarpLikeArray:
+        return _warp(self._view.get_masses(indices))
+
+
+# ---- stage and semantics utils ---------------------------------------------------------
+def get_current_stage() -> Usd.Stage:
+    return get_stage()
+
+
+def add_labels(prim: Usd.Prim, labels: Sequence[str], instance_name: str = "class", overwrite: bool = True) -> None:
+    """isaacsim.core.experimental.utils.semantics.add_labels."""
+    semlib.apply(prim, {instance_name: list(labels)}, mode="replace" if overwrite else "add")
+
+
+def get_labels(prim: Usd.Prim) -> dict[str, list[str]]:
+    return semlib.direct_labels(prim)
+
+
+def remove_labels(prim: Usd.Prim, instance_name: str | None = None) -> None:
+    if instance_name is None:
+        semlib.apply(prim, None, mode="clear")
+    else:
+        labels = {k: v for k, v in semlib.direct_labels(prim).items() if k != instance_name}
+        semlib.apply(prim, labels, mode="clear")
+
+
+# ---- omni.physx scene queries ------------------------------------------------------------
+class SceneQueryInterface:
+    """omni.physx's scene query interface; hits carry ``rigid_body`` / ``collision`` prim paths."""
+
+    def overlap_box(self, half_extent: Any, position: Any, rotation: Any,
+                    report_fn: Callable[[Any], bool] | None = None, any_hit: bool = False) -> int:
+        from graphsdg.sim.queries import overlap_box
+        return overlap_box(tuple(half_extent), tuple(position), tuple(rotation), report_fn, any_hit)
+
+    def overlap_sphere(self, radius: float, position: Any, report_fn: Callable[[Any], bool] | None = None,
+                       any_hit: bool = False) -> int:
+        from graphsdg.sim.queries import overlap_sphere
+        return overlap_sphere(radius, tuple(position), report_fn, any_hit)
+
+    def raycast_closest(self, origin: Any, direction: Any, distance: float) -> dict:
+        from graphsdg.sim.queries import raycast_closest
+        return raycast_closest(tuple(origin), tuple(direction), distance)
+
+    def raycast_all(self, origin: Any, direction: Any, distance: float, report_fn: Callable | None = None):
+        from graphsdg.sim.queries import raycast_all
+        return raycast_all(tuple(origin), tuple(direction), distance, report_fn)
+
+
+_scene_query = SceneQueryInterface()
+
+
+def get_physx_scene_query_interface() -> SceneQueryInterface:
+    return _scene_query

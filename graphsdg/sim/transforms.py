@@ -1,0 +1,47 @@
+"""World transforms of any prim, read from the stage.
+
+The stage is current: simulated rigid-body poses are authored on it after every
+physics step, so these functions see where bodies are now. They mirror
+``omni.usd.get_world_transform_matrix`` and Replicator's
+``scripts.functional.utils.get_world_position``.
+
+Example:
+    >>> import graphsdg as rep
+    >>> from graphsdg.sim import transforms
+    >>> _ = rep.stage.new_stage()
+    >>> world = rep.functional.create.xform(name="World", position=(1, 0, 0))
+    >>> cube = rep.functional.create.cube(parent=world, position=(0, 2, 0))
+    >>> transforms.get_world_position(cube).tolist()
+    [1.0, 2.0, 0.0]
+"""
+from __future__ import annotations
+
+import numpy as np
+from pxr import Gf, Usd, UsdGeom
+
+from graphsdg.stage.prims import PrimLike, resolve_prim
+from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+
+
+def get_world_transform_matrix(prim: PrimLike, time: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
+    """The prim's local-to-world transform as a ``Gf.Matrix4d`` (row-vector, USD layout)."""
+    p = resolve_prim(prim)
+    if not p.IsA(UsdGeom.Xformable):
+        return Gf.Matrix4d(1.0)
+    return UsdGeom.Xformable(p).ComputeLocalToWorldTransform(time)
+
+
+def get_world_position(prim: PrimLike) -> np.ndarray:
+    """World position of the prim's origin, shape (3,)."""
+    return world_matrix(resolve_prim(prim))[3, :3].copy()
+
+
+def get_world_pose(prim: PrimLike) -> tuple[np.ndarray, np.ndarray]:
+    """World (position (3,), orientation quaternion (w, x, y, z)) of the prim, scale removed."""
+    t, r, _ = decompose(world_matrix(resolve_prim(prim)))
+    return t, matrix_to_quat_wxyz(r)
+
+
+def get_world_scale(prim: PrimLike) -> np.ndarray:
+    """Per-axis world scale of the prim, shape (3,)."""
+    return decompose(world_matrix(resolve_prim(prim)))[2]
