@@ -185,8 +185,6 @@ def test_coco_writer_loads_with_pycocotools_and_masks_are_exact(out_dir, segment
                 assert iou > 0.75
             label = frame["info"]["idToSemantics"][iid]["class"]
             assert coco.loadCats(ann["category_id"])[0]["name"] == label
-        ball = by_path["/World/Ball"]
-        assert 0 < ball["occlusion_ratio"] < 1                      # partly behind the front cube
     assert min(a["id"] for a in coco.dataset["annotations"]) == 1
     writer.detach()
 
@@ -468,6 +466,21 @@ def test_yolo_writer_reads_back(out_dir):
                           for t in truth[n]["data"])
         assert sorted(got) == expected
     writer.detach()
+
+
+def test_yolo_writer_min_visibility_drops_hidden_objects(out_dir):
+    cam, rp = _occluding_scene()
+    occlusion = rep.annotators.get("occlusion", init_params={"semanticTypes": ["class"]})
+    occlusion.attach(rp)
+    writer = rep.writers.get("YoloWriter")
+    writer.initialize(output_dir=out_dir, classes=["box", "ball"], min_visibility=0.9)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    ratios = occlusion.get_data()["occlusionRatio"]
+    assert (ratios > 0.1).sum() == 1                                  # the ball, partly behind the front cube
+    lines = open(os.path.join(out_dir, "labels", "train", "000000.txt")).read().splitlines()
+    assert sorted(line.split()[0] for line in lines) == ["0", "0"]    # the two boxes; the ball is dropped
 
 
 def test_yolo_writer_fixed_classes_skip_others(out_dir):

@@ -12,8 +12,8 @@ annotation is one visible semantic instance: ``bbox`` ``[x, y, w, h]`` of its
 visible pixels, ``area`` = visible pixel count, ``segmentation`` its visible
 mask as compressed RLE (pycocotools' encoding, so ``COCO.annToMask`` returns
 exactly the rendered instance mask) or as polygons (``segmentation="polygon"``,
-outer boundaries through pixel centres: approximate, holes filled). Extra keys:
-``prim_path`` and ``occlusion_ratio``.
+outer boundaries through pixel centres: approximate, holes filled). Extra key:
+``prim_path``.
 
 Categories: with ``coco_categories`` (``{label: {"name", "id", ...}}``, as in
 Replicator) labels missing from it become ``"other"``; without it every label
@@ -176,13 +176,12 @@ class CocoWriter(Writer):
             if label is None:
                 continue
             mask = instances == int(instance_id)
-            self.coco["annotations"].append(self._annotation(mask, image_id, self.category_of(label), prim_path,
-                                                             float(row["occlusionRatio"])))
+            self.coco["annotations"].append(self._annotation(mask, image_id, self.category_of(label), prim_path))
         if self._write_panoptic:
             self.backend.schedule(iof.write_image, data=self._panoptic(rp["semantic_segmentation"]),
                                   path=self._file_name("panoptic", rp_name, rp["camera"]))
 
-    def _annotation(self, mask: np.ndarray, image_id: int, category: dict, prim_path: str, occlusion: float) -> dict:
+    def _annotation(self, mask: np.ndarray, image_id: int, category: dict, prim_path: str) -> dict:
         rle = self.mask_api.encode(np.asfortranarray(mask.astype(np.uint8)))
         bbox = [int(v) for v in self.mask_api.toBbox(rle)]
         if self._segmentation == "rle":
@@ -192,7 +191,7 @@ class CocoWriter(Writer):
         return {"id": len(self.coco["annotations"]) + 1,      # ids from 1: COCOeval treats id 0 as "no match"
                 "image_id": image_id, "category_id": int(category["id"]), "bbox": bbox,
                 "area": float(self.mask_api.area(rle)), "bbox_mode": 1, "iscrowd": 0,
-                "segmentation": segmentation, "prim_path": prim_path, "occlusion_ratio": occlusion}
+                "segmentation": segmentation, "prim_path": prim_path}
 
     def _panoptic(self, semantic: dict) -> np.ndarray:
         ids = np.asarray(semantic["data"])

@@ -18,8 +18,9 @@ A label line has KITTI's 15 fields::
 
 ``type`` is the class label (spaces become ``_``), the 2D box is the tight box
 of the visible pixels (inclusive pixel indices, as Replicator writes them);
-``occluded`` is 0 / 1 / 2 by the visible fraction ``1 - occlusionRatio``
-against ``fully_visible_threshold`` and ``partly_occluded_threshold``;
+``occluded`` is 0 / 1 / 2 by the visible fraction ``1 - occlusionRatio`` (of the
+3D box rows, which always compute it) against ``fully_visible_threshold`` and
+``partly_occluded_threshold``;
 ``truncated`` is the share of the projected 3D box outside the image. Where
 Replicator writes zeros, graphsdg writes the 3D box: ``h w l`` (metres, along
 the prim's local z, y, x axes with its scale), ``x y z`` the centre of the
@@ -165,11 +166,13 @@ class KittiWriter(Writer):
             label = self._label(tight["idToLabels"].get(str(int(row["semanticId"]))))
             if label is None:
                 continue
-            visible = 1.0 - float(row["occlusionRatio"])
-            occluded = 0 if visible >= self._fully else (1 if visible >= self._partly else 2)
             truncated, alpha, dims, loc, ry = 0.0, 0.0, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.0
+            occluded = 3                                  # KITTI's "unknown"
             box3d = rows3d.get(int(instance_id))
             if box3d is not None:
+                # the 3D box rows carry the exact occlusion ratio (tight boxes alone do not compute it)
+                visible = 1.0 - float(box3d["occlusionRatio"])
+                occluded = 0 if visible >= self._fully else (1 if visible >= self._partly else 2)
                 truncated, alpha, dims, loc, ry = self._geometry(box3d, camera)
             fields = [label, f"{truncated:.2f}", str(occluded), f"{alpha:.2f}",
                       *(f"{int(row[k])}" for k in ("x_min", "y_min", "x_max", "y_max")),

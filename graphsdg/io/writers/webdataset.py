@@ -5,7 +5,8 @@ Layout (the WebDataset convention: a sample is the tar members that share a key)
     <output_dir>/shard-000000.tar
         000000.png            the rgb image                     (rgb=True)
         000000.json           frame record: render product, camera, frame, sim time,
-                              boxes [{label, prim_path, x_min, y_min, x_max, y_max, occlusion_ratio}],
+                              boxes [{label, prim_path, x_min, y_min, x_max, y_max, occlusion_ratio}]
+                              (occlusion_ratio -1: not computed, as bounding_box_2d_tight reports it),
                               camera_params and id -> label maps of the id images
         000000.depth.npy      distance_to_image_plane, float32 (H, W)       (distance_to_image_plane=True)
         000000.semantic.png   16-bit semantic ids (map: json "semantic_labels")   (semantic_segmentation=True)

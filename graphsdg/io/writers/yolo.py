@@ -17,7 +17,9 @@ replacing ``/images/`` with ``/labels/`` in the image path.
 Classes are numbered from 0: the given ``classes`` (others are skipped), or
 every label in first-seen order. ``data.yaml`` holds ``path`` (the output
 directory), ``train``, ``val`` and ``names``; it is rewritten when a class is
-added and on ``flush()``. With ``val_every=N`` every N-th frame goes to the
+added and on ``flush()``. ``min_visibility`` > 0 drops objects whose visible
+fraction is lower (it attaches the ``occlusion`` annotator, which costs the
+unoccluded renders). With ``val_every=N`` every N-th frame goes to the
 ``val`` split; otherwise ``val`` points at the training images.
 
 Example:
@@ -80,8 +82,15 @@ class YoloWriter(Writer):
         self._frame_id = 0
         self._yaml = AggregateFile(self.backend, "data.yaml", encoder=data_yaml)
         self._dirty = True
+        if isinstance(min_visibility, bool) or not isinstance(min_visibility, (int, float)) \
+                or not 0.0 <= min_visibility <= 1.0:
+            raise ValueError(f"{name}: min_visibility must be in [0, 1], got {min_visibility!r}")
         self.annotators = [AnnotatorRegistry.get_annotator("rgb"),
                            AnnotatorRegistry.get_annotator(self._box, init_params={"semanticFilter": filter_text})]
+        if self._min_visibility > 0:
+            # tight boxes carry occlusion ratios only when an occlusion annotator pays for them
+            self.annotators.append(AnnotatorRegistry.get_annotator("occlusion",
+                                                                   init_params={"semanticFilter": filter_text}))
 
     def write(self, data: dict) -> None:
         products = data["renderProducts"]
@@ -101,7 +110,7 @@ class YoloWriter(Writer):
     def label_lines(self, boxes: dict, width: int, height: int) -> list[str]:
         lines = []
         for row in boxes["data"]:
-            if 1.0 - float(row["occlusionRatio"]) < self._min_visibility:
+            if self._min_visibility > 0 and 1.0 - float(row["occlusionRatio"]) < self._min_visibility:
                 continue
             label = class_name(boxes["idToLabels"].get(str(int(row["semanticId"]))), self.semantic_types)
             if label is None:
