@@ -168,7 +168,7 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
             continue
         data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
                                     extra={"provenance": provenance} if provenance else None)
-        writer.write(data)
+        writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
     _timed("write", t)
 
 
@@ -180,7 +180,13 @@ async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_
 
 
 def wait_until_complete() -> None:
-    """Block until every scheduled file is on disk; raise the first writer failure."""
+    """Block until every scheduled file is on disk; raise the first writer failure.
+
+    Attached writers flush their aggregate files first (COCO json, BOP json, open
+    WebDataset shards), so what is on disk afterwards is a complete dataset.
+    """
+    for writer in list(runtime().writers):
+        writer.flush()
     get_write_queue().wait_until_done()
 
 
