@@ -211,7 +211,10 @@ def bounding_box_2d_loose(frame: FrameView, params: dict) -> dict:
     if len(idx):
         rows["x_min"], rows["y_min"], rows["x_max"], rows["y_max"] = fp.boxes[idx].T
     rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
-    return {"data": rows, "info": _box_info(imap, rows["semanticId"], idx)}
+    info = _box_info(imap, rows["semanticId"], idx)
+    # graphsdg extension: each row's full (unoccluded) silhouette as a crop and its mask
+    info["unoccludedMasks"] = [fp.masks.get(int(k)) for k in idx]
+    return {"data": rows, "info": info}
 
 
 def _boxes_3d(frame: FrameView, filt: SemanticFilter, idx: np.ndarray) -> dict:

@@ -545,6 +545,12 @@ def test_bop_writer_reads_back(out_dir):
     ball = info[[g["obj_id"] for g in gt].index(2)]
     assert 0 < ball["visib_fract"] < 1 and ball["px_count_all"] > ball["px_count_visib"]
     assert ball["visib_fract"] == pytest.approx(ball["px_count_visib"] / ball["px_count_all"], abs=1e-3)
+    ball_gt = [g["obj_id"] for g in gt].index(2)
+    full = np.array(Image.open(os.path.join(scene, "mask", f"000000_{ball_gt:06d}.png"))) > 0
+    visib = np.array(Image.open(os.path.join(scene, "mask_visib", f"000000_{ball_gt:06d}.png"))) > 0
+    assert full.sum() == ball["px_count_all"] and np.all(full[visib])      # the silhouette holds the visible part
+    ys, xs = np.nonzero(full)
+    assert [xs.min(), ys.min(), xs.max() - xs.min() + 1, ys.max() - ys.min() + 1] == ball["bbox_obj"]
     x, y, w, h = ball["bbox_visib"]
     bx, by, bw, bh = ball["bbox_obj"]
     assert bx <= x and by <= y and bx + bw >= x + w and by + bh >= y + h

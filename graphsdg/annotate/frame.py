@@ -63,6 +63,7 @@ class Footprints:
 
     counts: np.ndarray     # int64 (n,)
     boxes: np.ndarray      # int32 (n, 4) x_min y_min x_max y_max
+    masks: dict = None     # k -> (x0, y0, x1, y1) crop and its bool mask (the full silhouette)
 
 
 class SceneLabels:
@@ -239,6 +240,7 @@ class FrameView:
             render = self.outputs.render_isolated if self.outputs is not None else None
             if render is None:
                 raise RuntimeError("isolated renders need the segmentation pass")
+            masks: dict[int, tuple[tuple[int, int, int, int], np.ndarray]] = {}
             shown = np.zeros(self.sim.model.ngeom, dtype=bool)
             shown[self.drawn_geoms()] = True
             rects = self._geom_rects()
@@ -257,6 +259,7 @@ class FrameView:
                 for k, geoms, crop in group:
                     part = ids[crop[1] - y0:crop[3] - y0, crop[0] - x0:crop[2] - x0]
                     mask = np.isin(part, geoms)
+                    masks[k] = (tuple(int(c) for c in crop), mask)
                     counts[k] = int(mask.sum())
                     if counts[k]:
                         ys, xs = np.nonzero(mask)
@@ -273,7 +276,7 @@ class FrameView:
                 else:
                     boxes[k, :2] = np.minimum(boxes[k, :2], box[:2])
                     boxes[k, 2:] = np.maximum(boxes[k, 2:], box[2:])
-            return Footprints(counts=counts, boxes=boxes)
+            return Footprints(counts=counts, boxes=boxes, masks=masks)
         return self.cached(("footprints", semantic_filter.text), build)
 
     def occlusion_ratios(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:

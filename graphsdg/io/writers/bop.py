@@ -5,6 +5,7 @@ render products; each captured frame is one image ``im_id`` (0, 1, ...)::
 
     <output_dir>/<split>/<scene_id:06d>/rgb/<im_id:06d>.png
     <output_dir>/<split>/<scene_id:06d>/depth/<im_id:06d>.png         uint16, depth [mm] / depth_scale
+    <output_dir>/<split>/<scene_id:06d>/mask/<im_id:06d>_<gt_id:06d>.png         full silhouette, 0/255
     <output_dir>/<split>/<scene_id:06d>/mask_visib/<im_id:06d>_<gt_id:06d>.png   visible mask, 0/255
     <output_dir>/<split>/<scene_id:06d>/scene_camera.json
     <output_dir>/<split>/<scene_id:06d>/scene_gt.json
@@ -22,9 +23,9 @@ when nothing is visible). Camera frames are OpenCV's (x right, y down, z
 forward). The model frame is the labelled prim's frame; its scale is not part
 of BOP's pose and is stored as ``graphsdg_scale``.
 
-``visib_fract``, ``px_count_visib`` and the masks are exact; ``px_count_all``
-is ``px_count_visib / visib_fract`` (exact after rounding unless an object is
-almost fully occluded; 0 when it is fully occluded). Object ids: ``obj_ids``
+``visib_fract``, ``px_count_visib``, ``px_count_all`` and the masks are exact:
+the full silhouette (``mask/``, ``px_count_all``) comes from the unoccluded render
+of each object that the loose boxes use. Object ids: ``obj_ids``
 (``{label: id}``), else labels numbered from 1 in first-seen order. Depth is
 ``distance_to_image_plane`` (BOP's z-depth), 0 where nothing was hit; the default
 ``depth_scale=1`` (1 mm steps) reaches 65.5 m, BOP's PBR value 0.1 only 6.5 m (farther depth is
@@ -146,6 +147,7 @@ class BopWriter(Writer):
             rp["bounding_box_2d_loose_fast"]
         tight_rows = {int(i): row for i, row in zip(tight["bboxIds"], tight["data"])}
         loose_rows = {int(i): row for i, row in zip(loose["bboxIds"], loose["data"])}
+        silhouettes = {int(i): m for i, m in zip(loose["bboxIds"], loose.get("unoccludedMasks", []))}
         ids = np.asarray(rp["instance_segmentation_fast"]["data"])
         gts, infos = [], []
         for row, instance_id in zip(boxes3d["data"], boxes3d["bboxIds"]):
@@ -159,6 +161,12 @@ class BopWriter(Writer):
                         "graphsdg_scale": scale.tolist()})
             mask = ids == int(instance_id)
             visible = int(mask.sum())
+            full = np.zeros(ids.shape[:2], dtype=bool)
+            silhouette = silhouettes.get(int(instance_id))
+            if silhouette is not None:
+                (x0, y0, x1, y1), crop = silhouette
+                full[y0:y1, x0:x1] = crop
+            full |= mask   # the silhouette always covers the visible part
             fract = 1.0 - float(row["occlusionRatio"]) if np.isfinite(row["occlusionRatio"]) else 0.0
             t_row, l_row = tight_rows.get(int(instance_id)), loose_rows.get(int(instance_id))
             infos.append({
@@ -166,9 +174,11 @@ class BopWriter(Writer):
                 if l_row is not None else [-1, -1, -1, -1],
                 "bbox_visib": _xywh(*(int(t_row[k]) for k in ("x_min", "y_min", "x_max", "y_max")))
                 if t_row is not None and visible else [-1, -1, -1, -1],
-                "px_count_all": int(round(visible / fract)) if fract > 0 and visible else 0,
+                "px_count_all": int(full.sum()),
                 "px_count_valid": visible, "px_count_visib": visible, "visib_fract": fract})
             if self._masks:
+                self.backend.schedule(iof.write_image, data=full.astype(np.uint8) * 255,
+                                      path=f"{folder}/mask/{n}_{len(gts) - 1:06d}.png")
                 self.backend.schedule(iof.write_image, data=mask.astype(np.uint8) * 255,
                                       path=f"{folder}/mask_visib/{n}_{len(gts) - 1:06d}.png")
         scene["scene_gt"][im_id] = gts
