@@ -26,6 +26,12 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/backend/writeThreads": (4, "writer worker threads of the I/O pool"),
     "/omni/replicator/backend/queueSize": (1000, "queued writes before the producer is throttled"),
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
+    "/graphsdg/io/queueMaxBytes": (1 << 30, "bytes of image/array data queued writes may hold before the producer "
+                                   "is throttled"),
+    "/graphsdg/io/fsync": (False, "fsync each file and its folder before a write counts as done (survives power "
+                           "loss, slower)"),
+    "/graphsdg/io/runState": (True, "keep graphsdg_run.json (which frames are complete on disk) in each writer's "
+                              "output folder"),
     "/exts/omni.replicator.core/enableWriteToFabric": (
         False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
     "/graphsdg/run/numFrames": (None, "frames for orchestrator.run() calls without num_frames (graphsdg run --frames)"),
