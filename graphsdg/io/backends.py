@@ -155,7 +155,7 @@ def _fsync_dir(directory: str) -> None:
         os.close(fd)
 
 
-def write_file_atomic(full_path: str, data: bytes, count: bool = True) -> None:
+def write_file_atomic(full_path: str, data: bytes) -> None:
     """Write ``data`` to ``full_path`` so that the file appears whole or not at all.
 
     The bytes go to a temporary name in the same folder, which is then renamed
@@ -164,6 +164,11 @@ def write_file_atomic(full_path: str, data: bytes, count: bool = True) -> None:
     ``/graphsdg/io/fsync`` the file and the folder are also synced before the
     write counts as done, so the same holds after a power loss.
     """
+    _write_atomic(full_path, data, count=True)
+
+
+def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
+    """:func:`write_file_atomic`; ``count=False`` leaves the totals alone (bookkeeping files: the run state)."""
     directory = os.path.dirname(full_path)
     os.makedirs(directory, exist_ok=True)
     tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{uuid.uuid4().hex[:12]}.tmp")

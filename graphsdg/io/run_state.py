@@ -232,7 +232,7 @@ def _path(output_dir: str) -> str:
 
 
 def _save_dir(output_dir: str, ledgers: list[FrameLedger]) -> None:
-    from graphsdg.io.backends import write_file_atomic
+    from graphsdg.io.backends import _write_atomic
     writers: dict[str, dict] = {}
     for ledger in ledgers:
         name = ledger.name
@@ -247,7 +247,7 @@ def _save_dir(output_dir: str, ledgers: list[FrameLedger]) -> None:
     lines = [f' "format": {json.dumps(FORMAT)},', f' "version": {VERSION},', ' "writers": {']
     lines += [f'  {json.dumps(name)}: {json.dumps(entry)}{"," if i < len(writers) - 1 else ""}'
               for i, (name, entry) in enumerate(writers.items())]
-    write_file_atomic(_path(output_dir), ("{\n" + "\n".join(lines) + "\n }\n}\n").encode(), count=False)
+    _write_atomic(_path(output_dir), ("{\n" + "\n".join(lines) + "\n }\n}\n").encode(), count=False)
 
 
 def save(force: bool = False) -> None:
@@ -270,7 +270,7 @@ def _save_quietly() -> None:
     """Save during capture: a failure (a full disk) is logged, and the frames' own writes report it."""
     try:
         save()
-    except OSError as exc:
+    except Exception as exc:  # noqa: BLE001 - bookkeeping must not stop the capture
         log.error("graphsdg: could not update the run-state file: %s", exc)
 
 
