@@ -195,7 +195,7 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
             continue
         data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
                                     extra={"provenance": provenance} if provenance else None)
-        with run_state.frame(writer, _state.stage_step):   # the frame's files, for graphsdg_run.json
+        with run_state.frame(writer, _state.stage_step, data.get("frame_index")):   # for graphsdg_run.json
             writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
     _timed("write", t)
 

@@ -129,7 +129,7 @@ def test_wait_until_complete_returns_only_when_every_file_is_on_disk(out_dir, mo
         rep.orchestrator.step()
     assert get_write_queue().pending() > 0          # the test is only meaningful if writes were still queued
     state = run_state.read(out_dir)["writers"]["BasicWriter"]
-    assert state["status"] == "writing" and state["frames_written"] >= 1
+    assert state["status"] == "writing" and state["next_frame"] >= 1
     rep.orchestrator.wait_until_complete()
     assert get_write_queue().pending() == 0
     for n in range(6):
@@ -328,7 +328,7 @@ def test_exit_without_wait_until_complete_still_writes_every_frame(tmp_path):
     for n in range(8):
         assert_frame_whole(out, n)
     state = run_state.read(out)["writers"]["BasicWriter"]         # the script did not finish its writes itself
-    assert state["status"] == "exited" and state["complete"] == [[0, 7]] and state["frames_written"] == 8
+    assert state["status"] == "exited" and state["complete"] == [[0, 7]] and state["next_frame"] == 8
 
 
 def test_exit_flushes_aggregate_files(tmp_path):
@@ -376,7 +376,7 @@ def _assert_resumable(out, status):
     on_disk = frames_on_disk(out)
     assert state["status"] == status
     assert on_disk == list(range(len(on_disk))) and len(on_disk) >= 3
-    assert state["complete"] == [[0, len(on_disk) - 1]] and state["frames_written"] == len(on_disk)
+    assert state["complete"] == [[0, len(on_disk) - 1]] and state["next_frame"] == len(on_disk)
     for n in on_disk:
         assert_frame_whole(out, n)
     assert no_temp_files(out)
@@ -412,3 +412,52 @@ def test_signal_handlers_of_the_script_are_left_alone():
         assert seen == ["mine"]
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+# ---- the run-state file ------------------------------------------------------------------------------------
+
+
+def test_aggregate_writers_frames_complete_only_after_their_shared_files_are_flushed(out_dir, monkeypatch):
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+    cube, cam, rp = unit_cube_scene(resolution=(32, 32))
+    writer = rep.writers.get("CocoWriter")
+    writer.initialize(output_dir=out_dir, dataset_id="agg")
+    writer.attach(rp)
+    for _ in range(3):
+        rep.orchestrator.step()
+    get_write_queue().wait_until_done()              # the images are on disk, the json is not rewritten yet
+    run_state.save(force=True)
+    state = run_state.read(writer.output_dir)["writers"]["CocoWriter"]
+    assert state["aggregate_files"] and state["complete"] == [] and state["next_frame"] == 3
+    rep.orchestrator.wait_until_complete()
+    assert run_state.read(writer.output_dir) is None
+    writer.detach()
+
+
+def test_ledger_restore_numbering_and_shard_file_names(out_dir):
+    cube, cam, rp = unit_cube_scene(resolution=(16, 16))
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir=out_dir, rgb=True)
+    writer.attach(rp)
+    ledger = run_state.ledger_for(writer)
+    ledger.restore({"complete": [[0, 4], [7, 7]], "steps": [[0, 0, 8]], "next_frame": 8})
+    assert ledger.next_frame == 5                     # frames 5 and 6 were left incomplete: redo from 5
+    rep.orchestrator.step()
+    get_write_queue().wait_until_done()
+    run_state.save(force=True)
+    state = run_state.read(out_dir)["writers"]["BasicWriter"]
+    assert state["complete"] == [[0, 5], [7, 7]] and state["next_frame"] == 6
+    assert state["steps"] == [[0, 0, 5], [5, 0, 1]]   # frame 5 was captured by this stage's first step
+    rep.settings.set("/graphsdg/run/shardIndex", 1)
+    rep.settings.set("/graphsdg/run/shardCount", 3)
+    assert run_state.file_name() == "graphsdg_run.shard-1-of-3.json"
+    rep.settings.reset()
+    rep.orchestrator.wait_until_complete()
+    writer.detach()
+
+
+def test_run_state_read_rejects_foreign_files(tmp_path):
+    (tmp_path / run_state.FILE_NAME).write_text('{"format": "something-else", "version": 1}')
+    with pytest.raises(ValueError, match=r"is not a graphsdg.run_state file of version 1 \(found \('something-else', 1\)\)"):
+        run_state.read(tmp_path)
+    assert run_state.read(tmp_path / "nowhere") is None

@@ -102,20 +102,29 @@ class FrameLedger:
         self.aggregate = type(writer).flush is not Writer.flush
         self.global_seed = get_global_seed()
         self._lock = threading.Lock()
-        self.frames_written = 0
-        self.first_frame = 0                  # > 0 when a resumed run continues an earlier one
+        self.next_frame = 0                   # one past the highest frame number handed to the writer
+        self.begun = 0                        # frames handed to the writer by this process
+        self.finished = 0                     # of those, frames whose tasks all succeeded
         self.done = _FrameSet()
+        self.restored = _FrameSet()           # complete frames of the run this one resumes
         self.failed: set[int] = set()
+        self.last_begun = -1
         self.flushed_upto = -1                # aggregate writers: frames <= this had their shared files flushed
         self.steps: list[list[int]] = []      # [first_frame, first_step, count] runs
         self.status = "writing"
         self.changed = True
 
-    def begin(self, step: int) -> int:
-        """Register the next frame (captured by orchestrator step ``step``); return its number."""
+    def begin(self, step: int, frame: int | None = None) -> int:
+        """Register a frame captured by orchestrator step ``step``; return its number.
+
+        ``frame`` is the frame's number in the whole dataset when the run says
+        (sharded and resumed runs); otherwise frames are numbered in order.
+        """
         with self._lock:
-            frame = self.first_frame + self.frames_written
-            self.frames_written += 1
+            frame = self.next_frame if frame is None else int(frame)
+            self.next_frame = max(self.next_frame, frame + 1)
+            self.begun += 1
+            self.last_begun = frame
             last = self.steps[-1] if self.steps else None
             if last is not None and last[0] + last[2] == frame and last[1] + last[2] == step:
                 last[2] += 1
@@ -130,6 +139,7 @@ class FrameLedger:
         with self._lock:
             if ok:
                 self.done.add(frame)
+                self.finished += 1
             else:
                 self.failed.add(frame)
             self.changed = True
@@ -137,44 +147,45 @@ class FrameLedger:
     def drained(self, status: str) -> None:
         """Writers flushed and the queue empty: every written frame's shared files are on disk."""
         with self._lock:
-            self.flushed_upto = self.first_frame + self.frames_written - 1
+            self.flushed_upto = self.last_begun
             self.status = status
             self.changed = True
 
-    def restore(self, entry: dict, first_frame: int | None = None) -> None:
-        """Continue an earlier run's entry (``read(dir)["writers"][name]``).
-
-        Its complete frames stay complete; this run's frames are numbered from
-        ``first_frame`` (default: the first frame that is not complete), so the
-        frames the interrupted run left incomplete are written again.
-        """
+    def restore(self, entry: dict) -> None:
+        """Continue an earlier run's entry (``read(dir)["writers"][name]``): its complete frames stay listed,
+        and frames are numbered on from the first one that is not complete."""
         with self._lock:
             for first, last in entry.get("complete", []):
                 for f in range(int(first), int(last) + 1):
-                    self.done.add(f)
-            self.first_frame = self.done.prefix if first_frame is None else int(first_frame)
-            self.flushed_upto = self.first_frame - 1
-            earlier = [list(r) for r in entry.get("steps", []) if r[0] < self.first_frame]
-            if earlier and earlier[-1][0] + earlier[-1][2] > self.first_frame:
-                earlier[-1][2] = self.first_frame - earlier[-1][0]
+                    self.restored.add(f)
+            self.next_frame = self.restored.prefix
+            earlier = [[r[0], r[1], min(r[2], self.next_frame - r[0])] for r in entry.get("steps", [])
+                       if r[0] < self.next_frame]
             self.steps = earlier + self.steps
             self.changed = True
 
+    def complete(self) -> _FrameSet:
+        out = _FrameSet()
+        out.prefix, out.extra = self.restored.prefix, set(self.restored.extra)
+        upto = self.flushed_upto if self.aggregate else None
+        for first, last in self.done.ranges(upto):
+            for f in range(first, last + 1):
+                out.add(f)
+        return out
+
     def entry(self) -> dict:
         with self._lock:
-            upto = self.flushed_upto if self.aggregate else None
-            failed = sorted(f for f in self.failed if f not in self.done)
+            complete = self.complete()
             return {"writer": self.name, "status": self.status, "global_seed": self.global_seed,
-                    "frames_written": self.first_frame + self.frames_written,
-                    "complete": self.done.ranges(upto), "failed": failed,
+                    "next_frame": self.next_frame, "complete": complete.ranges(),
+                    "failed": sorted(f for f in self.failed if f not in complete),
                     "steps": [list(r) for r in self.steps], "aggregate_files": self.aggregate}
 
     def all_complete(self) -> bool:
-        """Every frame handed to the writer (this run and the runs it continues) is complete."""
+        """Every frame this process handed to the writer is complete (shared files flushed too)."""
         with self._lock:
-            total = self.first_frame + self.frames_written
-            upto = self.flushed_upto if self.aggregate else total - 1
-            return not self.failed and self.done.prefix >= total and upto >= total - 1
+            return not self.failed and self.finished == self.begun and \
+                (not self.aggregate or self.flushed_upto >= self.last_begun)
 
     def writer_gone(self) -> bool:
         from graphsdg.runtime import _runtime
@@ -208,27 +219,52 @@ def ledger_for(writer: Any, create: bool = True) -> FrameLedger | None:
             ledger = None
         if ledger is None and create:
             ledger = _ledgers[key] = FrameLedger(writer, out)
+            if settings.get("/graphsdg/run/resume", False):     # graphsdg run --resume: keep what was complete
+                earlier = _read_quietly(out)
+                if earlier is not None and ledger.name in earlier["writers"]:
+                    ledger.restore(earlier["writers"][ledger.name])
         return ledger
 
 
+def _read_quietly(output_dir: str) -> dict | None:
+    try:
+        return read(output_dir)
+    except ValueError as exc:
+        log.warning("graphsdg: ignoring the run-state file in %s: %s", output_dir, exc)
+        return None
+
+
 @contextlib.contextmanager
-def frame(writer: Any, step: int) -> Iterator[None]:
-    """Wrap one ``writer._write(data)``: the tasks it schedules make up one frame."""
+def frame(writer: Any, step: int, frame_index: int | None = None) -> Iterator[None]:
+    """Wrap one ``writer._write(data)``: the tasks it schedules make up one frame.
+
+    ``frame_index``: the frame's number in the whole dataset, when the run assigns
+    one (sharded and resumed runs pass ``data["frame_index"]``).
+    """
     ledger = ledger_for(writer)
     if ledger is None:
         yield
         return
     from graphsdg.io.write_queue import get_write_queue
-    first = ledger.status != "writing" or ledger.frames_written == 0
-    number = ledger.begin(step)
+    first = ledger.status != "writing" or ledger.begun == 0
+    number = ledger.begin(step, frame_index)
     if first:     # the file exists whenever frames are in flight, so a killed run always leaves one
         _save_quietly()
     with get_write_queue().group(lambda ok: ledger.files_done(number, ok)):
         yield
 
 
+def file_name() -> str:
+    """``graphsdg_run.json``, or ``graphsdg_run.shard-<i>-of-<k>.json`` in shard ``i`` of a ``k``-way sharded
+    run (``/graphsdg/run/shardIndex`` / ``shardCount``), whose processes share output folders."""
+    count = settings.get("/graphsdg/run/shardCount", 1) or 1
+    if int(count) <= 1:
+        return FILE_NAME
+    return f"{FILE_NAME[:-5]}.shard-{int(settings.get('/graphsdg/run/shardIndex', 0) or 0)}-of-{int(count)}.json"
+
+
 def _path(output_dir: str) -> str:
-    return os.path.join(output_dir, FILE_NAME)
+    return os.path.join(output_dir, file_name())
 
 
 def _save_dir(output_dir: str, ledgers: list[FrameLedger]) -> None:
@@ -326,8 +362,8 @@ def summary() -> list[str]:
             entry = ledger.entry()
             ranges = ", ".join(f"{a}-{b}" if a != b else f"{a}" for a, b in entry["complete"]) or "none"
             failed = f", failed {entry['failed']}" if entry["failed"] else ""
-            out.append(f"{ledger.output_dir}: {ledger.name} wrote {entry['frames_written']} frames, complete "
-                       f"{ranges}{failed} (see {FILE_NAME} there)")
+            out.append(f"{ledger.output_dir}: {ledger.name} was given frames up to {entry['next_frame'] - 1}, "
+                       f"complete {ranges}{failed} (see {file_name()} there)")
     return out
 
 
