@@ -235,7 +235,7 @@ async def wait_until_complete_async() -> None:
 
 def set_capture_on_play(value: bool) -> None:
     """Capture every timeline tick while playing (Replicator's default) or only on ``step()``."""
-    settings.set("/omni/replicator/captureOnPlay", bool(value))
+    settings.set("/omni/replicator/captureOnPlay", value)   # refuses anything but True / False
 
 
 def get_capture_on_play() -> bool:

@@ -245,11 +245,12 @@ def test_queue_size_and_byte_limit_are_live_settings():
     finally:
         rep.settings.reset()
         reset_write_queue()
-    with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/queueSize must be a positive integer, "
+    with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/queueSize must be an integer >= 1, "
                                          r"got 0"):
         rep.settings.set("/omni/replicator/backend/queueSize", 0)
-        get_write_queue()
-    rep.settings.reset()
+    with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/writeThreads must be a positive integer, "
+                                         r"got 0"):
+        WriteQueue(num_threads=0)
 
 
 def test_byte_limit_throttles_the_producer_and_bounds_memory():

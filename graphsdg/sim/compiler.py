@@ -228,15 +228,24 @@ def _axis_index(axis: str) -> int:
     return "XYZ".index(axis)
 
 
+def _extent(prim: Usd.Prim, name: str, value: object) -> float:
+    """A size attribute of an implicit gprim; a CompileError naming the prim unless positive and finite."""
+    v = float(value)  # type: ignore[arg-type]
+    if not (v > 0 and np.isfinite(v)):
+        raise CompileError(f"{prim.GetTypeName()} {prim.GetPath()} has {name} {v!r}; expected a positive "
+                           f"number")
+    return v
+
+
 def primitive_size(prim: Usd.Prim, scale: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
     """(mjtGeom, size[3], local rotation) of an implicit gprim under world ``scale``."""
     s = np.abs(scale)
     t = prim.GetTypeName()
     if t == "Cube":
-        a = float(UsdGeom.Cube(prim).GetSizeAttr().Get())
+        a = _extent(prim, "size", UsdGeom.Cube(prim).GetSizeAttr().Get())
         return mujoco.mjtGeom.mjGEOM_BOX, a / 2 * s, np.eye(3)
     if t == "Sphere":
-        r = float(UsdGeom.Sphere(prim).GetRadiusAttr().Get())
+        r = _extent(prim, "radius", UsdGeom.Sphere(prim).GetRadiusAttr().Get())
         if np.allclose(s, s[0], rtol=1e-6):
             return mujoco.mjtGeom.mjGEOM_SPHERE, np.array([r * s[0], 0, 0]), np.eye(3)
         return mujoco.mjtGeom.mjGEOM_ELLIPSOID, r * s, np.eye(3)
@@ -245,13 +254,13 @@ def primitive_size(prim: Usd.Prim, scale: np.ndarray) -> tuple[int, np.ndarray, 
         axis = str(g.GetAxisAttr().Get())
         i = _axis_index(axis)
         perp = max(s[j] for j in range(3) if j != i)
-        r, h = float(g.GetRadiusAttr().Get()), float(g.GetHeightAttr().Get())
+        r, h = _extent(prim, "radius", g.GetRadiusAttr().Get()), _extent(prim, "height", g.GetHeightAttr().Get())
         kind = mujoco.mjtGeom.mjGEOM_CYLINDER if t == "Cylinder" else mujoco.mjtGeom.mjGEOM_CAPSULE
         return kind, np.array([r * perp, h / 2 * s[i], 0]), _axis_rotation(axis)
     if t == "Plane":
         g = UsdGeom.Plane(prim)
         axis = str(g.GetAxisAttr().Get())
-        w, length = float(g.GetWidthAttr().Get()), float(g.GetLengthAttr().Get())
+        w, length = _extent(prim, "width", g.GetWidthAttr().Get()), _extent(prim, "length", g.GetLengthAttr().Get())
         rot = _axis_rotation(axis)
         # USD Plane: width along the first in-plane axis, length along the second.
         in_plane = [j for j in range(3) if j != _axis_index(axis)]
