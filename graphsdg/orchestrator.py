@@ -497,7 +497,8 @@ def _flush_at_exit() -> None:
         folders = "".join(f"\n  {line}" for line in run_state.summary())
         log.error("graphsdg: ERROR at exit: writes failed and the dataset is incomplete; frames not listed as "
                   "complete were dropped:%s\n%s%s", folders or " (no run-state kept)", exc,
-                  f"\n({lost.pending()} writes still queued)" if lost is not None and lost.pending() else "")
+                  f"\n({lost.pending()} writes still queued)" if lost is not None and lost.pending() else "",
+                  exc_info=exc)
 
 
 atexit.register(_flush_at_exit)

@@ -33,7 +33,6 @@ import contextlib
 import logging
 import threading
 import time
-import traceback
 from typing import Any, Callable, Iterator
 
 import numpy as np
@@ -98,7 +97,7 @@ class WriteQueue:
         self._items: collections.deque = collections.deque()
         self._unfinished = 0              # waiting + running
         self._bytes = 0                   # held by waiting + running tasks
-        self._errors: list[tuple[BaseException, str, str]] = []
+        self._errors: list[tuple[BaseException, str]] = []
         self._threads: list[threading.Thread] = []
         self._retire = 0                  # workers asked to exit (fewer threads configured)
         self._closing = False
@@ -150,7 +149,7 @@ class WriteQueue:
             ok = False
             what = _describe(fn, kwargs)
             with self._cond:
-                self._errors.append((exc, what, traceback.format_exc()))
+                self._errors.append((exc, what))
             log.error("%s failed: %s", what, exc)
         profiling.add("encode+write", time.perf_counter() - start)
         finished = None
@@ -257,9 +256,10 @@ class WriteQueue:
         with self._cond:
             errors, self._errors = self._errors, []
         if errors:
-            exc, what, tb = errors[0]
+            exc, what = errors[0]
             more = f" (and {len(errors) - 1} more failures)" if len(errors) > 1 else ""
-            raise WriterError(f"{what} failed: {type(exc).__name__}: {exc}{more}\n{tb}") from exc
+            # one line; the worker's traceback stays on the chained cause (``raise ... from exc``)
+            raise WriterError(f"{what} failed: {type(exc).__name__}: {exc}{more}") from exc
 
     def shutdown(self) -> None:
         """Finish every task, then stop the workers."""
