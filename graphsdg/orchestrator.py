@@ -156,7 +156,8 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
             passes |= a.spec.passes
         render = rt.rasterizer.render(sim, view, passes, subframes) if passes else None
         t = _timed("render", t)
-        frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time)
+        frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time,
+                          attached=frozenset(a.spec.name for a in annotators))
         for a in annotators:
             outputs[(id(a), path)] = a.compute_for(frame)
         _timed("annotate", t)

@@ -180,8 +180,17 @@ def bounding_box_2d_tight(frame: FrameView, params: dict) -> dict:
     rows["semanticId"] = imap.semantic_ids[idx]
     if len(idx):
         rows["x_min"], rows["y_min"], rows["x_max"], rows["y_max"] = boxes.T
-    rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
+    # Occlusion needs one unoccluded render per group of instances: pay for it only when an
+    # attached annotator (occlusion, loose boxes) needs those renders anyway; else -1, as
+    # Replicator reports a ratio it did not compute.
+    if frame.attached & OCCLUSION_USERS:
+        rows["occlusionRatio"] = frame.occlusion_ratios(filt)[idx]
+    else:
+        rows["occlusionRatio"] = -1.0
     return {"data": rows, "info": _box_info(imap, rows["semanticId"], idx)}
+
+
+OCCLUSION_USERS = frozenset({"occlusion", "bounding_box_2d_loose"})
 
 
 def bounding_box_2d_loose(frame: FrameView, params: dict) -> dict:

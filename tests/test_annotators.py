@@ -730,3 +730,16 @@ def test_bounding_box_3d_360_lists_drawn_instances_outside_the_view():
     assert sorted(rows) == ["/World/Behind", "/World/Seen"]
     assert np.isnan(rows["/World/Behind"]["occlusionRatio"]) and rows["/World/Seen"]["occlusionRatio"] == 0
     np.testing.assert_allclose(rows["/World/Behind"]["transform"][3], [0, -10, 0, 1])
+
+
+def test_tight_box_occlusion_is_filled_only_when_paid_for():
+    from conftest import unit_cube_scene
+    cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(64, 48))
+    tight = rep.annotators.get("bounding_box_2d_tight")
+    tight.attach(rp)
+    rep.orchestrator.step()
+    assert tight.get_data()["data"][0]["occlusionRatio"] == -1.0      # not computed: no isolated renders
+    occ = rep.annotators.get("occlusion")
+    occ.attach(rp)
+    rep.orchestrator.step()
+    assert tight.get_data()["data"][0]["occlusionRatio"] == pytest.approx(0.0, abs=0.01)

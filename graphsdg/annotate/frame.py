@@ -127,8 +127,10 @@ class FrameView:
     """The passes of one render product at one step, plus shared derived maps."""
 
     def __init__(self, rp: RenderProduct, view: CameraView, outputs: RenderOutputs | None, sim: SimScene,
-                 stage: Usd.Stage, labels: SceneLabels, frame_index: int, sim_time: float) -> None:
+                 stage: Usd.Stage, labels: SceneLabels, frame_index: int, sim_time: float,
+                 attached: frozenset[str] = frozenset()) -> None:
         self.render_product = rp
+        self.attached = attached          # names of the annotator types computed for this product now
         self.camera = view
         self.outputs = outputs
         self.sim = sim
