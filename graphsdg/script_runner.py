@@ -32,8 +32,10 @@ def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, s
         settings.set("/graphsdg/run/numFrames", int(frames))
     if resolution_scale is not None:
         settings.set("/graphsdg/render/resolutionScale", float(resolution_scale))
+    installed_here = False
     if compat == "isaac":
         from graphsdg.compat import isaac
+        installed_here = not isaac.is_installed()
         isaac.install()
     loop = asyncio.new_event_loop()
     asyncio.set_event_loop(loop)
@@ -51,3 +53,6 @@ def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, s
         sys.argv, sys.path[:] = saved_argv, saved_path
         asyncio.set_event_loop(None)
         loop.close()
+        if installed_here:   # the Isaac names lived for this script only
+            from graphsdg.compat import isaac
+            isaac.uninstall()

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import sys
 import types
-import unittest
 
 from graphsdg.compat import isaac_core, kit
 from graphsdg.compat.modules import CompatFinder, CompatModule, ForwardingModule
@@ -48,7 +47,7 @@ def _modules() -> dict[str, types.ModuleType]:
                             TimelineEventType=TimelineEventType)
     app = CompatModule("omni.kit.app", get_app=kit.get_app)
     commands = CompatModule("omni.kit.commands", execute=kit.execute)
-    kit_test = CompatModule("omni.kit.test", AsyncTestCase=unittest.IsolatedAsyncioTestCase)
+    kit_test = CompatModule("omni.kit.test", AsyncTestCase=kit.AsyncTestCase)
     omni_kit = CompatModule("omni.kit", app=app, commands=commands, test=kit_test)
     usd = CompatModule("omni.usd", get_context=kit.get_context, StageEventType=kit.StageEventType,
                        get_world_transform_matrix=kit.get_world_transform_matrix,
@@ -130,6 +129,7 @@ def install() -> None:
     global _finder
     _finder = CompatFinder(_installed)
     sys.meta_path.insert(0, _finder)
+    kit.get_context()._listen()   # stage events from here on
 
 
 def uninstall() -> None:
@@ -139,10 +139,16 @@ def uninstall() -> None:
         if sys.modules.get(name) is _installed[name]:
             del sys.modules[name]
     _installed.clear()
+    kit.get_context()._stop_listening()
     if _finder is not None and _finder in sys.meta_path:
         sys.meta_path.remove(_finder)
     _finder = None
 
 
 def installed_names() -> list[str]:
+    """The Isaac / Omniverse module names currently installed."""
     return sorted(_installed)
+
+
+def is_installed() -> bool:
+    return bool(_installed)
