@@ -96,17 +96,36 @@ class EventStream(CompatObject):
 
 
 # ---- timeline -------------------------------------------------------------------
+class TimelineSubscription(CompatObject):
+    """A timeline subscription that, as in Kit, ends when the script drops it (or calls ``unsubscribe``)."""
+
+    _compat_name = "carb.events.ISubscription"
+
+    def __init__(self, inner) -> None:
+        self._inner = inner
+
+    def unsubscribe(self) -> None:
+        self._inner.unsubscribe()
+
+    def __del__(self) -> None:
+        try:
+            self._inner.unsubscribe()
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+
 class TimelineEventStream(CompatObject):
     """Kit's event-stream view of graphsdg's timeline events."""
 
     _compat_name = "omni.timeline.ITimeline.get_timeline_event_stream()"
 
     def create_subscription_to_pop_by_type(self, event_type: int, fn: Callable[[Any], Any], order: int = 0,
-                                           name: str = ""):
-        return runtime().timeline.subscribe(fn, event_type)
+                                           name: str = "") -> TimelineSubscription:
+        return TimelineSubscription(runtime().timeline.subscribe(fn, event_type))
 
-    def create_subscription_to_pop(self, fn: Callable[[Any], Any], order: int = 0, name: str = ""):
-        return runtime().timeline.subscribe(fn)
+    def create_subscription_to_pop(self, fn: Callable[[Any], Any], order: int = 0,
+                                   name: str = "") -> TimelineSubscription:
+        return TimelineSubscription(runtime().timeline.subscribe(fn))
 
 
 class TimelineInterface(CompatObject):
