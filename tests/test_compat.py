@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import asyncio
+import json
 import importlib.util
 import subprocess
 import sys
@@ -10,6 +11,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 import pytest
 
 import graphsdg as rep
@@ -264,3 +266,98 @@ def test_kit_async_test_case_runs_under_pytest(tmp_path):
                           "-p", "no:cacheprovider", str(test_file)], capture_output=True, text=True, cwd=str(tmp_path))
     assert out.returncode == 0, out.stdout + out.stderr
     assert "2 passed" in out.stdout
+
+
+# ---- the palletizing seed's SDG code on a stand-in scene ----------------------------------------------
+def _palletizing_seed_namespace() -> dict:
+    """The seed script's definitions (``PalletizingSDGDemo``), without its last statement, which starts the
+    full robot demo (``graphsdg.scenarios.palletizing``, built on its own branch)."""
+    import ast
+    path = HERE / "seed_scripts" / "ur10_palletizing_script_editor.py"
+    tree = ast.parse(path.read_text())
+    assert ast.unparse(tree.body[-1]) == "asyncio.ensure_future(run_example_async())"
+    tree.body = tree.body[:-1]
+    ns: dict = {"__name__": "ur10_palletizing_seed"}
+    exec(compile(tree, str(path), "exec"), ns)
+    return ns
+
+
+def _stand_in_palletizing_scene():
+    """The prim layout the seed relies on, without the robot: a flip helper, a pallet mesh, one bin above the
+    helper. Returns (bin path, bin mesh, pallet mesh)."""
+    create, physics = rep.functional.create, rep.functional.physics
+    create.xform(name="World")
+    create.dome_light(intensity=600, parent="/World")
+    create.xform(name="Ur10Table", parent="/World")
+    # the flip helper where the seed's bin-flip cameras look (0.78, 0.72, -0.1)
+    holder = create.cube(name="pallet_holder", parent="/World/Ur10Table", position=(0.78, 0.72, -0.3),
+                         scale=(0.4, 0.4, 0.2))
+    physics.apply_collider(holder)
+    create.xform(name="pallet", parent="/World/Ur10Table", position=(1.2, 0, 0))
+    create.xform(name="Xform", parent="/World/Ur10Table/pallet")
+    pallet = create.cube(name="Mesh_015", parent="/World/Ur10Table/pallet/Xform", position=(0, 0, 0.05),
+                         scale=(1.0, 0.8, 0.1))
+    physics.apply_collider(pallet)
+    create.material(mdl="OmniPBR.mdl", bind_prims=[pallet], diffuse_color_constant=(0.6, 0.4, 0.2), name="Wood")
+    create.xform(name="bins", parent="/World/Ur10Table")
+    create.xform(name="bin_0", parent="/World/Ur10Table/bins", position=(0.78, 0.72, 0.1), semantics={"class": "bin"})
+    create.xform(name="Visuals", parent="/World/Ur10Table/bins/bin_0")
+    box = create.cube(name="FOF_Mesh_Magenta_Box", parent="/World/Ur10Table/bins/bin_0/Visuals",
+                      scale=(0.3, 0.2, 0.15))
+    create.material(mdl="OmniPBR.mdl", bind_prims=[box], diffuse_color_constant=(1.0, 0.0, 1.0), name="Magenta")
+    physics.apply_rigid_body("/World/Ur10Table/bins/bin_0", with_collider=True)
+    return "/World/Ur10Table/bins/bin_0", box, pallet
+
+
+def test_palletizing_seed_sdg_runs_on_a_stand_in_scene(compat, tmp_path, monkeypatch, capsys):
+    """The seed's PalletizingSDGDemo, unchanged: bin-flip capture on contact with the flip helper, pallet capture
+    on contact with the pallet, materials restored, graph removed, simulation resumed."""
+    from pxr import UsdShade
+    import omni.kit.app
+    import omni.timeline
+    from isaacsim.core.experimental.prims import RigidPrim
+
+    monkeypatch.chdir(tmp_path)
+    rep.settings.set("/graphsdg/render/resolutionScale", 0.125)
+    demo_class = _palletizing_seed_namespace()["PalletizingSDGDemo"]
+    bin_path, box, pallet = _stand_in_palletizing_scene()
+    bound = lambda prim: UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()[0].GetPath()  # noqa: E731
+    originals = (bound(box), bound(pallet))
+    timeline = omni.timeline.get_timeline_interface()
+
+    async def drive():
+        timeline.play()
+        demo = demo_class()
+        demo.start(num_captures=1)
+        assert demo.is_running()
+        moved = False
+        for _ in range(400):
+            await omni.kit.app.get_app().next_update_async()
+            if demo._bin_flip_scenario_done and not moved:   # the robot would carry the bin to the pallet
+                RigidPrim(bin_path).set_world_poses(positions=[[1.2, 0.0, 0.6]], orientations=[[1, 0, 0, 0]])
+                moved = True
+            if not demo.is_running():
+                return True
+        return False
+    assert asyncio.run(drive()), "the demo did not finish"
+    out = capsys.readouterr().out
+    assert "Running bin flip scenario for bin 0" in out and "Running pallet scenario for bin 0" in out
+    assert "Palletizing SDG demo finished" in out
+    d = tmp_path / "_out_palletizing_sdg_demo"
+    annot = d / "annot_bin_0"
+    assert sorted(p.name for p in annot.iterdir()) == sorted(
+        [f"rgb_{i}.png" for i in range(4)] + [f"is_{i}.png" for i in range(4)] + [f"is_info_{i}.json" for i in range(4)])
+    frames = [np.asarray(Image.open(annot / f"rgb_{i}.png")) for i in range(4)]
+    assert frames[0].shape == (64, 64, 4)
+    assert all(np.abs(a.astype(int) - b).max() > 30 for a, b in zip(frames, frames[1:]))   # the camera walks
+    info = json.loads((annot / "is_info_0.json").read_text())
+    assert {"class": "bin"} in info["idToSemantics"].values()
+    writer_dir = d / "writer_bin_0"
+    assert len(list(writer_dir.glob("rgb_*.png"))) == 16
+    assert len(list(writer_dir.glob("instance_segmentation_*.png"))) == 16
+    # the SDG cleaned up after itself and let the simulation run on
+    assert (bound(box), bound(pallet)) == originals
+    assert not rep.stage.get_stage().GetPrimAtPath("/Replicator")
+    assert rep.settings.get("/rtx/rendermode") == "RayTracedLighting"
+    assert timeline.is_playing()
+    timeline.stop()
