@@ -91,8 +91,12 @@ def _modules() -> dict[str, types.ModuleType]:
                storage_native, core, core_utils, bounds, experimental, exp_utils, exp_bounds, exp_stage,
                exp_semantics, exp_prims]
     scenario = _palletizing_module()
-    if scenario is not None:
-        modules += scenario
+    if scenario is None:
+        scenario = [CompatModule("isaacsim.examples", hint=(
+            "Isaac's UR10 palletizing example maps to graphsdg.scenarios.palletizing, which this installation "
+            "does not have."))]
+    isaacsim.examples = scenario[-1]  # type: ignore[attr-defined]
+    modules += scenario
     return {m.__name__: m for m in modules}
 
 
@@ -100,8 +104,10 @@ def _palletizing_module() -> list[types.ModuleType] | None:
     """``isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing`` when the scenario exists."""
     try:
         from graphsdg.scenarios import palletizing
-    except ImportError:
-        return None
+    except ModuleNotFoundError as exc:   # absent; a scenario that is there but broken raises
+        if exc.name in ("graphsdg.scenarios", "graphsdg.scenarios.palletizing"):
+            return None
+        raise
     leaf = CompatModule("isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing",
                         BinStacking=palletizing.BinStacking)
     pkg = CompatModule("isaacsim.examples.interactive.ur10_palletizing", ur10_palletizing=leaf)
@@ -119,11 +125,6 @@ def install() -> None:
     if clash:
         raise RuntimeError(f"cannot install graphsdg's Isaac compat modules: {clash[0]!r} is already imported "
                            f"(a real Omniverse install?)")
-    if "isaacsim.examples" not in modules:
-        isaacsim = modules["isaacsim"]
-        isaacsim.examples = CompatModule("isaacsim.examples")  # type: ignore[attr-defined]
-    else:
-        modules["isaacsim"].examples = modules["isaacsim.examples"]  # type: ignore[attr-defined]
     sys.modules.update(modules)
     _installed.update(modules)
     global _finder

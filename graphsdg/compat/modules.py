@@ -38,11 +38,11 @@ def _public(names: Iterable[str]) -> list[str]:
     return sorted({n for n in names if not n.startswith("_")})
 
 
-def missing(owner: str, item: str, available: Iterable[str]) -> CompatError:
-    """The error for ``owner.item`` not being mapped, listing ``available``."""
+def missing(owner: str, item: str, available: Iterable[str], hint: str = "") -> CompatError:
+    """The error for ``owner.item`` not being mapped, listing ``available`` (and a ``hint``, if any)."""
     names = _public(available)
     return CompatError(f"{owner}.{item} is not available in graphsdg's compat mode; {owner} provides: "
-                       f"{', '.join(names) or 'nothing'}. {PORTING}")
+                       f"{', '.join(names) or 'nothing'}.{' ' + hint if hint else ''} {PORTING}")
 
 
 class _ExistingModule(importlib.abc.Loader):
@@ -82,8 +82,10 @@ class CompatFinder(importlib.abc.MetaPathFinder):
                 value = None
             if isinstance(value, types.ModuleType):
                 return importlib.util.spec_from_loader(fullname, _ExistingModule(value))
+            hint = owner.__dict__.get("_hint", "")
             raise CompatImportError(f"{fullname} is not available in graphsdg's compat mode; {parent} provides: "
-                                    f"{', '.join(available_names(owner))}. {PORTING}", name=fullname)
+                                    f"{', '.join(available_names(owner)) or 'nothing'}.{' ' + hint if hint else ''} "
+                                    f"{PORTING}", name=fullname)
         raise CompatImportError(f"module {fullname} is not available in graphsdg's compat mode; mapped modules: "
                                 f"{', '.join(sorted(self.provided))}. {PORTING}", name=fullname)
 
@@ -106,17 +108,18 @@ def _belongs(module: types.ModuleType, name: str, value: Any) -> bool:
 
 
 class CompatModule(types.ModuleType):
-    """A module that says which names it has when asked for one it lacks."""
+    """A module that says which names it has when asked for one it lacks (``hint``: a sentence to add)."""
 
-    def __init__(self, name: str, doc: str = "", **attrs: Any) -> None:
+    def __init__(self, name: str, doc: str = "", hint: str = "", **attrs: Any) -> None:
         super().__init__(name, doc)
         self.__dict__.update(attrs)
+        self._hint = hint
         self.__path__: list[str] = []   # a package, so submodules import
 
     def __getattr__(self, item: str) -> Any:
         if item.startswith("__"):
             raise AttributeError(item)
-        raise missing(self.__name__, item, self.__dict__)
+        raise missing(self.__name__, item, self.__dict__, self.__dict__.get("_hint", ""))
 
 
 class ForwardingModule(CompatModule):
