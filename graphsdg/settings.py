@@ -81,9 +81,10 @@ def get(key: str, default: Any = None) -> Any:
 
 
 def reset() -> None:
-    """Forget every value that was set (defaults apply again)."""
+    """Forget every value that was set (defaults apply again) and which keys were already warned about."""
     with _lock:
         _values.clear()
+        _warned.clear()
 
 
 # carb-style aliases so `settings.get_settings().set(...)` reads naturally.
