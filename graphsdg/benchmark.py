@@ -156,6 +156,7 @@ def _apply(draw: dict[str, np.ndarray], assets, cams) -> None:
 def run_graphsdg(config: BenchConfig) -> BenchResult:
     """Time graphsdg on the benchmark scene."""
     import graphsdg as rep
+    from graphsdg import profiling
     from graphsdg.io.write_queue import reset_write_queue
 
     rep.settings.set("/omni/replicator/backend/writeThreads", config.write_threads)
@@ -182,7 +183,9 @@ def run_graphsdg(config: BenchConfig) -> BenchResult:
     rep.orchestrator.reset_profile()
     start = last = time.perf_counter()
     for _ in range(config.frames):
+        t = time.perf_counter()
         _apply(draws.draw(), assets, cams)
+        profiling.add("randomize", time.perf_counter() - t)
         rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
         now = time.perf_counter()
         result.frame_times.append(now - last)

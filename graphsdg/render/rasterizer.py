@@ -33,6 +33,7 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
+import cv2
 import mujoco
 import numpy as np
 
@@ -226,7 +227,7 @@ class Rasterizer:
                 linear = np.ascontiguousarray(mean[::-1] / np.float32(255))
         elif want_linear:
             linear = np.ascontiguousarray(rgb[::-1].astype(np.float32) / np.float32(255))
-        return np.ascontiguousarray(rgb[::-1]), linear, depth
+        return cv2.flip(rgb, 0), linear, depth   # GL rows run bottom-up; cv2's flip is one fast copy
 
     def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None,
                     with_depth: bool) -> tuple[np.ndarray, np.ndarray | None]:
