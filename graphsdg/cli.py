@@ -93,7 +93,13 @@ def run_bench(args: argparse.Namespace) -> None:
                   "share of frame": "(worker threads)" if k == "encode+write" else
                   f"{v / config.frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
                  for k, v in sorted(prof.items(), key=lambda kv: -kv[1])])
-            table += f"\n\nframe time {frame_ms:.2f} ms; randomization (before step) is the rest of it"
+            table += f"\n\ngraphsdg frame time {frame_ms:.2f} ms"
+            if len(rows) == 2 and rows[1].profile:
+                base_ms = 1000.0 / rows[1].fps if rows[1].fps else 0.0
+                table += "\n\n" + benchmark.format_table(
+                    [{"hand-written phase": k, "ms/frame": round(v / config.frames * 1000, 2)}
+                     for k, v in sorted(rows[1].profile.items(), key=lambda kv: -kv[1])])
+                table += f"\n\nhand-written frame time {base_ms:.2f} ms"
     text = f"### {settings_line}\n\nMachine: {machine}\n\n{table}\n"
     print(text)
     if args.report:

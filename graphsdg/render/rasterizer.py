@@ -29,6 +29,7 @@ loose boxes are measured from.
 """
 from __future__ import annotations
 
+import os
 from collections import Counter
 from dataclasses import dataclass
 from typing import Callable, Sequence
@@ -57,6 +58,26 @@ class RenderOutputs:
     geom_ids: np.ndarray | None = None       # int32 (H, W), -1 on background
     # Follow-up renders of the same view and state: (geom ids, crop) -> int32 ids of the crop
     render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
+
+
+def make_gl_context():
+    """An offscreen GL context on the platform graphsdg chose (EGL when headless).
+
+    Chosen here rather than through ``mujoco.rendering.classic.gl_context`` so a
+    script that imported ``mujoco`` before ``graphsdg`` (which fixes MuJoCo's own
+    choice at import) still renders headless.
+    """
+    platform = os.environ.get("MUJOCO_GL", "").strip().lower()
+    if platform == "egl":
+        from mujoco.egl import GLContext
+    elif platform == "osmesa":
+        from mujoco.osmesa import GLContext
+    else:
+        from mujoco.rendering.classic import gl_context
+        GLContext = gl_context.GLContext
+        if GLContext is None:
+            raise RuntimeError("MuJoCo has no OpenGL platform; set MUJOCO_GL=egl (needs libEGL)")
+    return GLContext(64, 64)
 
 
 def halton(index: int, base: int) -> float:
@@ -92,11 +113,7 @@ class Rasterizer:
     # ---- contexts ------------------------------------------------------
     def _ensure_gl(self) -> None:
         if self._gl is None:
-            from mujoco.rendering.classic import gl_context
-            if gl_context.GLContext is None:
-                raise RuntimeError("MuJoCo has no OpenGL platform; set MUJOCO_GL=egl (needs libEGL) "
-                                   "before importing graphsdg")
-            self._gl = gl_context.GLContext(64, 64)
+            self._gl = make_gl_context()
         self._gl.make_current()
 
     def bind(self, sim: SimScene) -> None:
