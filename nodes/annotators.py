@@ -72,8 +72,12 @@ def present_ids(ids: np.ndarray) -> np.ndarray:
 
 def _colorize(ids: np.ndarray) -> np.ndarray:
     present = present_ids(ids)
-    lut_vals = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
-    return lut_vals[np.searchsorted(present, ids)]
+    colors = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
+    if present.size and int(present[-1]) < (1 << 20):
+        lut = np.zeros((int(present[-1]) + 1, 4), dtype=np.uint8)   # dense: one gather per pixel
+        lut[present] = colors
+        return lut[ids]
+    return colors[np.searchsorted(present, ids)]
 
 
 def _color_key(id_: int) -> str:

@@ -316,24 +316,37 @@ class FrameView:
 
 
 def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
-    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels)."""
-    flat = inst.ravel()
-    sel = np.nonzero(flat >= 0)[0]
-    boxes = np.full((n, 4), -1, dtype=np.int64)
-    if sel.size == 0:
-        return boxes.astype(np.int32)
-    k = flat[sel]
-    ys, xs = np.divmod(sel, inst.shape[1])
+    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels).
+
+    Only the ends of horizontal runs can be extreme: the left end of every run gives
+    x_min (and every row a label touches has one, so y_min / y_max), the right end
+    gives x_max. Scanning run ends instead of every labelled pixel makes the
+    scatter-min/max work proportional to the objects' outlines, not their areas.
+    """
+    h, w = inst.shape
+    boxes = np.full((n, 4), -1, dtype=np.int32)
+    if n == 0 or h == 0 or w == 0:
+        return boxes
+    padded = np.full((h, w + 2), -1, dtype=inst.dtype)
+    padded[:, 1:-1] = inst
+    starts = (padded[:, 1:-1] != padded[:, :-2]) & (inst >= 0)
+    ends = (padded[:, 1:-1] != padded[:, 2:]) & (inst >= 0)
+    sy, sx = np.nonzero(starts)
+    ey, ex = np.nonzero(ends)
+    if sy.size == 0:
+        return boxes
+    sk, ek = inst[sy, sx], inst[ey, ex]
     big = np.iinfo(np.int64).max
     lo_x, lo_y = np.full(n, big), np.full(n, big)
     hi_x, hi_y = np.full(n, -1), np.full(n, -1)
-    np.minimum.at(lo_x, k, xs)
-    np.minimum.at(lo_y, k, ys)
-    np.maximum.at(hi_x, k, xs)
-    np.maximum.at(hi_y, k, ys)
+    np.minimum.at(lo_x, sk, sx)
+    np.minimum.at(lo_y, sk, sy)
+    np.maximum.at(hi_y, sk, sy)
+    np.maximum.at(hi_x, ek, ex)
     present = hi_x >= 0
     boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
-    return boxes.astype(np.int32)
+    return boxes
+
 
 
 def _disjoint_groups(members: list) -> list[list]:

@@ -80,6 +80,18 @@ def make_gl_context():
     return GLContext(64, 64)
 
 
+def _is_current(gl) -> bool:
+    """Whether ``gl`` (an EGL context) is already current on this thread; False when unknown."""
+    context = getattr(gl, "_context", None)
+    if context is None or os.environ.get("MUJOCO_GL", "").lower() != "egl":
+        return False
+    import ctypes
+
+    from OpenGL import EGL
+    address = lambda p: ctypes.cast(p, ctypes.c_void_p).value  # noqa: E731
+    return address(EGL.eglGetCurrentContext()) == address(context)
+
+
 def halton(index: int, base: int) -> float:
     f, r = 1.0, 0.0
     while index > 0:
@@ -114,7 +126,8 @@ class Rasterizer:
     def _ensure_gl(self) -> None:
         if self._gl is None:
             self._gl = make_gl_context()
-        self._gl.make_current()
+        if not _is_current(self._gl):   # re-binding a current context can flush the GL pipeline
+            self._gl.make_current()
 
     def bind(self, sim: SimScene) -> None:
         """Make the GL contexts match the scene's current model."""
@@ -323,10 +336,9 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
         lin[(raw <= 0.0) | (lin > clip)] = np.inf
         return lin
     # Reversed Z: window depth w = near * (far - z) / (z * (far - near)), so z = near * far / (w * (far - near) + near).
-    # float64 for the division: float32 loses millimetres at tens of metres.
-    w = raw.astype(np.float64)
+    # In float32 the relative error stays ~1e-7 (w itself is a float32 read from GL).
     with np.errstate(divide="ignore"):
-        lin = (near * far / (w * (far - near) + near)).astype(np.float32)
+        lin = np.float32(near * far) / (raw * np.float32(far - near) + np.float32(near))
     lin[(raw <= 0.0) | (lin > clip)] = np.inf   # nothing drawn, or the sky
     return lin
 
