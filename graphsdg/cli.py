@@ -87,10 +87,19 @@ def run_bench(args: argparse.Namespace) -> None:
         table = benchmark.format_table(summaries)
         if args.profile:
             prof = rows[0].profile
-            total = sum(prof.values()) or 1.0
+            frame_ms = 1000.0 / rows[0].fps if rows[0].fps else 0.0
             table += "\n\n" + benchmark.format_table(
-                [{"phase": k, "ms/frame": round(v / config.frames * 1000, 2), "share": f"{v / total:.0%}"}
+                [{"phase": k, "ms/frame": round(v / config.frames * 1000, 2),
+                  "share of frame": "(worker threads)" if k == "encode+write" else
+                  f"{v / config.frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
                  for k, v in sorted(prof.items(), key=lambda kv: -kv[1])])
+            table += f"\n\ngraphsdg frame time {frame_ms:.2f} ms"
+            if len(rows) == 2 and rows[1].profile:
+                base_ms = 1000.0 / rows[1].fps if rows[1].fps else 0.0
+                table += "\n\n" + benchmark.format_table(
+                    [{"hand-written phase": k, "ms/frame": round(v / config.frames * 1000, 2)}
+                     for k, v in sorted(rows[1].profile.items(), key=lambda kv: -kv[1])])
+                table += f"\n\nhand-written frame time {base_ms:.2f} ms"
     text = f"### {settings_line}\n\nMachine: {machine}\n\n{table}\n"
     print(text)
     if args.report:

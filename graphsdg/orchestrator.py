@@ -14,7 +14,7 @@ import time
 from fractions import Fraction
 from typing import Any, Callable
 
-from graphsdg import settings
+from graphsdg import profiling, settings
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.io.write_queue import get_write_queue
@@ -46,7 +46,6 @@ class _State:
         self.status = Status.STOPPED
         self.frame_index = 0
         self.callbacks: dict[int, Callable[[Status], None]] = {}
-        self.profile: dict[str, float] = {}
         self.stop_requested = False
         self.pause_requested = False
         self.remaining: int | None = None
@@ -70,7 +69,7 @@ def _validate_subframes(rt_subframes: Any) -> int:
 
 def _timed(name: str, start: float) -> float:
     now = time.perf_counter()
-    _state.profile[name] = _state.profile.get(name, 0.0) + (now - start)
+    profiling.add(name, now - start)
     return now
 
 
@@ -158,9 +157,10 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
         t = _timed("render", t)
         frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time,
                           attached=frozenset(a.spec.name for a in annotators))
+        t = _timed("annotate:frame", t)
         for a in annotators:
             outputs[(id(a), path)] = a.compute_for(frame)
-        _timed("annotate", t)
+            t = _timed(f"annotate:{a.spec.name}", t)
     t = time.perf_counter()
     reference_time = Fraction(sim_time).limit_denominator(1_000_000)
     for writer in rt.writers:
@@ -168,7 +168,7 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
             continue
         data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
                                     extra={"provenance": provenance} if provenance else None)
-        writer.write(data)
+        writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
     _timed("write", t)
 
 
@@ -180,7 +180,13 @@ async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_
 
 
 def wait_until_complete() -> None:
-    """Block until every scheduled file is on disk; raise the first writer failure."""
+    """Block until every scheduled file is on disk; raise the first writer failure.
+
+    Attached writers flush their aggregate files first (COCO json, BOP json, open
+    WebDataset shards), so what is on disk afterwards is a complete dataset.
+    """
+    for writer in list(runtime().writers):
+        writer.flush()
     get_write_queue().wait_until_done()
 
 
@@ -402,12 +408,14 @@ async def stop_async() -> None:
 
 
 def get_profile() -> dict[str, float]:
-    """Seconds spent per phase (graph, sync, physics, render, annotate, write) since the last reset."""
-    return dict(_state.profile)
+    """Seconds spent per phase since the last reset: ``graph``, ``node:<name>``, ``sync``, ``physics``,
+    ``render:<pass>``, ``readback:<pass>``, ``annotate:<annotator>``, ``write`` (scheduling) and
+    ``encode+write`` (worker threads, overlapping the frame)."""
+    return profiling.snapshot()
 
 
 def reset_profile() -> None:
-    _state.profile.clear()
+    profiling.reset()
 
 
 def _flush_at_exit() -> None:

@@ -639,7 +639,8 @@ def test_basic_writer_writes_every_flag(out_dir):
         stems[f"bounding_box_{box}"] = ["npy"]
         stems[f"bounding_box_{box}_labels"] = ["json"]
         stems[f"bounding_box_{box}_prim_paths"] = ["json"]
-    expected = sorted(f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, exts in stems.items() for ext in exts)
+    expected = sorted([f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, exts in stems.items() for ext in exts]
+                      + ["metadata.txt"])
     assert sorted(os.listdir(out_dir)) == expected
 
     def load(name):

@@ -63,6 +63,7 @@ class Footprints:
 
     counts: np.ndarray     # int64 (n,)
     boxes: np.ndarray      # int32 (n, 4) x_min y_min x_max y_max
+    masks: dict = None     # k -> (x0, y0, x1, y1) crop and its bool mask (the full silhouette)
 
 
 class SceneLabels:
@@ -193,11 +194,13 @@ class FrameView:
 
     def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
         geom_ids = self.require("geom_ids")
-        inst = self.instance_image(semantic_filter)
-        out = np.where(geom_ids < 0, BACKGROUND_ID, UNLABELLED_ID).astype(np.uint32)
-        has = inst >= 0
-        out[has] = per_instance[inst[has]]
-        return out
+        imap = self.instance_map(semantic_filter)
+        # one lookup per pixel: geom -> id (unlabelled geoms 1), and index -1 (background) -> 0
+        lut = np.full(len(imap.geom_instance) + 1, UNLABELLED_ID, dtype=np.uint32)
+        labelled = imap.geom_instance >= 0
+        lut[:-1][labelled] = per_instance[imap.geom_instance[labelled]]
+        lut[-1] = BACKGROUND_ID
+        return lut[geom_ids]
 
     # ---- boxes and occlusion -------------------------------------------
     def visible_counts(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
@@ -237,6 +240,7 @@ class FrameView:
             render = self.outputs.render_isolated if self.outputs is not None else None
             if render is None:
                 raise RuntimeError("isolated renders need the segmentation pass")
+            masks: dict[int, tuple[tuple[int, int, int, int], np.ndarray]] = {}
             shown = np.zeros(self.sim.model.ngeom, dtype=bool)
             shown[self.drawn_geoms()] = True
             rects = self._geom_rects()
@@ -255,6 +259,7 @@ class FrameView:
                 for k, geoms, crop in group:
                     part = ids[crop[1] - y0:crop[3] - y0, crop[0] - x0:crop[2] - x0]
                     mask = np.isin(part, geoms)
+                    masks[k] = (tuple(int(c) for c in crop), mask)
                     counts[k] = int(mask.sum())
                     if counts[k]:
                         ys, xs = np.nonzero(mask)
@@ -271,7 +276,7 @@ class FrameView:
                 else:
                     boxes[k, :2] = np.minimum(boxes[k, :2], box[:2])
                     boxes[k, 2:] = np.maximum(boxes[k, 2:], box[2:])
-            return Footprints(counts=counts, boxes=boxes)
+            return Footprints(counts=counts, boxes=boxes, masks=masks)
         return self.cached(("footprints", semantic_filter.text), build)
 
     def occlusion_ratios(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
@@ -311,24 +316,37 @@ class FrameView:
 
 
 def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
-    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels)."""
-    flat = inst.ravel()
-    sel = np.nonzero(flat >= 0)[0]
-    boxes = np.full((n, 4), -1, dtype=np.int64)
-    if sel.size == 0:
-        return boxes.astype(np.int32)
-    k = flat[sel]
-    ys, xs = np.divmod(sel, inst.shape[1])
+    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels).
+
+    Only the ends of horizontal runs can be extreme: the left end of every run gives
+    x_min (and every row a label touches has one, so y_min / y_max), the right end
+    gives x_max. Scanning run ends instead of every labelled pixel makes the
+    scatter-min/max work proportional to the objects' outlines, not their areas.
+    """
+    h, w = inst.shape
+    boxes = np.full((n, 4), -1, dtype=np.int32)
+    if n == 0 or h == 0 or w == 0:
+        return boxes
+    padded = np.full((h, w + 2), -1, dtype=inst.dtype)
+    padded[:, 1:-1] = inst
+    starts = (padded[:, 1:-1] != padded[:, :-2]) & (inst >= 0)
+    ends = (padded[:, 1:-1] != padded[:, 2:]) & (inst >= 0)
+    sy, sx = np.nonzero(starts)
+    ey, ex = np.nonzero(ends)
+    if sy.size == 0:
+        return boxes
+    sk, ek = inst[sy, sx], inst[ey, ex]
     big = np.iinfo(np.int64).max
     lo_x, lo_y = np.full(n, big), np.full(n, big)
     hi_x, hi_y = np.full(n, -1), np.full(n, -1)
-    np.minimum.at(lo_x, k, xs)
-    np.minimum.at(lo_y, k, ys)
-    np.maximum.at(hi_x, k, xs)
-    np.maximum.at(hi_y, k, ys)
+    np.minimum.at(lo_x, sk, sx)
+    np.minimum.at(lo_y, sk, sy)
+    np.maximum.at(hi_y, sk, sy)
+    np.maximum.at(hi_x, ek, ex)
     present = hi_x >= 0
     boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
-    return boxes.astype(np.int32)
+    return boxes
+
 
 
 def _disjoint_groups(members: list) -> list[list]:

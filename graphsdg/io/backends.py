@@ -78,6 +78,8 @@ class DiskBackend(BaseBackend):
         root = settings.get("/omni/replicator/backends/disk/root_dir")
         path = output_dir if os.path.isabs(output_dir) else os.path.join(root or os.getcwd(), output_dir)
         path = os.path.abspath(path)
+        if os.path.exists(path) and not os.path.isdir(path):
+            raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
         if not overwrite and os.path.exists(path):
             i = 1
             while os.path.exists(f"{path}_{i:04d}"):
@@ -85,12 +87,14 @@ class DiskBackend(BaseBackend):
             path = f"{path}_{i:04d}"
         if os.path.exists(path) and not os.path.isdir(path):
             raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
+        blocker = _file_ancestor(path)
+        if blocker is not None:
+            raise NotADirectoryError(f"cannot create output_dir {path!r}: {blocker!r} is a file, not a directory")
         try:
             os.makedirs(path, exist_ok=True)
         except OSError as exc:
-            raise PermissionError(f"cannot create output_dir {path!r}: {exc.strerror}") from exc
-        if not os.access(path, os.W_OK | os.X_OK):
-            raise PermissionError(f"output_dir {path!r} is not writable")
+            raise PermissionError(f"cannot create output_dir {path!r}: {exc.strerror or exc}") from exc
+        _check_writable(path)
         return path
 
     def resolve(self, path: str) -> str:
@@ -107,6 +111,27 @@ class DiskBackend(BaseBackend):
     def read_blob(self, path: str) -> bytes:
         with open(self.resolve(path), "rb") as f:
             return f.read()
+
+
+def _file_ancestor(path: str) -> str | None:
+    """The first existing ancestor of ``path`` that is a file (so no directory can be made there), if any."""
+    parent = os.path.dirname(path)
+    while parent and not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    return parent if parent and not os.path.isdir(parent) else None
+
+
+def _check_writable(path: str) -> None:
+    """Create and remove a probe file: catches read-only mounts and ACLs that ``os.access`` misses (e.g. as root)."""
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise PermissionError(f"output_dir {path!r} is not writable")
+    probe = os.path.join(path, f".graphsdg-probe-{uuid.uuid4().hex[:8]}")
+    try:
+        with open(probe, "wb"):
+            pass
+        os.unlink(probe)
+    except OSError as exc:
+        raise PermissionError(f"output_dir {path!r} is not writable: {exc.strerror or exc}") from exc
 
 
 _counter_lock = threading.Lock()

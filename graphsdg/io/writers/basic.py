@@ -23,8 +23,9 @@ import numpy as np
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
-from graphsdg.io.backends import BackendDispatch, BackendGroup, BaseBackend
+from graphsdg.io.backends import BaseBackend
 from graphsdg.io.writer import Writer
+from graphsdg.io.writers import arguments
 
 # flag -> (annotator name BasicWriter requests, file stem)
 _FLAGS = {
@@ -65,11 +66,6 @@ class BasicWriter(Writer):
                  colorize_depth: bool = False, skeleton_data: bool = False, frame_padding: int = 4,
                  semantic_filter_predicate: str | None = None, use_common_output_dir: bool = False,
                  backend: BaseBackend | None = None, provenance: bool = False) -> None:
-        if s3_bucket or s3_region or s3_endpoint:
-            raise ValueError("BasicWriter: S3 output is not available in graphsdg; pass output_dir or backend")
-        if output_dir is None and backend is None:
-            raise ValueError("No `backend`, `output_dir` or `s3_` parameter specified; BasicWriter needs "
-                             "somewhere to write (e.g. output_dir='_out')")
         if str(image_output_format).lower() not in IMAGE_FORMATS:
             raise ValueError(f"image_output_format must be one of {IMAGE_FORMATS}, got {image_output_format!r}")
         if isinstance(frame_padding, bool) or not isinstance(frame_padding, int) or frame_padding < 0:
@@ -86,10 +82,8 @@ class BasicWriter(Writer):
         self.semantic_filter_predicate = semantic_filter.text
         self.version = "0.0.2"
         self.data_structure = "annotator"
-        backends = [backend] if backend is not None else []
-        if output_dir is not None:
-            backends.append(BackendDispatch(output_dir=output_dir))
-        self.backend = backends[0] if len(backends) == 1 else BackendGroup(backends)
+        self.backend = arguments.output_backend("BasicWriter", output_dir, backend, s3_bucket=s3_bucket,
+                                                s3_region=s3_region, s3_endpoint=s3_endpoint)
         self.output_dir = getattr(self.backend, "output_dir", None)
         self._frame_id = 0
         self._sequence = ""
@@ -140,8 +134,7 @@ class BasicWriter(Writer):
         return f"{prefix}{stem}{suffix}_{self._sequence}{n}"
 
     def write(self, data: dict) -> None:
-        seq = "".join(f"{count}_" for name, count in sorted(data.get("trigger_outputs", {}).items())
-                      if "on_time" in name)
+        seq = sequence_prefix(data.get("trigger_outputs", {}))
         if seq != self._sequence:
             self._sequence = seq
             self._frame_id = 0
@@ -157,7 +150,6 @@ class BasicWriter(Writer):
             self.backend.schedule(iof.write_json, data=record,
                                   path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
-        self.num_written += 1
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
         b = self.backend
@@ -198,6 +190,18 @@ class BasicWriter(Writer):
             b.schedule(iof.write_json, data=skeleton_json(payload), path=f"{path()}.json")
         else:
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+
+
+def sequence_prefix(trigger_outputs: dict) -> str:
+    """Replicator's ``{seq}``: ``"<count>_"`` for each ``on_time`` trigger, the last one first.
+
+    ``{"on_time": 3}`` gives ``"3_"``; with no ``on_time`` trigger it is ``""``.
+    """
+    seq = ""
+    for name, count in trigger_outputs.items():
+        if "on_time" in name:
+            seq = f"{count}_{seq}"
+    return seq
 
 
 def skeleton_json(payload: dict) -> dict:
