@@ -99,8 +99,6 @@ def test_getting_started_01_basic_writer_boxes_match_projection(tmp_path, monkey
         assert np.allclose(got, [lo[0], lo[1], hi[0], hi[1]], atol=1.0)
 
 
-@pytest.mark.skipif("PoseWriter" not in rep.WriterRegistry.get_writers(),
-                    reason="PoseWriter is not registered yet (it comes with the writers branch)")
 def test_getting_started_02_custom_writer_annotators_and_pose_writer(tmp_path, monkeypatch, capsys):
     root, out = run_both_forms("sdg_getting_started_02", tmp_path, monkeypatch, capsys)
     # the custom writer saw both render products' camera_params and bounding_box_3d, three times
