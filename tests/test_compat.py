@@ -379,3 +379,21 @@ def test_porting_guide_lists_every_mapped_module_and_name(compat):
     for obj in (kit.SimulationApp(), kit.get_app(), kit.get_context(), kit.get_settings()):
         missing += [f"{type(obj).__name__}.{m}" for m in available_names(obj) if m not in text]
     assert missing == []
+
+
+def test_app_updates_survive_an_event_loop_closed_mid_wait(compat):
+    """A coroutine cancelled while it waited (asyncio.run ending) leaves nothing that blocks the next loop."""
+    import omni.kit.app
+    app = omni.kit.app.get_app()
+
+    async def abandon():
+        waiter = asyncio.ensure_future(app.next_update_async())
+        await asyncio.sleep(0)
+        waiter.cancel()                 # its update is scheduled but the coroutine is gone
+    asyncio.run(abandon())
+
+    async def wait_twice():
+        await app.next_update_async()
+        await app.next_update_async()
+        return True
+    assert asyncio.run(asyncio.wait_for(wait_twice(), timeout=5))

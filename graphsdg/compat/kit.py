@@ -167,6 +167,7 @@ class App(CompatObject):
     def __init__(self) -> None:
         self._waiters: list[asyncio.Future] = []
         self._handle: asyncio.Handle | None = None   # an update scheduled on the event loop
+        self._handle_loop: asyncio.AbstractEventLoop | None = None
         self._pumping = False
         self._message_bus = EventStream()
         self._update_stream = EventStream()
@@ -180,7 +181,8 @@ class App(CompatObject):
         if self._handle is not None:   # this update serves the waiters the scheduled one was for
             self._handle.cancel()
             self._handle = None
-        waiters, self._waiters = self._waiters, []
+        # waiters of an event loop that was closed meanwhile (a finished asyncio.run) have no one to wake
+        waiters, self._waiters = [f for f in self._waiters if not f.get_loop().is_closed()], []
         try:
             orchestrator.update()
             self._update_stream.push(0, {"dt": runtime().timeline.frame_duration})
@@ -201,8 +203,10 @@ class App(CompatObject):
             pass
 
     def _schedule(self, loop: asyncio.AbstractEventLoop) -> None:
-        if self._handle is None:
-            self._handle = loop.call_soon(self._scheduled_update)
+        if self._handle is not None and self._handle_loop is loop and not self._handle.cancelled():
+            return   # already scheduled on this loop
+        self._handle_loop = loop
+        self._handle = loop.call_soon(self._scheduled_update)
 
     @staticmethod
     def _script_loop() -> asyncio.AbstractEventLoop | None:
