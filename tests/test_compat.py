@@ -346,7 +346,7 @@ def test_palletizing_seed_sdg_runs_on_a_stand_in_scene(compat, tmp_path, monkeyp
     d = tmp_path / "_out_palletizing_sdg_demo"
     annot = d / "annot_bin_0"
     assert sorted(p.name for p in annot.iterdir()) == sorted(
-        [f"rgb_{i}.png" for i in range(4)] + [f"is_{i}.png" for i in range(4)] + [f"is_info_{i}.json" for i in range(4)])
+        [f"{kind}_{i}.png" for kind in ("rgb", "is") for i in range(4)] + [f"is_info_{i}.json" for i in range(4)])
     frames = [np.asarray(Image.open(annot / f"rgb_{i}.png")) for i in range(4)]
     assert frames[0].shape == (64, 64, 4)
     assert all(np.abs(a.astype(int) - b).max() > 30 for a, b in zip(frames, frames[1:]))   # the camera walks

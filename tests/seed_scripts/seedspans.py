@@ -49,7 +49,8 @@ class Span:
 
 
 def _gs(n: int) -> list[Span]:
-    return [Span(f"sdg_getting_started_{n:02d}_script_editor", "001", r"^import asyncio$", r"^asyncio\.ensure_future\("),
+    return [Span(f"sdg_getting_started_{n:02d}_script_editor", "001", r"^import asyncio$",
+                 r"^asyncio\.ensure_future\("),
             Span(f"sdg_getting_started_{n:02d}", "001", r"^import os$", r"^simulation_app\.close\(\)$")]
 
 
