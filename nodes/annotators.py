@@ -70,13 +70,15 @@ def present_ids(ids: np.ndarray) -> np.ndarray:
     return np.unique(ids)
 
 
-def _colorize(ids: np.ndarray) -> np.ndarray:
-    present = present_ids(ids)
+def _colorize(ids: np.ndarray, present: np.ndarray | None = None) -> np.ndarray:
+    present = present_ids(ids) if present is None else present
     colors = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
     if present.size and int(present[-1]) < (1 << 20):
-        lut = np.zeros((int(present[-1]) + 1, 4), dtype=np.uint8)   # dense: one gather per pixel
+        # dense LUT of packed RGBA words: one 4-byte gather per pixel, then viewed as bytes
+        lut = np.zeros((int(present[-1]) + 1, 4), dtype=np.uint8)
         lut[present] = colors
-        return lut[ids]
+        packed = lut.view(np.uint32)[:, 0][ids]
+        return packed.view(np.uint8).reshape(*ids.shape, 4)
     return colors[np.searchsorted(present, ids)]
 
 
@@ -123,9 +125,10 @@ def semantic_segmentation(frame: FrameView, params: dict) -> dict:
     sem = frame.semantic_image(filt)
     imap = frame.instance_map(filt)
     lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
-    present = sorted(set(present_ids(sem).tolist()) | set(RESERVED))
+    drawn = frame.present_ids("semantic", filt)
+    present = sorted(set(drawn.tolist()) | set(RESERVED))
     key = _color_key if params.get("colorize") else str
-    data = _colorize(sem) if params.get("colorize") else sem.copy()
+    data = _colorize(sem, drawn) if params.get("colorize") else sem.copy()
     return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},
                                    "idToLabelLists": {key(i): lists[i] for i in present}}}
 
@@ -135,12 +138,13 @@ def instance_segmentation(frame: FrameView, params: dict) -> dict:
     filt = semantic_filter(params)
     ids = frame.instance_id_image(filt)
     imap = frame.instance_map(filt)
-    present = sorted(set(present_ids(ids).tolist()) | set(RESERVED))
+    drawn = frame.present_ids("instance", filt)
+    present = sorted(set(drawn.tolist()) | set(RESERVED))
     by_id = {int(i): k for k, i in enumerate(imap.instance_ids)}
     paths = {i: RESERVED[i] if i in RESERVED else imap.paths[by_id[i]] for i in present}
     lists = {i: {RESERVED_TYPE: [RESERVED[i]]} if i in RESERVED else imap.labels[by_id[i]] for i in present}
     key = _color_key if params.get("colorize") else str
-    data = _colorize(ids) if params.get("colorize") else ids.copy()
+    data = _colorize(ids, drawn) if params.get("colorize") else ids.copy()
     return {"data": data, "info": {"idToLabels": {key(i): paths[i] for i in present},
                                    "idToSemantics": {key(i): joined(lists[i]) for i in present},
                                    "idToSemanticLists": {key(i): lists[i] for i in present}}}

@@ -285,7 +285,7 @@ class Rasterizer:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         self.stats["ids" if crop is None else "isolated"] += 1
-        geom_ids = _decode_segmentation(ids[::-1], scene)
+        geom_ids = _decode_segmentation(cv2.flip(ids, 0), scene)
         depth = None
         if raw is not None:
             far = effective_far(sim.model, view)
@@ -346,8 +346,10 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
 def _decode_segmentation(rgb: np.ndarray, scene: mujoco.MjvScene) -> np.ndarray:
     """MuJoCo's id colours (segid + 1 in 24-bit RGB) -> geom ids, -1 where no geom was drawn."""
     if scene.ngeom + 1 < (1 << 16):
-        # Ids fit in red + green: read those two bytes as one little-endian uint16 (one pass).
-        segid = np.ascontiguousarray(rgb[..., :2]).view(np.uint16)[..., 0]
+        # Ids fit in red + green: as RGBA, each pixel's first two bytes are one little-endian
+        # uint16, read in place (cvtColor makes the 4-byte pixels in one vectorised pass).
+        rgba = cv2.cvtColor(np.ascontiguousarray(rgb), cv2.COLOR_RGB2RGBA)
+        segid = rgba.view(np.uint16).reshape(rgba.shape[0], rgba.shape[1], 2)[..., 0]
         size = 1 << 16
     else:
         segid = rgb[..., 0].astype(np.int32) | (rgb[..., 1].astype(np.int32) << 8) | \
