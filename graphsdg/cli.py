@@ -155,6 +155,8 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--seed", type=int, help="global seed (unless the script sets its own)")
     run.add_argument("--out", help="root for the script's relative output directories")
     run.add_argument("--frames", type=int, help="frames for orchestrator.run() calls without num_frames")
+    run.add_argument("--resolution-scale", type=float, metavar="F",
+                     help="scale every render product's resolution by F (e.g. 0.125 for a quick, small run)")
     view = sub.add_parser("view", help="contact sheet (and HTML gallery) of a dataset, with statistics")
     view.add_argument("dir")
     view.add_argument("--html", action="store_true", help="also write an HTML gallery")
@@ -177,7 +179,7 @@ def main(argv: list[str] | None = None) -> int:
         elif args.command == "run":
             from graphsdg.script_runner import run_script
             run_script(args.script, script_args, compat=args.compat, seed=args.seed, out_dir=args.out,
-                       frames=args.frames)
+                       frames=args.frames, resolution_scale=args.resolution_scale)
         elif args.command == "bench":
             run_bench(args)
         elif args.command == "view":

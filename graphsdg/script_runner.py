@@ -16,7 +16,8 @@ from graphsdg import orchestrator, rng, settings
 
 
 def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, seed: int | None = None,
-               out_dir: str | None = None, frames: int | None = None) -> None:
+               out_dir: str | None = None, frames: int | None = None,
+               resolution_scale: float | None = None) -> None:
     """Execute ``path`` as ``__main__`` with ``sys.argv = [path, *args]``."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"script {path!r} does not exist")
@@ -29,8 +30,12 @@ def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, s
         settings.set("/omni/replicator/backends/disk/root_dir", os.path.abspath(out_dir))
     if frames is not None:
         settings.set("/graphsdg/run/numFrames", int(frames))
+    if resolution_scale is not None:
+        settings.set("/graphsdg/render/resolutionScale", float(resolution_scale))
+    installed_here = False
     if compat == "isaac":
         from graphsdg.compat import isaac
+        installed_here = not isaac.is_installed()
         isaac.install()
     loop = asyncio.new_event_loop()
     asyncio.set_event_loop(loop)
@@ -48,3 +53,6 @@ def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, s
         sys.argv, sys.path[:] = saved_argv, saved_path
         asyncio.set_event_loop(None)
         loop.close()
+        if installed_here:   # the Isaac names lived for this script only
+            from graphsdg.compat import isaac
+            isaac.uninstall()
