@@ -149,7 +149,8 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
     for path, (rp, annotators) in products.items():
         t = time.perf_counter()
         sim.require_offscreen(rp.width, rp.height)
-        view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
+        with profiling.timed("render:camera"):
+            view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
         passes: set[str] = set()
         for a in annotators:
             passes |= a.spec.passes

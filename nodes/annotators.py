@@ -122,13 +122,16 @@ def distance_to_camera(frame: FrameView, params: dict) -> dict:
 def semantic_segmentation(frame: FrameView, params: dict) -> dict:
     """uint32 (H, W) semantic ids (uint8 (H, W, 4) with ``colorize``); ``idToLabels``."""
     filt = semantic_filter(params)
-    sem = frame.semantic_image(filt)
     imap = frame.instance_map(filt)
     lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
     drawn = frame.present_ids("semantic", filt)
     present = sorted(set(drawn.tolist()) | set(RESERVED))
     key = _color_key if params.get("colorize") else str
-    data = _colorize(sem, drawn) if params.get("colorize") else sem.copy()
+    if params.get("colorize"):
+        all_ids = set(imap.semantic_ids.tolist()) | set(RESERVED)
+        data = frame.colorized_id_image("semantic", filt, {i: color_of(i) for i in all_ids})
+    else:
+        data = frame.semantic_image(filt).copy()
     return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},
                                    "idToLabelLists": {key(i): lists[i] for i in present}}}
 

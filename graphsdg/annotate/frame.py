@@ -200,6 +200,18 @@ class FrameView:
         lut[-1] = BACKGROUND_ID
         return lut
 
+    def colorized_id_image(self, kind: str, semantic_filter: SemanticFilter, colors: dict[int, tuple]) -> np.ndarray:
+        """uint8 (H, W, 4): the ``"semantic"``/``"instance"`` id image already coloured, in one
+        lookup per pixel (geom -> packed RGBA) instead of ids then colours."""
+        imap = self.instance_map(semantic_filter)
+        per_instance = imap.semantic_ids if kind == "semantic" else imap.instance_ids
+        ids = self._id_lut(per_instance, imap)
+        palette = np.zeros((len(ids), 4), dtype=np.uint8)
+        for i, value in enumerate(ids):
+            palette[i] = colors[int(value)]
+        packed = palette.view(np.uint32)[:, 0][self.require("geom_ids")]
+        return packed.view(np.uint8).reshape(*packed.shape, 4)
+
     def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
         lut = self._id_lut(per_instance, self.instance_map(semantic_filter))
         return lut[self.require("geom_ids")]   # one lookup per pixel
@@ -231,15 +243,30 @@ class FrameView:
 
     def tight_boxes(self, semantic_filter: SemanticFilter = ALL_LABELS
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(instance indices, boxes (K, 4) inclusive x_min y_min x_max y_max, pixel counts) of visible instances."""
+        """(instance indices, boxes (K, 4) inclusive x_min y_min x_max y_max, None) of visible instances."""
         def build():
-            inst = self.instance_image(semantic_filter)
-            n = len(self.instance_map(semantic_filter).paths)
-            boxes = _mask_boxes(inst, n)
-            counts = self.visible_counts(semantic_filter)
-            present = np.nonzero(counts)[0]
-            return present, boxes[present], counts[present]
+            imap = self.instance_map(semantic_filter)
+            n = len(imap.paths)
+            # Boxes of each drawn geom straight from the id image (no per-pixel instance lookup),
+            # then each instance's box is the union of its geoms' boxes.
+            geom_boxes = self.geom_boxes()
+            drawn = np.flatnonzero(geom_boxes[:, 2] >= 0)
+            owner = imap.geom_instance[drawn] if drawn.size else np.zeros(0, dtype=np.int32)
+            keep = owner >= 0
+            drawn, owner = drawn[keep], owner[keep]
+            big = np.iinfo(np.int32).max
+            lo = np.full((n, 2), big, dtype=np.int32)
+            hi = np.full((n, 2), -1, dtype=np.int32)
+            np.minimum.at(lo, owner, geom_boxes[drawn, :2])
+            np.maximum.at(hi, owner, geom_boxes[drawn, 2:])
+            present = np.flatnonzero(hi[:, 0] >= 0)
+            boxes = np.concatenate([lo[present], hi[present]], axis=1)
+            return present, boxes, None
         return self.cached(("tight_boxes", semantic_filter.text), build)
+
+    def geom_boxes(self) -> np.ndarray:
+        """(ngeom, 4) inclusive pixel bounds of every geom drawn in the id pass (-1 rows if not drawn)."""
+        return self.cached("geom_boxes", lambda: _mask_boxes(self.require("geom_ids"), self.sim.model.ngeom))
 
     def footprints(self, semantic_filter: SemanticFilter = ALL_LABELS) -> Footprints:
         """Unoccluded footprint of every instance in view, from isolated id renders.

@@ -131,6 +131,10 @@ class Rasterizer:
 
     def bind(self, sim: SimScene) -> None:
         """Make the GL contexts match the scene's current model."""
+        with profiling.timed("render:bind+uploads"):
+            self._bind(sim)
+
+    def _bind(self, sim: SimScene) -> None:
         self._ensure_gl()
         model = sim.model
         if self._version != sim.model_version or self._model is not model:
@@ -285,7 +289,8 @@ class Rasterizer:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         self.stats["ids" if crop is None else "isolated"] += 1
-        geom_ids = _decode_segmentation(cv2.flip(ids, 0), scene)
+        with profiling.timed("decode:ids"):
+            geom_ids = _decode_segmentation(cv2.flip(ids, 0), scene)
         depth = None
         if raw is not None:
             far = effective_far(sim.model, view)
