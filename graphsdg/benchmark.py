@@ -65,6 +65,8 @@ class BenchConfig:
     seed: int = 11
     out_dir: str | None = None
     write_threads: int = 4
+    msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
+    shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
 
 
 @dataclass
@@ -124,6 +126,10 @@ def build_scene(config: BenchConfig):
     """The benchmark stage; returns (asset prims, camera prims, render products)."""
     import graphsdg as rep
 
+    if config.msaa_samples is not None:
+        rep.settings.set("/graphsdg/render/msaaSamples", int(config.msaa_samples))
+    if config.shadow_size is not None:
+        rep.settings.set("/graphsdg/render/shadowSize", int(config.shadow_size))
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)

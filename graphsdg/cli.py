@@ -67,8 +67,11 @@ def run_bench(args: argparse.Namespace) -> None:
         frames=args.num_frames, warmup=args.warmup, num_cameras=args.num_cameras, resolution=tuple(args.resolution),
         asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
         rt_subframes=args.rt_subframes, wait_for_render=not args.no_wait_for_render,
-        write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads)
-    settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}, "
+        write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
+        msaa_samples=args.msaa, shadow_size=args.shadow_size)
+    quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
+                       f", shadow map {args.shadow_size}" if args.shadow_size is not None else ""])
+    settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
                      f"{'skip-write' if args.skip_write else 'written'}")
     machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}"
@@ -143,6 +146,8 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--no-wait-for-render", action="store_true")
     bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
     bench.add_argument("--write-threads", type=int, default=4)
+    bench.add_argument("--msaa", type=int, help="multisample count of the colour pass (default: graphsdg's 4)")
+    bench.add_argument("--shadow-size", type=int, help="shadow map size (default: graphsdg's 1024)")
     bench.add_argument("--processes", type=int, default=0,
                        help="run this many graphsdg processes at once and report the aggregate (no baseline)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
