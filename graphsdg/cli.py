@@ -101,6 +101,29 @@ def run_bench(args: argparse.Namespace) -> None:
             f.write("\n" + text)
 
 
+def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
+    """``graphsdg graph``: build the script's graph (no render, no write); print it, write DOT and PNG."""
+    from graphsdg import graph as graphs
+    from graphsdg.script_runner import build_script
+
+    stopped_at = build_script(args.script, script_args, compat=args.compat, seed=args.seed)
+    g = graphs.current_graph(create=False)
+    stem = os.path.splitext(os.path.basename(args.script))[0]
+    out = args.out or "."
+    os.makedirs(out, exist_ok=True)
+    dot_path = args.dot or os.path.join(out, f"{stem}.graph.dot")
+    png_path = args.png or os.path.join(out, f"{stem}.graph.png")
+    json_path = args.json or os.path.join(out, f"{stem}.graph.json")
+    dot = graphs.to_dot(g, dot_path)
+    text = graphs.to_json(g, json_path)
+    graphs.draw(g, png_path)
+    printed = {"text": graphs.describe(g), "dot": dot, "json": text}[args.print]
+    print(printed.rstrip("\n"))
+    where = f"stopped at orchestrator.{stopped_at}()" if stopped_at else "the script ended without capturing"
+    print(f"\n{where}; wrote {dot_path}, {json_path}, {png_path}", file=sys.stderr)
+    return 0
+
+
 def _gl_renderer() -> str:
     try:
         from mujoco.rendering.classic import gl_context
@@ -154,6 +177,20 @@ def main(argv: list[str] | None = None) -> int:
     view.add_argument("--html", action="store_true", help="also write an HTML gallery")
     view.add_argument("--max", type=int, default=16, help="frames to show (default 16)")
     view.add_argument("--out", help="output folder (default: DIR.view next to the dataset)")
+    graph = sub.add_parser("graph", help="build a script's node graph without running it; print and draw it",
+                           usage="graphsdg graph SCRIPT [options] [-- SCRIPT_ARGS ...]",
+                           description="Runs SCRIPT until its first orchestrator capture call (run, step, "
+                                       "preview), which stops it: nothing is rendered or written. Prints the "
+                                       "graph and writes it as DOT, JSON and a PNG drawing.")
+    graph.add_argument("script")
+    graph.add_argument("--compat", choices=["isaac"], help="provide Isaac Sim's module names to the script")
+    graph.add_argument("--seed", type=int, help="global seed (values sampled while building)")
+    graph.add_argument("--print", choices=["text", "dot", "json"], default="text",
+                       help="what to print (default: text)")
+    graph.add_argument("--out", help="folder for SCRIPT.graph.{dot,json,png} (default: current folder)")
+    graph.add_argument("--dot", metavar="PATH", help="DOT file path")
+    graph.add_argument("--json", metavar="PATH", help="JSON file path")
+    graph.add_argument("--png", metavar="PATH", help="PNG drawing path")
     validate = sub.add_parser("validate", help="check a dataset's consistency; exit 1 on any violation")
     validate.add_argument("dir")
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -172,6 +209,8 @@ def main(argv: list[str] | None = None) -> int:
             from graphsdg.script_runner import run_script
             run_script(args.script, script_args, compat=args.compat, seed=args.seed, out_dir=args.out,
                        frames=args.frames)
+        elif args.command == "graph":
+            return run_graph(args, script_args)
         elif args.command == "bench":
             run_bench(args)
         elif args.command == "view":

@@ -78,6 +78,8 @@ class DiskBackend(BaseBackend):
         root = settings.get("/omni/replicator/backends/disk/root_dir")
         path = output_dir if os.path.isabs(output_dir) else os.path.join(root or os.getcwd(), output_dir)
         path = os.path.abspath(path)
+        if writes_discarded():
+            return path
         if os.path.exists(path) and not os.path.isdir(path):
             raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
         if not overwrite and os.path.exists(path):
@@ -147,8 +149,18 @@ def bytes_written() -> int:
     return _written["bytes"]
 
 
+def writes_discarded() -> bool:
+    """True while ``/graphsdg/io/discardWrites`` is set: disk backends create and write nothing.
+
+    ``graphsdg graph SCRIPT`` runs a script this way to build its graph without touching its outputs.
+    """
+    return bool(settings.get("/graphsdg/io/discardWrites", False))
+
+
 def write_file_atomic(full_path: str, data: bytes) -> None:
     """Write ``data`` to ``full_path`` so that the file appears whole or not at all."""
+    if writes_discarded():
+        return
     directory = os.path.dirname(full_path)
     os.makedirs(directory, exist_ok=True)
     tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{uuid.uuid4().hex[:12]}.tmp")
