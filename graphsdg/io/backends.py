@@ -16,7 +16,7 @@ import uuid
 from typing import Any, Callable
 
 
-from graphsdg import settings
+from graphsdg import frame_plan, settings
 from graphsdg.errors import unknown_name
 from graphsdg.io import encode
 from graphsdg.io.write_queue import get_write_queue
@@ -82,7 +82,8 @@ class DiskBackend(BaseBackend):
             return path
         if os.path.exists(path) and not os.path.isdir(path):
             raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
-        if not overwrite and os.path.exists(path):
+        # every shard, and a resumed run, must write into the folder the job started with
+        if not overwrite and os.path.exists(path) and frame_plan.current() is None:
             i = 1
             while os.path.exists(f"{path}_{i:04d}"):
                 i += 1
