@@ -119,3 +119,8 @@ def record_writer(writer) -> None:
 def records() -> list[dict]:
     """Every writer recorded by this process's planned runs."""
     return [r.to_dict() for r in _records.values()]
+
+
+def clear_records() -> None:
+    """Forget the recorded writers (a new job starts)."""
+    _records.clear()

@@ -471,6 +471,11 @@ async def stop_async() -> None:
     stop()
 
 
+def frames_captured() -> int:
+    """Frames captured (steps) by this process so far."""
+    return _state.frame_index
+
+
 def get_profile() -> dict[str, float]:
     """Seconds spent per phase since the last reset: ``graph``, ``node:<name>``, ``sync``, ``physics``,
     ``render:<pass>``, ``readback:<pass>``, ``annotate:<annotator>``, ``write`` (scheduling) and
