@@ -393,6 +393,11 @@ def _planned_frames(sched, progress: Progress) -> None:
     start = graph.frame if graph is not None else 0
     frames = [f for f in range(total) if plan.owns(f)]
     if plan.resume:
+        if not plan.sharded:   # shards share folders: the merge step removes their leftovers
+            from graphsdg.io.backends import remove_temporaries
+            for writer in writers:
+                if getattr(writer.backend, "output_dir", None):
+                    remove_temporaries(writer.backend.output_dir)
         frames = [f for f in frames
                   if not all(w.frame_complete(_state.frame_bases[id(w)] + f) for w in writers)]
         log.info("resume: %d of %d frames to capture", len(frames), total)

@@ -37,7 +37,7 @@ from PIL import Image
 from graphsdg.annotate.ids import color_of
 from graphsdg.frame_plan import SHARD_FOLDER
 from graphsdg.io import encode
-from graphsdg.io.backends import write_file_atomic
+from graphsdg.io.backends import remove_temporaries, write_file_atomic
 from graphsdg.io.writers.coco import renumber_annotations
 
 INDEX_FILE = "graphsdg_index.json"
@@ -175,6 +175,7 @@ def merge_shards(shard_results: list[dict]) -> list[dict]:
                     if os.path.exists(path):
                         os.remove(path)
         _move_rest(output_dir)
+        remove_temporaries(output_dir)     # interrupted writes of an earlier, resumed attempt
         datasets.append({"writer": kind, "output_dir": output_dir})
     return datasets
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import errno
 import inspect
 import os
+import re
 import threading
 import uuid
 from typing import Any, Callable
@@ -148,6 +149,26 @@ def files_written() -> int:
 
 def bytes_written() -> int:
     return _written["bytes"]
+
+
+_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{12}\.tmp$")
+
+
+def remove_temporaries(output_dir: str) -> int:
+    """Delete the temporary files that interrupted atomic writes left under ``output_dir``; return how many.
+
+    Only call it while nothing writes there (a resumed run before its first frame, a merge after its shards).
+    """
+    removed = 0
+    for folder, _, names in os.walk(output_dir):
+        for name in names:
+            if _TEMPORARY.match(name):
+                try:
+                    os.unlink(os.path.join(folder, name))
+                    removed += 1
+                except FileNotFoundError:
+                    pass
+    return removed
 
 
 def writes_discarded() -> bool:
