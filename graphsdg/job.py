@@ -36,6 +36,7 @@ class JobSpec:
     out: str | None = None
     frames: int | None = None
     resume: bool = False
+    resolution_scale: float | None = None
     env: dict = field(default_factory=dict)
 
     def fingerprint(self) -> dict:
@@ -43,7 +44,8 @@ class JobSpec:
         with open(self.script, "rb") as f:
             digest = hashlib.sha256(f.read()).hexdigest()
         return {"script": os.path.abspath(self.script), "script_sha256": digest, "args": list(self.args),
-                "compat": self.compat, "seed": self.seed, "frames": self.frames}
+                "compat": self.compat, "seed": self.seed, "frames": self.frames,
+                "resolution_scale": self.resolution_scale}
 
 
 def check_job_file(job: JobSpec) -> None:
@@ -76,7 +78,8 @@ def run_job(job: JobSpec, plan: FramePlan | None = None) -> dict:
     frame_plan.set_plan(plan)
     frame_plan.clear_records()
     try:
-        run_script(job.script, job.args, compat=job.compat, seed=job.seed, out_dir=job.out, frames=job.frames)
+        run_script(job.script, job.args, compat=job.compat, seed=job.seed, out_dir=job.out, frames=job.frames,
+                   resolution_scale=job.resolution_scale)
     finally:
         frame_plan.set_plan(None)
     seconds = time.perf_counter() - start

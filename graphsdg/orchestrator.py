@@ -395,6 +395,7 @@ def _planned_frames(sched, progress: Progress) -> None:
     if plan.resume:
         if not plan.sharded:   # shards share folders: the merge step removes their leftovers
             from graphsdg.io.backends import remove_temporaries
+            get_write_queue().wait_until_done()   # writes already scheduled (a writer's first json) land first
             for writer in writers:
                 if getattr(writer.backend, "output_dir", None):
                     remove_temporaries(writer.backend.output_dir)

@@ -31,7 +31,9 @@ class ScriptStopped(Exception):
         self.call = call
 
 
-def _configure(path: str, compat: str | None, seed: int | None, out_dir: str | None, frames: int | None) -> None:
+def _configure(path: str, compat: str | None, seed: int | None, out_dir: str | None, frames: int | None,
+               resolution_scale: float | None = None) -> bool:
+    """Apply the run's overrides; return whether the Isaac module names were installed for this script."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"script {path!r} does not exist")
     if compat not in (None, "isaac"):
@@ -43,9 +45,20 @@ def _configure(path: str, compat: str | None, seed: int | None, out_dir: str | N
         settings.set("/omni/replicator/backends/disk/root_dir", os.path.abspath(out_dir))
     if frames is not None:
         settings.set("/graphsdg/run/numFrames", int(frames))
+    if resolution_scale is not None:
+        settings.set("/graphsdg/render/resolutionScale", float(resolution_scale))
+    installed_here = False
     if compat == "isaac":
         from graphsdg.compat import isaac
+        installed_here = not isaac.is_installed()
         isaac.install()
+    return installed_here
+
+
+def _uninstall_compat(installed_here: bool) -> None:
+    if installed_here:   # the Isaac names lived for this script only
+        from graphsdg.compat import isaac
+        isaac.uninstall()
 
 
 def _execute(path: str, args: Sequence[str]) -> None:
@@ -69,11 +82,15 @@ def _execute(path: str, args: Sequence[str]) -> None:
 
 
 def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, seed: int | None = None,
-               out_dir: str | None = None, frames: int | None = None) -> None:
+               out_dir: str | None = None, frames: int | None = None,
+               resolution_scale: float | None = None) -> None:
     """Execute ``path`` as ``__main__`` with ``sys.argv = [path, *args]``."""
-    _configure(path, compat, seed, out_dir, frames)
-    _execute(path, args)
-    orchestrator.wait_until_complete()
+    installed_here = _configure(path, compat, seed, out_dir, frames, resolution_scale)
+    try:
+        _execute(path, args)
+        orchestrator.wait_until_complete()
+    finally:
+        _uninstall_compat(installed_here)
 
 
 @contextlib.contextmanager
@@ -106,10 +123,13 @@ def build_script(path: str, args: Sequence[str] = (), compat: str | None = None,
     or None if the script ended without capturing. The graph it built is
     ``graphsdg.graph.current_graph()``.
     """
-    _configure(path, compat, seed, None, None)
-    with capture_stopped():
-        try:
-            _execute(path, args)
-        except ScriptStopped as stop:
-            return stop.call
-    return None
+    installed_here = _configure(path, compat, seed, None, None)
+    try:
+        with capture_stopped():
+            try:
+                _execute(path, args)
+            except ScriptStopped as stop:
+                return stop.call
+        return None
+    finally:
+        _uninstall_compat(installed_here)

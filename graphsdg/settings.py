@@ -37,6 +37,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/graphsdg/render/msaaSamples": (4, "multisample anti-aliasing samples of the colour pass"),
     "/graphsdg/render/exposure": (1.0, "scale from photometric light units to display values"),
     "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
+    "/graphsdg/render/resolutionScale": (1.0, "factor applied to every new render product's resolution "
+                                         "(graphsdg run --resolution-scale; small test runs of full-size scripts)"),
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
@@ -83,9 +85,10 @@ def get(key: str, default: Any = None) -> Any:
 
 
 def reset() -> None:
-    """Forget every value that was set (defaults apply again)."""
+    """Forget every value that was set (defaults apply again) and which keys were already warned about."""
     with _lock:
         _values.clear()
+        _warned.clear()
 
 
 # carb-style aliases so `settings.get_settings().set(...)` reads naturally.

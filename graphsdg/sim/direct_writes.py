@@ -80,10 +80,16 @@ class DirectTargets:
         self.parent_s = np.array([decompose(m)[2] for m in mats])
         self.is_mesh = np.array([b.type_name in ("Mesh", "Cone") for b in self.bindings])
         self.prims = list(prims)
-        # Unit-scale sizes let box scales be written as one array product.
+        # Unit-scale sizes let box, sphere and z-axis cylinder/capsule scales be array products.
         self.is_box = np.array([b.type_name == "Cube" for b in self.bindings])
-        self.unit_box = np.array([primitive_size(p, np.ones(3))[1] if box else np.zeros(3)
-                                  for p, box in zip(self.prims, self.is_box)]).reshape(len(self.prims), 3)
+        self.unit_size = np.zeros((len(self.prims), 3))
+        self.simple = np.zeros(len(self.prims), dtype=bool)
+        for i, (p, b) in enumerate(zip(self.prims, self.bindings)):
+            if b.type_name in ("Cube", "Sphere") or (b.type_name in ("Cylinder", "Capsule")
+                                                     and str(p.GetAttribute("axis").Get()) == "Z"):
+                self.unit_size[i] = primitive_size(p, np.ones(3))[1]
+                self.simple[i] = True
+        self.kind = np.array([sim.model.geom_type[b.geom_id] for b in self.bindings])
 
 
 _cache: dict[tuple, DirectTargets] = {}
@@ -114,10 +120,11 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
     sizes = {}
     if scales is not None:
         world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3) * t.parent_s
+        sizes.update(_simple_sizes(t, world_scale))
         for i in range(n):
-            if t.is_box[i]:
-                sizes[i] = t.unit_box[i] * np.abs(world_scale[i])
-            elif not t.is_mesh[i]:
+            if i in sizes:
+                continue
+            if not t.is_mesh[i]:
                 kind, size, _ = primitive_size(t.prims[i], world_scale[i])
                 if int(kind) != int(m.geom_type[t.geom_ids[i]]):
                     return False   # e.g. a sphere scaled unevenly becomes an ellipsoid: recompile via USD
@@ -162,6 +169,24 @@ def _quat_matrix(q: np.ndarray) -> np.ndarray:
     out = np.empty(9)
     mujoco.mju_quat2Mat(out, np.asarray(q, dtype=np.float64) / max(np.linalg.norm(q), 1e-12))
     return out.reshape(3, 3)
+
+
+def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> dict[int, np.ndarray]:
+    """Sizes of boxes, uniformly scaled spheres and z-axis cylinders/capsules, as array products."""
+    g = mujoco.mjtGeom
+    s = np.abs(world_scale)
+    out = {}
+    box = t.simple & (t.kind == int(g.mjGEOM_BOX))
+    sphere = t.simple & (t.kind == int(g.mjGEOM_SPHERE)) & np.all(s == s[:, :1], axis=1)
+    tube = t.simple & np.isin(t.kind, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
+    sizes = np.zeros_like(s)
+    sizes[box] = t.unit_size[box] * s[box]
+    sizes[sphere, 0] = t.unit_size[sphere, 0] * s[sphere, 0]
+    sizes[tube, 0] = t.unit_size[tube, 0] * np.maximum(s[tube, 0], s[tube, 1])
+    sizes[tube, 1] = t.unit_size[tube, 1] * s[tube, 2]
+    for i in np.flatnonzero(box | sphere | tube):
+        out[int(i)] = sizes[i]
+    return out
 
 
 def _half_extent(kind: int, size: np.ndarray) -> np.ndarray:
