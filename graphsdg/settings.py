@@ -37,10 +37,16 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/exts/omni.replicator.core/enableWriteToFabric": (
         False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
     "/graphsdg/run/numFrames": (None, "frames for orchestrator.run() calls without num_frames (graphsdg run --frames)"),
+    "/graphsdg/run/shardIndex": (0, "this process's shard of a sharded run (graphsdg run --workers)"),
+    "/graphsdg/run/shardCount": (1, "shards of a sharded run: shard i captures frames i, i+K, ..."),
+    "/graphsdg/run/resume": (False, "skip frames complete on disk and adopt the writers' files (graphsdg run --resume)"),
+    "/graphsdg/io/discardWrites": (False, "disk backends create and write nothing (graphsdg graph)"),
     "/graphsdg/render/shadowSize": (1024, "shadow map size of shadow-casting lights"),
     "/graphsdg/render/msaaSamples": (4, "multisample anti-aliasing samples of the colour pass"),
     "/graphsdg/render/exposure": (1.0, "scale from photometric light units to display values"),
     "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
+    "/graphsdg/render/resolutionScale": (1.0, "factor applied to every new render product's resolution "
+                                         "(graphsdg run --resolution-scale; small test runs of full-size scripts)"),
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
@@ -86,6 +92,10 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/io/runState": _boolean,
     "/exts/omni.replicator.core/enableWriteToFabric": _boolean,
     "/graphsdg/run/numFrames": _integer(0, none_ok=True),
+    "/graphsdg/run/shardIndex": _integer(0),
+    "/graphsdg/run/shardCount": _integer(1),
+    "/graphsdg/run/resume": _boolean,
+    "/graphsdg/io/discardWrites": _boolean,
     "/graphsdg/render/shadowSize": _integer(1),
     "/graphsdg/render/msaaSamples": _integer(0),
     "/graphsdg/render/exposure": _positive_number,
@@ -139,9 +149,10 @@ def get(key: str, default: Any = None) -> Any:
 
 
 def reset() -> None:
-    """Forget every value that was set (defaults apply again)."""
+    """Forget every value that was set (defaults apply again) and which keys were already warned about."""
     with _lock:
         _values.clear()
+        _warned.clear()
 
 
 # carb-style aliases so `settings.get_settings().set(...)` reads naturally.

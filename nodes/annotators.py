@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
+import cv2
 import numpy as np
 from pxr import Usd, UsdGeom
 
@@ -69,10 +70,16 @@ def present_ids(ids: np.ndarray) -> np.ndarray:
     return np.unique(ids)
 
 
-def _colorize(ids: np.ndarray) -> np.ndarray:
-    present = present_ids(ids)
-    lut_vals = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
-    return lut_vals[np.searchsorted(present, ids)]
+def _colorize(ids: np.ndarray, present: np.ndarray | None = None) -> np.ndarray:
+    present = present_ids(ids) if present is None else present
+    colors = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
+    if present.size and int(present[-1]) < (1 << 20):
+        # dense LUT of packed RGBA words: one 4-byte gather per pixel, then viewed as bytes
+        lut = np.zeros((int(present[-1]) + 1, 4), dtype=np.uint8)
+        lut[present] = colors
+        packed = lut.view(np.uint32)[:, 0][ids]
+        return packed.view(np.uint8).reshape(*ids.shape, 4)
+    return colors[np.searchsorted(present, ids)]
 
 
 def _color_key(id_: int) -> str:
@@ -83,11 +90,8 @@ def _color_key(id_: int) -> str:
 # ---- colour and depth -------------------------------------------------------
 def rgb(frame: FrameView, params: dict) -> dict:
     """uint8 (H, W, 4) RGBA colour; alpha 255."""
-    color = frame.require("color")
-    out = np.empty((frame.height, frame.width, 4), dtype=np.uint8)
-    out[..., :3] = color
-    out[..., 3] = 255
-    return {"data": out}
+    # cvtColor writes the interleaved RGBA in one vectorised pass (a strided numpy copy is ~10x slower)
+    return {"data": cv2.cvtColor(frame.require("color"), cv2.COLOR_RGB2RGBA)}
 
 
 def hdr_color(frame: FrameView, params: dict) -> dict:
@@ -118,12 +122,16 @@ def distance_to_camera(frame: FrameView, params: dict) -> dict:
 def semantic_segmentation(frame: FrameView, params: dict) -> dict:
     """uint32 (H, W) semantic ids (uint8 (H, W, 4) with ``colorize``); ``idToLabels``."""
     filt = semantic_filter(params)
-    sem = frame.semantic_image(filt)
     imap = frame.instance_map(filt)
     lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
-    present = sorted(set(present_ids(sem).tolist()) | set(RESERVED))
+    drawn = frame.present_ids("semantic", filt)
+    present = sorted(set(drawn.tolist()) | set(RESERVED))
     key = _color_key if params.get("colorize") else str
-    data = _colorize(sem) if params.get("colorize") else sem.copy()
+    if params.get("colorize"):
+        all_ids = set(imap.semantic_ids.tolist()) | set(RESERVED)
+        data = frame.colorized_id_image("semantic", filt, {i: color_of(i) for i in all_ids})
+    else:
+        data = frame.semantic_image(filt).copy()
     return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},
                                    "idToLabelLists": {key(i): lists[i] for i in present}}}
 
@@ -133,12 +141,13 @@ def instance_segmentation(frame: FrameView, params: dict) -> dict:
     filt = semantic_filter(params)
     ids = frame.instance_id_image(filt)
     imap = frame.instance_map(filt)
-    present = sorted(set(present_ids(ids).tolist()) | set(RESERVED))
+    drawn = frame.present_ids("instance", filt)
+    present = sorted(set(drawn.tolist()) | set(RESERVED))
     by_id = {int(i): k for k, i in enumerate(imap.instance_ids)}
     paths = {i: RESERVED[i] if i in RESERVED else imap.paths[by_id[i]] for i in present}
     lists = {i: {RESERVED_TYPE: [RESERVED[i]]} if i in RESERVED else imap.labels[by_id[i]] for i in present}
     key = _color_key if params.get("colorize") else str
-    data = _colorize(ids) if params.get("colorize") else ids.copy()
+    data = _colorize(ids, drawn) if params.get("colorize") else ids.copy()
     return {"data": data, "info": {"idToLabels": {key(i): paths[i] for i in present},
                                    "idToSemantics": {key(i): joined(lists[i]) for i in present},
                                    "idToSemanticLists": {key(i): lists[i] for i in present}}}

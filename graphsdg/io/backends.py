@@ -11,12 +11,13 @@ from __future__ import annotations
 import errno
 import inspect
 import os
+import re
 import threading
 import uuid
 from typing import Any, Callable
 
 
-from graphsdg import settings
+from graphsdg import frame_plan, settings
 from graphsdg.errors import unknown_name
 from graphsdg.io import encode
 from graphsdg.io.write_queue import get_write_queue
@@ -78,9 +79,12 @@ class DiskBackend(BaseBackend):
         root = settings.get("/omni/replicator/backends/disk/root_dir")
         path = output_dir if os.path.isabs(output_dir) else os.path.join(root or os.getcwd(), output_dir)
         path = os.path.abspath(path)
+        if writes_discarded():
+            return path
         if os.path.exists(path) and not os.path.isdir(path):
             raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
-        if not overwrite and os.path.exists(path):
+        # every shard, and a resumed run, must write into the folder the job started with
+        if not overwrite and os.path.exists(path) and frame_plan.current() is None:
             i = 1
             while os.path.exists(f"{path}_{i:04d}"):
                 i += 1
@@ -147,6 +151,34 @@ def bytes_written() -> int:
     return _written["bytes"]
 
 
+_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{12}\.tmp$")
+
+
+def remove_temporaries(output_dir: str) -> int:
+    """Delete the temporary files that interrupted atomic writes left under ``output_dir``; return how many.
+
+    Only call it while nothing writes there (a resumed run before its first frame, a merge after its shards).
+    """
+    removed = 0
+    for folder, _, names in os.walk(output_dir):
+        for name in names:
+            if _TEMPORARY.match(name):
+                try:
+                    os.unlink(os.path.join(folder, name))
+                    removed += 1
+                except FileNotFoundError:
+                    pass
+    return removed
+
+
+def writes_discarded() -> bool:
+    """True while ``/graphsdg/io/discardWrites`` is set: disk backends create and write nothing.
+
+    ``graphsdg graph SCRIPT`` runs a script this way to build its graph without touching its outputs.
+    """
+    return bool(settings.get("/graphsdg/io/discardWrites", False))
+
+
 def _fsync_dir(directory: str) -> None:
     fd = os.open(directory, os.O_RDONLY)
     try:
@@ -169,6 +201,8 @@ def write_file_atomic(full_path: str, data: bytes) -> None:
 
 def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
     """:func:`write_file_atomic`; ``count=False`` leaves the totals alone (bookkeeping files: the run state)."""
+    if writes_discarded():
+        return
     directory = os.path.dirname(full_path)
     os.makedirs(directory, exist_ok=True)
     tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{uuid.uuid4().hex[:12]}.tmp")

@@ -45,6 +45,9 @@ class Writer:
     annotators: list = []
     num_written: int = 0
     data_structure: str = "legacy"
+    #: True for writers that name a frame's files by ``data["frame_index"]`` when it is given (sharded and
+    #: resumed runs pass it); only such writers can be sharded or resumed.
+    frame_indexed: bool = False
 
     def __new__(cls, *args: Any, **kwargs: Any) -> "Writer":
         # Per-instance defaults (Replicator seeds them in __new__ too), so a subclass
@@ -168,6 +171,14 @@ class Writer:
         Writers that keep such files override this; ``orchestrator.wait_until_complete()``
         and :meth:`detach` call it, so the files on disk are complete after either.
         """
+
+    def frame_complete(self, frame_index: int) -> bool:
+        """Whether every file of frame ``frame_index`` is on disk (``--resume`` skips such frames)."""
+        return False
+
+    def shard_info(self) -> dict:
+        """What the merge step of a sharded run needs: ``{"aggregates": {final path: shard path}, ...}``."""
+        return {}
 
     def get_metadata(self) -> dict:
         """The writer's metadata: name, version and the global seed."""

@@ -16,6 +16,7 @@ Example:
 """
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -52,6 +53,8 @@ IMAGE_FORMATS = ("png", "jpg", "jpeg")
 
 class BasicWriter(Writer):
     """Replicator's BasicWriter (see the module docstring for the files it writes)."""
+
+    frame_indexed = True
 
     def __init__(self, output_dir: str | None = None, s3_bucket: str | None = None, s3_region: str | None = None,
                  s3_endpoint: str | None = None, semantic_types: list[str] | None = None, rgb: bool = False,
@@ -123,8 +126,8 @@ class BasicWriter(Writer):
         self._annotator_objs = None
 
     # ---- paths ---------------------------------------------------------
-    def _path(self, stem: str, rp_name: str, multi: bool, suffix: str) -> str:
-        n = f"{self._frame_id:0{self._padding}d}"
+    def _path(self, stem: str, rp_name: str, multi: bool, suffix: str, frame_id: int | None = None) -> str:
+        n = f"{self._frame_id if frame_id is None else frame_id:0{self._padding}d}"
         if not multi:
             prefix = ""
         elif self._common_dir:
@@ -138,6 +141,8 @@ class BasicWriter(Writer):
         if seq != self._sequence:
             self._sequence = seq
             self._frame_id = 0
+        if "frame_index" in data:          # sharded / resumed runs: the frame's number in the whole dataset
+            self._frame_id = int(data["frame_index"])
         annotators = data["annotators"]
         multi = len({rp for per_rp in annotators.values() for rp in per_rp}) > 1
         for anno_name, per_rp in annotators.items():
@@ -150,6 +155,39 @@ class BasicWriter(Writer):
             self.backend.schedule(iof.write_json, data=record,
                                   path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
+
+    def _files_of(self, stem: str) -> list[str]:
+        """The ``suffix.ext`` of every file :meth:`_write_one` writes for ``stem``."""
+        files = {"rgb": [f".{self._image_ext}"], "semantic_segmentation": [".png", "_labels.json"],
+                 "instance_id_segmentation": [".png", "_mapping.json"], "camera_params": [".json"],
+                 "instance_segmentation": [".png", "_mapping.json", "_semantics_mapping.json"],
+                 "normals": [".png"], "skeleton": [".json"],
+                 "pointcloud": [".npy", "_rgb.npy", "_normals.npy", "_semantic.npy", "_instance.npy"]}
+        if stem.startswith("bounding_box"):
+            return [".npy", "_labels.json", "_prim_paths.json"]
+        if stem.startswith("distance_to"):
+            return [".npy", ".png"] if self._colorize_depth else [".npy"]
+        return files.get(stem, [".npy"])
+
+    def expected_files(self, frame_index: int) -> list[str]:
+        """The files (relative to the output folder) this writer writes for frame ``frame_index``."""
+        rps = [rp.name for rp in self.render_products]
+        multi = len(rps) > 1
+        out = []
+        for anno in self._annotator_objects():
+            stem = self._stems.get(anno.name, anno.name[:-5] if anno.name.endswith("_fast") else anno.name)
+            for rp_name in rps:
+                for tail in self._files_of(stem):
+                    suffix, ext = tail.rsplit(".", 1)
+                    out.append(f"{self._path(stem, rp_name, multi, suffix, frame_index)}.{ext}")
+        if self._provenance:
+            out.append(f"provenance_{self._sequence}{frame_index:0{self._padding}d}.json")
+        return out
+
+    def frame_complete(self, frame_index: int) -> bool:
+        root = getattr(self.backend, "output_dir", None)
+        return root is not None and all(os.path.exists(os.path.join(root, f))
+                                        for f in self.expected_files(frame_index))
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
         b = self.backend

@@ -32,6 +32,8 @@ Example:
 """
 from __future__ import annotations
 
+import json
+import os
 import random
 import string
 from typing import Any, Sequence
@@ -39,7 +41,7 @@ from typing import Any, Sequence
 import cv2
 import numpy as np
 
-from graphsdg import rng
+from graphsdg import frame_plan, rng
 from graphsdg.annotate.ids import color_of
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof
@@ -65,6 +67,8 @@ def _mask_api():
 
 class CocoWriter(Writer):
     """COCO detection + instance segmentation (see the module docstring for the layout)."""
+
+    frame_indexed = True
 
     def __init__(self, output_dir: str | None = None, semantic_types: Sequence[str] | None = None,
                  coco_categories: dict | None = None, s3_bucket: str | None = None, s3_region: str | None = None,
@@ -102,10 +106,14 @@ class CocoWriter(Writer):
             "images": [], "annotations": [], "categories": [],
         }
         self.annotation_path = f"coco_annotations_{self.dataset_id}.json"
-        self._file = AggregateFile(self.backend, self.annotation_path)
+        self._file = AggregateFile(self.backend, frame_plan.aggregate_path(self.annotation_path))
         self._frame_id = 0
         self._sequence = ""
         self._dirty = True
+        self._indexed = False            # image ids from data["frame_index"] (sharded / resumed runs)
+        self._complete_images: set[int] = set()
+        if frame_plan.resuming():
+            self._adopt_existing()
         self.annotators = [
             AnnotatorRegistry.get_annotator("rgb"),
             AnnotatorRegistry.get_annotator("bounding_box_2d_tight_fast", init_params={"semanticFilter": filter_text}),
@@ -150,8 +158,12 @@ class CocoWriter(Writer):
         seq = f"{seq}_" if seq else ""          # Replicator's CocoWriter: "<count>_<seq>_"
         if seq != self._sequence:
             self._sequence, self._frame_id = seq, 0
-        for rp_name, rp_data in data["renderProducts"].items():
-            self._write_product(rp_name, rp_data)
+        if "frame_index" in data:           # sharded / resumed: image ids follow the frame's global number
+            self._frame_id, self._indexed = int(data["frame_index"]), True
+        products = data["renderProducts"]
+        for i, (rp_name, rp_data) in enumerate(products.items()):
+            image_id = self._frame_id * len(products) + i if self._indexed else len(self.coco["images"])
+            self._write_product(rp_name, rp_data, image_id)
         self._frame_id += 1
         self._dirty = True
         if self._frame_id % FLUSH_EVERY == 0:
@@ -161,11 +173,14 @@ class CocoWriter(Writer):
         return (f"{rp_name}/{kind}_{arguments.camera_name(camera)}_{self.dataset_id}."
                 f"{self._sequence}{self._frame_id:0{self._padding}d}.{self._ext}")
 
-    def _write_product(self, rp_name: str, rp: dict) -> None:
+    def _write_product(self, rp_name: str, rp: dict, image_id: int) -> None:
         width, height = (int(v) for v in rp["resolution"])
         rgb_path = self._file_name("rgb", rp_name, rp["camera"])
         self.backend.schedule(iof.write_image, data=rp["rgb"]["data"], path=rgb_path)
-        image_id = len(self.coco["images"])
+        if image_id in self._complete_images:     # a resumed frame redone: its old entries go
+            self._complete_images.discard(image_id)
+            self.coco["images"] = [im for im in self.coco["images"] if im["id"] != image_id]
+            self.coco["annotations"] = [a for a in self.coco["annotations"] if a["image_id"] != image_id]
         self.coco["images"].append({"file_name": rgb_path, "id": image_id, "height": height, "width": width,
                                     "license": 0, "date_captured": self._date, "flicker_url": "",
                                     "camera": rp["camera"], "render_product": rp_name})
@@ -211,12 +226,63 @@ class CocoWriter(Writer):
         snapshot = dict(self.coco)
         snapshot["images"] = list(self.coco["images"])
         snapshot["annotations"] = list(self.coco["annotations"])
+        if self._indexed or self._complete_images:
+            # frames may come out of order (resumed, sharded): images by id, annotations by image, renumbered
+            snapshot["images"].sort(key=lambda im: im["id"])
+            snapshot["annotations"] = renumber_annotations(snapshot["annotations"])
         snapshot["categories"] = [self._used[k] for k in sorted(self._used)]
         self._file.schedule(snapshot)
         self._dirty = False
 
     def on_final_frame(self) -> None:
         self.flush()
+
+    # ---- sharded and resumed runs ----------------------------------------------
+    def _image_files(self, image: dict) -> list[str]:
+        files = [image["file_name"]]
+        if self._write_panoptic:
+            folder, name = os.path.split(image["file_name"])
+            files.append(os.path.join(folder, "panoptic_" + name[len("rgb_"):]))
+        return files
+
+    def _adopt_existing(self) -> None:
+        """Resume: take over the images (whose files are on disk), annotations and categories already written."""
+        root = self.output_dir
+        found = [os.path.join(root, p) for p in dict.fromkeys([self.annotation_path, self._file.path])
+                 if root and os.path.exists(os.path.join(root, p))]
+        images: dict[int, dict] = {}
+        annotations: dict[int, list] = {}
+        for path in found:
+            with open(path, encoding="utf-8") as f:
+                doc = json.load(f)
+            self.coco["info"] = doc.get("info", self.coco["info"])
+            self._date = self.coco["info"].get("date_created", self._date)
+            for cat in sorted(doc.get("categories", []), key=lambda c: int(c["id"])):
+                self._used.setdefault(int(cat["id"]), cat)
+                if self._categories is None:
+                    self._auto.id_of(cat["name"])
+            for image in doc.get("images", []):
+                if all(os.path.exists(os.path.join(root, f)) for f in self._image_files(image)):
+                    images[int(image["id"])] = image
+            for a in doc.get("annotations", []):
+                annotations.setdefault(int(a["image_id"]), []).append(a)
+        self.coco["images"] = [images[i] for i in sorted(images)]
+        self.coco["annotations"] = [a for i in sorted(images) for a in annotations.get(i, [])]
+        self._complete_images = set(images)
+
+    def frame_complete(self, frame_index: int) -> bool:
+        n = max(len(self.render_products), 1)
+        return all(frame_index * n + i in self._complete_images for i in range(n))
+
+    def shard_info(self) -> dict:
+        return {"aggregates": {self.annotation_path: self._file.path}, "auto_categories": self._categories is None,
+                "panoptic": self._write_panoptic}
+
+
+def renumber_annotations(annotations: list[dict]) -> list[dict]:
+    """Annotations ordered by image (stable within an image) with ids 1, 2, ... (copies)."""
+    ordered = sorted(annotations, key=lambda a: a["image_id"])
+    return [{**a, "id": i + 1} for i, a in enumerate(ordered)]
 
 
 def mask_polygons(mask: np.ndarray) -> list[list[float]]:
