@@ -21,6 +21,8 @@ import os
 import sys
 from dataclasses import dataclass
 
+from graphsdg.settings import KNOWN_KEYS
+
 DOC = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs", "errors.md")
 
 
@@ -377,13 +379,7 @@ CASES: list[Case] = [
       'rep.settings.set("/omni/replicator/RTSubframe", 4)',
       "UserWarning", "setting '/omni/replicator/RTSubframe' has no effect in graphsdg (stored, but nothing reads it) "
                      "(did you mean '/omni/replicator/RTSubframes'?); honoured keys: "
-                     "/exts/omni.replicator.core/enableWriteToFabric, /graphsdg/io/fsync, /graphsdg/io/queueMaxBytes, "
-                     "/graphsdg/io/runState, /graphsdg/render/exposure, /graphsdg/render/maxResolution, "
-                     "/graphsdg/render/msaaSamples, /graphsdg/render/shadowSize, /graphsdg/run/numFrames, "
-                     "/omni/replicator/RTSubframes, /omni/replicator/backend/queueSize, "
-                     "/omni/replicator/backend/writeThreads, /omni/replicator/backends/disk/root_dir, "
-                     "/omni/replicator/captureOnPlay, /omni/replicator/globalSeed, "
-                     "/persistent/isaac/asset_root/default, /rtx/rendermode"),
+                     + ", ".join(sorted(KNOWN_KEYS))),
     C("settings", "a setting value of the wrong type", 'rep.settings.set("/omni/replicator/RTSubframes", "four")',
       "ValueError", "setting /omni/replicator/RTSubframes must be an integer >= 0, got 'four'"),
     C("settings", "a write queue of size 0", 'rep.settings.set("/omni/replicator/backend/queueSize", 0)',
@@ -396,7 +392,7 @@ CASES: list[Case] = [
       "ValueError", "global seed must be a non-negative integer, got '7'"),
     # ---- command line --------------------------------------------------------------------------------------------
     C("cli", "zero frames for the demo", 'cli("demo", "--frames", "0")',
-      "exit 2", "graphsdg: error: --frames must be >= 1, got 0"),
+      "exit 2", "graphsdg demo: error: argument --frames: must be a positive integer, got 0"),
     C("cli", "running a script that does not exist", 'cli("run", os.path.join(tmp, "job.py"))',
       "exit 1", "graphsdg: error: script '<tmp>/job.py' does not exist"),
     C("cli", "validating a folder that does not exist", 'cli("validate", os.path.join(tmp, "nowhere"))',

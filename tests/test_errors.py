@@ -9,7 +9,30 @@ import pytest
 from pxr import UsdGeom
 
 import graphsdg as rep
+from graphsdg.annotate.annotator import AnnotatorRegistry
+from graphsdg.graph.registry import NodeRegistry
+from graphsdg.io import backends
 from error_cases import CASES, DOC, CommandFailed, cli, render_markdown
+
+# The registries as graphsdg ships them (collected before any test registers its own writers, annotators,
+# backends or nodes): messages that list known names list these.
+_REGISTRIES = [(rep.WriterRegistry, "_writers"), (AnnotatorRegistry, "_specs"), (AnnotatorRegistry, "_aliases"),
+               (AnnotatorRegistry, "_aovs"), (NodeRegistry, "_types"), (backends, "_registry")]
+_BUILT_IN = [dict(getattr(owner, name)) for owner, name in _REGISTRIES]
+
+
+@pytest.fixture
+def built_in_registries():
+    saved = [dict(getattr(owner, name)) for owner, name in _REGISTRIES]
+    for (owner, name), shipped in zip(_REGISTRIES, _BUILT_IN):
+        table = getattr(owner, name)
+        table.clear()
+        table.update(shipped)
+    yield
+    for (owner, name), current in zip(_REGISTRIES, saved):
+        table = getattr(owner, name)
+        table.clear()
+        table.update(current)
 
 
 @pytest.fixture
@@ -46,7 +69,7 @@ def _raised(code: str, namespace: dict) -> tuple[str, str]:
 
 
 @pytest.mark.parametrize("case", CASES, ids=[f"{i + 1}-{c.area}-{c.mistake[:40]}" for i, c in enumerate(CASES)])
-def test_mistake_is_answered_exactly(case, scratch):
+def test_mistake_is_answered_exactly(case, scratch, built_in_registries):
     namespace = {"rep": rep, "os": os, "np": np, "UsdGeom": UsdGeom, "tmp": scratch, "cli": cli, **_scene()}
     try:
         kind, message = _raised(case.code, namespace)
