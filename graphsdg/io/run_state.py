@@ -4,11 +4,13 @@ While a writer with an output folder has frames that are not yet known to be
 complete, ``<output_dir>/graphsdg_run.json`` says which are (format documented in
 ``docs/reproducibility.md``). It appears with the first frame and is rewritten
 atomically about once a second and at every flush point (``wait_until_complete()``,
-``stop()``, the end of ``run()``, an interrupt, interpreter exit). When a flush point
-finds every frame complete, the file is removed: a finished dataset holds exactly
-the writer's own files, byte-identical to an uninterrupted run's, and a folder
-*with* the file was interrupted (status ``"interrupted"``), failed (``"failed"``) or
-is still being written (``"writing"``, also what a killed process leaves).
+``stop()``, the end of ``run()``, an interrupt, interpreter exit). When
+``wait_until_complete()``, ``stop()`` or the end of ``run()`` finds every frame
+complete, the file is removed: a finished dataset holds exactly the writer's own
+files, byte-identical to an uninterrupted run's. A folder *with* the file was
+interrupted (status ``"interrupted"``), failed (``"failed"``), was flushed only by
+the exit hook (``"exited"``) or is still being written (``"writing"``, also what a
+killed process leaves).
 
 A frame is *complete* once every file the writer scheduled for it is on disk under
 its final name; for writers that keep dataset-wide files (COCO json, BOP scene json,
