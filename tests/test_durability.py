@@ -462,3 +462,14 @@ def test_run_state_read_rejects_foreign_files(tmp_path):
     with pytest.raises(ValueError, match=r"is not a graphsdg.run_state file of version 1 \(found \('something-else', 1\)\)"):
         run_state.read(tmp_path)
     assert run_state.read(tmp_path / "nowhere") is None
+
+
+def test_validate_reports_an_unfinished_run(tmp_path):
+    from graphsdg.dataset.validate import validate
+    script = tmp_path / "job.py"
+    script.write_text(JOB)
+    subprocess.run([sys.executable, str(script), str(tmp_path / "out"), "steps", "3"], check=True, timeout=120,
+                   capture_output=True, cwd=str(tmp_path))      # exits without wait_until_complete: status exited
+    found = [str(v) for v in validate(str(tmp_path / "out")) if "did not finish" in str(v)]
+    assert found == ["-: [complete] the run that wrote this folder did not finish (graphsdg_run.json: BasicWriter "
+                     "exited, complete frames 0-2); resume or rerun it"]
