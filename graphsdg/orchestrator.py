@@ -23,6 +23,7 @@ from graphsdg.io.write_queue import current_write_queue, get_write_queue
 from graphsdg.progress import Progress
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
+from graphsdg.stage.context import stage_context
 
 log = logging.getLogger("graphsdg.orchestrator")
 
@@ -69,8 +70,6 @@ _state = _State()
 def _on_stage_replaced(stage) -> None:
     _state.stage_step = 0
 
-
-from graphsdg.stage.context import stage_context  # noqa: E402
 
 stage_context.subscribe_replaced(_on_stage_replaced)
 
@@ -318,14 +317,19 @@ def unregister_status_callback(handle: int) -> None:
     _state.callbacks.pop(handle, None)
 
 
-def stop(_status: str = "finished") -> None:
+def stop() -> None:
     """Stop generation: writers' ``on_final_frame`` runs, then pending writes are flushed."""
+    _stop("finished")
+
+
+def _stop(status: str) -> None:
+    """:func:`stop`, recording ``status`` (``finished`` or ``interrupted``) in the run-state files."""
     _state.stop_requested = True
     _state.pause_requested = False
     _state.set(Status.STOPPING)
     for writer in runtime().writers:
         writer.on_final_frame()
-    _drain(_status)
+    _drain(status)
     _state.remaining = None
     _state.set(Status.STOPPED)
 
@@ -386,7 +390,7 @@ def _run_loop() -> None:
             raise
         if held is not None and held.received is not None:
             log.warning("graphsdg: interrupted after %d frames; flushing the writers", progress.frames)
-            stop("interrupted")
+            _stop("interrupted")
             log.warning("graphsdg: run interrupted; every captured frame is on disk (%s)", progress.summary())
             interrupts.raise_for(held.received)
     if not paused and not _state.stop_requested:
