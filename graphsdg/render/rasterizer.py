@@ -37,7 +37,7 @@ import mujoco
 import numpy as np
 
 from graphsdg.render.camera import CameraView
-from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
+from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
 
 PASSES = ("color", "hdr", "depth", "segmentation")
@@ -101,6 +101,11 @@ class Rasterizer:
         """Make the GL contexts match the scene's current model."""
         self._ensure_gl()
         model = sim.model
+        quality = render_quality()
+        if (int(model.vis.quality.shadowsize), int(model.vis.quality.offsamples)) != quality:
+            # the render mode changed since the compile: takes effect now, no recompile needed
+            model.vis.quality.shadowsize, model.vis.quality.offsamples = quality
+            self._version = -1
         if self._version != sim.model_version or self._model is not model:
             if self._mjr is not None:
                 self._mjr.free()

@@ -147,6 +147,16 @@ def _validate_resolution(resolution: object) -> tuple[int, int]:
     return int(w), int(h)
 
 
+def _scaled(resolution: tuple[int, int]) -> tuple[int, int]:
+    """``resolution`` times the ``/graphsdg/render/resolutionScale`` setting (aspect kept up to rounding)."""
+    scale = float(settings.get("/graphsdg/render/resolutionScale", 1.0))
+    if not scale > 0:
+        raise ValueError(f"setting /graphsdg/render/resolutionScale must be > 0, got {scale!r}")
+    if scale == 1.0:
+        return resolution
+    return max(1, round(resolution[0] * scale)), max(1, round(resolution[1] * scale))
+
+
 def _camera_path(camera: object) -> str:
     if hasattr(camera, "get_output_prims"):  # a graph item wrapping a camera node
         prims = camera.get_output_prims()["prims"]
@@ -178,6 +188,7 @@ def create_render_product(camera: object, resolution: Sequence[int], force_new: 
                                                                            for c in camera)):
         return [create_render_product(c, res, force_new, name, render_vars) for c in camera]  # type: ignore
     path = _camera_path(camera)
+    res = _scaled(res)
     if not force_new:
         for rp in registry:
             if rp.camera == path and rp.resolution == res and (name is None or rp.name == name):
