@@ -38,8 +38,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
-                        "rasteriser settings (8x MSAA, 4096 px shadow maps, /rtx/pathtracing/totalSpp jittered "
-                        "subframes per capture)"),
+                        "rasteriser settings (8x MSAA, shadow maps of 8 texels per image pixel up to 4096 px, "
+                        "/rtx/pathtracing/totalSpp jittered subframes per capture)"),
     "/rtx/pathtracing/spp": (1, "samples per pixel per frame in PathTracing mode (see totalSpp)"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),

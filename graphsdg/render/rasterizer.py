@@ -101,7 +101,7 @@ class Rasterizer:
         """Make the GL contexts match the scene's current model."""
         self._ensure_gl()
         model = sim.model
-        quality = render_quality()
+        quality = render_quality(max(int(model.vis.global_.offwidth), int(model.vis.global_.offheight)))
         if (int(model.vis.quality.shadowsize), int(model.vis.quality.offsamples)) != quality:
             # the render mode changed since the compile: takes effect now, no recompile needed
             model.vis.quality.shadowsize, model.vis.quality.offsamples = quality

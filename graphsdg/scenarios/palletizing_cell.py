@@ -61,7 +61,7 @@ class CellLayout:
     helper_inner_radius: float = 0.92                            # bins' inner face on the helper
     helper_top: float = -0.15
     pallet_center: tuple[float, float] = (0.70, -0.45)
-    slot_gap: float = 0.02
+    slot_gap: tuple[float, float] = (0.05, 0.03)                 # between bins on the pallet (x, y)
     input_stack_center: tuple[float, float] = (-1.30, 1.95)
 
     @property
@@ -83,8 +83,8 @@ class CellLayout:
         length, width, height = self.bin_size
         layer, k = divmod(index, 6)
         ix, iy = 1 - k // 3, k % 3          # outer column (away from the robot) first
-        x = self.pallet_center[0] + (ix - 0.5) * (width + self.slot_gap)
-        y = self.pallet_center[1] + (1 - iy) * (length + self.slot_gap)
+        x = self.pallet_center[0] + (ix - 0.5) * (width + self.slot_gap[0])
+        y = self.pallet_center[1] + (1 - iy) * (length + self.slot_gap[1])
         z = self.pallet_top + layer * height + height / 2
         return np.array([x, y, z]), math.pi / 2
 

@@ -38,8 +38,8 @@ from graphsdg.stage.xform import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 Z = np.array([0.0, 0.0, 1.0])
 SPEED = 1.0                 # m/s, peak tool speed of swings and long descents
 TURN_SPEED = 2.5            # rad/s, peak tool turning speed (a UR10's wrist turns at up to 3.1 rad/s)
-APPROACH_SPEED = 0.35       # m/s, peak speed of short straight approaches and retreats
-TOUCH_SPEED = 0.08          # m/s, the last centimetres before the cup touches
+APPROACH_SPEED = 0.4        # m/s, peak speed of short straight approaches and retreats
+TOUCH_SPEED = 0.1           # m/s, the last centimetres before the cup touches
 PLACE_CLEARANCE = 0.004     # a bin is let go this far above its support
 BELT_GAIN = 8.0             # 1/s, traction towards the belt speed
 BELT_FRICTION = 0.5
@@ -273,14 +273,26 @@ class PalletizingController:
         yield from self._path(target, False, final_speed)
 
     # ---- gripping ---------------------------------------------------------------------
-    def _tool_down(self, x_axis: np.ndarray) -> np.ndarray:
-        """Tool pointing down, its x along the horizontal ``x_axis`` (sign nearest the current tool)."""
+    def _kindest(self, position: np.ndarray, rotations: list[np.ndarray]) -> np.ndarray:
+        """Of tool orientations that are all fine for the task (a bin is the same turned by half a turn),
+        the one that leaves the wrist's last joint nearest zero: the wrist never runs into its limit."""
+        best, best_cost = rotations[0], math.inf
+        for rot in rotations:
+            try:
+                q = self.kin.solve(Frame(position, rot), self.kin.seed_for(position, self.q_cmd))
+            except ValueError:
+                continue
+            cost = abs(q[5]) + 10.0 * float(np.sum(np.maximum(np.abs(q) - (2 * math.pi - 0.5), 0.0)))
+            if cost < best_cost:
+                best, best_cost = rot, cost
+        return best
+
+    def _tool_down(self, position: np.ndarray, x_axis: np.ndarray) -> np.ndarray:
+        """Tool pointing down, its x along the horizontal ``x_axis`` (either sign: see :meth:`_kindest`)."""
         x = np.array([x_axis[0], x_axis[1], 0.0])
         x /= np.linalg.norm(x)
-        if np.dot(x, self.tcp_cmd.rot[:, 0]) < 0:
-            x = -x
         z = -Z
-        return np.stack([x, np.cross(z, x), z], axis=1)
+        return self._kindest(position, [np.stack([s * x, np.cross(z, s * x), z], axis=1) for s in (1.0, -1.0)])
 
     def _up_face(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         """(centre of the bin's upward face, tool-down rotation aligned with the bin's long axis)."""
@@ -289,7 +301,7 @@ class PalletizingController:
         k = int(np.argmax(np.abs(pose.rot[2, :])))
         face = pose.pos + pose.rot[:, k] * np.sign(pose.rot[2, k]) * half[k]
         long_axis = pose.rot[:, 0] if k != 0 else pose.rot[:, 1]
-        return face, self._tool_down(long_axis)
+        return face, self._tool_down(face, long_axis)
 
     def _grip_from_above(self, i: int) -> Iterator[None]:
         """Travel over bin ``i``'s upward face, come down until the cup touches, switch the grip on."""
@@ -315,6 +327,7 @@ class PalletizingController:
         yield from self._hold(0.1)
 
     def _release(self, i: int, where: str) -> Iterator[None]:
+        yield from self._hold(0.1)          # let the bin settle in the grip before letting go
         set_fixed_joint_enabled(self.suction[i], False)
         self._carrying = None
         self.events.append(Event(float(self._data().time), f"released_on_{where}", i))
@@ -350,18 +363,16 @@ class PalletizingController:
         u = lay.helper_u
         r_in, z_h = lay.helper_inner_radius, lay.helper_top
         # 1. on its side: the tool turns horizontal (pointing away from the robot), the bin's bottom faces it
-        rot = self._sideways()
-        yield from self._travel(Frame(u * r_in + Z * (z_h + width / 2 + PLACE_CLEARANCE), rot),
-                                final_speed=0.15, final_drop=0.05)
+        at = u * r_in + Z * (z_h + width / 2 + PLACE_CLEARANCE)
+        yield from self._travel(Frame(at, self._sideways(at)), final_speed=0.15, final_drop=0.05)
         yield from self._release(i, "helper")
         yield from self._path(Frame(self.tcp_cmd.pos - u * 0.06, self.tcp_cmd.rot), False, APPROACH_SPEED)
         yield from self._lift(0.10)
         # 2. grip the side now facing up and stand the bin up on the helper
         yield from self._grip_from_above(i)
         yield from self._lift(0.15)
-        rot = self._sideways()
-        yield from self._travel(Frame(u * r_in + Z * (z_h + height / 2 + PLACE_CLEARANCE), rot),
-                                final_speed=0.15, final_drop=0.05)
+        at = u * r_in + Z * (z_h + height / 2 + PLACE_CLEARANCE)
+        yield from self._travel(Frame(at, self._sideways(at)), final_speed=0.15, final_drop=0.05)
         yield from self._release(i, "helper")
         yield from self._path(Frame(self.tcp_cmd.pos - u * 0.06, self.tcp_cmd.rot), False, APPROACH_SPEED)
         yield from self._lift(0.10)
@@ -369,25 +380,20 @@ class PalletizingController:
         yield from self._grip_from_above(i)
         yield from self._lift(0.12)
 
-    def _sideways(self) -> np.ndarray:
-        """Tool horizontal and pointing away from the robot over the helper, its x kept along the bin."""
+    def _sideways(self, position: np.ndarray) -> np.ndarray:
+        """Tool horizontal and pointing away from the robot over the helper, its x along the bin."""
         u = self.layout.helper_u
         t = np.cross(Z, u)
-        x = t if np.dot(t, self.tcp_cmd.rot[:, 0]) >= 0 else -t
-        return np.stack([x, np.cross(u, x), u], axis=1)
+        return self._kindest(position, [np.stack([x, np.cross(u, x), u], axis=1) for x in (t, -t)])
 
     def _place_on_pallet(self, i: int) -> Iterator[None]:
         slot = len(self.placed)
         centre, yaw = self.layout.slot(slot)
-        current = self.bin_pose(i).rot[:, 0]
-        # of the two yaws that put the bin in the slot, take the one that turns the wrist less: the
-        # swing turns the base by the change of bearing, the wrist by the rest
-        here = math.atan2(self.tcp_cmd.pos[1], self.tcp_cmd.pos[0])
-        there = math.atan2(centre[1], centre[0])
-        wrist_turn = (yaw - there) - (math.atan2(current[1], current[0]) - here)
-        if math.cos(wrist_turn) < 0:
-            yaw += math.pi
-        target = Frame(centre + Z * PLACE_CLEARANCE, rotation_about(2, yaw)) @ self._grasp
+        # either of the two yaws half a turn apart puts the bin in its slot
+        options = [Frame(centre + Z * PLACE_CLEARANCE, rotation_about(2, yaw + k * math.pi)) @ self._grasp
+                   for k in (0, 1)]
+        rot = self._kindest(options[0].pos, [o.rot for o in options])
+        target = next(o for o in options if o.rot is rot)
         yield from self._travel(target, final_speed=0.15, final_drop=0.05)
         yield from self._release(i, "pallet")
         self.placed.append(i)

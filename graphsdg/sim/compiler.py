@@ -153,24 +153,28 @@ class CompiledScene:
     probe_sphere: int = -1
 
 
-def snap_unit_scale(scale: np.ndarray) -> np.ndarray:
-    """``scale`` with components within 1e-12 of +-1 made exactly +-1 (a rotation's rounding noise)."""
-    s = np.asarray(scale, dtype=np.float64).copy()
-    near = np.abs(np.abs(s) - 1.0) < 1e-12
-    s[near] = np.sign(s[near])
-    return s
+def clean_scale(scale: np.ndarray) -> np.ndarray:
+    """A scale read off a rotated matrix, rounded to 12 significant digits.
+
+    The row norms of ``R * s`` carry rounding noise that depends on the rotation;
+    rounding it away makes a body's geometry, and so its inertia, identical
+    however the body is turned when the stage is compiled.
+    """
+    return np.array([float(f"{v:.12g}") for v in np.asarray(scale, dtype=np.float64)])
 
 
-def render_quality() -> tuple[int, int]:
+def render_quality(largest_image: int = 4096) -> tuple[int, int]:
     """(shadow map size, MSAA samples) for the current settings.
 
     ``/rtx/rendermode = PathTracing`` (Isaac's highest-quality mode) maps to the
-    rasteriser's best: 4096 px shadow maps and 8x multisampling (at least).
+    rasteriser's best: 8x multisampling and shadow maps of 8 texels per pixel of
+    the largest image (``largest_image``, its longer edge), up to 4096 px, never
+    below ``/graphsdg/render/shadowSize``.
     """
     shadow = int(settings.get("/graphsdg/render/shadowSize", 1024))
     samples = int(settings.get("/graphsdg/render/msaaSamples", 4))
     if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
-        shadow, samples = max(shadow, 4096), max(samples, 8)
+        shadow, samples = max(shadow, min(4096, 8 * int(largest_image))), max(samples, 8)
     return shadow, samples
 
 
@@ -377,7 +381,7 @@ class _Builder:
         self.configure_physics_scene(up)
         vis = spec.visual
         vis.global_.offwidth, vis.global_.offheight = self.offscreen
-        vis.quality.shadowsize, vis.quality.offsamples = render_quality()
+        vis.quality.shadowsize, vis.quality.offsamples = render_quality(max(self.offscreen))
         # Cameras get their own near/far from USD; these two (relative to the model extent)
         # only bound MuJoCo's shadow-map depth range, so they are kept tight for precision.
         vis.map.znear = 0.01
@@ -500,7 +504,7 @@ class _Builder:
         rel, _ = self.cache.ComputeRelativeTransform(prim, root)
         _, _, root_scale = decompose(world_matrix(root, self.cache))
         scale = np.eye(4)
-        scale[0, 0], scale[1, 1], scale[2, 2] = snap_unit_scale(root_scale)
+        scale[0, 0], scale[1, 1], scale[2, 2] = clean_scale(root_scale)
         return np.array(rel, dtype=np.float64) @ scale
 
     def add_link(self, link: jointmap.TreeLink):

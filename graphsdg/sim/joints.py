@@ -190,9 +190,8 @@ def _local_frame(prim: Usd.Prim, pos_attr: Usd.Attribute, rot_attr: Usd.Attribut
     if body != WORLD:
         # localPos is in the body's local space, so the body's scale applies to it.
         _, _, scale = decompose(world_matrix(prim.GetStage().GetPrimAtPath(body)))
-        near = np.abs(np.abs(scale) - 1.0) < 1e-12      # a rotation's rounding noise is no scale
-        scale[near] = np.sign(scale[near])
-        pos = pos * scale
+        # rounded like the compiler's body scales: the same frame wherever the body is
+        pos = pos * np.array([float(f"{v:.12g}") for v in scale])
     frame = Frame(pos, rot)
     return static_frame @ frame if static_frame is not None else frame
 
