@@ -35,6 +35,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
     "/graphsdg/render/resolutionScale": (1.0, "factor applied to every new render product's resolution "
                                          "(graphsdg run --resolution-scale; small test runs of full-size scripts)"),
+    "/graphsdg/scenarios/palletizing/numBins": (36, "bins in the palletizing scenario's cell (BinStacking() without "
+                                                    "num_bins); fewer make CI-sized runs"),
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
