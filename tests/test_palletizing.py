@@ -207,3 +207,36 @@ def test_seed_script_captures_on_robot_events_and_leaves_the_simulation_unchange
         assert np.linalg.norm(pos[i] - centre) < 0.01
         tilt = 2 * math.degrees(math.asin(min(1.0, np.linalg.norm(quat[i, 1:3]))))
         assert tilt < 2.0
+
+
+# ---- the render-mode switch and the CI knobs -------------------------------------------------
+def test_path_tracing_mode_maps_to_the_best_rasteriser_settings_and_ci_knobs_bound_it():
+    from conftest import unit_cube_scene
+    cube, cam, rp = unit_cube_scene(resolution=(64, 48))
+    rgb = rep.AnnotatorRegistry.get_annotator("rgb")
+    rgb.attach(rp)
+    raster = runtime().rasterizer
+
+    def renders_per_capture(**kwargs):
+        before = raster.stats["color"]
+        rep.orchestrator.step(delta_time=0.0, **kwargs)
+        return raster.stats["color"] - before
+
+    plain = rgb.get_data() if renders_per_capture() else None
+    assert renders_per_capture() == 1
+    assert (runtime().sim.model.vis.quality.shadowsize, runtime().sim.model.vis.quality.offsamples) == (1024, 4)
+    settings.set("/rtx/rendermode", "PathTracing")
+    settings.set("/rtx/pathtracing/totalSpp", 6)
+    assert renders_per_capture() == 6                         # the samples are jittered subframes
+    m = runtime().sim.model
+    assert (m.vis.quality.shadowsize, m.vis.quality.offsamples) == (1024, 8)    # 8 x 64 px < the 1024 floor
+    smooth = rgb.get_data()
+    assert smooth.shape == plain.shape and np.abs(smooth.astype(int) - plain).max() > 0
+    settings.set("/graphsdg/render/maxSubframes", 3)
+    assert renders_per_capture(rt_subframes=24) == 3
+    settings.set("/rtx/rendermode", "RayTracedLighting")
+    settings.set("/graphsdg/render/maxSubframes", 0)
+    assert renders_per_capture() == 1
+    assert runtime().sim.model.vis.quality.offsamples == 4
+    settings.set("/graphsdg/render/resolutionScale", 0.5)
+    assert rep.create.render_product(cam, (512, 384)).resolution == (256, 192)
