@@ -27,7 +27,7 @@ from graphsdg.runtime import runtime
 from graphsdg.sim.timeline import TimelineEventType
 
 SEED = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests", "seed_scripts",
-                    "palletizing_sdg_demo.py")
+                    "ur10_palletizing_script_editor.py")
 
 
 def robot_only(bins: int) -> dict:

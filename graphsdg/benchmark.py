@@ -65,6 +65,8 @@ class BenchConfig:
     seed: int = 11
     out_dir: str | None = None
     write_threads: int = 4
+    msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
+    shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
 
 
 @dataclass
@@ -124,6 +126,10 @@ def build_scene(config: BenchConfig):
     """The benchmark stage; returns (asset prims, camera prims, render products)."""
     import graphsdg as rep
 
+    if config.msaa_samples is not None:
+        rep.settings.set("/graphsdg/render/msaaSamples", int(config.msaa_samples))
+    if config.shadow_size is not None:
+        rep.settings.set("/graphsdg/render/shadowSize", int(config.shadow_size))
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)
@@ -156,6 +162,7 @@ def _apply(draw: dict[str, np.ndarray], assets, cams) -> None:
 def run_graphsdg(config: BenchConfig) -> BenchResult:
     """Time graphsdg on the benchmark scene."""
     import graphsdg as rep
+    from graphsdg import profiling
     from graphsdg.io.write_queue import reset_write_queue
 
     rep.settings.set("/omni/replicator/backend/writeThreads", config.write_threads)
@@ -182,7 +189,9 @@ def run_graphsdg(config: BenchConfig) -> BenchResult:
     rep.orchestrator.reset_profile()
     start = last = time.perf_counter()
     for _ in range(config.frames):
+        t = time.perf_counter()
         _apply(draws.draw(), assets, cams)
+        profiling.add("randomize", time.perf_counter() - t)
         rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
         now = time.perf_counter()
         result.frame_times.append(now - last)
@@ -209,6 +218,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     import mujoco
 
     import graphsdg as rep  # noqa: F401  (EGL selection)
+    from graphsdg import profiling
     from graphsdg.runtime import runtime
 
     assets, cams, rps = build_scene(config)
@@ -246,6 +256,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
             np.save(path, payload)
 
     def frame(draw, index):
+        t0 = time.perf_counter()
         data.mocap_pos[mocap] = draw["position"]
         for mid, rot in zip(mocap, draw["rotation"]):
             quat = np.empty(4)
@@ -254,6 +265,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
         model.geom_size[geom_ids[~is_mesh]] = unit_size[~is_mesh] * draw["scale"][~is_mesh, :1]
         model.geom_rgba[geom_ids, :3] = draw["color"]
         mujoco.mj_kinematics(model, data)
+        profiling.add("baseline:randomize", time.perf_counter() - t0)
         for c, pos in enumerate(draw["camera"]):
             d = np.linalg.norm(pos)
             cam.lookat[:] = 0
@@ -263,20 +275,24 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
             renderer.disable_depth_rendering()
             renderer.disable_segmentation_rendering()
             renderer.update_scene(data, cam)
-            rgb = renderer.render()
+            with profiling.timed("baseline:render:rgb"):
+                rgb = renderer.render()
             if not config.skip_write:
                 pending.append(pool.submit(write, f"{tmp}/rgb_{c}_{index}.png", rgb[..., ::-1].copy()))
             if need_depth:
                 renderer.enable_depth_rendering()
-                depth = renderer.render()
+                with profiling.timed("baseline:render:depth"):
+                    depth = renderer.render()
                 renderer.disable_depth_rendering()
                 if not config.skip_write:
                     pending.append(pool.submit(write, f"{tmp}/depth_{c}_{index}.npy", depth))
             if need_seg:
                 renderer.enable_segmentation_rendering()
-                seg = renderer.render()
+                with profiling.timed("baseline:render:segmentation"):
+                    seg = renderer.render()
+                t1 = time.perf_counter()
                 renderer.disable_segmentation_rendering()
-                ids = np.where(seg[..., 1] == mujoco.mjtObj.mjOBJ_GEOM, seg[..., 0], -1)
+                ids = np.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
                 inst = geom_to_asset[ids]
                 flat = inst.ravel()
                 sel = np.nonzero(flat >= 0)[0]
@@ -288,6 +304,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
                 np.minimum.at(boxes[:, 1], k, ys)
                 np.maximum.at(boxes[:, 2], k, xs)
                 np.maximum.at(boxes[:, 3], k, ys)
+                profiling.add("baseline:boxes", time.perf_counter() - t1)
                 if not config.skip_write:
                     sem = (labels[inst] + 2).astype(np.uint16)
                     pending.append(pool.submit(write, f"{tmp}/seg_{c}_{index}.png", sem))
@@ -298,6 +315,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
         frame(draws.draw(), -1 - i)
     concurrent.futures.wait(pending)
     pending.clear()
+    profiling.reset()
     start = last = time.perf_counter()
     for i in range(config.frames):
         frame(draws.draw(), i)
@@ -312,6 +330,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
         f.result()
     result.drain_seconds = time.perf_counter() - t
     result.peak_rss_mb = _peak_rss_mb()
+    result.profile = profiling.snapshot()
     pool.shutdown()
     renderer.close()
     import shutil

@@ -1,8 +1,7 @@
-"""The ``graphsdg`` command line.
+"""The ``graphsdg`` command line: ``demo``, ``run``, ``graph``, ``view``, ``validate``, ``bench``.
 
-``graphsdg demo [--out DIR] [--frames N] [--resolution W H] [--seed S]`` writes a
-small dataset of the built-in demo scene (rgb, semantic segmentation, tight 2D
-boxes, depth) with BasicWriter.
+``graphsdg COMMAND --help`` describes each; docs/cli.md has examples and the
+semantics of ``run --workers`` (sharding on Ray) and ``run --resume``.
 """
 from __future__ import annotations
 
@@ -67,8 +66,11 @@ def run_bench(args: argparse.Namespace) -> None:
         frames=args.num_frames, warmup=args.warmup, num_cameras=args.num_cameras, resolution=tuple(args.resolution),
         asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
         rt_subframes=args.rt_subframes, wait_for_render=not args.no_wait_for_render,
-        write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads)
-    settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}, "
+        write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
+        msaa_samples=args.msaa, shadow_size=args.shadow_size)
+    quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
+                       f", shadow map {args.shadow_size}" if args.shadow_size is not None else ""])
+    settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
                      f"{'skip-write' if args.skip_write else 'written'}")
     machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}"
@@ -87,15 +89,47 @@ def run_bench(args: argparse.Namespace) -> None:
         table = benchmark.format_table(summaries)
         if args.profile:
             prof = rows[0].profile
-            total = sum(prof.values()) or 1.0
+            frame_ms = 1000.0 / rows[0].fps if rows[0].fps else 0.0
             table += "\n\n" + benchmark.format_table(
-                [{"phase": k, "ms/frame": round(v / config.frames * 1000, 2), "share": f"{v / total:.0%}"}
+                [{"phase": k, "ms/frame": round(v / config.frames * 1000, 2),
+                  "share of frame": "(worker threads)" if k == "encode+write" else
+                  f"{v / config.frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
                  for k, v in sorted(prof.items(), key=lambda kv: -kv[1])])
+            table += f"\n\ngraphsdg frame time {frame_ms:.2f} ms"
+            if len(rows) == 2 and rows[1].profile:
+                base_ms = 1000.0 / rows[1].fps if rows[1].fps else 0.0
+                table += "\n\n" + benchmark.format_table(
+                    [{"hand-written phase": k, "ms/frame": round(v / config.frames * 1000, 2)}
+                     for k, v in sorted(rows[1].profile.items(), key=lambda kv: -kv[1])])
+                table += f"\n\nhand-written frame time {base_ms:.2f} ms"
     text = f"### {settings_line}\n\nMachine: {machine}\n\n{table}\n"
     print(text)
     if args.report:
         with open(args.report, "a", encoding="utf-8") as f:
             f.write("\n" + text)
+
+
+def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
+    """``graphsdg graph``: build the script's graph (no render, no write); print it, write DOT and PNG."""
+    from graphsdg import graph as graphs
+    from graphsdg.script_runner import build_script
+
+    stopped_at = build_script(args.script, script_args, compat=args.compat, seed=args.seed)
+    g = graphs.current_graph(create=False)
+    stem = os.path.splitext(os.path.basename(args.script))[0]
+    out = args.out or "."
+    os.makedirs(out, exist_ok=True)
+    dot_path = args.dot or os.path.join(out, f"{stem}.graph.dot")
+    png_path = args.png or os.path.join(out, f"{stem}.graph.png")
+    json_path = args.json or os.path.join(out, f"{stem}.graph.json")
+    dot = graphs.to_dot(g, dot_path)
+    text = graphs.to_json(g, json_path)
+    graphs.draw(g, png_path)
+    printed = {"text": graphs.describe(g), "dot": dot, "json": text}[args.print]
+    print(printed.rstrip("\n"))
+    where = f"stopped at orchestrator.{stopped_at}()" if stopped_at else "the script ended without capturing"
+    print(f"\n{where}; wrote {dot_path}, {json_path}, {png_path}", file=sys.stderr)
+    return 0
 
 
 def _gl_renderer() -> str:
@@ -112,16 +146,77 @@ def _gl_renderer() -> str:
         return f"unknown ({exc})"
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="graphsdg", description="Synthetic data generation on MuJoCo + OpenUSD")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
-    sub = parser.add_subparsers(dest="command", required=True)
-    demo = sub.add_parser("demo", help="write a small dataset of the built-in demo scene")
+def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
+    """``graphsdg run``: the script in this process, or sharded over Ray workers; then the summary."""
+    from graphsdg.job import JobSpec, check_job_file, format_summary, run_job
+
+    if not os.path.isfile(args.script):
+        raise FileNotFoundError(f"script {args.script!r} does not exist")
+    job = JobSpec(script=args.script, args=tuple(script_args), compat=args.compat, seed=args.seed, out=args.out,
+                  frames=args.frames, resume=args.resume, resolution_scale=args.resolution_scale)
+    if args.workers is not None:
+        from graphsdg.scaleout import import_ray, run_sharded
+        import_ray()                      # says how to get Ray before anything runs
+        check_job_file(job)
+        summary = run_sharded(job, args.workers, address=args.address, gpus_per_worker=args.gpus_per_worker)
+    else:
+        check_job_file(job)
+        summary = run_job(job)
+    print(f"graphsdg run: {format_summary(summary)}")
+    if summary.get("index"):
+        print(f"graphsdg run: index {summary['index']}")
+    return 0
+
+
+def _hint(exc: BaseException) -> str:
+    """The hint line printed under a one-line error."""
+    from graphsdg.job import JobMismatchError
+    from graphsdg.scaleout import RayMissingError
+    if isinstance(exc, RayMissingError):
+        return "install Ray with: pip install 'graphsdg[ray]'"
+    if isinstance(exc, JobMismatchError):
+        return "resume with the arguments of the first run, or write to a fresh --out"
+    if isinstance(exc, (FileNotFoundError, NotADirectoryError)):
+        return "check the path; rerun with --debug for the traceback"
+    return "rerun with --debug for the traceback"
+
+
+def _positive(value: str) -> int:
+    n = int(value)
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
+    return n
+
+
+def _fraction(value: str) -> float:
+    x = float(value)
+    if not x >= 0:
+        raise argparse.ArgumentTypeError(f"must be a number >= 0, got {value}")
+    return x
+
+
+EPILOG = ("exit codes: 0 success, 1 error (one line and a hint; --debug shows the traceback), 2 bad command "
+          "line, 130 interrupted (Ctrl-C). See docs/cli.md.")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``graphsdg`` argument parser (every command has ``--help``)."""
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="show the traceback of an error")
+    parser = argparse.ArgumentParser(prog="graphsdg", description="Synthetic data generation on MuJoCo + OpenUSD",
+                                     epilog=EPILOG)
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    demo = sub.add_parser("demo", parents=[common], help="write a small dataset of the built-in demo scene",
+                          description="Writes rgb, semantic segmentation, tight 2D boxes and depth of the "
+                                      "built-in demo scene with BasicWriter.", epilog=EPILOG)
     demo.add_argument("--out", default="_out_demo", help="output directory (default: _out_demo)")
-    demo.add_argument("--frames", type=int, default=10, help="frames to capture (default: 10)")
-    demo.add_argument("--resolution", type=int, nargs=2, default=(512, 512), metavar=("W", "H"))
+    demo.add_argument("--frames", type=_positive, default=10, help="frames to capture (default: 10)")
+    demo.add_argument("--resolution", type=_positive, nargs=2, default=(512, 512), metavar=("W", "H"))
     demo.add_argument("--seed", type=int, default=0)
-    bench = sub.add_parser("bench", help="Isaac Sim's SDG benchmark scene vs a hand-written MuJoCo loop")
+    bench = sub.add_parser("bench", parents=[common],
+                           help="Isaac Sim's SDG benchmark scene vs a hand-written MuJoCo loop", epilog=EPILOG)
     bench.add_argument("--num-frames", type=int, default=600)
     bench.add_argument("--warmup", type=int, default=10)
     bench.add_argument("--num-cameras", type=int, default=1)
@@ -134,25 +229,75 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--no-wait-for-render", action="store_true")
     bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
     bench.add_argument("--write-threads", type=int, default=4)
+    bench.add_argument("--msaa", type=int, help="multisample count of the colour pass (default: graphsdg's 4)")
+    bench.add_argument("--shadow-size", type=int, help="shadow map size (default: graphsdg's 1024)")
     bench.add_argument("--processes", type=int, default=0,
                        help="run this many graphsdg processes at once and report the aggregate (no baseline)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
     bench.add_argument("--profile", action="store_true", help="print where each frame's time goes")
     bench.add_argument("--report", metavar="MD", help="append the result table to this Markdown file")
-    run = sub.add_parser("run", help="run a graphsdg (or, with --compat isaac, an Isaac Sim Replicator) script",
-                         usage="graphsdg run SCRIPT [options] [-- SCRIPT_ARGS ...]")
+    run = sub.add_parser("run", parents=[common],
+                         help="run a graphsdg (or, with --compat isaac, an Isaac Sim Replicator) script",
+                         usage="graphsdg run SCRIPT [options] [-- SCRIPT_ARGS ...]",
+                         description="Runs SCRIPT as __main__ and prints a summary (frames, files, bytes, "
+                                     "wall time, frames/s). --workers shards orchestrator.run(num_frames) over "
+                                     "Ray processes and merges their output; --resume continues an interrupted "
+                                     "run. Everything after -- goes to the script's sys.argv.", epilog=EPILOG)
     run.add_argument("script")
     run.add_argument("--compat", choices=["isaac"], help="provide Isaac Sim's module names to the script")
     run.add_argument("--seed", type=int, help="global seed (unless the script sets its own)")
     run.add_argument("--out", help="root for the script's relative output directories")
-    run.add_argument("--frames", type=int, help="frames for orchestrator.run() calls without num_frames")
-    view = sub.add_parser("view", help="contact sheet (and HTML gallery) of a dataset, with statistics")
+    run.add_argument("--frames", type=_positive, help="frames for orchestrator.run() calls without num_frames")
+    run.add_argument("--resolution-scale", type=float, metavar="F",
+                     help="scale every render product's resolution by F (e.g. 0.125 for a quick, small run)")
+    run.add_argument("--workers", type=_positive, metavar="K",
+                     help="shard the run over K Ray worker processes and merge their output (needs --out; "
+                          "pip install 'graphsdg[ray]')")
+    run.add_argument("--address", help="join this Ray cluster (e.g. ray://host:10001 or auto) instead of "
+                                       "starting a local one")
+    run.add_argument("--gpus-per-worker", type=_fraction, metavar="F",
+                     help="GPUs per worker, may be a fraction (default: the cluster's GPUs shared evenly, at "
+                          "most 1; 0 without GPUs)")
+    run.add_argument("--resume", action="store_true",
+                     help="continue an interrupted run: frames complete on disk are kept, the rest are captured")
+    view = sub.add_parser("view", parents=[common],
+                          help="contact sheet (and HTML gallery) of a dataset, with statistics",
+                          description="Draws boxes, class names and masks over the frames of a BasicWriter, "
+                                      "COCO, KITTI or YOLO dataset (detected from its files) into a contact "
+                                      "sheet PNG and prints per-class counts, empty frames and box sizes.",
+                          epilog=EPILOG)
     view.add_argument("dir")
     view.add_argument("--html", action="store_true", help="also write an HTML gallery")
-    view.add_argument("--max", type=int, default=16, help="frames to show (default 16)")
+    view.add_argument("--max", type=_positive, default=16, help="frames to show (default 16)")
     view.add_argument("--out", help="output folder (default: DIR.view next to the dataset)")
-    validate = sub.add_parser("validate", help="check a dataset's consistency; exit 1 on any violation")
+    graph = sub.add_parser("graph", parents=[common],
+                           help="build a script's node graph without running it; print and draw it",
+                           usage="graphsdg graph SCRIPT [options] [-- SCRIPT_ARGS ...]",
+                           description="Runs SCRIPT until its first orchestrator capture call (run, step, "
+                                       "preview), which stops it: nothing is rendered or written. Prints the "
+                                       "graph and writes it as DOT, JSON and a PNG drawing.", epilog=EPILOG)
+    graph.add_argument("script")
+    graph.add_argument("--compat", choices=["isaac"], help="provide Isaac Sim's module names to the script")
+    graph.add_argument("--seed", type=int, help="global seed (values sampled while building)")
+    graph.add_argument("--print", choices=["text", "dot", "json"], default="text",
+                       help="what to print (default: text)")
+    graph.add_argument("--out", help="folder for SCRIPT.graph.{dot,json,png} (default: current folder)")
+    graph.add_argument("--dot", metavar="PATH", help="DOT file path")
+    graph.add_argument("--json", metavar="PATH", help="JSON file path")
+    graph.add_argument("--png", metavar="PATH", help="PNG drawing path")
+    validate = sub.add_parser("validate", parents=[common],
+                              help="check a dataset's consistency; exit 1 on any violation",
+                              description="Checks a BasicWriter dataset: complete frames, boxes inside the image "
+                                          "and around their masks, ids that agree, finite depth on objects, "
+                                          "empty and duplicate frames. Exit code 1 if anything is violated.",
+                              epilog=EPILOG)
     validate.add_argument("dir")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``graphsdg`` console script; returns the exit code."""
+    parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     script_args: list[str] = []
     if "--" in argv:   # everything after "--" belongs to the script (graphsdg run SCRIPT ... -- ARGS)
@@ -161,14 +306,12 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         if args.command == "demo":
-            if args.frames < 1:
-                parser.error(f"--frames must be >= 1, got {args.frames}")
             summary = run_demo(args.out, args.frames, tuple(args.resolution), args.seed)
             print(f"wrote {summary['frames']} frames to {summary['output_dir']} in {summary['seconds']:.1f} s")
         elif args.command == "run":
-            from graphsdg.script_runner import run_script
-            run_script(args.script, script_args, compat=args.compat, seed=args.seed, out_dir=args.out,
-                       frames=args.frames)
+            return run_job_command(args, script_args)
+        elif args.command == "graph":
+            return run_graph(args, script_args)
         elif args.command == "bench":
             run_bench(args)
         elif args.command == "view":
@@ -186,11 +329,18 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     except SystemExit:
         raise
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        hint = " (rerun with --resume to continue)" if args.command == "run" else ""
+        print(f"graphsdg: interrupted{hint}", file=sys.stderr)
+        return 130
     except Exception as exc:  # one clear line unless --debug
         if args.debug:
             raise
-        print(f"graphsdg: error: {exc}", file=sys.stderr)
-        print("hint: rerun with --debug for the traceback", file=sys.stderr)
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"graphsdg: error: {message}", file=sys.stderr)
+        print(f"hint: {_hint(exc)}", file=sys.stderr)
         return 1
 
 

@@ -14,7 +14,7 @@ import time
 from fractions import Fraction
 from typing import Any, Callable
 
-from graphsdg import settings
+from graphsdg import profiling, settings
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.io.write_queue import get_write_queue
@@ -46,10 +46,12 @@ class _State:
         self.status = Status.STOPPED
         self.frame_index = 0
         self.callbacks: dict[int, Callable[[Status], None]] = {}
-        self.profile: dict[str, float] = {}
         self.stop_requested = False
         self.pause_requested = False
         self.remaining: int | None = None
+        self.plan = None                      # a FramePlan while a sharded or resumed run() is going on
+        self.planned_frame: int | None = None  # the run's global frame being captured (planned runs)
+        self.frame_bases: dict[int, int] = {}  # writer -> frames it had written when the planned run began
 
     def set(self, status: Status) -> None:
         if status != self.status:
@@ -70,7 +72,7 @@ def _validate_subframes(rt_subframes: Any) -> int:
 
 def _timed(name: str, start: float) -> float:
     now = time.perf_counter()
-    _state.profile[name] = _state.profile.get(name, 0.0) + (now - start)
+    profiling.add(name, now - start)
     return now
 
 
@@ -166,24 +168,30 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
     for path, (rp, annotators) in products.items():
         t = time.perf_counter()
         sim.require_offscreen(rp.width, rp.height)
-        view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
+        with profiling.timed("render:camera"):
+            view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
         passes: set[str] = set()
         for a in annotators:
             passes |= a.spec.passes
         render = rt.rasterizer.render(sim, view, passes, subframes) if passes else None
         t = _timed("render", t)
-        frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time)
+        frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time,
+                          attached=frozenset(a.spec.name for a in annotators))
+        t = _timed("annotate:frame", t)
         for a in annotators:
             outputs[(id(a), path)] = a.compute_for(frame)
-        _timed("annotate", t)
+            t = _timed(f"annotate:{a.spec.name}", t)
     t = time.perf_counter()
     reference_time = Fraction(sim_time).limit_denominator(1_000_000)
     for writer in rt.writers:
         if not writer.wants_frame(fired):
             continue
+        extra = {"provenance": provenance} if provenance else {}
+        if _state.planned_frame is not None:   # sharded / resumed: the frame's number in the whole dataset
+            extra["frame_index"] = _state.frame_bases.get(id(writer), 0) + _state.planned_frame
         data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
-                                    extra={"provenance": provenance} if provenance else None)
-        writer.write(data)
+                                    extra=extra or None)
+        writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
     _timed("write", t)
 
 
@@ -195,7 +203,13 @@ async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_
 
 
 def wait_until_complete() -> None:
-    """Block until every scheduled file is on disk; raise the first writer failure."""
+    """Block until every scheduled file is on disk; raise the first writer failure.
+
+    Attached writers flush their aggregate files first (COCO json, BOP json, open
+    WebDataset shards), so what is on disk afterwards is a complete dataset.
+    """
+    for writer in list(runtime().writers):
+        writer.flush()
     get_write_queue().wait_until_done()
 
 
@@ -320,6 +334,10 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
         if unlimited:
             raise OrchestratorError(f"run() without num_frames would never stop: trigger(s) {unlimited} have no "
                                     f"max_execs; pass num_frames=N or set max_execs")
+    from graphsdg import frame_plan
+    _state.plan = frame_plan.current()
+    if _state.plan is not None:
+        num_frames = _planned_length(num_frames, sched)
     if start_timeline:
         runtime().timeline.play()
     _state.remaining = num_frames
@@ -345,6 +363,9 @@ def _run_loop() -> None:
 
 def _frames(sched, progress: Progress) -> bool:
     """Capture until done, stopped or paused; returns whether it paused."""
+    if _state.plan is not None:
+        _planned_frames(sched, progress)
+        return False
     while not _state.stop_requested:
         if _state.pause_requested:
             _state.set(Status.PAUSED)
@@ -359,6 +380,63 @@ def _frames(sched, progress: Progress) -> bool:
             _state.remaining -= 1
         _state.set(Status.STARTED)
     return False
+
+
+def _planned_length(num_frames: int | None, sched) -> int:
+    """The frame count of a sharded/resumed run: ``num_frames``, or what on_frame ``max_execs`` imply."""
+    if num_frames is not None:
+        return num_frames
+    graph = sched.active_graph()
+    counted = [t for t in graph.triggers if t.counts_toward_completion] if graph is not None else []
+    if not counted or any(not hasattr(t, "interval") or not t.max_execs for t in counted):
+        raise OrchestratorError("a sharded or resumed run() needs num_frames (or graphsdg run --frames N) "
+                                "unless every trigger is an on_frame trigger with max_execs")
+    return max((t.max_execs - 1) * t.interval + 1 for t in counted)
+
+
+def _planned_frames(sched, progress: Progress) -> None:
+    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.frame_plan`)."""
+    from graphsdg import frame_plan
+    plan, total = _state.plan, _state.remaining or 0
+    writers = list(runtime().writers)
+    for writer in writers:
+        if not getattr(writer, "frame_indexed", False):
+            raise OrchestratorError(
+                f"{type(writer).__name__} cannot be sharded or resumed: it does not name its files by the "
+                f"frame_index it receives (set frame_indexed = True on a writer that does; see docs/cli.md)")
+        frame_plan.record_writer(writer)
+    _state.frame_bases = {id(w): w.num_written or 0 for w in writers}
+    graph = sched.active_graph()
+    start = graph.frame if graph is not None else 0
+    frames = [f for f in range(total) if plan.owns(f)]
+    if plan.resume:
+        if not plan.sharded:   # shards share folders: the merge step removes their leftovers
+            from graphsdg.io.backends import remove_temporaries
+            get_write_queue().wait_until_done()   # writes already scheduled (a writer's first json) land first
+            for writer in writers:
+                if getattr(writer.backend, "output_dir", None):
+                    remove_temporaries(writer.backend.output_dir)
+        frames = [f for f in frames
+                  if not all(w.frame_complete(_state.frame_bases[id(w)] + f) for w in writers)]
+        log.info("resume: %d of %d frames to capture", len(frames), total)
+    progress.set_total(len(frames))
+    following = 0
+    try:
+        for f in frames:
+            if _state.stop_requested:
+                break
+            if f != following and graph is not None:
+                sched.seek(start + f)     # the frame's random values, as in one uninterrupted run
+            _state.planned_frame = f
+            step(pause_timeline=False)
+            following = f + 1
+            progress.advance()
+            _state.remaining = max(total - following, 0)
+            _state.set(Status.STARTED)
+    finally:
+        _state.planned_frame = None
+    if graph is not None and following != total:
+        sched.seek(start + total, restore_state=False)   # where an uninterrupted run would have left it
 
 
 def run_until_complete(num_frames: int | None = None, start_timeline: bool = False) -> None:
@@ -416,13 +494,20 @@ async def stop_async() -> None:
     stop()
 
 
+def frames_captured() -> int:
+    """Frames captured (steps) by this process so far."""
+    return _state.frame_index
+
+
 def get_profile() -> dict[str, float]:
-    """Seconds spent per phase (graph, sync, physics, render, annotate, write) since the last reset."""
-    return dict(_state.profile)
+    """Seconds spent per phase since the last reset: ``graph``, ``node:<name>``, ``sync``, ``physics``,
+    ``render:<pass>``, ``readback:<pass>``, ``annotate:<annotator>``, ``write`` (scheduling) and
+    ``encode+write`` (worker threads, overlapping the frame)."""
+    return profiling.snapshot()
 
 
 def reset_profile() -> None:
-    _state.profile.clear()
+    profiling.reset()
 
 
 def _flush_at_exit() -> None:

@@ -39,6 +39,13 @@ class Progress:
             self._bar = tqdm(total=self.total, desc=self.description, unit="frame", dynamic_ncols=True)
         return self
 
+    def set_total(self, total: int | None) -> None:
+        """Change the number of frames expected (a resumed run learns it after checking the disk)."""
+        self.total = total
+        if self._bar is not None:
+            self._bar.total = total
+            self._bar.refresh()
+
     def advance(self, n: int = 1) -> None:
         self.frames += n
         pending = get_write_queue().pending()

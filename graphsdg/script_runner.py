@@ -3,21 +3,37 @@
 Scripts written for Isaac Sim's Script Editor schedule a coroutine with
 ``asyncio.ensure_future(...)`` and rely on Kit's running loop; after the script
 body returns, this runner drives the event loop until those tasks finish.
+
+:func:`build_script` runs a script only up to its first capture (``graphsdg graph``):
+the orchestrator's capture calls stop it, and disk backends write nothing.
 """
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import os
 import runpy
 import sys
-from typing import Sequence
+from typing import Iterator, Sequence
 
 from graphsdg import orchestrator, rng, settings
 
+# the orchestrator's entry points that capture frames (build_script turns them into a stop)
+CAPTURE_CALLS = ("step", "step_async", "run", "run_async", "run_until_complete", "run_until_complete_async",
+                 "preview", "preview_async", "resume")
 
-def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, seed: int | None = None,
-               out_dir: str | None = None, frames: int | None = None) -> None:
-    """Execute ``path`` as ``__main__`` with ``sys.argv = [path, *args]``."""
+
+class ScriptStopped(Exception):
+    """Raised inside a script by a capture call while the script is only being built."""
+
+    def __init__(self, call: str) -> None:
+        super().__init__(f"the script reached orchestrator.{call}()")
+        self.call = call
+
+
+def _configure(path: str, compat: str | None, seed: int | None, out_dir: str | None, frames: int | None,
+               resolution_scale: float | None = None) -> bool:
+    """Apply the run's overrides; return whether the Isaac module names were installed for this script."""
     if not os.path.isfile(path):
         raise FileNotFoundError(f"script {path!r} does not exist")
     if compat not in (None, "isaac"):
@@ -29,9 +45,23 @@ def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, s
         settings.set("/omni/replicator/backends/disk/root_dir", os.path.abspath(out_dir))
     if frames is not None:
         settings.set("/graphsdg/run/numFrames", int(frames))
+    if resolution_scale is not None:
+        settings.set("/graphsdg/render/resolutionScale", float(resolution_scale))
+    installed_here = False
     if compat == "isaac":
         from graphsdg.compat import isaac
+        installed_here = not isaac.is_installed()
         isaac.install()
+    return installed_here
+
+
+def _uninstall_compat(installed_here: bool) -> None:
+    if installed_here:   # the Isaac names lived for this script only
+        from graphsdg.compat import isaac
+        isaac.uninstall()
+
+
+def _execute(path: str, args: Sequence[str]) -> None:
     loop = asyncio.new_event_loop()
     asyncio.set_event_loop(loop)
     saved_argv, saved_path = sys.argv, list(sys.path)
@@ -43,8 +73,63 @@ def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, s
         while pending:
             loop.run_until_complete(asyncio.gather(*pending))
             pending = [t for t in asyncio.all_tasks(loop) if not t.done()]
-        orchestrator.wait_until_complete()
     finally:
+        for task in asyncio.all_tasks(loop):
+            task.cancel()
         sys.argv, sys.path[:] = saved_argv, saved_path
         asyncio.set_event_loop(None)
         loop.close()
+
+
+def run_script(path: str, args: Sequence[str] = (), compat: str | None = None, seed: int | None = None,
+               out_dir: str | None = None, frames: int | None = None,
+               resolution_scale: float | None = None) -> None:
+    """Execute ``path`` as ``__main__`` with ``sys.argv = [path, *args]``."""
+    installed_here = _configure(path, compat, seed, out_dir, frames, resolution_scale)
+    try:
+        _execute(path, args)
+        orchestrator.wait_until_complete()
+    finally:
+        _uninstall_compat(installed_here)
+
+
+@contextlib.contextmanager
+def capture_stopped() -> Iterator[None]:
+    """Within the block, orchestrator capture calls raise :class:`ScriptStopped` and disk writes are dropped."""
+    saved = {name: getattr(orchestrator, name) for name in CAPTURE_CALLS}
+
+    def stopper(name: str):
+        def stop(*args, **kwargs):
+            raise ScriptStopped(name)
+        return stop
+
+    discard = settings.get("/graphsdg/io/discardWrites", False)
+    settings.set("/graphsdg/io/discardWrites", True)
+    for name in CAPTURE_CALLS:
+        setattr(orchestrator, name, stopper(name))
+    try:
+        yield
+    finally:
+        for name, fn in saved.items():
+            setattr(orchestrator, name, fn)
+        settings.set("/graphsdg/io/discardWrites", discard)
+
+
+def build_script(path: str, args: Sequence[str] = (), compat: str | None = None,
+                 seed: int | None = None) -> str | None:
+    """Run ``path`` up to its first capture call without rendering or writing anything.
+
+    Returns the name of the capture call that stopped it (``"run"``, ``"step"``...),
+    or None if the script ended without capturing. The graph it built is
+    ``graphsdg.graph.current_graph()``.
+    """
+    installed_here = _configure(path, compat, seed, None, None)
+    try:
+        with capture_stopped():
+            try:
+                _execute(path, args)
+            except ScriptStopped as stop:
+                return stop.call
+        return None
+    finally:
+        _uninstall_compat(installed_here)

@@ -29,6 +29,10 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/exts/omni.replicator.core/enableWriteToFabric": (
         False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
     "/graphsdg/run/numFrames": (None, "frames for orchestrator.run() calls without num_frames (graphsdg run --frames)"),
+    "/graphsdg/run/shardIndex": (0, "this process's shard of a sharded run (graphsdg run --workers)"),
+    "/graphsdg/run/shardCount": (1, "shards of a sharded run: shard i captures frames i, i+K, ..."),
+    "/graphsdg/run/resume": (False, "skip frames complete on disk and adopt the writers' files (graphsdg run --resume)"),
+    "/graphsdg/io/discardWrites": (False, "disk backends create and write nothing (graphsdg graph)"),
     "/graphsdg/render/shadowSize": (1024, "shadow map size of shadow-casting lights"),
     "/graphsdg/render/msaaSamples": (4, "multisample anti-aliasing samples of the colour pass"),
     "/graphsdg/render/exposure": (1.0, "scale from photometric light units to display values"),
@@ -89,9 +93,10 @@ def get(key: str, default: Any = None) -> Any:
 
 
 def reset() -> None:
-    """Forget every value that was set (defaults apply again)."""
+    """Forget every value that was set (defaults apply again) and which keys were already warned about."""
     with _lock:
         _values.clear()
+        _warned.clear()
 
 
 # carb-style aliases so `settings.get_settings().set(...)` reads naturally.

@@ -639,7 +639,8 @@ def test_basic_writer_writes_every_flag(out_dir):
         stems[f"bounding_box_{box}"] = ["npy"]
         stems[f"bounding_box_{box}_labels"] = ["json"]
         stems[f"bounding_box_{box}_prim_paths"] = ["json"]
-    expected = sorted(f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, exts in stems.items() for ext in exts)
+    expected = sorted([f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, exts in stems.items() for ext in exts]
+                      + ["metadata.txt"])
     assert sorted(os.listdir(out_dir)) == expected
 
     def load(name):
@@ -730,3 +731,16 @@ def test_bounding_box_3d_360_lists_drawn_instances_outside_the_view():
     assert sorted(rows) == ["/World/Behind", "/World/Seen"]
     assert np.isnan(rows["/World/Behind"]["occlusionRatio"]) and rows["/World/Seen"]["occlusionRatio"] == 0
     np.testing.assert_allclose(rows["/World/Behind"]["transform"][3], [0, -10, 0, 1])
+
+
+def test_tight_box_occlusion_is_filled_only_when_paid_for():
+    from conftest import unit_cube_scene
+    cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(64, 48))
+    tight = rep.annotators.get("bounding_box_2d_tight")
+    tight.attach(rp)
+    rep.orchestrator.step()
+    assert tight.get_data()["data"][0]["occlusionRatio"] == -1.0      # not computed: no isolated renders
+    occ = rep.annotators.get("occlusion")
+    occ.attach(rp)
+    rep.orchestrator.step()
+    assert tight.get_data()["data"][0]["occlusionRatio"] == pytest.approx(0.0, abs=0.01)

@@ -65,7 +65,7 @@ def test_run_drives_script_editor_coroutines(tmp_path):
     script.write_text(ASYNC_SCRIPT)
     out = tmp_path / "out"
     assert main(["run", str(script), "--", str(out)]) == 0
-    assert sorted(os.listdir(out)) == ["rgb_0000.png", "rgb_0001.png"]
+    assert sorted(os.listdir(out)) == ["metadata.txt", "rgb_0000.png", "rgb_0001.png"]
 
 
 def test_run_missing_script(capsys):

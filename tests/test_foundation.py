@@ -150,7 +150,7 @@ def _capture(out_dir, seed=11, frames=3):
 def test_same_seed_same_bytes(tmp_path):
     a = _capture(str(tmp_path / "a"))
     b = _capture(str(tmp_path / "b"))
-    assert a.keys() == b.keys() and len(a) == 3 * 6
+    assert a.keys() == b.keys() and len(a) == 3 * 6 + 1      # + metadata.txt
     assert all(a[k] == b[k] for k in a)
     c = _capture(str(tmp_path / "c"), seed=12)
     assert any(a[k] != c[k] for k in a if k.startswith("rgb"))
@@ -166,10 +166,10 @@ def test_basic_writer_files_match_replicator_layout(out_dir):
         rep.orchestrator.step()
     rep.orchestrator.wait_until_complete()
     names = sorted(os.listdir(out_dir))
-    expected = sorted(f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, ext in [
+    expected = sorted([f"{stem}_{n:04d}.{ext}" for n in range(2) for stem, ext in [
         ("rgb", "png"), ("bounding_box_2d_tight", "npy"), ("bounding_box_2d_tight_labels", "json"),
         ("bounding_box_2d_tight_prim_paths", "json"), ("semantic_segmentation", "png"),
-        ("semantic_segmentation_labels", "json")])
+        ("semantic_segmentation_labels", "json")]] + ["metadata.txt"])
     assert names == expected
     boxes = np.load(os.path.join(out_dir, "bounding_box_2d_tight_0000.npy"))
     assert boxes.dtype == BBOX_2D_DTYPE and len(boxes) == 1

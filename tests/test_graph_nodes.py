@@ -414,3 +414,22 @@ def test_same_graph_same_samples_in_separate_processes():
     outs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                            env={**os.environ, "PYTHONHASHSEED": str(salt)}).stdout for salt in (1, 2)]
     assert outs[0] == outs[1] and outs[0].count("\n") == 3
+
+
+def test_scatter_2d_node_places_prims_on_the_surface_without_overlap():
+    from graphsdg.sim.bounds import compute_aabb
+    floor = rep.functional.create.plane(scale=(4, 4, 1), name="Floor")
+    boxes = rep.functional.create_batch.cube(count=6, scale=0.3, semantics={"class": "box"})
+    with rep.trigger.on_frame(max_execs=2):
+        with rep.get.prims(semantics=[("class", "box")]):
+            rep.randomizer.scatter_2d(surface_prims=[floor], check_for_collisions=True)
+    for _ in range(2):
+        rep.orchestrator.step()
+        boxes_aabb = np.array([compute_aabb(b) for b in boxes])
+        centers = (boxes_aabb[:, :3] + boxes_aabb[:, 3:]) / 2
+        assert np.all(np.abs(centers[:, :2]) <= 2.0 + 1e-6)        # sampled on the 4 x 4 m floor
+        for i in range(6):
+            for j in range(i + 1, 6):
+                a, b = boxes_aabb[i], boxes_aabb[j]
+                overlap = np.all(np.minimum(a[3:], b[3:]) - np.maximum(a[:3], b[:3]) > 1e-6)
+                assert not overlap, (i, j)

@@ -149,3 +149,53 @@ def test_bytes_do_not_depend_on_writer_threads(tmp_path, threads):
         rep.settings.reset()
         reset_write_queue()
     assert reference == other
+
+
+def test_seed_custom_writer_example(capsys):
+    """The MyWriter of Isaac Sim's getting-started example 02, registered and attached to two cameras."""
+
+    class MyWriter(rep.Writer):
+        def __init__(self, camera_params: bool = True, bounding_box_3d: bool = True):
+            self.data_structure = "renderProduct"
+            self.annotators = []
+            if camera_params:
+                self.annotators.append(rep.annotators.get("camera_params"))
+            if bounding_box_3d:
+                self.annotators.append(rep.annotators.get("bounding_box_3d"))
+            self._frame_id = 0
+            self.frames = []
+
+        def write(self, data: dict):
+            print(f"[MyWriter][{self._frame_id}] data:")
+            for key, value in data.items():
+                print(f"  {key}: {value}")
+            self.frames.append(data)
+            self._frame_id += 1
+
+    rep.writers.register_writer(MyWriter)
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=500, parent="/World", name="DomeLight")
+    cube = rep.functional.create.cube(parent="/World", name="Cube")
+    rep.functional.modify.semantics(cube, {"class": "my_cube"}, mode="add")
+    top = rep.functional.create.camera(position=(0, 0, 5), look_at=(0, 0, 0), parent="/World", name="TopCamera")
+    persp = rep.functional.create.camera(position=(5, 5, 5), look_at=(0, 0, 0), parent="/World", name="PerspCamera")
+    rp_top = rep.create.render_product(top.GetPath(), (40, 40), name="top_view")
+    rp_persp = rep.create.render_product(persp.GetPath(), (51, 51), name="persp_view")
+    writer = rep.writers.get("MyWriter")
+    writer.initialize(camera_params=True, bounding_box_3d=True)
+    writer.attach([rp_top, rp_persp])
+    for _ in range(3):
+        rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    assert writer._frame_id == 3
+    products = writer.frames[-1]["renderProducts"]
+    assert set(products) == {"top_view", "persp_view"}
+    top_data = products["top_view"]
+    assert top_data["camera"] == "/World/TopCamera" and top_data["resolution"] == [40, 40]
+    assert list(top_data["camera_params"]["renderProductResolution"]) == [40, 40]
+    box = top_data["bounding_box_3d"]
+    assert box["primPaths"] == ["/World/Cube"] and np.allclose(box["data"][0]["x_max"], 0.5)
+    assert "[MyWriter][2] data:" in capsys.readouterr().out
+    writer.detach()
+    rp_top.destroy()
+    rp_persp.destroy()

@@ -54,3 +54,12 @@ def test_source_checkout_imports_the_node_library():
     code = "import graphsdg, sys; assert graphsdg.__file__.startswith(sys.argv[1]); " \
            "assert 'rgb' in graphsdg.annotators.get_registered_annotators()"
     subprocess.run([sys.executable, "-c", code, ROOT], check=True, cwd=ROOT)
+
+
+def test_rendering_works_when_mujoco_was_imported_first(tmp_path):
+    code = ("import mujoco\nimport graphsdg as rep\n"
+            "cam = rep.functional.create.camera(position=(3, 3, 3), look_at=(0, 0, 0))\n"
+            "rp = rep.create.render_product(cam, (16, 16)); a = rep.annotators.get('rgb'); a.attach(rp)\n"
+            "rep.orchestrator.step(); assert a.get_data().shape == (16, 16, 4)\n")
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=str(tmp_path), env=env)

@@ -1,6 +1,6 @@
 """The UR10-style palletizing scenario and the Isaac tutorial's SDG script running on it, unchanged.
 
-The seed script (tests/seed_scripts/palletizing_sdg_demo.py) runs under the Isaac
+The seed script (tests/seed_scripts/ur10_palletizing_script_editor.py) runs under the Isaac
 compat layer for 3 bins at CI size: render products at 1/8 of the size the
 script asks for (``/graphsdg/render/resolutionScale``), at most 2 accumulated
 subframes per capture (``/graphsdg/render/maxSubframes``), a 3-bin cell
@@ -33,7 +33,7 @@ from graphsdg.sim.bodies import RigidBodyView
 from graphsdg.sim.bounds import create_bbox_cache
 from graphsdg.sim.timeline import TimelineEventType
 
-SEED_SCRIPT = Path(__file__).parent / "seed_scripts" / "palletizing_sdg_demo.py"
+SEED_SCRIPT = Path(__file__).parent / "seed_scripts" / "ur10_palletizing_script_editor.py"
 NUM_BINS = 3
 BIN_MESHES = [f"{cell.BINS}/bin_{i}/{cell.BIN_MESH}" for i in range(NUM_BINS)]
 

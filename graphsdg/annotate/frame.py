@@ -63,6 +63,7 @@ class Footprints:
 
     counts: np.ndarray     # int64 (n,)
     boxes: np.ndarray      # int32 (n, 4) x_min y_min x_max y_max
+    masks: dict = None     # k -> (x0, y0, x1, y1) crop and its bool mask (the full silhouette)
 
 
 class SceneLabels:
@@ -127,8 +128,10 @@ class FrameView:
     """The passes of one render product at one step, plus shared derived maps."""
 
     def __init__(self, rp: RenderProduct, view: CameraView, outputs: RenderOutputs | None, sim: SimScene,
-                 stage: Usd.Stage, labels: SceneLabels, frame_index: int, sim_time: float) -> None:
+                 stage: Usd.Stage, labels: SceneLabels, frame_index: int, sim_time: float,
+                 attached: frozenset[str] = frozenset()) -> None:
         self.render_product = rp
+        self.attached = attached          # names of the annotator types computed for this product now
         self.camera = view
         self.outputs = outputs
         self.sim = sim
@@ -189,13 +192,45 @@ class FrameView:
             return self._id_image(semantic_filter, imap.instance_ids)
         return self.cached(("instance_id_image", semantic_filter.text), build)
 
+    def _id_lut(self, per_instance: np.ndarray, imap: InstanceMap) -> np.ndarray:
+        """geom index -> id (unlabelled geoms 1), with index -1 (background) -> 0."""
+        lut = np.full(len(imap.geom_instance) + 1, UNLABELLED_ID, dtype=np.uint32)
+        labelled = imap.geom_instance >= 0
+        lut[:-1][labelled] = per_instance[imap.geom_instance[labelled]]
+        lut[-1] = BACKGROUND_ID
+        return lut
+
+    def colorized_id_image(self, kind: str, semantic_filter: SemanticFilter, colors: dict[int, tuple]) -> np.ndarray:
+        """uint8 (H, W, 4): the ``"semantic"``/``"instance"`` id image already coloured, in one
+        lookup per pixel (geom -> packed RGBA) instead of ids then colours."""
+        imap = self.instance_map(semantic_filter)
+        per_instance = imap.semantic_ids if kind == "semantic" else imap.instance_ids
+        ids = self._id_lut(per_instance, imap)
+        palette = np.zeros((len(ids), 4), dtype=np.uint8)
+        for i, value in enumerate(ids):
+            palette[i] = colors[int(value)]
+        packed = palette.view(np.uint32)[:, 0][self.require("geom_ids")]
+        return packed.view(np.uint8).reshape(*packed.shape, 4)
+
     def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
-        geom_ids = self.require("geom_ids")
-        inst = self.instance_image(semantic_filter)
-        out = np.where(geom_ids < 0, BACKGROUND_ID, UNLABELLED_ID).astype(np.uint32)
-        has = inst >= 0
-        out[has] = per_instance[inst[has]]
-        return out
+        lut = self._id_lut(per_instance, self.instance_map(semantic_filter))
+        return lut[self.require("geom_ids")]   # one lookup per pixel
+
+    def present_geoms(self) -> np.ndarray:
+        """Geom ids drawn in this frame (-1 included when background shows)."""
+        def build():
+            counts = np.bincount(self.require("geom_ids").ravel() + 1)
+            return np.flatnonzero(counts) - 1
+        return self.cached("present_geoms", build)
+
+    def present_ids(self, kind: str, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
+        """Sorted distinct ``"semantic"`` or ``"instance"`` ids in this frame, from the drawn geoms
+        (one histogram of the id image shared by every id annotator, not one scan each)."""
+        def build():
+            imap = self.instance_map(semantic_filter)
+            per_instance = imap.semantic_ids if kind == "semantic" else imap.instance_ids
+            return np.unique(self._id_lut(per_instance, imap)[self.present_geoms()])
+        return self.cached(("present_ids", kind, semantic_filter.text), build)
 
     # ---- boxes and occlusion -------------------------------------------
     def visible_counts(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
@@ -203,20 +238,35 @@ class FrameView:
         def build():
             inst = self.instance_image(semantic_filter)
             n = len(self.instance_map(semantic_filter).paths)
-            return np.bincount(inst[inst >= 0].ravel(), minlength=n)
+            return np.bincount(inst.ravel() + 1, minlength=n + 1)[1:]   # slot 0 holds the -1 pixels
         return self.cached(("visible_counts", semantic_filter.text), build)
 
     def tight_boxes(self, semantic_filter: SemanticFilter = ALL_LABELS
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(instance indices, boxes (K, 4) inclusive x_min y_min x_max y_max, pixel counts) of visible instances."""
+        """(instance indices, boxes (K, 4) inclusive x_min y_min x_max y_max, None) of visible instances."""
         def build():
-            inst = self.instance_image(semantic_filter)
-            n = len(self.instance_map(semantic_filter).paths)
-            boxes = _mask_boxes(inst, n)
-            counts = self.visible_counts(semantic_filter)
-            present = np.nonzero(counts)[0]
-            return present, boxes[present], counts[present]
+            imap = self.instance_map(semantic_filter)
+            n = len(imap.paths)
+            # Boxes of each drawn geom straight from the id image (no per-pixel instance lookup),
+            # then each instance's box is the union of its geoms' boxes.
+            geom_boxes = self.geom_boxes()
+            drawn = np.flatnonzero(geom_boxes[:, 2] >= 0)
+            owner = imap.geom_instance[drawn] if drawn.size else np.zeros(0, dtype=np.int32)
+            keep = owner >= 0
+            drawn, owner = drawn[keep], owner[keep]
+            big = np.iinfo(np.int32).max
+            lo = np.full((n, 2), big, dtype=np.int32)
+            hi = np.full((n, 2), -1, dtype=np.int32)
+            np.minimum.at(lo, owner, geom_boxes[drawn, :2])
+            np.maximum.at(hi, owner, geom_boxes[drawn, 2:])
+            present = np.flatnonzero(hi[:, 0] >= 0)
+            boxes = np.concatenate([lo[present], hi[present]], axis=1)
+            return present, boxes, None
         return self.cached(("tight_boxes", semantic_filter.text), build)
+
+    def geom_boxes(self) -> np.ndarray:
+        """(ngeom, 4) inclusive pixel bounds of every geom drawn in the id pass (-1 rows if not drawn)."""
+        return self.cached("geom_boxes", lambda: _mask_boxes(self.require("geom_ids"), self.sim.model.ngeom))
 
     def footprints(self, semantic_filter: SemanticFilter = ALL_LABELS) -> Footprints:
         """Unoccluded footprint of every instance in view, from isolated id renders.
@@ -235,6 +285,7 @@ class FrameView:
             render = self.outputs.render_isolated if self.outputs is not None else None
             if render is None:
                 raise RuntimeError("isolated renders need the segmentation pass")
+            masks: dict[int, tuple[tuple[int, int, int, int], np.ndarray]] = {}
             shown = np.zeros(self.sim.model.ngeom, dtype=bool)
             shown[self.drawn_geoms()] = True
             rects = self._geom_rects()
@@ -253,6 +304,7 @@ class FrameView:
                 for k, geoms, crop in group:
                     part = ids[crop[1] - y0:crop[3] - y0, crop[0] - x0:crop[2] - x0]
                     mask = np.isin(part, geoms)
+                    masks[k] = (tuple(int(c) for c in crop), mask)
                     counts[k] = int(mask.sum())
                     if counts[k]:
                         ys, xs = np.nonzero(mask)
@@ -269,7 +321,7 @@ class FrameView:
                 else:
                     boxes[k, :2] = np.minimum(boxes[k, :2], box[:2])
                     boxes[k, 2:] = np.maximum(boxes[k, 2:], box[2:])
-            return Footprints(counts=counts, boxes=boxes)
+            return Footprints(counts=counts, boxes=boxes, masks=masks)
         return self.cached(("footprints", semantic_filter.text), build)
 
     def occlusion_ratios(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
@@ -309,24 +361,39 @@ class FrameView:
 
 
 def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
-    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels)."""
+    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels).
+
+    Only the ends of horizontal runs can be extreme: the left end of every run gives
+    x_min (and every row a label touches has one, so y_min / y_max), the right end
+    gives x_max. Scanning run ends instead of every labelled pixel makes the
+    scatter-min/max work proportional to the objects' outlines, not their areas.
+    """
+    h, w = inst.shape
+    boxes = np.full((n, 4), -1, dtype=np.int32)
+    if n == 0 or h == 0 or w == 0:
+        return boxes
     flat = inst.ravel()
-    sel = np.nonzero(flat >= 0)[0]
-    boxes = np.full((n, 4), -1, dtype=np.int64)
-    if sel.size == 0:
-        return boxes.astype(np.int32)
-    k = flat[sel]
-    ys, xs = np.divmod(sel, inst.shape[1])
+    # run starts: where the label changes along the row-major pixel order, and every row start
+    starts = np.union1d(np.flatnonzero(flat[1:] != flat[:-1]) + 1, np.arange(0, h * w, w))
+    ends = np.append(starts[1:] - 1, h * w - 1)   # a run ends where the next one starts
+    labels = flat[starts]
+    keep = labels >= 0
+    if not keep.any():
+        return boxes
+    starts, ends, labels = starts[keep], ends[keep], labels[keep]
+    sy, sx = np.divmod(starts, w)
+    ex = ends % w
     big = np.iinfo(np.int64).max
     lo_x, lo_y = np.full(n, big), np.full(n, big)
     hi_x, hi_y = np.full(n, -1), np.full(n, -1)
-    np.minimum.at(lo_x, k, xs)
-    np.minimum.at(lo_y, k, ys)
-    np.maximum.at(hi_x, k, xs)
-    np.maximum.at(hi_y, k, ys)
+    np.minimum.at(lo_x, labels, sx)
+    np.minimum.at(lo_y, labels, sy)
+    np.maximum.at(hi_y, labels, sy)
+    np.maximum.at(hi_x, labels, ex)
     present = hi_x >= 0
     boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
-    return boxes.astype(np.int32)
+    return boxes
+
 
 
 def _disjoint_groups(members: list) -> list[list]:

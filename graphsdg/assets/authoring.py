@@ -27,6 +27,7 @@ def new_asset_stage(path: str, root_name: str, kind: str = Kind.Tokens.component
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
     stage.SetMetadata("kilogramsPerUnit", 1.0)
+    stage.SetTimeCodesPerSecond(60.0)   # Kit's rate: a timeline tick is 1/60 s on an opened asset too
     layer.documentation = GENERATOR_NOTE
     root = UsdGeom.Xform.Define(stage, f"/{root_name}").GetPrim()
     stage.SetDefaultPrim(root)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import sys
 import types
-import unittest
 
 from graphsdg.compat import isaac_core, kit
 from graphsdg.compat.modules import CompatFinder, CompatModule, ForwardingModule
@@ -48,7 +47,7 @@ def _modules() -> dict[str, types.ModuleType]:
                             TimelineEventType=TimelineEventType)
     app = CompatModule("omni.kit.app", get_app=kit.get_app)
     commands = CompatModule("omni.kit.commands", execute=kit.execute)
-    kit_test = CompatModule("omni.kit.test", AsyncTestCase=unittest.IsolatedAsyncioTestCase)
+    kit_test = CompatModule("omni.kit.test", AsyncTestCase=kit.AsyncTestCase)
     omni_kit = CompatModule("omni.kit", app=app, commands=commands, test=kit_test)
     usd = CompatModule("omni.usd", get_context=kit.get_context, StageEventType=kit.StageEventType,
                        get_world_transform_matrix=kit.get_world_transform_matrix,
@@ -92,8 +91,12 @@ def _modules() -> dict[str, types.ModuleType]:
                storage_native, core, core_utils, bounds, experimental, exp_utils, exp_bounds, exp_stage,
                exp_semantics, exp_prims]
     scenario = _palletizing_module()
-    if scenario is not None:
-        modules += scenario
+    if scenario is None:
+        scenario = [CompatModule("isaacsim.examples", hint=(
+            "Isaac's UR10 palletizing example maps to graphsdg.scenarios.palletizing, which this installation "
+            "does not have."))]
+    isaacsim.examples = scenario[-1]  # type: ignore[attr-defined]
+    modules += scenario
     return {m.__name__: m for m in modules}
 
 
@@ -101,8 +104,10 @@ def _palletizing_module() -> list[types.ModuleType] | None:
     """``isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing`` when the scenario exists."""
     try:
         from graphsdg.scenarios import palletizing
-    except ImportError:
-        return None
+    except ModuleNotFoundError as exc:   # absent; a scenario that is there but broken raises
+        if exc.name in ("graphsdg.scenarios", "graphsdg.scenarios.palletizing"):
+            return None
+        raise
     leaf = CompatModule("isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing",
                         BinStacking=palletizing.BinStacking)
     pkg = CompatModule("isaacsim.examples.interactive.ur10_palletizing", ur10_palletizing=leaf)
@@ -120,16 +125,12 @@ def install() -> None:
     if clash:
         raise RuntimeError(f"cannot install graphsdg's Isaac compat modules: {clash[0]!r} is already imported "
                            f"(a real Omniverse install?)")
-    if "isaacsim.examples" not in modules:
-        isaacsim = modules["isaacsim"]
-        isaacsim.examples = CompatModule("isaacsim.examples")  # type: ignore[attr-defined]
-    else:
-        modules["isaacsim"].examples = modules["isaacsim.examples"]  # type: ignore[attr-defined]
     sys.modules.update(modules)
     _installed.update(modules)
     global _finder
     _finder = CompatFinder(_installed)
     sys.meta_path.insert(0, _finder)
+    kit.get_context()._listen()   # stage events from here on
 
 
 def uninstall() -> None:
@@ -139,10 +140,16 @@ def uninstall() -> None:
         if sys.modules.get(name) is _installed[name]:
             del sys.modules[name]
     _installed.clear()
+    kit.get_context()._stop_listening()
     if _finder is not None and _finder in sys.meta_path:
         sys.meta_path.remove(_finder)
     _finder = None
 
 
 def installed_names() -> list[str]:
+    """The Isaac / Omniverse module names currently installed."""
     return sorted(_installed)
+
+
+def is_installed() -> bool:
+    return bool(_installed)

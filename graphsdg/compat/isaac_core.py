@@ -10,6 +10,7 @@ from typing import Any, Callable, Iterable, Sequence
 import numpy as np
 from pxr import Usd, UsdGeom
 
+from graphsdg.compat.modules import CompatObject
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prim
@@ -61,8 +62,10 @@ def compute_obb(bbox_cache: UsdGeom.BBoxCache, prim_path: str):
 
 
 # ---- prims --------------------------------------------------------------------------
-class XformPrim:
+class XformPrim(CompatObject):
     """isaacsim.core.experimental.prims.XformPrim: world poses of prims matched by path(s)."""
+
+    _compat_name = "isaacsim.core.experimental.prims.XformPrim"
 
     def __init__(self, paths: str | Sequence[str], **_: Any) -> None:
         self.paths = [paths] if isinstance(paths, str) else list(paths)
@@ -70,35 +73,28 @@ class XformPrim:
             resolve_prim(p)
 
     def _selected(self, indices: Sequence[int] | None) -> list[str]:
-        return self.paths if indices is None else [self.paths[int(i)] for i in indices]
+        return self.paths if indices is None else [self.paths[int(i)] for i in np.atleast_1d(indices)]
 
     def get_world_poses(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
+        """(positions (k, 3), orientations (k, 4) w, x, y, z)."""
         from graphsdg.sim.transforms import get_world_pose
         poses = [get_world_pose(p) for p in self._selected(indices)]
         return _warp([p[0] for p in poses]), _warp([p[1] for p in poses])
 
     def set_world_poses(self, positions: Any = None, orientations: Any = None,
                         indices: Sequence[int] | None = None) -> None:
-        from graphsdg.functional import modify
-        from graphsdg.stage.xform import decompose, quat_wxyz_to_matrix, world_matrix
-        for i, path in enumerate(self._selected(indices)):
-            prim = resolve_prim(path)
-            parent = prim.GetParent()
-            parent_m = world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
-            world = world_matrix(prim)
-            if positions is not None:
-                world[3, :3] = np.asarray(positions, dtype=np.float64).reshape(-1, 3)[i]
-            if orientations is not None:
-                _, _, scale = decompose(world)
-                r = quat_wxyz_to_matrix(np.asarray(orientations, dtype=np.float64).reshape(-1, 4)[i])
-                world[:3, :3] = (r * scale).T
-            t, r, _ = decompose(world @ np.linalg.inv(parent_m))
-            from graphsdg.stage.xform import matrix_to_quat_wxyz
-            modify.pose(prim, position_value=t, rotation_value=matrix_to_quat_wxyz(r))
+        from graphsdg.sim.transforms import set_world_pose
+        paths = self._selected(indices)
+        pos = None if positions is None else np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+        quat = None if orientations is None else np.asarray(orientations, dtype=np.float64).reshape(-1, 4)
+        for i, path in enumerate(paths):
+            set_world_pose(path, None if pos is None else pos[i], None if quat is None else quat[i])
 
 
 class RigidPrim(XformPrim):
     """isaacsim.core.experimental.prims.RigidPrim over graphsdg's rigid-body view."""
+
+    _compat_name = "isaacsim.core.experimental.prims.RigidPrim"
 
     def __init__(self, paths: str | Sequence[str], **kwargs: Any) -> None:
         super().__init__(paths, **kwargs)
@@ -148,8 +144,10 @@ def remove_labels(prim: Usd.Prim, instance_name: str | None = None) -> None:
 
 
 # ---- omni.physx scene queries ------------------------------------------------------------
-class SceneQueryInterface:
+class SceneQueryInterface(CompatObject):
     """omni.physx's scene query interface; hits carry ``rigid_body`` / ``collision`` prim paths."""
+
+    _compat_name = "omni.physx.IPhysxSceneQuery"
 
     def overlap_box(self, half_extent: Any, position: Any, rotation: Any,
                     report_fn: Callable[[Any], bool] | None = None, any_hit: bool = False) -> int:

@@ -5,7 +5,7 @@
 * :mod:`~graphsdg.graph.graph`: the ``networkx.DiGraph`` of data dependencies, order and stable ids;
 * :mod:`~graphsdg.graph.builder`: items, ``with`` scopes, ``new_layer``;
 * :mod:`~graphsdg.graph.scheduler`: per-step trigger firing, execution, provenance, seek;
-* :mod:`~graphsdg.graph.export` and :mod:`~graphsdg.graph.dry_run`: seeing the graph.
+* :mod:`~graphsdg.graph.export`, :mod:`~graphsdg.graph.drawing` and :mod:`~graphsdg.graph.dry_run`: seeing the graph.
 
 Example:
     >>> import graphsdg as rep
@@ -19,6 +19,7 @@ Example:
 from graphsdg.graph import scheduler
 from graphsdg.graph.builder import (GraphBuildError, ReplicatorItem, current_graph, new_layer,
                                     remove_prim_specs)
+from graphsdg.graph.drawing import draw, layout
 from graphsdg.graph.dry_run import DryRunReport, dry_run
 from graphsdg.graph.export import describe, to_dict, to_dot, to_json, to_networkx
 from graphsdg.graph.graph import REPLICATOR_ROOT, Graph
@@ -30,5 +31,5 @@ scheduler.install()
 
 __all__ = ["Node", "Port", "TriggerNode", "ExecContext", "NodeRegistry", "register_node", "Graph", "ReplicatorItem",
            "GraphBuildError", "current_graph", "new_layer", "describe", "to_dict", "to_dot", "to_json",
-           "to_networkx", "dry_run", "DryRunReport", "clear", "seek", "remove_prim_specs", "REPLICATOR_ROOT",
+           "to_networkx", "draw", "layout", "dry_run", "DryRunReport", "clear", "seek", "remove_prim_specs", "REPLICATOR_ROOT",
            "scheduler"]

@@ -21,6 +21,7 @@ from typing import Any, Iterable
 
 from pxr import Sdf, Usd
 
+from graphsdg import profiling
 from graphsdg.graph.builder import ReplicatorItem, current_graph, edit_context, release_graph
 from graphsdg.graph.graph import Graph, effective_triggers
 from graphsdg.graph.node import ExecContext, Node, TriggerNode
@@ -36,8 +37,8 @@ def execute(node: Node, frame: int, dry: bool = False) -> None:
     """Run one execution of ``node``."""
     ctx = ExecContext(node, node.exec_count, frame, dry)
     node.record = {}
-    with (contextlib.nullcontext() if dry else edit_context(node)):   # a dry run keeps edits in its own layer
-        out = node.compute(ctx)
+    with (contextlib.nullcontext() if dry else edit_context(node)), profiling.timed(f"node:{node.name}"):
+        out = node.compute(ctx)   # a dry run keeps its edits in its own layer
     if out:
         node.output_values = {**node.output_values, **out}
     node.exec_count += 1

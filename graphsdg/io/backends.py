@@ -11,12 +11,13 @@ from __future__ import annotations
 import errno
 import inspect
 import os
+import re
 import threading
 import uuid
 from typing import Any, Callable
 
 
-from graphsdg import settings
+from graphsdg import frame_plan, settings
 from graphsdg.errors import unknown_name
 from graphsdg.io import encode
 from graphsdg.io.write_queue import get_write_queue
@@ -78,19 +79,26 @@ class DiskBackend(BaseBackend):
         root = settings.get("/omni/replicator/backends/disk/root_dir")
         path = output_dir if os.path.isabs(output_dir) else os.path.join(root or os.getcwd(), output_dir)
         path = os.path.abspath(path)
-        if not overwrite and os.path.exists(path):
+        if writes_discarded():
+            return path
+        if os.path.exists(path) and not os.path.isdir(path):
+            raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
+        # every shard, and a resumed run, must write into the folder the job started with
+        if not overwrite and os.path.exists(path) and frame_plan.current() is None:
             i = 1
             while os.path.exists(f"{path}_{i:04d}"):
                 i += 1
             path = f"{path}_{i:04d}"
         if os.path.exists(path) and not os.path.isdir(path):
             raise NotADirectoryError(f"output_dir {path!r} exists and is a file, not a directory")
+        blocker = _file_ancestor(path)
+        if blocker is not None:
+            raise NotADirectoryError(f"cannot create output_dir {path!r}: {blocker!r} is a file, not a directory")
         try:
             os.makedirs(path, exist_ok=True)
         except OSError as exc:
-            raise PermissionError(f"cannot create output_dir {path!r}: {exc.strerror}") from exc
-        if not os.access(path, os.W_OK | os.X_OK):
-            raise PermissionError(f"output_dir {path!r} is not writable")
+            raise PermissionError(f"cannot create output_dir {path!r}: {exc.strerror or exc}") from exc
+        _check_writable(path)
         return path
 
     def resolve(self, path: str) -> str:
@@ -109,6 +117,27 @@ class DiskBackend(BaseBackend):
             return f.read()
 
 
+def _file_ancestor(path: str) -> str | None:
+    """The first existing ancestor of ``path`` that is a file (so no directory can be made there), if any."""
+    parent = os.path.dirname(path)
+    while parent and not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    return parent if parent and not os.path.isdir(parent) else None
+
+
+def _check_writable(path: str) -> None:
+    """Create and remove a probe file: catches read-only mounts and ACLs that ``os.access`` misses (e.g. as root)."""
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise PermissionError(f"output_dir {path!r} is not writable")
+    probe = os.path.join(path, f".graphsdg-probe-{uuid.uuid4().hex[:8]}")
+    try:
+        with open(probe, "wb"):
+            pass
+        os.unlink(probe)
+    except OSError as exc:
+        raise PermissionError(f"output_dir {path!r} is not writable: {exc.strerror or exc}") from exc
+
+
 _counter_lock = threading.Lock()
 _written = {"files": 0, "bytes": 0}
 
@@ -122,8 +151,38 @@ def bytes_written() -> int:
     return _written["bytes"]
 
 
+_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{12}\.tmp$")
+
+
+def remove_temporaries(output_dir: str) -> int:
+    """Delete the temporary files that interrupted atomic writes left under ``output_dir``; return how many.
+
+    Only call it while nothing writes there (a resumed run before its first frame, a merge after its shards).
+    """
+    removed = 0
+    for folder, _, names in os.walk(output_dir):
+        for name in names:
+            if _TEMPORARY.match(name):
+                try:
+                    os.unlink(os.path.join(folder, name))
+                    removed += 1
+                except FileNotFoundError:
+                    pass
+    return removed
+
+
+def writes_discarded() -> bool:
+    """True while ``/graphsdg/io/discardWrites`` is set: disk backends create and write nothing.
+
+    ``graphsdg graph SCRIPT`` runs a script this way to build its graph without touching its outputs.
+    """
+    return bool(settings.get("/graphsdg/io/discardWrites", False))
+
+
 def write_file_atomic(full_path: str, data: bytes) -> None:
     """Write ``data`` to ``full_path`` so that the file appears whole or not at all."""
+    if writes_discarded():
+        return
     directory = os.path.dirname(full_path)
     os.makedirs(directory, exist_ok=True)
     tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{uuid.uuid4().hex[:12]}.tmp")

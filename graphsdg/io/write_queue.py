@@ -15,7 +15,7 @@ import time
 import traceback
 from typing import Any, Callable
 
-from graphsdg import settings
+from graphsdg import profiling, settings
 from graphsdg.errors import WriterError
 
 log = logging.getLogger("graphsdg.io")
@@ -51,7 +51,9 @@ class WriteQueue:
                 if item is None:
                     return
                 fn, args, kwargs = item
+                start = time.perf_counter()
                 fn(*args, **kwargs)
+                profiling.add("encode+write", time.perf_counter() - start)
                 with self._lock:
                     self.completed += 1
             except BaseException as exc:  # noqa: BLE001 - every failure must reach the script

@@ -25,12 +25,12 @@ Example:
 from __future__ import annotations
 
 import inspect
-import json
 from typing import Any, Iterable
 
 from graphsdg import rng
 from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry, shape_output
 from graphsdg.errors import unknown_name
+from graphsdg.io.io_functions import write_json
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
 
 DATA_STRUCTURES = ("legacy", "annotator", "renderProduct")
@@ -45,6 +45,17 @@ class Writer:
     annotators: list = []
     num_written: int = 0
     data_structure: str = "legacy"
+    #: True for writers that name a frame's files by ``data["frame_index"]`` when it is given (sharded and
+    #: resumed runs pass it); only such writers can be sharded or resumed.
+    frame_indexed: bool = False
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> "Writer":
+        # Per-instance defaults (Replicator seeds them in __new__ too), so a subclass
+        # __init__ that appends to self.annotators never touches a shared list.
+        instance = super().__new__(cls)
+        instance.annotators = []
+        instance.num_written = 0
+        return instance
 
     def write(self, data: dict) -> None:
         """Called once per captured frame."""
@@ -107,6 +118,7 @@ class Writer:
             raise ValueError(f"{type(self).__name__} has no annotators to write; set self.annotators "
                              f"(e.g. rgb=True for BasicWriter)")
         self._render_products = rps
+        self.num_written = 0
         self._trigger = trigger
         self._manual_requests = 0
         for a in annotators:
@@ -119,8 +131,10 @@ class Writer:
         return _attach()
 
     def detach(self) -> None:
-        """Stop receiving frames; the writer's annotators detach."""
+        """Stop receiving frames (aggregate files are flushed first); the writer's annotators detach."""
         from graphsdg.runtime import runtime
+        if self in runtime().writers:
+            self.flush()
         for a in self._annotator_objects():
             a.detach(self.render_products) if self.render_products else None
         self._render_products = []
@@ -144,15 +158,45 @@ class Writer:
         return trigger in fired_triggers
 
     def on_final_frame(self) -> None:
-        """Called when generation stops (flush aggregate files here)."""
+        """Called when generation stops (``orchestrator.stop()``, the end of ``run()``)."""
+
+    def flush(self) -> None:
+        """Schedule the current state of aggregate files (a dataset-wide json, an open shard).
+
+        Writers that keep such files override this; ``orchestrator.wait_until_complete()``
+        and :meth:`detach` call it, so the files on disk are complete after either.
+        """
+
+    def frame_complete(self, frame_index: int) -> bool:
+        """Whether every file of frame ``frame_index`` is on disk (``--resume`` skips such frames)."""
+        return False
+
+    def shard_info(self) -> dict:
+        """What the merge step of a sharded run needs: ``{"aggregates": {final path: shard path}, ...}``."""
+        return {}
+
+    def get_metadata(self) -> dict:
+        """The writer's metadata: name, version and the global seed."""
+        self.metadata = {"name": type(self).__name__, "version": self.version,
+                         "replicator_global_seed:": rng.get_global_seed()}
+        return self.metadata
 
     def write_metadata(self) -> None:
-        """Write ``metadata.txt`` (Replicator's JSON, stray colon in the seed key included)."""
+        """Schedule ``metadata.txt`` (Replicator's JSON, stray colon in the seed key included).
+
+        Called before the first frame a writer writes; a writer without a backend writes none.
+        """
         if self.backend is None:
             return
-        meta = {"name": type(self).__name__, "version": self.version,
-                "replicator_global_seed:": rng.get_global_seed()}
-        self.backend.write_blob("metadata.txt", json.dumps(meta).encode())
+        self.backend.schedule(write_json, data=self.get_metadata(), path="metadata.txt")
+        self._is_metadata_written = True
+
+    def _write(self, data: dict) -> None:
+        """What the orchestrator calls per captured frame: metadata first, then :meth:`write`."""
+        if not getattr(self, "_is_metadata_written", False):
+            self.write_metadata()
+        self.write(data)
+        self.num_written = (self.num_written or 0) + 1
 
     # ---- data assembly -------------------------------------------------
     def build_payload(self, outputs: dict[tuple[int, str], dict], trigger_outputs: dict,

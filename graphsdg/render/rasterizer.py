@@ -29,13 +29,16 @@ loose boxes are measured from.
 """
 from __future__ import annotations
 
+import os
 from collections import Counter
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
+import cv2
 import mujoco
 import numpy as np
 
+from graphsdg import profiling
 from graphsdg.render.camera import CameraView
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
@@ -55,6 +58,38 @@ class RenderOutputs:
     geom_ids: np.ndarray | None = None       # int32 (H, W), -1 on background
     # Follow-up renders of the same view and state: (geom ids, crop) -> int32 ids of the crop
     render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
+
+
+def make_gl_context():
+    """An offscreen GL context on the platform graphsdg chose (EGL when headless).
+
+    Chosen here rather than through ``mujoco.rendering.classic.gl_context`` so a
+    script that imported ``mujoco`` before ``graphsdg`` (which fixes MuJoCo's own
+    choice at import) still renders headless.
+    """
+    platform = os.environ.get("MUJOCO_GL", "").strip().lower()
+    if platform == "egl":
+        from mujoco.egl import GLContext
+    elif platform == "osmesa":
+        from mujoco.osmesa import GLContext
+    else:
+        from mujoco.rendering.classic import gl_context
+        GLContext = gl_context.GLContext
+        if GLContext is None:
+            raise RuntimeError("MuJoCo has no OpenGL platform; set MUJOCO_GL=egl (needs libEGL)")
+    return GLContext(64, 64)
+
+
+def _is_current(gl) -> bool:
+    """Whether ``gl`` (an EGL context) is already current on this thread; False when unknown."""
+    context = getattr(gl, "_context", None)
+    if context is None or os.environ.get("MUJOCO_GL", "").lower() != "egl":
+        return False
+    import ctypes
+
+    from OpenGL import EGL
+    address = lambda p: ctypes.cast(p, ctypes.c_void_p).value  # noqa: E731
+    return address(EGL.eglGetCurrentContext()) == address(context)
 
 
 def halton(index: int, base: int) -> float:
@@ -90,15 +125,16 @@ class Rasterizer:
     # ---- contexts ------------------------------------------------------
     def _ensure_gl(self) -> None:
         if self._gl is None:
-            from mujoco.rendering.classic import gl_context
-            if gl_context.GLContext is None:
-                raise RuntimeError("MuJoCo has no OpenGL platform; set MUJOCO_GL=egl (needs libEGL) "
-                                   "before importing graphsdg")
-            self._gl = gl_context.GLContext(64, 64)
-        self._gl.make_current()
+            self._gl = make_gl_context()
+        if not _is_current(self._gl):   # re-binding a current context can flush the GL pipeline
+            self._gl.make_current()
 
     def bind(self, sim: SimScene) -> None:
         """Make the GL contexts match the scene's current model."""
+        with profiling.timed("render:bind+uploads"):
+            self._bind(sim)
+
+    def _bind(self, sim: SimScene) -> None:
         self._ensure_gl()
         model = sim.model
         quality = render_quality(max(int(model.vis.global_.offwidth), int(model.vis.global_.offheight)))
@@ -205,8 +241,10 @@ class Rasterizer:
         rgb = np.empty((h, w, 3), dtype=np.uint8)
         raw = np.empty((h, w), dtype=np.float32) if want_depth else None
         self._update_scene(sim, view, (0.0, 0.0))
-        mujoco.mjr_render(rect, scene, ctx)
-        mujoco.mjr_readPixels(rgb, raw, rect, ctx)
+        with profiling.timed("render:color"):
+            mujoco.mjr_render(rect, scene, ctx)
+        with profiling.timed("readback:color"):
+            mujoco.mjr_readPixels(rgb, raw, rect, ctx)
         self.stats["color"] += 1
         depth = None
         if raw is not None:
@@ -228,7 +266,7 @@ class Rasterizer:
                 linear = np.ascontiguousarray(mean[::-1] / np.float32(255))
         elif want_linear:
             linear = np.ascontiguousarray(rgb[::-1].astype(np.float32) / np.float32(255))
-        return np.ascontiguousarray(rgb[::-1]), linear, depth
+        return cv2.flip(rgb, 0), linear, depth   # GL rows run bottom-up; cv2's flip is one fast copy
 
     def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None,
                     with_depth: bool) -> tuple[np.ndarray, np.ndarray | None]:
@@ -245,15 +283,19 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
         try:
             self._update_scene(sim, view, (0.0, 0.0), crop)
-            mujoco.mjr_render(rect, scene, ctx)
+            kind = "ids" if crop is None else "isolated"
+            with profiling.timed(f"render:{kind}"):
+                mujoco.mjr_render(rect, scene, ctx)
             ids = np.empty((h, w, 3), dtype=np.uint8)
             raw = np.empty((h, w), dtype=np.float32) if with_depth else None
-            mujoco.mjr_readPixels(ids, raw, rect, ctx)
+            with profiling.timed(f"readback:{kind}"):
+                mujoco.mjr_readPixels(ids, raw, rect, ctx)
         finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         self.stats["ids" if crop is None else "isolated"] += 1
-        geom_ids = _decode_segmentation(ids[::-1], scene)
+        with profiling.timed("decode:ids"):
+            geom_ids = _decode_segmentation(cv2.flip(ids, 0), scene)
         depth = None
         if raw is not None:
             far = effective_far(sim.model, view)
@@ -303,25 +345,29 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
         lin = (far - raw.astype(np.float64) * (far - near)).astype(np.float32)
         lin[(raw <= 0.0) | (lin > clip)] = np.inf
         return lin
-    zfar, znear = np.float32(far), np.float32(near)
-    c = -(zfar + znear) / (zfar - znear)
-    d = -(np.float32(2) * zfar * znear) / (zfar - znear)
-    c = np.float32(-0.5) * c - np.float32(0.5)
-    d = np.float32(-0.5) * d
-    z = raw.astype(np.float64)
+    # Reversed Z: window depth w = near * (far - z) / (z * (far - near)), so z = near * far / (w * (far - near) + near).
+    # In float32 the relative error stays ~1e-7 (w itself is a float32 read from GL).
     with np.errstate(divide="ignore"):
-        lin = d / (z + c)
-    lin = lin.astype(np.float32)
+        lin = np.float32(near * far) / (raw * np.float32(far - near) + np.float32(near))
     lin[(raw <= 0.0) | (lin > clip)] = np.inf   # nothing drawn, or the sky
     return lin
 
 
 def _decode_segmentation(rgb: np.ndarray, scene: mujoco.MjvScene) -> np.ndarray:
-    segid = rgb[..., 0].astype(np.int32) | (rgb[..., 1].astype(np.int32) << 8) | \
-        (rgb[..., 2].astype(np.int32) << 16)
-    lut = np.full(scene.ngeom + 2, -1, dtype=np.int32)
+    """MuJoCo's id colours (segid + 1 in 24-bit RGB) -> geom ids, -1 where no geom was drawn."""
+    if scene.ngeom + 1 < (1 << 16):
+        # Ids fit in red + green: as RGBA, each pixel's first two bytes are one little-endian
+        # uint16, read in place (cvtColor makes the 4-byte pixels in one vectorised pass).
+        rgba = cv2.cvtColor(np.ascontiguousarray(rgb), cv2.COLOR_RGB2RGBA)
+        segid = rgba.view(np.uint16).reshape(rgba.shape[0], rgba.shape[1], 2)[..., 0]
+        size = 1 << 16
+    else:
+        segid = rgb[..., 0].astype(np.int32) | (rgb[..., 1].astype(np.int32) << 8) | \
+            (rgb[..., 2].astype(np.int32) << 16)
+        size = scene.ngeom + 2
+        segid = np.clip(segid, 0, size - 1)
+    lut = np.full(size, -1, dtype=np.int32)
     for g in scene.geoms[:scene.ngeom]:
         if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
             lut[g.segid + 1] = g.objid
-    segid = np.clip(segid, 0, len(lut) - 1)
     return lut[segid]

@@ -80,10 +80,16 @@ class DirectTargets:
         self.parent_s = np.array([decompose(m)[2] for m in mats])
         self.is_mesh = np.array([b.type_name in ("Mesh", "Cone") for b in self.bindings])
         self.prims = list(prims)
-        # Unit-scale sizes let box scales be written as one array product.
+        # Unit-scale sizes let box, sphere and z-axis cylinder/capsule scales be array products.
         self.is_box = np.array([b.type_name == "Cube" for b in self.bindings])
-        self.unit_box = np.array([primitive_size(p, np.ones(3))[1] if box else np.zeros(3)
-                                  for p, box in zip(self.prims, self.is_box)]).reshape(len(self.prims), 3)
+        self.unit_size = np.zeros((len(self.prims), 3))
+        self.simple = np.zeros(len(self.prims), dtype=bool)
+        for i, (p, b) in enumerate(zip(self.prims, self.bindings)):
+            if b.type_name in ("Cube", "Sphere") or (b.type_name in ("Cylinder", "Capsule")
+                                                     and str(p.GetAttribute("axis").Get()) == "Z"):
+                self.unit_size[i] = primitive_size(p, np.ones(3))[1]
+                self.simple[i] = True
+        self.kind = np.array([sim.model.geom_type[b.geom_id] for b in self.bindings])
 
 
 _cache: dict[tuple, DirectTargets] = {}
@@ -91,7 +97,7 @@ _cache: dict[tuple, DirectTargets] = {}
 
 def targets_for(sim: SimScene, prims: Sequence[Usd.Prim]) -> DirectTargets:
     sim.sync_dirty_prims()   # structure first: the indices must be current
-    key = (id(sim), sim.model_version, tuple(str(p.GetPath()) for p in prims))
+    key = (id(sim), sim.model_version, tuple(p.GetPath() for p in prims))
     found = _cache.get(key)
     if found is None:
         if len(_cache) > 64:
@@ -114,10 +120,11 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
     sizes = {}
     if scales is not None:
         world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3) * t.parent_s
+        sizes.update(_simple_sizes(t, world_scale))
         for i in range(n):
-            if t.is_box[i]:
-                sizes[i] = t.unit_box[i] * np.abs(world_scale[i])
-            elif not t.is_mesh[i]:
+            if i in sizes:
+                continue
+            if not t.is_mesh[i]:
                 kind, size, _ = primitive_size(t.prims[i], world_scale[i])
                 if int(kind) != int(m.geom_type[t.geom_ids[i]]):
                     return False   # e.g. a sphere scaled unevenly becomes an ellipsoid: recompile via USD
@@ -133,16 +140,15 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
             local_r = euler_xyz_to_matrices(rot.reshape(n, 3))
         d.mocap_quat[t.mocap_ids] = matrices_to_quats(np.einsum("nij,njk->nik", t.parent_r, local_r))
     if scales is not None:
-        for i in range(n):
-            b = t.bindings[i]
-            if t.is_mesh[i]:
-                if not np.allclose(world_scale[i], b.scale):
-                    sim.meshes_to_upload.add(rescale_mesh_geom(m, b.geom_id, b.scale, world_scale[i]))
-            else:
-                m.geom_size[b.geom_id] = sizes[i]
-                m.geom_rbound[b.geom_id] = float(np.linalg.norm(_half_extent(int(m.geom_type[b.geom_id]),
-                                                                             sizes[i])))
-            b.scale = world_scale[i]
+        _write_mesh_scales(sim, t, world_scale)
+        rows = np.array(sorted(sizes), dtype=np.int64)
+        if rows.size:
+            size_arr = np.array([sizes[i] for i in rows])
+            gids = t.geom_ids[rows]
+            m.geom_size[gids] = size_arr
+            m.geom_rbound[gids] = np.linalg.norm(_half_extents(t.kind[rows], size_arr), axis=1)
+            for i in rows:
+                t.bindings[i].scale = world_scale[i]
     mujoco.mj_kinematics(m, d)
     return True
 
@@ -164,13 +170,51 @@ def _quat_matrix(q: np.ndarray) -> np.ndarray:
     return out.reshape(3, 3)
 
 
-def _half_extent(kind: int, size: np.ndarray) -> np.ndarray:
+def _write_mesh_scales(sim: SimScene, t: DirectTargets, world_scale: np.ndarray) -> None:
+    """Rescale the mesh geoms whose scale changed (compared as one array, not per prim)."""
+    mesh_rows = np.flatnonzero(t.is_mesh)
+    if not mesh_rows.size:
+        return
+    old = np.array([t.bindings[i].scale for i in mesh_rows])
+    new = world_scale[mesh_rows]
+    changed = np.any(np.abs(new - old) > 1e-12 * np.maximum(1.0, np.abs(old)), axis=1)
+    for i, row in enumerate(mesh_rows):
+        if changed[i]:
+            b = t.bindings[row]
+            sim.meshes_to_upload.add(rescale_mesh_geom(sim.model, b.geom_id, b.scale, new[i]))
+            b.scale = new[i]
+
+
+def _half_extents(kinds: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """(N, 3) half extents of primitive geoms of ``kinds`` with ``sizes`` (MuJoCo size convention)."""
     g = mujoco.mjtGeom
-    if kind == int(g.mjGEOM_SPHERE):
-        return np.full(3, size[0])
-    if kind in (int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)):
-        return np.array([size[0], size[0], size[1] + (size[0] if kind == int(g.mjGEOM_CAPSULE) else 0)])
-    return np.asarray(size[:3])
+    out = np.array(sizes, dtype=np.float64, copy=True)
+    sphere = kinds == int(g.mjGEOM_SPHERE)
+    out[sphere] = sizes[sphere, :1]
+    tube = np.isin(kinds, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
+    out[tube, 1] = sizes[tube, 0]
+    out[tube, 2] = sizes[tube, 1]
+    capsule = kinds == int(g.mjGEOM_CAPSULE)
+    out[capsule, 2] += sizes[capsule, 0]
+    return out
+
+
+def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> dict[int, np.ndarray]:
+    """Sizes of boxes, uniformly scaled spheres and z-axis cylinders/capsules, as array products."""
+    g = mujoco.mjtGeom
+    s = np.abs(world_scale)
+    out = {}
+    box = t.simple & (t.kind == int(g.mjGEOM_BOX))
+    sphere = t.simple & (t.kind == int(g.mjGEOM_SPHERE)) & np.all(s == s[:, :1], axis=1)
+    tube = t.simple & np.isin(t.kind, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
+    sizes = np.zeros_like(s)
+    sizes[box] = t.unit_size[box] * s[box]
+    sizes[sphere, 0] = t.unit_size[sphere, 0] * s[sphere, 0]
+    sizes[tube, 0] = t.unit_size[tube, 0] * np.maximum(s[tube, 0], s[tube, 1])
+    sizes[tube, 1] = t.unit_size[tube, 1] * s[tube, 2]
+    for i in np.flatnonzero(box | sphere | tube):
+        out[int(i)] = sizes[i]
+    return out
 
 
 __all__ = ["write_poses", "write_colors", "euler_xyz_to_matrices"]

@@ -22,10 +22,18 @@ def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray
     if mesh_id < 0:
         raise ValueError(f"geom {geom_id} is not a mesh geom")
     ratio = np.asarray(new_scale, dtype=np.float64) / np.asarray(old_scale, dtype=np.float64)
+    v0, nv = model.mesh_vertadr[mesh_id], model.mesh_vertnum[mesh_id]
+    if ratio[0] == ratio[1] == ratio[2]:
+        # Uniform: vertices, offset and bounds scale by one factor; normals are unchanged.
+        k = float(ratio[0])
+        model.mesh_vert[v0:v0 + nv] *= k
+        model.geom_pos[geom_id] *= k
+        model.geom_aabb[geom_id] *= abs(k)
+        model.geom_rbound[geom_id] *= abs(k)
+        return mesh_id
     rg = quat_wxyz_to_matrix(model.geom_quat[geom_id])
     linear = rg.T @ np.diag(ratio) @ rg
     normal_map = rg.T @ np.diag(1.0 / ratio) @ rg
-    v0, nv = model.mesh_vertadr[mesh_id], model.mesh_vertnum[mesh_id]
     verts = model.mesh_vert[v0:v0 + nv] @ linear.T
     model.mesh_vert[v0:v0 + nv] = verts
     n0, nn = model.mesh_normaladr[mesh_id], model.mesh_normalnum[mesh_id]

@@ -42,6 +42,38 @@ def get_world_pose(prim: PrimLike) -> tuple[np.ndarray, np.ndarray]:
     return t, matrix_to_quat_wxyz(r)
 
 
+def set_world_pose(prim: PrimLike, position=None, orientation=None) -> None:
+    """Place the prim so its world position is ``position`` (3,) and its world rotation the quaternion
+    ``orientation`` (w, x, y, z); either may be ``None`` (kept). The world scale is kept; the local pose
+    authored is the one that yields this world pose under the prim's parent.
+
+    Example:
+        >>> import graphsdg as rep
+        >>> from graphsdg.sim import transforms
+        >>> _ = rep.stage.new_stage()
+        >>> world = rep.functional.create.xform(name="World", position=(1, 0, 0))
+        >>> cube = rep.functional.create.cube(parent=world)
+        >>> transforms.set_world_pose(cube, position=(0, 0, 3))
+        >>> transforms.get_world_position(cube).tolist()
+        [0.0, 0.0, 3.0]
+    """
+    from graphsdg.functional import modify
+    from graphsdg.stage.xform import quat_wxyz_to_matrix
+
+    p = resolve_prim(prim)
+    parent = p.GetParent()
+    parent_m = world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
+    world = world_matrix(p)
+    if position is not None:
+        world[3, :3] = np.asarray(position, dtype=np.float64).reshape(3)
+    if orientation is not None:
+        scale = decompose(world)[2]
+        r = quat_wxyz_to_matrix(np.asarray(orientation, dtype=np.float64).reshape(4))
+        world[:3, :3] = (r * scale).T   # row-vector layout: rows are the scaled local axes
+    t, r, _ = decompose(world @ np.linalg.inv(parent_m))
+    modify.pose(p, position_value=t, rotation_value=matrix_to_quat_wxyz(r))
+
+
 def get_world_scale(prim: PrimLike) -> np.ndarray:
     """Per-axis world scale of the prim, shape (3,)."""
     return decompose(world_matrix(resolve_prim(prim)))[2]

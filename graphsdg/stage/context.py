@@ -26,12 +26,26 @@ class StageContext:
         self.tracker: ChangeTracker | None = None
         self.generation = 0
         self._on_replaced: list[Callable[[Usd.Stage | None], None]] = []
+        self._on_replacing: list[Callable[[Usd.Stage], None]] = []
 
     def subscribe_replaced(self, callback: Callable[[Usd.Stage | None], None]) -> None:
         """Call ``callback(new_stage)`` whenever the stage is replaced or closed."""
         self._on_replaced.append(callback)
 
+    def subscribe_replacing(self, callback: Callable[[Usd.Stage], None]) -> None:
+        """Call ``callback(old_stage)`` just before the current stage is replaced or closed (Kit's CLOSING)."""
+        self._on_replacing.append(callback)
+
+    def unsubscribe(self, callback: Callable) -> None:
+        """Stop calling ``callback`` (either kind of subscription)."""
+        for callbacks in (self._on_replaced, self._on_replacing):
+            if callback in callbacks:
+                callbacks.remove(callback)
+
     def _install(self, stage: Usd.Stage | None) -> Usd.Stage | None:
+        if self.stage is not None:
+            for cb in list(self._on_replacing):
+                cb(self.stage)
         if self.tracker is not None:
             self.tracker.revoke()
         self.stage = stage

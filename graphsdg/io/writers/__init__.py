@@ -1,7 +1,15 @@
 """Built-in writers; importing this package registers them."""
 from graphsdg.io.writer import WriterRegistry
 from graphsdg.io.writers.basic import BasicWriter
+from graphsdg.io.writers.bop import BopWriter
+from graphsdg.io.writers.coco import CocoWriter
+from graphsdg.io.writers.kitti import KittiWriter
+from graphsdg.io.writers.pose import PoseWriter
+from graphsdg.io.writers.webdataset import WebDatasetWriter
+from graphsdg.io.writers.yolo import YoloWriter
 
-WriterRegistry.register(BasicWriter, category="default")
+for _writer in (BasicWriter, BopWriter, CocoWriter, KittiWriter, PoseWriter, WebDatasetWriter, YoloWriter):
+    WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter"]
+__all__ = ["BasicWriter", "BopWriter", "CocoWriter", "KittiWriter", "PoseWriter", "WebDatasetWriter",
+           "YoloWriter"]

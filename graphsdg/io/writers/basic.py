@@ -16,6 +16,7 @@ Example:
 """
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -23,8 +24,9 @@ import numpy as np
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
-from graphsdg.io.backends import BackendDispatch, BackendGroup, BaseBackend
+from graphsdg.io.backends import BaseBackend
 from graphsdg.io.writer import Writer
+from graphsdg.io.writers import arguments
 
 # flag -> (annotator name BasicWriter requests, file stem)
 _FLAGS = {
@@ -52,6 +54,8 @@ IMAGE_FORMATS = ("png", "jpg", "jpeg")
 class BasicWriter(Writer):
     """Replicator's BasicWriter (see the module docstring for the files it writes)."""
 
+    frame_indexed = True
+
     def __init__(self, output_dir: str | None = None, s3_bucket: str | None = None, s3_region: str | None = None,
                  s3_endpoint: str | None = None, semantic_types: list[str] | None = None, rgb: bool = False,
                  bounding_box_2d_tight: bool = False, bounding_box_2d_loose: bool = False,
@@ -65,11 +69,6 @@ class BasicWriter(Writer):
                  colorize_depth: bool = False, skeleton_data: bool = False, frame_padding: int = 4,
                  semantic_filter_predicate: str | None = None, use_common_output_dir: bool = False,
                  backend: BaseBackend | None = None, provenance: bool = False) -> None:
-        if s3_bucket or s3_region or s3_endpoint:
-            raise ValueError("BasicWriter: S3 output is not available in graphsdg; pass output_dir or backend")
-        if output_dir is None and backend is None:
-            raise ValueError("No `backend`, `output_dir` or `s3_` parameter specified; BasicWriter needs "
-                             "somewhere to write (e.g. output_dir='_out')")
         if str(image_output_format).lower() not in IMAGE_FORMATS:
             raise ValueError(f"image_output_format must be one of {IMAGE_FORMATS}, got {image_output_format!r}")
         if isinstance(frame_padding, bool) or not isinstance(frame_padding, int) or frame_padding < 0:
@@ -86,10 +85,8 @@ class BasicWriter(Writer):
         self.semantic_filter_predicate = semantic_filter.text
         self.version = "0.0.2"
         self.data_structure = "annotator"
-        backends = [backend] if backend is not None else []
-        if output_dir is not None:
-            backends.append(BackendDispatch(output_dir=output_dir))
-        self.backend = backends[0] if len(backends) == 1 else BackendGroup(backends)
+        self.backend = arguments.output_backend("BasicWriter", output_dir, backend, s3_bucket=s3_bucket,
+                                                s3_region=s3_region, s3_endpoint=s3_endpoint)
         self.output_dir = getattr(self.backend, "output_dir", None)
         self._frame_id = 0
         self._sequence = ""
@@ -129,8 +126,8 @@ class BasicWriter(Writer):
         self._annotator_objs = None
 
     # ---- paths ---------------------------------------------------------
-    def _path(self, stem: str, rp_name: str, multi: bool, suffix: str) -> str:
-        n = f"{self._frame_id:0{self._padding}d}"
+    def _path(self, stem: str, rp_name: str, multi: bool, suffix: str, frame_id: int | None = None) -> str:
+        n = f"{self._frame_id if frame_id is None else frame_id:0{self._padding}d}"
         if not multi:
             prefix = ""
         elif self._common_dir:
@@ -140,11 +137,12 @@ class BasicWriter(Writer):
         return f"{prefix}{stem}{suffix}_{self._sequence}{n}"
 
     def write(self, data: dict) -> None:
-        seq = "".join(f"{count}_" for name, count in sorted(data.get("trigger_outputs", {}).items())
-                      if "on_time" in name)
+        seq = sequence_prefix(data.get("trigger_outputs", {}))
         if seq != self._sequence:
             self._sequence = seq
             self._frame_id = 0
+        if "frame_index" in data:          # sharded / resumed runs: the frame's number in the whole dataset
+            self._frame_id = int(data["frame_index"])
         annotators = data["annotators"]
         multi = len({rp for per_rp in annotators.values() for rp in per_rp}) > 1
         for anno_name, per_rp in annotators.items():
@@ -157,7 +155,39 @@ class BasicWriter(Writer):
             self.backend.schedule(iof.write_json, data=record,
                                   path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
-        self.num_written += 1
+
+    def _files_of(self, stem: str) -> list[str]:
+        """The ``suffix.ext`` of every file :meth:`_write_one` writes for ``stem``."""
+        files = {"rgb": [f".{self._image_ext}"], "semantic_segmentation": [".png", "_labels.json"],
+                 "instance_id_segmentation": [".png", "_mapping.json"], "camera_params": [".json"],
+                 "instance_segmentation": [".png", "_mapping.json", "_semantics_mapping.json"],
+                 "normals": [".png"], "skeleton": [".json"],
+                 "pointcloud": [".npy", "_rgb.npy", "_normals.npy", "_semantic.npy", "_instance.npy"]}
+        if stem.startswith("bounding_box"):
+            return [".npy", "_labels.json", "_prim_paths.json"]
+        if stem.startswith("distance_to"):
+            return [".npy", ".png"] if self._colorize_depth else [".npy"]
+        return files.get(stem, [".npy"])
+
+    def expected_files(self, frame_index: int) -> list[str]:
+        """The files (relative to the output folder) this writer writes for frame ``frame_index``."""
+        rps = [rp.name for rp in self.render_products]
+        multi = len(rps) > 1
+        out = []
+        for anno in self._annotator_objects():
+            stem = self._stems.get(anno.name, anno.name[:-5] if anno.name.endswith("_fast") else anno.name)
+            for rp_name in rps:
+                for tail in self._files_of(stem):
+                    suffix, ext = tail.rsplit(".", 1)
+                    out.append(f"{self._path(stem, rp_name, multi, suffix, frame_index)}.{ext}")
+        if self._provenance:
+            out.append(f"provenance_{self._sequence}{frame_index:0{self._padding}d}.json")
+        return out
+
+    def frame_complete(self, frame_index: int) -> bool:
+        root = getattr(self.backend, "output_dir", None)
+        return root is not None and all(os.path.exists(os.path.join(root, f))
+                                        for f in self.expected_files(frame_index))
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
         b = self.backend
@@ -198,6 +228,18 @@ class BasicWriter(Writer):
             b.schedule(iof.write_json, data=skeleton_json(payload), path=f"{path()}.json")
         else:
             b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+
+
+def sequence_prefix(trigger_outputs: dict) -> str:
+    """Replicator's ``{seq}``: ``"<count>_"`` for each ``on_time`` trigger, the last one first.
+
+    ``{"on_time": 3}`` gives ``"3_"``; with no ``on_time`` trigger it is ``""``.
+    """
+    seq = ""
+    for name, count in trigger_outputs.items():
+        if "on_time" in name:
+            seq = f"{count}_{seq}"
+    return seq
 
 
 def skeleton_json(payload: dict) -> dict:

@@ -1,0 +1,122 @@
+"""Scale-out on Ray: ``graphsdg run SCRIPT --workers K`` runs K shards of one job and merges them.
+
+Each shard is a Ray actor: its own process, so its own GL context and MuJoCo
+model. Shard ``i`` runs the whole script with the job's seed and captures the
+frames ``i, i + K, ...`` of its ``orchestrator.run(num_frames)`` (the scheduler
+seeks to each, so every frame holds the values of one uninterrupted run and the
+union of the shards is that run's dataset). Actors ask for one CPU and
+``gpus_per_worker`` GPUs (a fraction shares a GPU); the EGL device follows the
+GPU Ray assigned. The driver then merges the shards (:mod:`graphsdg.dataset.merge`)
+and writes ``graphsdg_index.json``.
+
+With ``address`` the driver joins that Ray cluster (every node needs graphsdg and
+the output folder on a shared filesystem at the same path); otherwise it starts
+a local one for the job and shuts it down afterwards.
+
+Ray is optional: ``pip install 'graphsdg[ray]'``.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import time
+from dataclasses import replace
+
+from graphsdg.job import JobSpec, run_job
+
+log = logging.getLogger("graphsdg.scaleout")
+RAY_HINT = "pip install 'graphsdg[ray]'"
+
+
+class RayMissingError(ImportError):
+    """``--workers`` without Ray installed."""
+
+
+def import_ray():
+    """The ``ray`` module, or a clear error saying how to get it."""
+    try:
+        import ray
+    except ImportError as exc:
+        raise RayMissingError(f"--workers runs shards on Ray, which is not installed; {RAY_HINT} "
+                              f"(or run without --workers)") from exc
+    return ray
+
+
+class ShardWorker:
+    """One shard's process (made a Ray actor by :func:`run_sharded`)."""
+
+    def __init__(self) -> None:
+        import ray
+        from graphsdg.render.egl_device import follow_assigned_gpu
+        self.gpu_ids = list(ray.get_gpu_ids())
+        self.egl_device = follow_assigned_gpu(self.gpu_ids)   # before the first GL context
+
+    def run(self, job: JobSpec, index: int, count: int) -> dict:
+        from graphsdg.frame_plan import FramePlan
+        summary = run_job(job, FramePlan(index, count, job.resume))
+        summary.update(pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device)
+        return summary
+
+
+def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per_worker: float | None = None,
+                num_cpus: int | None = None) -> dict:
+    """Run ``job`` as ``workers`` Ray shards, merge them; return the job summary (with per-shard rows)."""
+    from graphsdg.dataset import merge
+
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"--workers must be a positive integer, got {workers!r}")
+    if job.out is None:
+        raise ValueError("--workers needs --out DIR: the shards write into one output root (on a shared "
+                         "filesystem when the cluster has several machines)")
+    ray = import_ray()
+    start = time.perf_counter()
+    started_here = not ray.is_initialized()
+    if started_here:
+        if address:
+            ray.init(address=address, log_to_driver=True)
+        else:
+            ray.init(num_cpus=num_cpus or max(workers, os.cpu_count() or 1), include_dashboard=False,
+                     log_to_driver=True)
+    try:
+        gpus = float(ray.cluster_resources().get("GPU", 0))
+        per_worker = gpus_per_worker if gpus_per_worker is not None else (min(1.0, gpus / workers) if gpus else 0)
+        if per_worker > gpus:
+            raise ValueError(f"--gpus-per-worker {per_worker} but the cluster has {gpus:g} GPU(s)")
+        env = {k: v for k, v in os.environ.items() if k in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "SOURCE_DATE_EPOCH")}
+        job = replace(job, out=os.path.abspath(job.out), script=os.path.abspath(job.script), env=env)
+        actor = ray.remote(num_cpus=1, num_gpus=per_worker)(ShardWorker)
+        actors = [actor.remote() for _ in range(workers)]
+        pending = {a.run.remote(job, i, workers): i for i, a in enumerate(actors)}
+        results: list[dict] = []
+        try:
+            while pending:
+                done, _ = ray.wait(list(pending), num_returns=1)
+                index = pending.pop(done[0])
+                try:
+                    result = ray.get(done[0])
+                except Exception as exc:   # noqa: BLE001 - one line naming the shard, the cause kept
+                    cause = getattr(exc, "cause", None) or exc
+                    raise RuntimeError(f"shard {index} of {workers} failed: {type(cause).__name__}: {cause}") \
+                        from exc
+                log.info("shard %d: %d frames in %.1f s", index, result["frames"], result["seconds"])
+                results.append(result)
+        finally:
+            for a in actors:
+                ray.kill(a)
+    finally:
+        if started_here:
+            ray.shutdown()
+    results.sort(key=lambda r: r["shard"])
+    datasets = merge.merge_shards(results)
+    seconds = time.perf_counter() - start
+    frames = sum(r["frames"] for r in results)
+    summary = {"frames": frames, "files": sum(r["files"] for r in results),
+               "bytes": sum(r["bytes"] for r in results), "seconds": round(seconds, 3),
+               "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0, "workers": workers,
+               "gpus_per_worker": per_worker,
+               "shards": [{k: r[k] for k in ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device")}
+                          for r in results]}
+    job_info = {k: v for k, v in results[0]["job"].items() if k != "env"} if results else {}
+    summary["index"] = merge.write_index(job.out, {**job_info, "workers": workers, "shards": summary["shards"]},
+                                         datasets)
+    return summary
