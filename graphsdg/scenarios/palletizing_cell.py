@@ -60,7 +60,7 @@ class CellLayout:
     helper_direction_deg: float = math.degrees(math.atan2(0.72, 0.78))
     helper_inner_radius: float = 0.92                            # bins' inner face on the helper
     helper_top: float = -0.15
-    pallet_center: tuple[float, float] = (0.70, -0.45)
+    pallet_center: tuple[float, float] = (0.64, -0.40)          # every slot reachable 0.25 m above a full stack
     slot_gap: tuple[float, float] = (0.05, 0.03)                 # between bins on the pallet (x, y)
     input_stack_center: tuple[float, float] = (-1.30, 1.95)
 

@@ -253,10 +253,10 @@ class PalletizingController:
         self.qd_cmd = np.zeros(6)
 
     def _safe_height(self) -> float:
-        length, width, height = self.layout.bin_size
+        height = self.layout.bin_size[2]
         stack_top = self.layout.pallet_top + self._layers_used * height
-        carried = max(length, width, height) * 0.75 if self._carrying is not None else 0.0
-        return max(0.30, stack_top + 0.12 + carried)
+        carried = height + 0.03 if self._carrying is not None else 0.0     # a gripped bin hangs under the cup
+        return max(0.30, stack_top + 0.08 + carried)
 
     def _travel(self, target: Frame, final_speed: float = APPROACH_SPEED, final_drop: float = 0.10
                 ) -> Iterator[None]:
