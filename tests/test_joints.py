@@ -267,3 +267,13 @@ def test_min_friction_combine_mode_makes_a_slippery_surface_win():
     v = RigidBodyView(box).get_velocities()[0][0, 0]
     # sliding friction 0.02 g for one second: 1 - 0.196 m/s (with the box's own 0.5 it would have stopped)
     assert v == pytest.approx(1.0 - 0.02 * G * 1.0, abs=0.02)
+
+
+@pytest.mark.parametrize("name", ["graphsdg.sim.joints", "graphsdg.sim.articulations", "graphsdg.scenarios.ur10",
+                                  "graphsdg.scenarios.palletizing"])
+def test_docstring_examples(name):
+    import doctest
+    import importlib
+    rep.stage.new_stage()
+    result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
+    assert result.attempted > 0 and result.failed == 0

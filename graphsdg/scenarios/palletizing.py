@@ -39,13 +39,13 @@ from __future__ import annotations
 import random
 from typing import Callable
 
+import numpy as np
+
 from graphsdg import settings
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
 from graphsdg.scenarios.palletizing_controller import Event, PalletizingController
 from graphsdg.sim.joints import Frame
-
-import numpy as np
 
 CALLBACK = "graphsdg.scenarios.palletizing"
 NUM_BINS_SETTING = "/graphsdg/scenarios/palletizing/numBins"

@@ -26,7 +26,6 @@ import math
 from dataclasses import dataclass, field
 from typing import Iterator
 
-import mujoco
 import numpy as np
 
 from graphsdg.scenarios.palletizing_cell import CellLayout
