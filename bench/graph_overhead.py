@@ -35,8 +35,13 @@ def pallet_graph(steps: int) -> dict[str, float]:
     spec = importlib.util.spec_from_file_location("palletizing_sdg", os.path.join(EXAMPLES, "palletizing_sdg.py"))
     pal = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(pal)
-    textures = pal.build_scene(tempfile.mkdtemp())
-    demo = pal.PalletizingSDGDemo(tempfile.mkdtemp(), textures)
+    import random
+
+    from graphsdg.scenarios.palletizing import BinStacking
+    random.seed(0)
+    BinStacking(num_bins=4).load_world()          # the palletizing cell, not running
+    demo = pal.PalletizingSDGDemo(tempfile.mkdtemp())
+    demo._stage = rep.stage.get_stage()
     demo._bin_counter = 3
     demo._create_bin_and_pallet_graph()
     rep.orchestrator.step(delta_time=0.0)

@@ -1,23 +1,44 @@
-"""Randomization in Simulation - UR10 Palletizing (Isaac Sim tutorial), on a small built scene.
+"""Randomization in Simulation - UR10 Palletizing (Isaac Sim tutorial), ported to graphsdg's own API.
 
-The tutorial's Replicator graphs, unchanged but for the import line:
+A UR10-style arm palletizes bins in a running MuJoCo simulation
+(:mod:`graphsdg.scenarios.palletizing`); this script watches the bin the robot is
+working on and, at two events, pauses the simulation, captures data and resumes:
 
-* bin flip scenario: three sphere lights (temperature, intensity, position,
-  scale and a colour palette, all randomized) from a registered randomizer, and a
-  camera walking a sequence of positions, all ``on_frame()``; data read from
-  annotators directly;
-* pallet scenario: ten OmniPBR materials randomized and assigned to the bins
-  every frame, and the pallet's texture and the camera pose every 4th frame
-  (``on_frame(interval=4)``); data written by BasicWriter.
+* bin flip scenario (the bin touches the flip helper): the high-quality render
+  mode, three randomized sphere lights and a camera walking four poses; rgb and
+  colorized instance segmentation read from annotators and saved with Pillow;
+* pallet scenario (the bin touches the pallet or a bin on it): the materials of
+  the bins placed so far randomized every frame, the pallet's wood texture and
+  the camera every 4th frame; 16 frames written by BasicWriter with 24 subframes.
 
-The UR10 simulation (which decides *when* to capture) is replaced by a built
-pallet-and-bins scene; Omniverse asset textures by generated wood textures; and
-``DeletePrimsCommand(paths=["/Replicator"])`` by ``rep.graph.clear()``, which
-also releases the graph. The pallet scenario's BasicWriter also writes
-``provenance_{n}.json`` (what the graph sampled for each frame).
+Each capture builds its graph and render product, then removes them and puts the
+original materials back, so the robot's work is exactly what it is without any
+capture (``tests/test_palletizing.py`` checks this bit for bit).
+
+The code follows the tutorial line by line. What changes with the imports:
+
+==============================================================  ===========================================
+Isaac Sim                                                        graphsdg
+==============================================================  ===========================================
+``omni.timeline.get_timeline_interface()`` + event stream        ``rep.timeline.get_timeline_interface()``,
+                                                                 ``subscribe(callback, event_type)``
+``get_physx_scene_query_interface().overlap_box(...)``           ``graphsdg.sim.queries.overlap_box(...)``
+``isaacsim.core.utils.bounds.create_bbox_cache``                 ``graphsdg.sim.bounds.create_bbox_cache``
+``omni.usd.get_world_transform_matrix``                          ``graphsdg.sim.transforms.get_world_transform_matrix``
+``DeletePrimsCommand(paths=["/Replicator"])``                    ``rep.graph.clear()`` (also releases the graph)
+``carb.settings.get_settings().set(...)``                        ``rep.settings.set(...)``
+``get_assets_root_path()`` (Nucleus)                             ``graphsdg.assets.get_assets_root_path()``
+``asyncio.ensure_future(self._run_..._scenario())``              the scenario runs from the app loop
+                                                                 (:meth:`PalletizingSDGDemo.update`)
+``BinStacking`` (isaacsim.examples.interactive)                  ``graphsdg.scenarios.palletizing.BinStacking``
+==============================================================  ===========================================
+
+The unchanged Isaac script runs too: ``graphsdg run --compat isaac <script>``.
+Run this one with ``python examples/palletizing_sdg.py [output_dir]``.
 """
 import json
 import os
+import random
 import sys
 
 import numpy as np
@@ -25,46 +46,12 @@ from PIL import Image
 from pxr import UsdShade
 
 import graphsdg as rep
-from graphsdg import settings, stage
-from graphsdg.stage.xform import world_matrix
-
-
-def build_scene(texture_dir):
-    """A table with a pallet, a flip helper and bins; returns the wood texture paths."""
-    stage.new_stage()
-    rep.functional.create.xform(name="World")
-    rep.functional.create.dome_light(intensity=400, parent="/World", name="Sky")
-    rep.functional.create.xform(name="Ur10Table", parent="/World")
-    rep.functional.create.xform(name="pallet", parent="/World/Ur10Table")
-    rep.functional.create.xform(name="Xform", parent="/World/Ur10Table/pallet")
-    pallet = rep.functional.create.cube(name="Mesh_015", parent="/World/Ur10Table/pallet/Xform",
-                                        position=(0.78, 0.72, -0.2), scale=(1.2, 1.0, 0.12),
-                                        semantics={"class": "pallet"})
-    rep.functional.create.material(name="PalletWood", parent="/World", diffuse_color_constant=(0.55, 0.4, 0.25),
-                                   bind_prims=[pallet])
-    rep.functional.create.cube(name="pallet_holder", parent="/World/Ur10Table", position=(0.0, 0.0, -0.2),
-                               scale=(0.4, 0.4, 0.1))
-    rep.functional.create.xform(name="bins", parent="/World/Ur10Table")
-    magenta = rep.functional.create.material(name="Magenta", parent="/World", diffuse_color_constant=(0.8, 0.1, 0.7))
-    for i in range(4):
-        rep.functional.create.xform(name=f"bin_{i}", parent="/World/Ur10Table/bins")
-        rep.functional.create.xform(name="Visuals", parent=f"/World/Ur10Table/bins/bin_{i}")
-        box = rep.functional.create.cube(name="FOF_Mesh_Magenta_Box", parent=f"/World/Ur10Table/bins/bin_{i}/Visuals",
-                                         position=(0.53 + 0.5 * (i % 2), 0.5 + 0.45 * (i // 2), -0.06),
-                                         scale=(0.4, 0.3, 0.16), semantics={"class": "bin"})
-        rep.functional.modify.material(box, magenta)
-    os.makedirs(texture_dir, exist_ok=True)
-    paths = []
-    rng = np.random.default_rng(0)
-    for name, base in (("Oak", (150, 110, 70)), ("Ash", (200, 180, 150)), ("Plywood", (210, 170, 110)),
-                       ("Timber", (120, 80, 50))):
-        y = np.arange(64)[:, None] + 3 * np.sin(np.arange(64)[None, :] / 5.0) + rng.normal(0, 0.5, (64, 64))
-        grain = 0.8 + 0.2 * np.sin(y / 2.5)
-        img = np.clip(np.asarray(base)[None, None, :] * grain[..., None], 0, 255).astype(np.uint8)
-        path = os.path.join(texture_dir, f"{name}_BaseColor.png")
-        Image.fromarray(img).save(path)
-        paths.append(path)
-    return paths
+from graphsdg.assets import get_assets_root_path
+from graphsdg.scenarios.palletizing import BinStacking
+from graphsdg.sim.bounds import create_bbox_cache
+from graphsdg.sim.queries import overlap_box
+from graphsdg.sim.timeline import TimelineEventType
+from graphsdg.sim.transforms import get_world_transform_matrix
 
 
 class PalletizingSDGDemo:
@@ -74,33 +61,138 @@ class PalletizingSDGDemo:
     BIN_FLIP_SCENARIO_FRAMES = 4
     PALLET_SCENARIO_FRAMES = 16
 
-    def __init__(self, output_dir, texture_paths, resolution=(512, 512)):
+    def __init__(self, output_dir=None, resolution=(512, 512)):
+        # There are 36 bins in total
         self._bin_counter = 0
-        self._stage = stage.get_stage()
+        self._num_captures = 36
+        self._stage = None
+        self._active_bin = None
+        # Simulation state flags
+        self._in_running_state = False
+        self._bin_flip_scenario_done = False
+        # Used to pause/resume the simulation
+        self._timeline = None
+        # Used to actively track the active bins surroundings (e.g., in contact with pallet)
+        self._timeline_sub = None
+        self._overlap_extent = None
+        # The capture the last tick asked for (Isaac schedules it with asyncio.ensure_future)
+        self._due = None
+        # SDG
         self._rep_camera = None
-        self._output_dir = output_dir
-        self._texture_paths = texture_paths
         self._resolution = resolution
+        self._output_dir = output_dir or os.path.join(os.getcwd(), "_out_palletizing_sdg_demo", "")
+        print(f"[PalletizingSDGDemo] Output directory: {self._output_dir}")
 
-    def _clear_graph(self):
-        # Isaac: omni.kit.commands.execute("DeletePrimsCommand", paths=["/Replicator"])
+    def start(self, num_captures):
+        self._num_captures = num_captures if 1 <= num_captures <= 36 else 36
+        if self._init():
+            self._start()
+
+    def is_running(self):
+        return self._in_running_state
+
+    def update(self):
+        """One app update: the capture a tick asked for, else one simulation frame."""
+        if self._due is not None:
+            scenario, self._due = self._due, None
+            scenario()
+        else:
+            rep.orchestrator.update()
+
+    def _init(self):
+        self._stage = rep.stage.get_stage()
+        self._active_bin = self._stage.GetPrimAtPath(f"{self.BINS_FOLDER_PATH}/bin_{self._bin_counter}")
+        if not self._active_bin:
+            print("[PalletizingSDGDemo] Could not find bin, make sure the palletizing demo is loaded..")
+            return False
+        bb_cache = create_bbox_cache()
+        half_ext = bb_cache.ComputeLocalBound(self._active_bin).GetRange().GetSize() * 0.5
+        self._overlap_extent = (half_ext[0], half_ext[1], half_ext[2] * 1.1)
+        self._timeline = rep.timeline.get_timeline_interface()
+        if not self._timeline.is_playing():
+            print("[PalletizingSDGDemo] Please start the palletizing demo first..")
+            return False
+        # Disable capture on play for replicator, data capture will be triggered manually
+        rep.orchestrator.set_capture_on_play(False)
+        # Clear any previously generated SDG graphs
+        if self._stage.GetPrimAtPath("/Replicator"):
+            rep.graph.clear()
+        return True
+
+    def _start(self):
+        self._timeline_sub = self._timeline.subscribe(self._on_timeline_event, TimelineEventType.CURRENT_TIME_TICKED)
+        self._in_running_state = True
+        print("[PalletizingSDGDemo] Starting the palletizing SDG demo..")
+
+    def clear(self):
+        if self._timeline_sub:
+            self._timeline_sub.unsubscribe()
+            self._timeline_sub = None
+        self._in_running_state = False
+        self._bin_counter = 0
+        self._active_bin = None
         if self._stage.GetPrimAtPath("/Replicator"):
             rep.graph.clear()
 
-    def run(self, num_bins=2):
-        rep.orchestrator.set_capture_on_play(False)
-        self._clear_graph()
-        for self._bin_counter in range(num_bins):
-            self._run_bin_flip_scenario()
-            self._run_pallet_scenario()
+    def _on_timeline_event(self, e):
+        self._check_bin_overlaps()
+
+    def _check_bin_overlaps(self):
+        bin_pose = get_world_transform_matrix(self._active_bin)
+        origin = bin_pose.ExtractTranslation()
+        quat_gf = bin_pose.ExtractRotation().GetQuaternion()
+        overlap_box(
+            self._overlap_extent,
+            (origin[0], origin[1], origin[2]),
+            (quat_gf.GetImaginary()[0], quat_gf.GetImaginary()[1], quat_gf.GetImaginary()[2], quat_gf.GetReal()),
+            self._on_overlap_hit,
+            False,
+        )
+
+    def _on_overlap_hit(self, hit):
+        if hit.rigid_body == self._active_bin.GetPrimPath():
+            return True  # Self hit, return True to continue the query
+
+        # First contact with the flip helper
+        if hit.rigid_body.startswith(self.FLIP_HELPER_PATH) and not self._bin_flip_scenario_done:
+            self._timeline.pause()
+            self._timeline_sub.unsubscribe()
+            self._timeline_sub = None
+            self._due = self._run_bin_flip_scenario
+            return False  # Relevant hit, return False to finish the hit query
+
+        # Contact with the pallet or other bin on the pallet
+        pallet_hit = hit.rigid_body.startswith(self.PALLET_PRIM_MESH_PATH)
+        other_bin_hit = hit.rigid_body.startswith(f"{self.BINS_FOLDER_PATH}/bin_")
+        if pallet_hit or other_bin_hit:
+            self._timeline.pause()
+            self._timeline_sub.unsubscribe()
+            self._timeline_sub = None
+            self._due = self._run_pallet_scenario
+            return False  # Relevant hit, return False to finish the hit query
+
+        return True  # No relevant hit, return True to continue the query
+
+    def _switch_to_pathtracing(self):
+        # graphsdg's best rasteriser settings: 8x MSAA, large shadow maps, totalSpp jittered subframes
+        rep.settings.set("/rtx/rendermode", "PathTracing")
+        rep.settings.set("/rtx/pathtracing/spp", 32)
+        rep.settings.set("/rtx/pathtracing/totalSpp", 32)
+
+    def _switch_to_raytracing(self):
+        rep.settings.set("/rtx/rendermode", "RayTracedLighting")
 
     def _run_bin_flip_scenario(self):
         print(f"[PalletizingSDGDemo] Running bin flip scenario for bin {self._bin_counter}..")
 
+        # Util function to save rgb images to file
         def save_img(rgb_data, filename):
-            Image.fromarray(rgb_data).convert("RGBA").save(filename + ".png")
+            rgb_img = Image.fromarray(rgb_data).convert("RGBA")
+            rgb_img.save(filename + ".png")
 
+        self._switch_to_pathtracing()
         self._create_bin_flip_graph()
+
         rgb_annot = rep.AnnotatorRegistry.get_annotator("rgb")
         is_annot = rep.AnnotatorRegistry.get_annotator("instance_segmentation", init_params={"colorize": True})
         rp = rep.create.render_product(self._rep_camera, self._resolution)
@@ -108,20 +200,41 @@ class PalletizingSDGDemo:
         is_annot.attach(rp)
         out_dir = os.path.join(self._output_dir, f"annot_bin_{self._bin_counter}", "")
         os.makedirs(out_dir, exist_ok=True)
+
         for i in range(self.BIN_FLIP_SCENARIO_FRAMES):
             rep.orchestrator.step(delta_time=0.0)
-            save_img(rgb_annot.get_data(), f"{out_dir}rgb_{i}")
+
+            rgb_data = rgb_annot.get_data()
+            rgb_filename = f"{out_dir}rgb_{i}"
+            save_img(rgb_data, rgb_filename)
+
             is_data = is_annot.get_data()
+            is_filename = f"{out_dir}is_{i}"
             is_img_data = is_data["data"]
             height, width = is_img_data.shape[:2]
-            save_img(is_img_data.view(np.uint8).reshape(height, width, -1), f"{out_dir}is_{i}")
+            is_img_data = is_img_data.view(np.uint8).reshape(height, width, -1)
+            save_img(is_img_data, is_filename)
+            is_info = is_data["info"]
             with open(f"{out_dir}is_info_{i}.json", "w") as f:
-                json.dump(is_data["info"], f, indent=4)
+                json.dump(is_info, f, indent=4)
+
+        # Free up resources
         rgb_annot.detach()
         is_annot.detach()
         rp.destroy()
+
+        # Make sure the backend finishes writing the data before clearing the generated SDG graph
         rep.orchestrator.wait_until_complete()
-        self._clear_graph()
+
+        # Cleanup the generated SDG graph
+        if self._stage.GetPrimAtPath("/Replicator"):
+            rep.graph.clear()
+
+        self._switch_to_raytracing()
+
+        self._bin_flip_scenario_done = True
+        self._timeline_sub = self._timeline.subscribe(self._on_timeline_event, TimelineEventType.CURRENT_TIME_TICKED)
+        self._timeline.play()
 
     def _create_bin_flip_graph(self):
         # Create new random lights using the color palette for the color attribute
@@ -143,6 +256,7 @@ class PalletizingSDGDemo:
 
         # Move the camera to the given location sequences and look at the predefined location
         camera_positions = [(1.96, 0.72, -0.34), (1.48, 0.70, 0.90), (0.79, -0.86, 0.12), (-0.49, 1.47, 0.58)]
+
         self._rep_camera = rep.create.camera()
         with rep.trigger.on_frame():
             rep.randomizer.randomize_bin_flip_lights()
@@ -161,21 +275,37 @@ class PalletizingSDGDemo:
             mesh_to_orig_mats[bin_mesh] = bin_orig_mat
 
         self._create_bin_and_pallet_graph()
+
         out_dir = os.path.join(self._output_dir, f"writer_bin_{self._bin_counter}", "")
         writer = rep.WriterRegistry.get("BasicWriter")
+        # provenance (graphsdg's): what the graph sampled for each frame, next to the frame
         writer.initialize(output_dir=out_dir, rgb=True, instance_segmentation=True,
                           colorize_instance_segmentation=True, provenance=True)
         rp = rep.create.render_product(self._rep_camera, self._resolution)
         writer.attach(rp)
         for i in range(self.PALLET_SCENARIO_FRAMES):
             rep.orchestrator.step(rt_subframes=24, delta_time=0.0)
+
+        # Free up resources after the capture
         writer.detach()
         rp.destroy()
+
+        # Restore the original materials of the randomized meshes
         for mesh, mat in mesh_to_orig_mats.items():
             print(f"[PalletizingSDGDemo] Restoring original material({mat.GetPath()}) for {mesh.GetPath()}")
             UsdShade.MaterialBindingAPI(mesh).Bind(mat, UsdShade.Tokens.strongerThanDescendants)
+
+        # Make sure the backend finishes writing the data before clearing the generated SDG graph
         rep.orchestrator.wait_until_complete()
-        self._clear_graph()
+
+        # Cleanup the generated SDG graph
+        if self._stage.GetPrimAtPath("/Replicator"):
+            rep.graph.clear()
+
+        self._timeline.play()
+        if self._next_bin():
+            self._timeline_sub = self._timeline.subscribe(self._on_timeline_event,
+                                                          TimelineEventType.CURRENT_TIME_TICKED)
 
     def _create_bin_and_pallet_graph(self):
         # Bin material randomization
@@ -194,10 +324,16 @@ class PalletizingSDGDemo:
                 rep.randomizer.materials(mats)
 
         # Camera and pallet texture randomization at a slower rate
-        texture_paths = self._texture_paths
+        assets_root_path = get_assets_root_path()
+        texture_paths = [
+            assets_root_path + "/NVIDIA/Materials/Base/Wood/Oak/Oak_BaseColor.png",
+            assets_root_path + "/NVIDIA/Materials/Base/Wood/Ash/Ash_BaseColor.png",
+            assets_root_path + "/NVIDIA/Materials/Base/Wood/Plywood/Plywood_BaseColor.png",
+            assets_root_path + "/NVIDIA/Materials/Base/Wood/Timber/Timber_BaseColor.png",
+        ]
         pallet_node = rep.get.prim_at_path(self.PALLET_PRIM_MESH_PATH)
         pallet_prim = pallet_node.get_output_prims()["prims"][0]
-        pallet_loc = world_matrix(pallet_prim)[3, :3]   # omni.usd.get_world_transform_matrix(...).ExtractTranslation()
+        pallet_loc = get_world_transform_matrix(pallet_prim).ExtractTranslation()
         self._rep_camera = rep.create.camera()
         with rep.trigger.on_frame(interval=4):
             with pallet_node:
@@ -208,16 +344,47 @@ class PalletizingSDGDemo:
                     look_at=(pallet_loc[0], pallet_loc[1], pallet_loc[2]),
                 )
 
+    def _next_bin(self):
+        self._bin_counter += 1
+        if self._bin_counter >= self._num_captures:
+            self.clear()
+            print("[PalletizingSDGDemo] Palletizing SDG demo finished..")
+            return False
+        self._active_bin = self._stage.GetPrimAtPath(f"{self.BINS_FOLDER_PATH}/bin_{self._bin_counter}")
+        print(f"[PalletizingSDGDemo] Moving to bin {self._bin_counter}..")
+        self._bin_flip_scenario_done = False
+        return True
 
-def main(output_dir=None, resolution=(512, 512), num_bins=2):
-    output_dir = output_dir or os.path.join(os.getcwd(), "_out_palletizing_sdg_demo")
-    settings.set("/rtx/rendermode", "RayTracedLighting")
-    rep.set_global_seed(7)
-    textures = build_scene(os.path.join(output_dir, "textures"))
-    print(f"[PalletizingSDGDemo] Output directory: {output_dir}")
-    PalletizingSDGDemo(output_dir, textures, resolution).run(num_bins=num_bins)
-    return output_dir
+
+NUM_CAPTURES = 12
+
+
+def run_example(output_dir=None, num_captures=NUM_CAPTURES, resolution=(512, 512), seed=42, num_bins=None):
+    """Load and start the palletizing cell, then run the SDG on top of it until ``num_captures`` bins are done.
+
+    Returns ``(demo, sample)``: the SDG demo and the running ``BinStacking``.
+    """
+    # Load the bin stacking stage and start the demo
+    random.seed(seed)
+    rep.set_global_seed(seed)
+    bin_stacking_sample = BinStacking(num_bins=num_bins)
+    bin_stacking_sample.load_world()
+    bin_stacking_sample.start()
+
+    # Wait a few frames for the stacking demo to start
+    for _ in range(3):
+        rep.orchestrator.update()
+
+    # Start the SDG pipeline on top of the palletizing demo
+    sdg_demo = PalletizingSDGDemo(output_dir, resolution)
+    sdg_demo.start(num_captures=num_captures)
+
+    # Wait until the demo is finished
+    while sdg_demo.is_running():
+        sdg_demo.update()
+    print("[PalletizingSDGDemo] Done..")
+    return sdg_demo, bin_stacking_sample
 
 
 if __name__ == "__main__":
-    main(output_dir=sys.argv[1] if len(sys.argv) > 1 else None)
+    run_example(output_dir=sys.argv[1] if len(sys.argv) > 1 else None)

@@ -139,13 +139,29 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None) -> 
     if pause_timeline and rt.timeline.is_playing():
         rt.timeline.pause()
     t = _timed("physics", t)
-    subframes = rt_subframes if rt_subframes > 0 else max(int(settings.get("/omni/replicator/RTSubframes", 1)),
-                                                          subframes_override, 1)
+    subframes = capture_subframes(rt_subframes, subframes_override)
     _capture(subframes, fired, trigger_outputs, provenance)   # times its render, annotate and write phases itself
     _state.frame_index += 1
     _state.stage_step += 1
     run_state.checkpoint()
     _state.set(Status.STEPPED)
+
+
+def capture_subframes(rt_subframes: int, graph_request: int = 0) -> int:
+    """Accumulated subframes of one capture.
+
+    ``rt_subframes`` when given, else ``/omni/replicator/RTSubframes`` or what the
+    graph asked for; in ``PathTracing`` render mode at least
+    ``/rtx/pathtracing/totalSpp`` (a path tracer's samples are the rasteriser's
+    jittered subframes); never more than ``/graphsdg/render/maxSubframes`` when
+    that is set.
+    """
+    n = rt_subframes if rt_subframes > 0 else max(int(settings.get("/omni/replicator/RTSubframes", 1)),
+                                                  graph_request, 1)
+    if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
+        n = max(n, int(settings.get("/rtx/pathtracing/totalSpp", 1) or 1))
+    cap = int(settings.get("/graphsdg/render/maxSubframes", 0) or 0)
+    return max(1, min(n, cap)) if cap > 0 else n
 
 
 def advance_time(delta_time: float | None) -> None:

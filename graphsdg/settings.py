@@ -47,10 +47,18 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/graphsdg/render/maxResolution": (4096, "largest render product edge"),
     "/graphsdg/render/resolutionScale": (1.0, "factor applied to every new render product's resolution "
                                          "(graphsdg run --resolution-scale; small test runs of full-size scripts)"),
+    "/graphsdg/scenarios/palletizing/numBins": (36, "bins in the palletizing scenario's cell (BinStacking() without "
+                                                    "num_bins); fewer make CI-sized runs"),
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
-                        "rasteriser settings (more MSAA samples and larger shadow maps)"),
+                        "rasteriser settings (8x MSAA, shadow maps of 8 texels per image pixel up to 4096 px, "
+                        "/rtx/pathtracing/totalSpp jittered subframes per capture)"),
+    "/rtx/pathtracing/spp": (1, "samples per pixel per frame in PathTracing mode (see totalSpp)"),
+    "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
+                                     "accumulates"),
+    "/graphsdg/render/maxSubframes": (0, "upper bound on accumulated subframes per capture (rt_subframes and "
+                                         "path-tracing samples); 0 means no bound (CI-sized runs of full scripts)"),
 }
 
 def _integer(minimum: int, none_ok: bool = False) -> Callable[[str, Any], None]:

@@ -47,7 +47,7 @@ def test_comment_check_catches_code_swallowed_by_a_flattened_comment():
 
 
 def test_every_vendored_script_parses_and_only_uses_names_the_layer_maps():
-    """Every module a seed script imports resolves in compat mode (the palletizing scenario aside)."""
+    """Every module a seed script imports resolves in compat mode (the palletizing scenario included)."""
     import ast
     isaac.install()
     try:
@@ -58,8 +58,6 @@ def test_every_vendored_script_parses_and_only_uses_names_the_layer_maps():
                 names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
                     [node.module] if isinstance(node, ast.ImportFrom) and node.module else []
                 for name in names:
-                    if name.startswith("isaacsim.examples"):
-                        continue   # the palletizing scenario, built on its own branch
                     assert importlib.import_module(name), name
     finally:
         isaac.uninstall()
@@ -271,7 +269,7 @@ def test_kit_async_test_case_runs_under_pytest(tmp_path):
 # ---- the palletizing seed's SDG code on a stand-in scene ----------------------------------------------
 def _palletizing_seed_namespace() -> dict:
     """The seed script's definitions (``PalletizingSDGDemo``), without its last statement, which starts the
-    full robot demo (``graphsdg.scenarios.palletizing``, built on its own branch)."""
+    full robot demo (``graphsdg.scenarios.palletizing``; tests/test_palletizing.py runs the whole script)."""
     import ast
     path = HERE / "seed_scripts" / "ur10_palletizing_script_editor.py"
     tree = ast.parse(path.read_text())

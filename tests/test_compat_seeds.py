@@ -10,7 +10,6 @@ the checks then assert what the documents say the outputs show.
 """
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
 import re
@@ -247,20 +246,6 @@ def test_workflow_02_pallets_on_the_floor_stacks_on_pallets(tmp_path, monkeypatc
             below = box
 
 
-@pytest.mark.skipif(importlib.util.find_spec("graphsdg.scenarios") is None
-                    or importlib.util.find_spec("graphsdg.scenarios.palletizing") is None,
-                    reason="graphsdg.scenarios.palletizing (the UR10 palletizing scenario) is not built yet")
-def test_ur10_palletizing_script_editor(tmp_path, monkeypatch, capsys):
-    out = run_seed("ur10_palletizing_script_editor", tmp_path, monkeypatch, capsys)
-    assert "[PalletizingSDGDemo] Done.." in out
-    d = tmp_path / "_out_palletizing_sdg_demo"
-    writer_bins = sorted(int(p.name.rsplit("_", 1)[1]) for p in d.glob("writer_bin_*"))
-    assert writer_bins and writer_bins == list(range(len(writer_bins)))
-    for b in writer_bins:   # BasicWriter: 16 frames of rgb and colorized instance segmentation
-        w = d / f"writer_bin_{b}"
-        assert len(list(w.glob("rgb_*.png"))) == 16
-        assert len(list(w.glob("instance_segmentation_*.png"))) == 16
-    for a in d.glob("annot_bin_*"):   # the seed's own helpers: 4 frames of rgb, instance ids and their info
-        assert sorted(p.name for p in a.iterdir()) == sorted(
-            [f"rgb_{i}.png" for i in range(4)] + [f"is_{i}.png" for i in range(4)]
-            + [f"is_info_{i}.json" for i in range(4)])
+# The palletizing script (ur10_palletizing_script_editor.py) needs the robot simulation to run for
+# every bin it follows (12): tests/test_palletizing.py runs it unchanged at CI size for 3 bins and
+# checks its outputs, the restored materials and that the robot's work equals a run without it.

@@ -37,10 +37,17 @@ def test_custom_event_dome_colour_changes_only_on_event_frames(tmp_path):
 
 
 def _pallet_demo(tmp_path):
+    """The palletizing cell (loaded, not running) and the example's SDG demo on it."""
+    import random
+
+    from graphsdg.scenarios.palletizing import BinStacking
     example = load_example("palletizing_sdg")
+    random.seed(0)
+    BinStacking(num_bins=2).load_world()
     rep.set_global_seed(3)
-    textures = example.build_scene(str(tmp_path / "textures"))
-    return example, example.PalletizingSDGDemo(str(tmp_path / "out"), textures, resolution=(24, 24))
+    demo = example.PalletizingSDGDemo(str(tmp_path / "out"), resolution=(24, 24))
+    demo._stage = rep.stage.get_stage()
+    return example, demo
 
 
 def test_bin_flip_camera_walks_the_sequence_in_order_and_wraps(tmp_path):
@@ -89,7 +96,11 @@ def test_pallet_graph_interval_four_changes_on_frames_0_4_8_only(tmp_path):
 
 def test_palletizing_example_end_to_end_writes_and_clears(tmp_path):
     example = load_example("palletizing_sdg")
-    out = example.main(output_dir=str(tmp_path / "pal"), resolution=(24, 24), num_bins=1)
+    rep.settings.set("/graphsdg/render/maxSubframes", 2)
+    out = str(tmp_path / "pal")
+    # seed 1: the first bin arrives upside down, so both scenarios run for it
+    demo, sample = example.run_example(output_dir=out, num_captures=1, resolution=(24, 24), seed=1, num_bins=1)
+    assert sample.flipped == [True] and not demo.is_running()
     flip = sorted(os.listdir(os.path.join(out, "annot_bin_0")))
     assert [f for f in flip if f.startswith("rgb_")] == [f"rgb_{i}.png" for i in range(4)]
     written = sorted(os.listdir(os.path.join(out, "writer_bin_0")))

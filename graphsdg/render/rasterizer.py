@@ -42,7 +42,7 @@ import numpy as np
 
 from graphsdg import profiling
 from graphsdg.render.camera import CameraView
-from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
+from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
 
 PASSES = ("color", "hdr", "depth", "segmentation")
@@ -139,6 +139,11 @@ class Rasterizer:
     def _bind(self, sim: SimScene) -> None:
         self._ensure_gl()
         model = sim.model
+        quality = render_quality(max(int(model.vis.global_.offwidth), int(model.vis.global_.offheight)))
+        if (int(model.vis.quality.shadowsize), int(model.vis.quality.offsamples)) != quality:
+            # the render mode changed since the compile: takes effect now, no recompile needed
+            model.vis.quality.shadowsize, model.vis.quality.offsamples = quality
+            self._version = -1
         if self._version != sim.model_version or self._model is not model:
             if self._mjr is not None:
                 self._mjr.free()

@@ -11,8 +11,11 @@ Mapping (USD -> MuJoCo):
   live) or into the mesh vertices (meshes: a scale edit recompiles).
 * physics (``UsdPhysics``): a prim with ``RigidBodyAPI`` is a free body (a
   mocap body when ``kinematicEnabled``); a rigid body nested in another moves
-  with the outermost one (graphsdg has no joints, so nesting cannot mean
-  anything else); ``CollisionAPI`` makes a gprim collide, with
+  with the outermost one (prim nesting is not a joint, as in PhysX); joints
+  (revolute, prismatic, spherical, fixed) hang bodies in a kinematic tree with
+  hinge / slide / ball joints, drives become actuators and fixed joints outside
+  the tree become weld constraints (:mod:`graphsdg.sim.joints`);
+  ``CollisionAPI`` makes a gprim collide, with
   ``MeshCollisionAPI`` approximations mapped by :mod:`graphsdg.sim.colliders`
   (proxy shapes in group :data:`COLLISION_ONLY_GROUP`, never drawn); a static
   or kinematic ``Plane`` collider is an infinite plane, as in PhysX;
@@ -46,6 +49,7 @@ from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
 from graphsdg.sim import colliders, environment_map
+from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import texture_images
 from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
@@ -103,6 +107,24 @@ class BodyBinding:
     qpos_adr: int = -1               # free joint address (dynamic bodies)
     qvel_adr: int = -1
     kinematic: bool = False
+    articulated: bool = False        # moved by a joint to a parent body (a link of a kinematic tree)
+
+
+@dataclass
+class JointBinding:
+    """A UsdPhysics joint in the compiled model (see :mod:`graphsdg.sim.joints`)."""
+
+    path: str
+    kind: str                        # revolute, prismatic, spherical, fixed
+    body0: str
+    body1: str
+    joint_id: int = -1               # MuJoCo joint (-1: fixed, or a weld)
+    qpos_adr: int = -1
+    dof_adr: int = -1
+    actuator_id: int = -1            # the drive, if any
+    eq_id: int = -1                  # weld constraint (fixed joints outside the tree)
+    articulation: str = ""           # articulation root (or tree root body) the joint belongs to
+    reversed: bool = False           # the tree hangs USD body0 from body1
 
 
 @dataclass
@@ -121,6 +143,7 @@ class CompiledScene:
     geoms: dict[str, GeomBinding] = field(default_factory=dict)
     geom_paths: list[str] = field(default_factory=list)      # geom id -> gprim path ("" if none)
     bodies: dict[str, BodyBinding] = field(default_factory=dict)
+    joints: dict[str, JointBinding] = field(default_factory=dict)
     lights: dict[str, LightBinding] = field(default_factory=dict)
     materials: dict[str, int] = field(default_factory=dict)
     sky_texture_id: int = -1
@@ -131,6 +154,31 @@ class CompiledScene:
     collider_paths: set[str] = field(default_factory=set)          # gprims that collide (own geom or proxies)
     probe_box: int = -1              # geom ids of the query probes
     probe_sphere: int = -1
+
+
+def clean_scale(scale: np.ndarray) -> np.ndarray:
+    """A scale read off a rotated matrix, rounded to 12 significant digits.
+
+    The row norms of ``R * s`` carry rounding noise that depends on the rotation;
+    rounding it away makes a body's geometry, and so its inertia, identical
+    however the body is turned when the stage is compiled.
+    """
+    return np.array([float(f"{v:.12g}") for v in np.asarray(scale, dtype=np.float64)])
+
+
+def render_quality(largest_image: int = 4096) -> tuple[int, int]:
+    """(shadow map size, MSAA samples) for the current settings.
+
+    ``/rtx/rendermode = PathTracing`` (Isaac's highest-quality mode) maps to the
+    rasteriser's best: 8x multisampling and shadow maps of 8 texels per pixel of
+    the largest image (``largest_image``, its longer edge), up to 4096 px, never
+    below ``/graphsdg/render/shadowSize``.
+    """
+    shadow = int(settings.get("/graphsdg/render/shadowSize", 1024))
+    samples = int(settings.get("/graphsdg/render/msaaSamples", 4))
+    if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
+        shadow, samples = max(shadow, min(4096, 8 * int(largest_image))), max(samples, 8)
+    return shadow, samples
 
 
 def _is_renderable(prim: Usd.Prim) -> bool:
@@ -185,17 +233,27 @@ def _approximation(prim: Usd.Prim) -> str:
         raise CompileError(str(exc)) from None
 
 
-def _friction(prim: Usd.Prim) -> float:
-    """Dynamic friction of the physics material bound to ``prim`` (PhysX's 0.5 when none)."""
+def _friction(prim: Usd.Prim) -> tuple[float, int]:
+    """(dynamic friction, contact priority) of the physics material bound to ``prim``.
+
+    PhysX's 0.5 when none. MuJoCo takes the larger friction of two touching geoms
+    unless one has a higher priority; a material whose
+    ``physxMaterial:frictionCombineMode`` is ``min`` or ``multiply`` (PhysX: the
+    smaller value wins) gets priority 1, so a slippery surface stays slippery.
+    """
     binding = UsdShade.MaterialBindingAPI(prim)
     material, _ = binding.ComputeBoundMaterial("physics")
     if material and material.GetPrim().HasAPI(UsdPhysics.MaterialAPI):
-        api = UsdPhysics.MaterialAPI(material.GetPrim())
+        mat = material.GetPrim()
+        combine = mat.GetAttribute("physxMaterial:frictionCombineMode")
+        priority = 1 if combine and str(combine.Get()) in ("min", "multiply") else 0
+        api = UsdPhysics.MaterialAPI(mat)
         for attr in (api.GetDynamicFrictionAttr(), api.GetStaticFrictionAttr()):
             v = attr.Get() if attr else None
             if v is not None:
-                return max(float(v), 0.0)
-    return DEFAULT_FRICTION
+                return max(float(v), 0.0), priority
+        return DEFAULT_FRICTION, priority
+    return DEFAULT_FRICTION, 0
 
 
 def _collides(prim: Usd.Prim) -> bool:
@@ -317,10 +375,13 @@ class _Builder:
         self.sky_rgb: np.ndarray | None = None
         self.sky_maps: list[tuple[environment_map.EnvironmentMap, np.ndarray, np.ndarray]] = []
         self.sky_flat = np.zeros(3)                      # untextured domes' share of the background
+        self.joint_plan = jointmap.JointPlan()
+        self.free_poses: dict[str, np.ndarray] = {}     # free body -> its current (position, quaternion)
 
     # ---- options -------------------------------------------------------
     def configure(self) -> None:
         spec = self.spec
+        spec.compiler.degree = False          # joint ranges are given in radians
         spec.compiler.boundmass = 1e-6
         spec.compiler.boundinertia = 1e-9
         spec.option.timestep = 1.0 / PHYSICS_STEPS_PER_SECOND
@@ -332,10 +393,7 @@ class _Builder:
         self.configure_physics_scene(up)
         vis = spec.visual
         vis.global_.offwidth, vis.global_.offheight = self.offscreen
-        vis.quality.shadowsize = int(settings.get("/graphsdg/render/shadowSize", 1024))
-        vis.quality.offsamples = int(settings.get("/graphsdg/render/msaaSamples", 4))
-        if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
-            vis.quality.shadowsize = max(vis.quality.shadowsize, 4096)
+        vis.quality.shadowsize, vis.quality.offsamples = render_quality(max(self.offscreen))
         # Cameras get their own near/far from USD; these two (relative to the model extent)
         # only bound MuJoCo's shadow-map depth range, so they are kept tight for precision.
         vis.map.znear = 0.01
@@ -424,12 +482,23 @@ class _Builder:
         path = str(root.GetPath())
         if path in self.body_records:
             return self.body_records[path]
-        t, r, _ = decompose(world_matrix(root, self.cache))
+        link = self.joint_plan.links.get(path)
         kinematic = _is_kinematic(root)
-        body = self.spec.worldbody.add_body(name=path, pos=t.tolist(), quat=matrix_to_quat_wxyz(r).tolist(),
-                                            mocap=kinematic)
+        if link is not None:
+            body = self.add_link(link)
+        else:
+            t, r, _ = decompose(world_matrix(root, self.cache))
+            q = matrix_to_quat_wxyz(r)
+            # A free body's reference orientation is the identity (its current one goes into qpos at
+            # bind time): constants MuJoCo derives at qpos0 (inverse inertia weights) then do not
+            # depend on where the body happens to be when the stage is compiled.
+            body = self.spec.worldbody.add_body(name=path, pos=t.tolist(),
+                                                quat=q.tolist() if kinematic else [1.0, 0.0, 0.0, 0.0],
+                                                mocap=kinematic)
+            if not kinematic:
+                body.add_freejoint(name=f"{path}#free")
+                self.free_poses[path] = np.concatenate([t, q])
         if not kinematic:
-            body.add_freejoint(name=f"{path}#free")
             disable = root.GetAttribute("physxRigidBody:disableGravity")
             if disable and disable.Get():
                 body.gravcomp = 1.0
@@ -437,17 +506,85 @@ class _Builder:
         self.body_mass[path] = _mass_api_values(root)
         return body
 
+    def in_body_frame(self, prim: Usd.Prim, root: Usd.Prim) -> np.ndarray:
+        """``prim``'s transform in its rigid body's frame (the body's scale kept in it), row-vector 4x4.
+
+        Composed from the local transforms between the two prims rather than from
+        their world transforms, so it is exactly the same wherever the body is:
+        a recompile mid-simulation then builds a bit-identical body.
+        """
+        rel, _ = self.cache.ComputeRelativeTransform(prim, root)
+        _, _, root_scale = decompose(world_matrix(root, self.cache))
+        scale = np.eye(4)
+        scale[0, 0], scale[1, 1], scale[2, 2] = clean_scale(root_scale)
+        return np.array(rel, dtype=np.float64) @ scale
+
+    def add_link(self, link: jointmap.TreeLink):
+        """The MuJoCo body of a tree link: under its parent at the joint's zero pose, with its joint."""
+        if link.parent == jointmap.WORLD:
+            parent = self.spec.worldbody
+        else:
+            parent = self.body_for_rigid(self.stage.GetPrimAtPath(link.parent))
+        rest = link.rest_pose()
+        body = parent.add_body(name=link.body, pos=rest.pos.tolist(), quat=matrix_to_quat_wxyz(rest.rot).tolist())
+        j = link.joint
+        kinds = {"revolute": mujoco.mjtJoint.mjJNT_HINGE, "prismatic": mujoco.mjtJoint.mjJNT_SLIDE,
+                 "spherical": mujoco.mjtJoint.mjJNT_BALL}
+        if j.kind in kinds:
+            joint = body.add_joint(name=j.path, type=kinds[j.kind], pos=link.child_frame.pos.tolist(),
+                                   axis=link.axis_in_child().tolist(), armature=j.armature)
+            if j.lower is not None:
+                joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+                joint.range = [j.lower, j.upper]
+            else:
+                joint.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+        return body
+
+    def add_joint_elements(self) -> None:
+        """Tree bodies without geometry, drive actuators, weld constraints and self-collision filters."""
+        jp = self.joint_plan
+        for body in list(jp.links):
+            self.body_for_rigid(self.stage.GetPrimAtPath(body))
+        for path in jp.order:
+            link = next(lk for lk in jp.links.values() if lk.joint.path == path)
+            drive = link.joint.drive
+            if drive is None or link.joint.kind not in ("revolute", "prismatic"):
+                continue
+            act = self.spec.add_actuator(name=path, target=path, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+            act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+            act.gainprm[0] = drive.stiffness
+            act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+            act.biasprm[:3] = [drive.damping * drive.target_velocity, -drive.stiffness, -drive.damping]
+            act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+            if np.isfinite(drive.max_force):
+                act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+                act.forcerange = [-drive.max_force, drive.max_force]
+            else:
+                act.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        for weld in jp.welds:
+            for body in (weld.body0, weld.body1):
+                if body != jointmap.WORLD:
+                    self.body_for_rigid(self.stage.GetPrimAtPath(body))
+            rel = weld.frame0 @ weld.frame1.inverse()      # body1 in body0's frame when the joint holds
+            data = np.zeros(mujoco.mjNEQDATA)
+            data[3:6] = rel.pos
+            data[6:10] = matrix_to_quat_wxyz(rel.rot)
+            data[10] = 1.0                                  # torque scale
+            self.spec.add_equality(name=weld.path, type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,
+                                   name1=weld.body0 or "world", name2=weld.body1 or "world",
+                                   active=weld.enabled, data=data.tolist())
+        for bodies in jp.no_self_collision:
+            for i, a in enumerate(bodies):
+                for b in bodies[i + 1:]:
+                    self.spec.add_exclude(bodyname1=a, bodyname2=b)
+
     def add_gprim(self, prim: Usd.Prim) -> None:
         path = str(prim.GetPath())
         m_world = world_matrix(prim, self.cache)
         root = rigid_root(prim)
         if root is not None:
             body = self.body_for_rigid(root)
-            t_root, r_root, _ = decompose(world_matrix(root, self.cache))
-            m_root = np.eye(4)
-            m_root[:3, :3] = r_root.T
-            m_root[3, :3] = t_root
-            t, r, scale = decompose(m_world @ np.linalg.inv(m_root))
+            t, r, scale = decompose(self.in_body_frame(prim, root))
         else:
             t, r, scale = decompose(m_world)
             body = self.spec.worldbody.add_body(name=path, pos=t.tolist(), quat=matrix_to_quat_wxyz(r).tolist(),
@@ -545,9 +682,10 @@ class _Builder:
         bodies_with_colliders = {root for root, _, _, _, collides in self.mass_records if collides and root}
         for root, prim, geom, physical, collides in self.mass_records:
             if collides:
-                friction = _friction(prim)
+                friction, priority = _friction(prim)
                 for part in physical:
                     part.friction = [friction, 0.005, 0.0001]
+                    part.priority = priority
             if root is None:
                 for part in physical:
                     part.density = DEFAULT_DENSITY if collides else 0.0
@@ -686,7 +824,15 @@ class _Builder:
     def build(self) -> CompiledScene:
         self.configure()
         predicate = Usd.TraverseInstanceProxies(Usd.PrimIsActive & Usd.PrimIsDefined & ~Usd.PrimIsAbstract)
-        for prim in Usd.PrimRange.Stage(self.stage, predicate):
+        prims = list(Usd.PrimRange.Stage(self.stage, predicate))
+        joint_prims = [p for p in prims if p.GetTypeName() in jointmap.JOINT_KINDS]
+        if joint_prims:
+            try:
+                self.joint_plan = jointmap.plan(self.stage, joint_prims, rigid_root,
+                                                lambda path: _is_kinematic(self.stage.GetPrimAtPath(path)))
+            except jointmap.JointError as exc:
+                raise CompileError(str(exc)) from None
+        for prim in prims:
             type_name = prim.GetTypeName()
             if type_name in lightmap.LIGHT_KINDS:
                 self.add_light(prim)
@@ -697,6 +843,7 @@ class _Builder:
                     raise
                 except Exception as exc:  # pxr / mujoco errors: say which prim
                     raise CompileError(f"cannot compile prim {prim.GetPath()} ({type_name}): {exc}") from exc
+        self.add_joint_elements()
         self.finish_lighting()
         self.assign_masses()
         self.add_probes()
@@ -708,6 +855,31 @@ class _Builder:
             raise CompileError(f"MuJoCo could not compile the stage: {exc}") from exc
         data = mujoco.MjData(model)
         return self._bind(model, data)
+
+    def _bind_joints(self, scene: CompiledScene) -> None:
+        """Joint bindings; tree joints start at the value the links' authored poses show."""
+        model, data = scene.model, scene.data
+        jp = self.joint_plan
+        for link in jp.links.values():
+            j = link.joint
+            b = JointBinding(path=j.path, kind=j.kind, body0=j.body0, body1=j.body1,
+                             articulation=jp.articulation.get(link.body, ""), reversed=link.reversed)
+            b.joint_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.path)
+            if b.joint_id >= 0:
+                b.qpos_adr, b.dof_adr = int(model.jnt_qposadr[b.joint_id]), int(model.jnt_dofadr[b.joint_id])
+                parent = jointmap.Frame(np.zeros(3), np.eye(3)) if link.parent == jointmap.WORLD else \
+                    jointmap.Frame.of_prim(self.stage.GetPrimAtPath(link.parent), self.cache)
+                child = jointmap.Frame.of_prim(self.stage.GetPrimAtPath(link.body), self.cache)
+                value = jointmap.measured_position(link, parent, child)
+                data.qpos[b.qpos_adr:b.qpos_adr + len(value)] = value
+            b.actuator_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, j.path)
+            if b.actuator_id >= 0:
+                data.ctrl[b.actuator_id] = j.drive.target_position
+            scene.joints[j.path] = b
+        for weld in jp.welds:
+            b = JointBinding(path=weld.path, kind=weld.kind, body0=weld.body0, body1=weld.body1)
+            b.eq_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, weld.path)
+            scene.joints[weld.path] = b
 
     def _bind(self, model: mujoco.MjModel, data: mujoco.MjData) -> CompiledScene:
         scene = CompiledScene(model=model, data=data, has_scene_lights=self.has_lights)
@@ -726,7 +898,8 @@ class _Builder:
             bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, path)
             binding = BodyBinding(path=path, body_id=bid, mocap_id=int(model.body_mocapid[bid]))
             binding.kinematic = binding.mocap_id >= 0
-            if model.body_jntnum[bid] > 0:
+            binding.articulated = path in self.joint_plan.links
+            if model.body_jntnum[bid] > 0 and model.jnt_type[model.body_jntadr[bid]] == mujoco.mjtJoint.mjJNT_FREE:
                 jid = int(model.body_jntadr[bid])
                 binding.qpos_adr, binding.qvel_adr = int(model.jnt_qposadr[jid]), int(model.jnt_dofadr[jid])
             scene.bodies[path] = binding
@@ -753,6 +926,11 @@ class _Builder:
             scene.materials[path] = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, path)
         place_directional_lights(model)
         scene.sky_texture_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, SKY_TEXTURE)
+        # after mj_setConst, which uses the data as scratch: the current state
+        for path, b in scene.bodies.items():
+            if b.qpos_adr >= 0:
+                data.qpos[b.qpos_adr:b.qpos_adr + 7] = self.free_poses[path]
+        self._bind_joints(scene)
         mujoco.mj_forward(model, data)
         return scene
 

@@ -134,11 +134,24 @@ def _overlap(probe: int, size: np.ndarray, rbound: float, half: np.ndarray, posi
              rot: np.ndarray, callback: Callable[[OverlapHit], bool] | None, any_hit: bool) -> int:
     c = _scene()
     m, d = c.model, c.data
+    saved = (m.geom_size[probe].copy(), float(m.geom_rbound[probe]), m.geom_aabb[probe].copy(),
+             d.geom_xpos[probe].copy(), d.geom_xmat[probe].copy())
     m.geom_size[probe] = size
     m.geom_rbound[probe] = rbound
     m.geom_aabb[probe] = np.concatenate([np.zeros(3), half])
     d.geom_xpos[probe] = position
     d.geom_xmat[probe] = rot.ravel()
+    try:
+        return _report_overlaps(c, probe, half, position, rot, callback, any_hit)
+    finally:
+        # a query leaves no trace in the simulation: the next physics step sees the model it saw before
+        m.geom_size[probe], m.geom_rbound[probe], m.geom_aabb[probe] = saved[0], saved[1], saved[2]
+        d.geom_xpos[probe], d.geom_xmat[probe] = saved[3], saved[4]
+
+
+def _report_overlaps(c: CompiledScene, probe: int, half: np.ndarray, position: np.ndarray, rot: np.ndarray,
+                     callback: Callable[[OverlapHit], bool] | None, any_hit: bool) -> int:
+    m, d = c.model, c.data
     ids = _collider_ids(c)
     if len(ids) == 0:
         return 0

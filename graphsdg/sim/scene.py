@@ -28,8 +28,10 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg.sim import lights as lightmap
+from graphsdg.sim import joints as jointmap
 from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
-                                   display_rgba, light_dir_and_pos, place_directional_lights, primitive_size)
+                                   display_rgba, light_dir_and_pos, place_directional_lights, primitive_size,
+                                   rigid_root)
 from graphsdg.sim.mesh_scaling import rescale_mesh_geom
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
@@ -84,6 +86,7 @@ class SimScene:
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
+        self._physics_callbacks: dict[str, Callable[[float], None]] = {}
 
     # ---- compile -------------------------------------------------------
     @property
@@ -117,12 +120,7 @@ class SimScene:
         start = time.perf_counter()
         new = compile_stage(self.stage, self.offscreen)
         if old is not None and keep_state:
-            new.data.time = old.data.time
-            for path, body in new.bodies.items():
-                prev = old.bodies.get(path)
-                if prev is not None and prev.qpos_adr >= 0 and body.qpos_adr >= 0:
-                    new.data.qpos[body.qpos_adr:body.qpos_adr + 7] = old.data.qpos[prev.qpos_adr:prev.qpos_adr + 7]
-                    new.data.qvel[body.qvel_adr:body.qvel_adr + 6] = old.data.qvel[prev.qvel_adr:prev.qvel_adr + 6]
+            carry_state(old, new)
             mujoco.mj_forward(new.model, new.data)
         self.compiled = new
         self.model_version += 1
@@ -175,6 +173,9 @@ class SimScene:
         index = self._subtree_index()
         for path, names in edited.items():
             p = str(path)
+            if p in c.joints:
+                self._refresh_drive(p, names)
+                continue
             aspects = edit_aspects(names)
             inherited = aspects & INHERITED_ASPECTS
             for kind, bound in index.get(p, ()):
@@ -234,6 +235,8 @@ class SimScene:
         if not prim:
             raise NeedsRecompile
         b = c.bodies[path]
+        if b.articulated:
+            return      # links follow their joints; their authored poses are our own write-back
         t, r, _ = decompose(world_matrix(prim, cache))
         q = matrix_to_quat_wxyz(r)
         if b.mocap_id >= 0:
@@ -302,6 +305,22 @@ class SimScene:
                 m.geom_matid[g.geom_id] = -1
                 m.geom_rgba[g.geom_id] = display_rgba(prim)
             g.material = mat_path
+
+    def _refresh_drive(self, path: str, names: set[str]) -> None:
+        """A drive's target edited on the stage: a write into ``ctrl`` / the actuator's bias."""
+        c = self.compiled
+        assert c is not None
+        j = c.joints[path]
+        if not all(n.startswith("drive:") and n.endswith(("targetPosition", "targetVelocity")) for n in names):
+            raise NeedsRecompile     # stiffness, damping, limits...: rebuild the actuator
+        if j.actuator_id < 0:
+            raise NeedsRecompile     # a drive that did not exist at compile time
+        prim = self.stage.GetPrimAtPath(path)
+        drive = jointmap.read_joint(prim, rigid_root).drive
+        if drive is None:
+            raise NeedsRecompile
+        c.data.ctrl[j.actuator_id] = drive.target_position
+        c.model.actuator_biasprm[j.actuator_id, 0] = drive.damping * drive.target_velocity
 
     def _resize(self, prim: Usd.Prim, g, scale: np.ndarray) -> None:
         c = self.compiled
@@ -396,12 +415,35 @@ class SimScene:
         target = d.time + seconds
         steps = 0
         while d.time < target - 0.5 * m.opt.timestep or steps == 0:
+            for callback in list(self._physics_callbacks.values()):
+                callback(float(m.opt.timestep))
+            if self.compiled is not c:
+                raise RuntimeError("a physics callback recompiled the stage in the middle of a physics step; "
+                                   "physics callbacks may write simulation state (joint targets, constraints) "
+                                   "but not edit the stage's structure")
             mujoco.mj_step(m, d)
             steps += 1
         # mj_step leaves positions-derived quantities one step behind; renders,
         # queries and contacts need them (and the contacts) for the new state.
         mujoco.mj_forward(m, d)
         self.write_back_rigid_bodies()
+
+    def add_physics_callback(self, name: str, callback: Callable[[float], None]) -> None:
+        """Call ``callback(step_size)`` before every physics step (Isaac's ``World.add_physics_callback``).
+
+        Controllers read and write simulation state here (joint targets through
+        :class:`graphsdg.sim.articulations.ArticulationView`, weld constraints);
+        the callback must not change the stage's structure.
+        """
+        if not callable(callback):
+            raise TypeError(f"physics callback {name!r} must be callable, got {callback!r}")
+        self._physics_callbacks[str(name)] = callback
+
+    def remove_physics_callback(self, name: str) -> None:
+        self._physics_callbacks.pop(str(name), None)
+
+    def has_physics_callback(self, name: str) -> bool:
+        return str(name) in self._physics_callbacks
 
     def write_back_rigid_bodies(self) -> None:
         """Author simulated rigid-body poses on the stage (as PhysX does for USD readers)."""
@@ -412,7 +454,11 @@ class SimScene:
         writers = self._pose_writers
         with self.tracker.muted(), Sdf.ChangeBlock():
             for path, b in c.bodies.items():
-                if b.qpos_adr < 0:
+                if b.qpos_adr >= 0:
+                    pose = c.data.qpos[b.qpos_adr:b.qpos_adr + 7]
+                elif b.articulated:
+                    pose = np.concatenate([c.data.xpos[b.body_id], c.data.xquat[b.body_id]])
+                else:
                     continue
                 writer = writers.get(path)
                 if writer is None or not writer.prim:
@@ -420,7 +466,7 @@ class SimScene:
                     if not prim:
                         continue
                     writer = writers[path] = PoseWriter(prim)
-                writer.write(c.data.qpos[b.qpos_adr:b.qpos_adr + 7], cache)
+                writer.write(pose, cache)
 
     # ---- rigid-body state ----------------------------------------------
     def body(self, path: str) -> BodyBinding:
@@ -439,12 +485,18 @@ class SimScene:
         d = self.data
         if b.mocap_id >= 0:
             return d.mocap_pos[b.mocap_id].copy(), d.mocap_quat[b.mocap_id].copy()
+        if b.qpos_adr < 0:       # a link of a kinematic tree (or a body fixed to the world)
+            return d.xpos[b.body_id].copy(), d.xquat[b.body_id].copy()
         q = d.qpos[b.qpos_adr:b.qpos_adr + 7]
         return q[:3].copy(), q[3:].copy()
 
     def body_velocity(self, path: str) -> tuple[np.ndarray, np.ndarray]:
         """World-frame (linear m/s, angular rad/s) velocity of a rigid body's frame origin."""
         b = self.body(path)
+        if b.articulated:
+            vel = np.zeros(6)
+            mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, b.body_id, vel, 0)
+            return vel[3:].copy(), vel[:3].copy()      # MuJoCo: (angular, linear), world-aligned
         if b.qvel_adr < 0:
             return np.zeros(3), np.zeros(3)
         d = self.data
@@ -456,6 +508,9 @@ class SimScene:
                       orientation: np.ndarray | None = None) -> None:
         """Move a rigid body to a world pose (quaternion w, x, y, z), keeping its velocity; authors the stage."""
         b = self.body(path)
+        if b.articulated:
+            raise ValueError(f"rigid body {path} hangs from a joint; move it through its joints "
+                             f"(graphsdg.sim.articulations.ArticulationView.set_joint_positions)")
         c = self.ensure_compiled()
         d = c.data
         pos, quat = self.body_pose(path)
@@ -476,6 +531,8 @@ class SimScene:
                           angular: np.ndarray | None = None) -> None:
         """Set a dynamic body's world-frame linear (m/s) and angular (rad/s) velocity."""
         b = self.body(path)
+        if b.articulated:
+            raise ValueError(f"rigid body {path} hangs from a joint; set its joints' velocities instead")
         if b.qvel_adr < 0:
             raise ValueError(f"rigid body {path} is kinematic; it has no simulated velocity to set")
         d = self.data
@@ -520,6 +577,51 @@ class SimScene:
                         attr.Set(value)
         self.tracker.drain()
         self.recompile(keep_state=False)
+
+
+_QPOS_SIZE = {int(mujoco.mjtJoint.mjJNT_FREE): 7, int(mujoco.mjtJoint.mjJNT_BALL): 4,
+              int(mujoco.mjtJoint.mjJNT_SLIDE): 1, int(mujoco.mjtJoint.mjJNT_HINGE): 1}
+_DOF_SIZE = {int(mujoco.mjtJoint.mjJNT_FREE): 6, int(mujoco.mjtJoint.mjJNT_BALL): 3,
+             int(mujoco.mjtJoint.mjJNT_SLIDE): 1, int(mujoco.mjtJoint.mjJNT_HINGE): 1}
+
+
+def carry_state(old: CompiledScene, new: CompiledScene) -> None:
+    """Copy the simulation state of ``old`` into ``new`` by element name.
+
+    Time, every joint's position, velocity and solver warm start (free joints of
+    rigid bodies and the joints of kinematic trees) and every actuator's control,
+    velocity target and activation carry over, so a model recompiled for a
+    render-only edit (a light, a material, a texture) continues the simulation
+    bit for bit. Weld constraints are compiled from the stage (whoever switches
+    one authors ``physics:jointEnabled`` and the joint frames, see
+    :func:`graphsdg.sim.articulations.set_fixed_joint`); elements new to ``new``
+    keep what the stage says.
+    """
+    om, od, nm, nd = old.model, old.data, new.model, new.data
+    nd.time = od.time
+    for jid in range(nm.njnt):
+        name = mujoco.mj_id2name(nm, mujoco.mjtObj.mjOBJ_JOINT, jid)
+        oid = mujoco.mj_name2id(om, mujoco.mjtObj.mjOBJ_JOINT, name) if name else -1
+        if oid < 0 or om.jnt_type[oid] != nm.jnt_type[jid]:
+            continue
+        kind = int(nm.jnt_type[jid])
+        nq, nv = _QPOS_SIZE[kind], _DOF_SIZE[kind]
+        qa, oqa = nm.jnt_qposadr[jid], om.jnt_qposadr[oid]
+        va, ova = nm.jnt_dofadr[jid], om.jnt_dofadr[oid]
+        nd.qpos[qa:qa + nq] = od.qpos[oqa:oqa + nq]
+        nd.qvel[va:va + nv] = od.qvel[ova:ova + nv]
+        nd.qacc_warmstart[va:va + nv] = od.qacc_warmstart[ova:ova + nv]
+    for aid in range(nm.nu):
+        name = mujoco.mj_id2name(nm, mujoco.mjtObj.mjOBJ_ACTUATOR, aid)
+        oid = mujoco.mj_name2id(om, mujoco.mjtObj.mjOBJ_ACTUATOR, name) if name else -1
+        if oid < 0:
+            continue
+        nd.ctrl[aid] = od.ctrl[oid]
+        nm.actuator_biasprm[aid, 0] = om.actuator_biasprm[oid, 0]      # the drive's velocity target
+        if nm.actuator_actnum[aid] and nm.actuator_actnum[aid] == om.actuator_actnum[oid]:
+            na = nm.actuator_actnum[aid]
+            nd.act[nm.actuator_actadr[aid]:nm.actuator_actadr[aid] + na] = \
+                od.act[om.actuator_actadr[oid]:om.actuator_actadr[oid] + na]
 
 
 def _aabb_half(kind: int, size: np.ndarray) -> np.ndarray:
