@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import difflib
+import re
 from typing import Iterable
 
 
@@ -43,3 +44,25 @@ def unknown_name(kind: str, name: object, known: Iterable[str]) -> UnknownNameEr
     known = sorted(known)
     hint = closest(str(name), known)
     return UnknownNameError(f"unknown {kind} {name!r}{hint}; known {kind}s: {', '.join(known)}")
+
+
+_TF_ERROR = re.compile(r"Error in '[^']*' at line \d+ in file \S+ : '(.*?)'\s*(?=\n\s*Error in|\Z)", re.S)
+
+
+def usd_error_text(exc: BaseException) -> str:
+    """The messages of a pxr (Tf) error without its C++ locations.
+
+    Example:
+        >>> usd_error_text(RuntimeError("\\n\\tError in 'Sdf::Parse' at line 48 in file parser.h : 'a.usda:2:3: "
+        ...                             "Expected )'\\n"))
+        'a.usda:2:3: Expected )'
+    """
+    text = str(exc)
+    found = [m.strip() for m in _TF_ERROR.findall(text)]
+    return "; ".join(found) if found else text.strip()
+
+
+def describe(value: object) -> str:
+    """``repr`` of a bad value for a message, arrays shown as lists (``[nan, 0.0]`` not ``array([nan, 0.])``)."""
+    tolist = getattr(value, "tolist", None)
+    return repr(tolist()) if callable(tolist) and not isinstance(value, (str, bytes)) else repr(value)

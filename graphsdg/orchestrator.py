@@ -10,17 +10,20 @@ from __future__ import annotations
 import atexit
 import enum
 import logging
+import sys
 import time
 from fractions import Fraction
 from typing import Any, Callable
 
-from graphsdg import profiling, settings
+from graphsdg import interrupts, profiling, settings
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
-from graphsdg.io.write_queue import get_write_queue
+from graphsdg.io import run_state
+from graphsdg.io.write_queue import current_write_queue, get_write_queue
 from graphsdg.progress import Progress
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
+from graphsdg.stage.context import stage_context
 
 log = logging.getLogger("graphsdg.orchestrator")
 
@@ -45,6 +48,7 @@ class _State:
     def __init__(self) -> None:
         self.status = Status.STOPPED
         self.frame_index = 0
+        self.stage_step = 0        # steps since the stage was created or opened (the run-state file's steps)
         self.callbacks: dict[int, Callable[[Status], None]] = {}
         self.stop_requested = False
         self.pause_requested = False
@@ -61,6 +65,13 @@ class _State:
 
 
 _state = _State()
+
+
+def _on_stage_replaced(stage) -> None:
+    _state.stage_step = 0
+
+
+stage_context.subscribe_replaced(_on_stage_replaced)
 
 
 def _validate_subframes(rt_subframes: Any) -> int:
@@ -86,12 +97,25 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     step; ``pause_timeline=True`` leaves it paused afterwards (so a script that
     wants it running again calls ``timeline.play()``).
     ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
+    Ctrl-C (or SIGTERM) during a step takes effect when the frame has been handed
+    to the writers (:mod:`graphsdg.interrupts`).
     """
     rt_subframes = _validate_subframes(rt_subframes)
     if delta_time is not None and (not isinstance(delta_time, (int, float)) or delta_time < 0):
         raise ValueError(f"delta_time must be None, 0 or a positive number of seconds, got {delta_time!r}")
+    with interrupts.deferred() as held:
+        _step(rt_subframes, pause_timeline, delta_time)
+    if held is not None and held.received is not None:
+        interrupts.raise_for(held.received)
+
+
+def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None) -> None:
     queue = get_write_queue()
-    queue.raise_errors()
+    try:
+        queue.raise_errors()
+    except BaseException:
+        run_state.mark_failed()
+        raise
     rt = runtime()
     rt.check_attachments()
     _state.set(Status.STEPPING)
@@ -118,6 +142,8 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     subframes = capture_subframes(rt_subframes, subframes_override)
     _capture(subframes, fired, trigger_outputs, provenance)   # times its render, annotate and write phases itself
     _state.frame_index += 1
+    _state.stage_step += 1
+    run_state.checkpoint()
     _state.set(Status.STEPPED)
 
 
@@ -191,7 +217,8 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
             extra["frame_index"] = _state.frame_bases.get(id(writer), 0) + _state.planned_frame
         data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
                                     extra=extra or None)
-        writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
+        with run_state.frame(writer, _state.stage_step, data.get("frame_index")):   # for graphsdg_run.json
+            writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
     _timed("write", t)
 
 
@@ -206,11 +233,22 @@ def wait_until_complete() -> None:
     """Block until every scheduled file is on disk; raise the first writer failure.
 
     Attached writers flush their aggregate files first (COCO json, BOP json, open
-    WebDataset shards), so what is on disk afterwards is a complete dataset.
+    WebDataset shards), so what is on disk afterwards is a complete dataset, and
+    each output folder's ``graphsdg_run.json`` lists every frame as complete.
     """
-    for writer in list(runtime().writers):
-        writer.flush()
-    get_write_queue().wait_until_done()
+    _drain("flushed")
+
+
+def _drain(status: str) -> None:
+    """Flush writers' shared files, wait for every write, record ``status`` in the run-state files."""
+    try:
+        for writer in list(runtime().writers):
+            writer.flush()
+        get_write_queue().wait_until_done()
+    except BaseException:
+        run_state.mark_failed()
+        raise
+    run_state.drained(status)
 
 
 async def wait_until_complete_async() -> None:
@@ -219,7 +257,7 @@ async def wait_until_complete_async() -> None:
 
 def set_capture_on_play(value: bool) -> None:
     """Capture every timeline tick while playing (Replicator's default) or only on ``step()``."""
-    settings.set("/omni/replicator/captureOnPlay", bool(value))
+    settings.set("/omni/replicator/captureOnPlay", value)   # refuses anything but True / False
 
 
 def get_capture_on_play() -> bool:
@@ -297,12 +335,17 @@ def unregister_status_callback(handle: int) -> None:
 
 def stop() -> None:
     """Stop generation: writers' ``on_final_frame`` runs, then pending writes are flushed."""
+    _stop("finished")
+
+
+def _stop(status: str) -> None:
+    """:func:`stop`, recording ``status`` (``finished`` or ``interrupted``) in the run-state files."""
     _state.stop_requested = True
     _state.pause_requested = False
     _state.set(Status.STOPPING)
     for writer in runtime().writers:
         writer.on_final_frame()
-    wait_until_complete()
+    _drain(status)
     _state.remaining = None
     _state.set(Status.STOPPED)
 
@@ -350,12 +393,22 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
 def _run_loop() -> None:
     sched = _graph_scheduler()
     progress = Progress(_state.remaining, "run")
-    try:
-        with progress:
-            paused = _frames(sched, progress)
-    except BaseException:
-        _state.set(Status.STOPPED)
-        raise
+
+    def interrupted(signum: int) -> None:   # Ctrl-C / SIGTERM: end after the current frame
+        _state.stop_requested = True
+
+    with interrupts.deferred(on_signal=interrupted) as held:
+        try:
+            with progress:
+                paused = _frames(sched, progress)
+        except BaseException:
+            _state.set(Status.STOPPED)
+            raise
+        if held is not None and held.received is not None:
+            log.warning("graphsdg: interrupted after %d frames; flushing the writers", progress.frames)
+            _stop("interrupted")
+            log.warning("graphsdg: run interrupted; every captured frame is on disk (%s)", progress.summary())
+            interrupts.raise_for(held.received)
     if not paused and not _state.stop_requested:
         stop()
         log.info("run finished: %s", progress.summary())
@@ -511,14 +564,37 @@ def reset_profile() -> None:
 
 
 def _flush_at_exit() -> None:
-    queue = get_write_queue()
-    pending = queue.pending()
-    if pending:
-        log.warning("graphsdg: %d writes were still queued at exit; flushing them now", pending)
+    """At interpreter exit: flush attached writers, finish every queued write, or say loudly what was lost."""
+    from graphsdg import runtime as runtime_module
+    queue = current_write_queue()
+    rt = runtime_module._runtime          # never create a runtime (a GL context) just to exit
+    writers = list(rt.writers) if rt is not None else []
+    if queue is None and not writers:
+        return
     try:
-        queue.wait_until_done()
-    except Exception as exc:  # noqa: BLE001 - report, exit continues
-        log.error("graphsdg: writes failed at exit: %s", exc)
+        for writer in writers:
+            writer.flush()
+        queue = current_write_queue()
+        pending = queue.pending() if queue is not None else 0
+        if pending:
+            log.warning("graphsdg: %d file writes were still queued at exit (wait_until_complete() was not "
+                        "called); finishing them now", pending)
+        if queue is not None:
+            queue.wait_until_done()
+        stopped_by_signal = interrupts.last_signal is not None or isinstance(getattr(sys, "last_value", None),
+                                                                               KeyboardInterrupt)
+        run_state.drained("interrupted" if stopped_by_signal else "exited", only_writing=True)
+    except BaseException as exc:  # noqa: BLE001 - report loudly, the interpreter exits anyway
+        lost = current_write_queue()
+        try:
+            run_state.mark_failed()
+        except BaseException:  # noqa: BLE001
+            pass
+        folders = "".join(f"\n  {line}" for line in run_state.summary())
+        log.error("graphsdg: ERROR at exit: writes failed and the dataset is incomplete; frames not listed as "
+                  "complete were dropped:%s\n%s%s", folders or " (no run-state kept)", exc,
+                  f"\n({lost.pending()} writes still queued)" if lost is not None and lost.pending() else "",
+                  exc_info=exc)
 
 
 atexit.register(_flush_at_exit)

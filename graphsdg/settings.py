@@ -14,9 +14,11 @@ Example:
 """
 from __future__ import annotations
 
+import numbers
+import os
 import threading
 import warnings
-from typing import Any
+from typing import Any, Callable
 
 # key -> (default, meaning). Only these keys change graphsdg's behaviour.
 KNOWN_KEYS: dict[str, tuple[Any, str]] = {
@@ -26,6 +28,12 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/backend/writeThreads": (4, "writer worker threads of the I/O pool"),
     "/omni/replicator/backend/queueSize": (1000, "queued writes before the producer is throttled"),
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
+    "/graphsdg/io/queueMaxBytes": (1 << 30, "bytes of image/array data queued writes may hold before the producer "
+                                   "is throttled"),
+    "/graphsdg/io/fsync": (False, "fsync each file and its folder before a write counts as done (survives power "
+                           "loss, slower)"),
+    "/graphsdg/io/runState": (True, "keep graphsdg_run.json (which frames are complete on disk) in each writer's "
+                              "output folder"),
     "/exts/omni.replicator.core/enableWriteToFabric": (
         False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
     "/graphsdg/run/numFrames": (None, "frames for orchestrator.run() calls without num_frames (graphsdg run --frames)"),
@@ -53,6 +61,55 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                          "path-tracing samples); 0 means no bound (CI-sized runs of full scripts)"),
 }
 
+def _integer(minimum: int, none_ok: bool = False) -> Callable[[str, Any], None]:
+    def check(key: str, value: Any) -> None:
+        if value is None and none_ok:
+            return
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+            raise ValueError(f"setting {key} must be an integer >= {minimum}{' or None' if none_ok else ''}, "
+                             f"got {value!r}")
+    return check
+
+
+def _boolean(key: str, value: Any) -> None:
+    if not (isinstance(value, bool) or type(value).__name__ == "bool_" or (isinstance(value, numbers.Integral)
+                                                                           and value in (0, 1))):
+        raise ValueError(f"setting {key} must be True or False, got {value!r}")
+
+
+def _positive_number(key: str, value: Any) -> None:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value > 0:
+        raise ValueError(f"setting {key} must be a number > 0, got {value!r}")
+
+
+def _path_or_none(key: str, value: Any) -> None:
+    if value is not None and not isinstance(value, (str, os.PathLike)):
+        raise ValueError(f"setting {key} must be a folder path or None, got {value!r}")
+
+
+# key -> check(key, value): known keys refuse values graphsdg cannot use, naming the key (no late, obscure error).
+VALIDATORS: dict[str, Callable[[str, Any], None]] = {
+    "/omni/replicator/captureOnPlay": _boolean,
+    "/omni/replicator/RTSubframes": _integer(0),
+    "/omni/replicator/globalSeed": _integer(0, none_ok=True),
+    "/omni/replicator/backend/writeThreads": _integer(1),
+    "/omni/replicator/backend/queueSize": _integer(1),
+    "/omni/replicator/backends/disk/root_dir": _path_or_none,
+    "/graphsdg/io/queueMaxBytes": _integer(1),
+    "/graphsdg/io/fsync": _boolean,
+    "/graphsdg/io/runState": _boolean,
+    "/exts/omni.replicator.core/enableWriteToFabric": _boolean,
+    "/graphsdg/run/numFrames": _integer(0, none_ok=True),
+    "/graphsdg/run/shardIndex": _integer(0),
+    "/graphsdg/run/shardCount": _integer(1),
+    "/graphsdg/run/resume": _boolean,
+    "/graphsdg/io/discardWrites": _boolean,
+    "/graphsdg/render/shadowSize": _integer(1),
+    "/graphsdg/render/msaaSamples": _integer(0),
+    "/graphsdg/render/exposure": _positive_number,
+    "/graphsdg/render/maxResolution": _integer(1),
+}
+
 _values: dict[str, Any] = {}
 _warned: set[str] = set()
 _lock = threading.Lock()
@@ -66,16 +123,23 @@ def normalize_key(key: str) -> str:
 
 
 def set(key: str, value: Any) -> None:  # noqa: A001 - mirrors carb's API name
-    """Store ``value`` under ``key``; warn once if graphsdg does not use the key."""
+    """Store ``value`` under ``key``; warn once if graphsdg does not use the key.
+
+    A key graphsdg uses refuses a value it cannot use (``ValueError`` naming the key).
+    """
     k = normalize_key(key)
+    check = VALIDATORS.get(k)
+    if check is not None:
+        check(k, value)
     with _lock:
         _values[k] = value
         unknown = k not in KNOWN_KEYS and k not in _warned
         if unknown:
             _warned.add(k)
     if unknown:
+        from graphsdg.errors import closest
         warnings.warn(
-            f"setting {k!r} has no effect in graphsdg (stored, but nothing reads it); "
+            f"setting {k!r} has no effect in graphsdg (stored, but nothing reads it){closest(k, KNOWN_KEYS)}; "
             f"honoured keys: {', '.join(sorted(KNOWN_KEYS))}",
             stacklevel=2,
         )

@@ -186,7 +186,7 @@ class Visibility(Node):
         elif ctx.is_random("value"):
             values = [bool(v) for v in np.asarray(sample_port(ctx, "value", len(prims))).reshape(-1)]
         else:
-            values = bool(ctx.value("value"))
+            values = ctx.value("value")      # True/False, or one per prim; the functional call checks it
         F.visibility(prims, values)
         return {"prims": prims}
 

@@ -18,7 +18,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from graphsdg.errors import unknown_name
+from graphsdg.errors import closest, unknown_name
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
 
 ComputeFn = Callable[["FrameView", dict], dict]  # noqa: F821 (FrameView in annotate.frame)
@@ -215,7 +215,8 @@ class AnnotatorRegistry:
 def _params(spec: AnnotatorSpec, given: dict) -> dict:
     unknown = set(given) - set(spec.defaults)
     if unknown:
-        raise ValueError(f"annotator {spec.name!r} has no init param(s) {sorted(unknown)}; "
+        hints = "".join(closest(str(u), spec.defaults) for u in sorted(unknown))
+        raise ValueError(f"annotator {spec.name!r} has no init param(s) {sorted(unknown)}{hints}; "
                          f"known: {sorted(spec.defaults) or 'none'}")
     params = {**copy.deepcopy(spec.defaults), **given}
     if spec.validate is not None:

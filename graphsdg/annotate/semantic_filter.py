@@ -134,7 +134,11 @@ class SemanticFilter:
         """The predicate ``"typeA:*; typeB:*"`` (Replicator's translation of ``semanticTypes``)."""
         if isinstance(types, str):
             types = [types]
-        names = list(types)
+        try:
+            names = list(types)
+        except TypeError:
+            raise SemanticFilterError(f"semanticTypes must be a non-empty list of type names such as ['class'], "
+                                      f"got {types!r}") from None
         if not names or any(not isinstance(t, str) or not t.strip() or _TOKEN_CHARS & set(t) for t in names):
             raise SemanticFilterError(f"semanticTypes must be a non-empty list of type names, got {types!r}")
         return cls(tuple((Clause(t.strip(), ((Literal(ANY),),)),) for t in names))

@@ -120,6 +120,22 @@ def _check_content(ds: BasicWriterDataset, f: Frame, seen: dict[str, str], out: 
             seen[digest] = name
 
 
+def _unfinished_run(root: str) -> list[Violation]:
+    """A run-state file means the run that wrote the folder did not finish (docs/reproducibility.md)."""
+    from graphsdg.io import run_state
+    try:
+        doc = run_state.read(root)
+    except ValueError as exc:
+        return [Violation("-", "complete", str(exc))]
+    out = []
+    for name, entry in (doc or {}).get("writers", {}).items():
+        ranges = ", ".join(f"{a}-{b}" if a != b else f"{a}" for a, b in entry.get("complete", [])) or "none"
+        out.append(Violation("-", "complete", f"the run that wrote this folder did not finish ({run_state.FILE_NAME}: "
+                                              f"{name} {entry.get('status')}, complete frames {ranges}); resume or "
+                                              f"rerun it"))
+    return out
+
+
 def validate(root: str) -> list[Violation]:
     """Every violation found in the dataset at ``root`` (empty list: consistent)."""
     ds = BasicWriterDataset(root)
@@ -128,6 +144,7 @@ def validate(root: str) -> list[Violation]:
         return [Violation("-", "complete", f"no BasicWriter frames found under {root}")]
     for path in ds.stray:
         out.append(Violation("-", "complete", f"temporary or hidden file left behind: {os.path.relpath(path, root)}"))
+    out += _unfinished_run(root)
     stems_by_folder: dict[str, set[str]] = {}
     for f in ds.frames.values():
         stems_by_folder.setdefault(f.folder, set()).update(f.files)

@@ -13,11 +13,14 @@ Example:
 """
 from __future__ import annotations
 
+import math
 import os
 from typing import Any, Sequence
 
+import numpy as np
 from pxr import Gf, Pcp, Sdf, Usd, UsdGeom, UsdLux
 
+from graphsdg.errors import closest, usd_error_text
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage import shapes
@@ -93,10 +96,14 @@ def camera(position: Vec3 | None = None, rotation: Vec3 | None = None, look_at: 
            clipping_range: tuple[float, float] = (0.01, 1000000.0), projection_type: str = "pinhole",
            name: str | None = None, parent: PrimLike | None = None, semantics: Any = None) -> Usd.Prim:
     """Define a ``UsdGeom.Camera`` (looks down its -Z; ``look_at`` aims it)."""
-    if focal_length <= 0 or horizontal_aperture <= 0:
-        raise ValueError(f"focal_length ({focal_length}) and horizontal_aperture ({horizontal_aperture}) "
-                         f"must be positive")
-    near, far = clipping_range
+    focal_length = _number("focal_length", focal_length, 0, exclusive=True)
+    horizontal_aperture = _number("horizontal_aperture", horizontal_aperture, 0, exclusive=True)
+    if vertical_aperture is not None:
+        vertical_aperture = _number("vertical_aperture", vertical_aperture, 0, exclusive=True)
+    try:
+        near, far = (float(v) for v in clipping_range)
+    except (TypeError, ValueError):
+        raise ValueError(f"clipping_range must be (near, far) with 0 < near < far, got {clipping_range!r}") from None
     if not 0 < near < far:
         raise ValueError(f"clipping_range must be (near, far) with 0 < near < far, got {clipping_range!r}")
     if projection_type not in ("pinhole", "perspective", "orthographic"):
@@ -116,15 +123,44 @@ def camera(position: Vec3 | None = None, rotation: Vec3 | None = None, look_at: 
     return _finish(cam.GetPrim(), position, rotation, None, look_at, look_at_up_axis, semantics)
 
 
+def _number(what: str, value: Any, minimum: float | None = None, exclusive: bool = False) -> float:
+    """``value`` as a float, or a ValueError naming ``what``, the value and the allowed range."""
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) \
+        and math.isfinite(float(value))
+    if ok and minimum is not None:
+        ok = float(value) > minimum if exclusive else float(value) >= minimum
+    if not ok:
+        bound = "" if minimum is None else f" {'>' if exclusive else '>='} {minimum:g}"
+        raise ValueError(f"{what} must be a finite number{bound}, got {value!r}")
+    return float(value)
+
+
+def _rgb(what: str, value: Any) -> tuple[float, float, float]:
+    try:
+        rgb = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        rgb = ()
+    if len(rgb) != 3 or not all(math.isfinite(v) and v >= 0 for v in rgb):
+        raise ValueError(f"{what} must be an (r, g, b) colour of 3 finite numbers >= 0, got {value!r}")
+    return rgb  # type: ignore[return-value]
+
+
 def _light(schema, default_name: str, intensity: float, exposure: float | None, color: Vec3 | None,
            temperature: float | None, name, parent, position, rotation, scale, look_at, look_at_up_axis,
            **shape: float) -> Usd.Prim:
+    intensity = _number("intensity", intensity)
+    exposure = None if exposure is None else _number("exposure", exposure)
+    temperature = None if temperature is None else _number("temperature (Kelvin)", temperature, 0, exclusive=True)
+    if color is not None:
+        color = _rgb("color", color)
+    shape = {attr: None if v is None else _number(attr.lower(), v, 0, exclusive=attr != "Angle")
+             for attr, v in shape.items()}
     light = schema.Define(get_stage(), _new_path(name, default_name, parent))
     light.CreateIntensityAttr(float(intensity))
     if exposure is not None:
         light.CreateExposureAttr(float(exposure))
     if color is not None:
-        light.CreateColorAttr(Gf.Vec3f(*(float(c) for c in color)))
+        light.CreateColorAttr(Gf.Vec3f(*color))
     if temperature is not None:
         light.CreateEnableColorTemperatureAttr(True)
         light.CreateColorTemperatureAttr(float(temperature))
@@ -139,6 +175,8 @@ def dome_light(intensity: float = 1000.0, exposure: float | None = None, color: 
                parent: PrimLike | None = None, position: Vec3 | None = None, rotation: Vec3 | None = None,
                scale: Vec3 | None = None) -> Usd.Prim:
     """Define a ``UsdLux.DomeLight`` (ambient sky light; ``texture`` an equirect image)."""
+    if texture is not None and "://" not in os.fspath(texture) and not os.path.isfile(os.fspath(texture)):
+        raise FileNotFoundError(f"dome light texture {os.fspath(texture)!r} does not exist")
     prim = _light(UsdLux.DomeLight, "DomeLight", intensity, exposure, color, temperature, name, parent,
                   position, rotation, scale, None, None)
     if texture is not None:
@@ -208,7 +246,8 @@ def material(mdl: str = "OmniPBR.mdl", bind_prims: Sequence[PrimLike] | PrimLike
              "project_uvw", "specular_level"}
     unknown = set(inputs) - known
     if unknown:
-        raise ValueError(f"unknown material input(s) {sorted(unknown)}; known: {sorted(known)}")
+        hints = "".join(closest(u, known) for u in sorted(unknown))
+        raise ValueError(f"unknown material input(s) {sorted(unknown)}{hints}; known: {sorted(known)}")
     if not isinstance(mdl, str) or not mdl:
         raise ValueError(f"mdl must name a material such as 'OmniPBR.mdl', got {mdl!r}")
     stage = get_stage()
@@ -294,7 +333,7 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
     try:
         layer = Sdf.Layer.FindOrOpen(path_str)
     except Exception as exc:  # pxr raises Tf.ErrorException on parse errors
-        raise ValueError(f"reference usd_path {path_str!r} does not parse as USD: {exc}") from exc
+        raise ValueError(f"reference usd_path {path_str!r} does not parse as USD: {usd_error_text(exc)}") from exc
     if layer is None:
         raise ValueError(f"reference usd_path {path_str!r} does not parse as USD")
     target = _reference_target(layer, path_str)

@@ -19,6 +19,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from graphsdg import settings
+from graphsdg.errors import closest
 from graphsdg.functional.create_batch import per_prim
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -149,8 +150,8 @@ def attribute(prims: Any, name: str, value: Any, attribute_type: str | None = No
         if not attr or not attr.IsValid():
             if attribute_type is None:
                 known = sorted(a.GetName() for a in prim.GetAttributes())
-                raise ValueError(f"prim {prim.GetPath()} has no attribute {name!r}; pass attribute_type to "
-                                 f"create it. Its attributes: {known}")
+                raise ValueError(f"prim {prim.GetPath()} has no attribute {name!r}{closest(name, known)}; pass "
+                                 f"attribute_type to create it. Its attributes: {known}")
             sdf_type = Sdf.ValueTypeNames.Find(attribute_type)
             if not sdf_type:
                 raise ValueError(f"attribute_type {attribute_type!r} is not an Sdf value type name "
@@ -159,8 +160,8 @@ def attribute(prims: Any, name: str, value: Any, attribute_type: str | None = No
         try:
             ok = attr.Set(_convert(attr, value))
         except Exception as exc:  # pxr raises Tf.ErrorException for type mismatches
-            raise TypeError(f"cannot set {prim.GetPath()}.{name} ({attr.GetTypeName()}) to {value!r}: {exc}") \
-                from exc
+            raise TypeError(f"cannot set {prim.GetPath()}.{name} to {value!r}: expected a value of type "
+                            f"{attr.GetTypeName()}") from exc
         if not ok:
             raise TypeError(f"cannot set {prim.GetPath()}.{name} ({attr.GetTypeName()}) to {value!r}")
 
@@ -188,6 +189,8 @@ def visibility(prims: Any, value: bool | list[bool]) -> None:
     if len(values) != len(targets):
         raise ValueError(f"visibility got {len(values)} values for {len(targets)} prims")
     for prim, v in zip(targets, values):
+        if not isinstance(v, (bool, np.bool_)):
+            raise TypeError(f"visibility must be True or False (or one of them per prim), got {v!r}")
         img = UsdGeom.Imageable(prim)
         if not img:
             raise TypeError(f"prim {prim.GetPath()} ({prim.GetTypeName()}) is not imageable")
@@ -223,7 +226,8 @@ def material_inputs(materials: Any, **inputs: Any) -> None:
              "emissive_color": "emissive_color", "emissive_intensity": "emissive_intensity"}
     unknown = sorted(set(inputs) - set(names))
     if unknown:
-        raise ValueError(f"unknown material input(s) {unknown}; known: {sorted(names)}")
+        hints = "".join(closest(u, names) for u in unknown)
+        raise ValueError(f"unknown material input(s) {unknown}{hints}; known: {sorted(names)}")
     prims = resolve_prims(materials)
     for p in prims:
         if not p.IsA(UsdShade.Material):

@@ -28,6 +28,7 @@ from typing import Any, Sequence
 
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
+from graphsdg.errors import closest
 from graphsdg.sim.colliders import APPROXIMATIONS, check_approximation
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prims
@@ -92,8 +93,10 @@ def apply_rigid_body(prims: Any, with_collider: bool = False, kinematicEnabled: 
     exempts the body from gravity.
     """
     if kwargs:
-        raise ValueError(f"apply_rigid_body got unknown argument(s) {sorted(kwargs)}; known: with_collider, "
-                         f"kinematicEnabled, approximation, mass, density, disableGravity")
+        known = ["with_collider", "kinematicEnabled", "approximation", "mass", "density", "disableGravity"]
+        hints = "".join(closest(k, known) for k in sorted(kwargs))
+        raise ValueError(f"apply_rigid_body got unknown argument(s) {sorted(kwargs)}{hints}; known: "
+                         f"{', '.join(known)}")
     if approximation is not None:
         check_approximation(approximation)
     if mass is not None:

@@ -179,20 +179,47 @@ def writes_discarded() -> bool:
     return bool(settings.get("/graphsdg/io/discardWrites", False))
 
 
+def _fsync_dir(directory: str) -> None:
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 def write_file_atomic(full_path: str, data: bytes) -> None:
-    """Write ``data`` to ``full_path`` so that the file appears whole or not at all."""
+    """Write ``data`` to ``full_path`` so that the file appears whole or not at all.
+
+    The bytes go to a temporary name in the same folder, which is then renamed
+    over ``full_path`` (atomic on POSIX). A process that dies at any point leaves
+    either the old file or the new one, never a truncated one. With the setting
+    ``/graphsdg/io/fsync`` the file and the folder are also synced before the
+    write counts as done, so the same holds after a power loss.
+    """
+    _write_atomic(full_path, data, count=True)
+
+
+def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
+    """:func:`write_file_atomic`; ``count=False`` leaves the totals alone (bookkeeping files: the run state)."""
     if writes_discarded():
         return
     directory = os.path.dirname(full_path)
     os.makedirs(directory, exist_ok=True)
     tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{uuid.uuid4().hex[:12]}.tmp")
+    durable = bool(settings.get("/graphsdg/io/fsync", False))
     try:
         with open(tmp, "wb") as f:
             f.write(data)
+            if durable:
+                f.flush()
+                os.fsync(f.fileno())
         os.replace(tmp, full_path)
-        with _counter_lock:
-            _written["files"] += 1
-            _written["bytes"] += len(data)
+        if durable:
+            _fsync_dir(directory)
+        if count:     # bookkeeping files (the run state) are not part of the dataset's totals
+            with _counter_lock:
+                _written["files"] += 1
+                _written["bytes"] += len(data)
     except BaseException as exc:
         try:
             os.unlink(tmp)

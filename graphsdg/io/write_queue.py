@@ -1,119 +1,307 @@
 """The background write queue: a bounded pool of worker threads.
 
 Encoding and file writes run here so rendering never waits on disk. The queue
-is bounded (``/omni/replicator/backend/queueSize``): a producer that outruns
-the disk blocks ("throttles") instead of growing memory. A task that raises is
-remembered and re-raised in the script by :meth:`WriteQueue.raise_errors`
-(called at every ``step()`` and by ``wait_until_complete()``), never only logged.
+is bounded two ways: at most ``/omni/replicator/backend/queueSize`` tasks wait,
+and the arrays held by waiting and running tasks stay under
+``/graphsdg/io/queueMaxBytes``. A producer that outruns the disk blocks
+("throttles") instead of growing memory. Both settings, and
+``/omni/replicator/backend/writeThreads``, apply to the live queue.
+
+Tasks run in the order they were scheduled (FIFO; writers such as the WebDataset
+shard writer rely on it). A task that raises is remembered and re-raised in the
+script by :meth:`WriteQueue.raise_errors` (called at every ``step()`` and by
+``wait_until_complete()``), never only logged.
+
+:meth:`WriteQueue.group` collects the tasks scheduled inside a block (one frame of
+one writer) and reports when all of them are done: the run-state index of
+:mod:`graphsdg.io.run_state` is built on it.
+
+Example:
+    >>> q = WriteQueue(num_threads=2, max_size=8)
+    >>> done = []
+    >>> with q.group(lambda ok: done.append(ok)):
+    ...     q.schedule(print, "written")
+    written
+    >>> q.wait_until_done(); done
+    [True]
+    >>> q.shutdown()
 """
 from __future__ import annotations
 
+import collections
+import contextlib
 import logging
-import queue
 import threading
 import time
-import traceback
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
+
+import numpy as np
 
 from graphsdg import profiling, settings
 from graphsdg.errors import WriterError
 
 log = logging.getLogger("graphsdg.io")
 
+THREADS_KEY = "/omni/replicator/backend/writeThreads"
+SIZE_KEY = "/omni/replicator/backend/queueSize"
+BYTES_KEY = "/graphsdg/io/queueMaxBytes"
+_THROTTLE_LOG_EVERY_S = 10.0
+
+
+class TaskGroup:
+    """The tasks scheduled inside one :meth:`WriteQueue.group` block."""
+
+    def __init__(self, on_done: Callable[[bool], None]) -> None:
+        self.on_done = on_done
+        self.pending = 0
+        self.failed = False
+        self.closed = False
+
+
+def payload_bytes(args: tuple, kwargs: dict) -> int:
+    """Bytes of the arrays and byte strings a task holds (what queued tasks cost in memory)."""
+    total = 0
+    for value in (*args, *kwargs.values()):
+        if isinstance(value, np.ndarray):
+            total += value.nbytes
+        elif isinstance(value, (bytes, bytearray, memoryview)):
+            total += len(value)
+    return total
+
+
+def _describe(fn: Callable[..., Any], kwargs: dict) -> str:
+    """``"a background write of 'rgb_0003.png'"``: the file a failed task was writing, when it says."""
+    path = kwargs.get("path")
+    if isinstance(path, str):
+        return f"a background write of {path!r}"
+    return f"a background write ({getattr(fn, '__qualname__', type(fn).__name__)})"
+
+
+def _positive_int(key: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"setting {key} must be a positive integer, got {value!r}")
+    return int(value)
+
 
 class WriteQueue:
-    """Runs scheduled callables on worker threads."""
+    """Runs scheduled callables on worker threads, in order, with bounded memory."""
 
-    def __init__(self, num_threads: int | None = None, max_size: int | None = None) -> None:
-        self.num_threads = int(num_threads or settings.get("/omni/replicator/backend/writeThreads", 4))
-        self.max_size = int(max_size or settings.get("/omni/replicator/backend/queueSize", 1000))
-        if self.num_threads < 1 or self.max_size < 1:
-            raise ValueError(f"write queue needs >= 1 thread and size >= 1, got {self.num_threads}, {self.max_size}")
-        self._queue: queue.Queue = queue.Queue(maxsize=self.max_size)
+    def __init__(self, num_threads: int | None = None, max_size: int | None = None,
+                 max_bytes: int | None = None) -> None:
+        self.num_threads = _positive_int(THREADS_KEY, num_threads if num_threads is not None
+                                         else settings.get(THREADS_KEY, 4))
+        self.max_size = _positive_int(SIZE_KEY, max_size if max_size is not None else settings.get(SIZE_KEY, 1000))
+        self.max_bytes = _positive_int(BYTES_KEY, max_bytes if max_bytes is not None
+                                       else settings.get(BYTES_KEY, 1 << 30))
+        self._cond = threading.Condition()
+        self._items: collections.deque = collections.deque()
+        self._unfinished = 0              # waiting + running
+        self._bytes = 0                   # held by waiting + running tasks
         self._errors: list[tuple[BaseException, str]] = []
-        self._lock = threading.Lock()
         self._threads: list[threading.Thread] = []
+        self._retire = 0                  # workers asked to exit (fewer threads configured)
+        self._closing = False
+        self._local = threading.local()
+        self._last_throttle_log = -_THROTTLE_LOG_EVERY_S
         self.throttled_seconds = 0.0
         self.completed = 0
+        self.peak_bytes = 0
 
-    def _ensure_threads(self) -> None:
-        if self._threads:
-            return
-        for i in range(self.num_threads):
-            t = threading.Thread(target=self._work, name=f"graphsdg-writer-{i}", daemon=True)
-            t.start()
+    # ---- workers ---------------------------------------------------------
+    def _start_threads(self) -> bool:
+        """Bring the pool up to ``num_threads``; False if no thread can start (interpreter shutdown)."""
+        alive = [t for t in self._threads if t.is_alive()]
+        self._threads = alive
+        while len(self._threads) - self._retire < self.num_threads:
+            if self._retire:
+                self._retire -= 1
+                continue
+            t = threading.Thread(target=self._work, name=f"graphsdg-writer-{len(self._threads)}", daemon=True)
+            try:
+                t.start()
+            except RuntimeError:           # "can't create new thread at interpreter shutdown"
+                return bool(self._threads)
             self._threads.append(t)
+        return True
 
     def _work(self) -> None:
         while True:
-            item = self._queue.get()
-            try:
-                if item is None:
+            with self._cond:
+                while not self._items and not self._closing and not self._retire:
+                    self._cond.wait()
+                if self._retire and not self._closing:
+                    self._retire -= 1
+                    self._threads.remove(threading.current_thread())
                     return
-                fn, args, kwargs = item
-                start = time.perf_counter()
-                fn(*args, **kwargs)
-                profiling.add("encode+write", time.perf_counter() - start)
-                with self._lock:
-                    self.completed += 1
-            except BaseException as exc:  # noqa: BLE001 - every failure must reach the script
-                with self._lock:
-                    self._errors.append((exc, traceback.format_exc()))
-                log.error("write task failed: %s", exc)
-            finally:
-                self._queue.task_done()
+                if not self._items:        # closing and drained
+                    return
+                item = self._items.popleft()
+                self._cond.notify_all()    # a throttled producer may go on
+            self._run(item)
+
+    def _run(self, item: tuple) -> None:
+        fn, args, kwargs, nbytes, group = item
+        ok = True
+        start = time.perf_counter()
+        try:
+            fn(*args, **kwargs)
+        except BaseException as exc:  # noqa: BLE001 - every failure must reach the script
+            ok = False
+            what = _describe(fn, kwargs)
+            with self._cond:
+                self._errors.append((exc, what))
+            log.error("%s failed: %s", what, exc)
+        profiling.add("encode+write", time.perf_counter() - start)
+        finished = None
+        with self._cond:
+            self._unfinished -= 1
+            self._bytes -= nbytes
+            if ok:
+                self.completed += 1
+            if group is not None:
+                group.pending -= 1
+                group.failed |= not ok
+                if group.closed and group.pending == 0:
+                    finished = group
+            self._cond.notify_all()
+        if finished is not None:
+            finished.on_done(not finished.failed)
+
+    # ---- producers -------------------------------------------------------
+    def _full(self, nbytes: int) -> bool:
+        return len(self._items) >= self.max_size or (self._bytes > 0 and self._bytes + nbytes > self.max_bytes)
 
     def schedule(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
-        """Queue ``fn(*args, **kwargs)``; blocks while the queue is full."""
-        self._ensure_threads()
-        item = (fn, args, kwargs)
-        try:
-            self._queue.put_nowait(item)
-        except queue.Full:
-            log.warning("Throttling generation due to I/O bottleneck.")
-            start = time.perf_counter()
-            self._queue.put(item)
-            self.throttled_seconds += time.perf_counter() - start
+        """Queue ``fn(*args, **kwargs)``; blocks while the queue is full (backpressure)."""
+        nbytes = payload_bytes(args, kwargs)
+        group = getattr(self._local, "group", None)
+        with self._cond:
+            if not self._start_threads():
+                inline = True
+            else:
+                inline = False
+                # A task that schedules a follow-up must not wait for room it occupies itself.
+                if self._full(nbytes) and threading.current_thread() not in self._threads:
+                    now = time.perf_counter()
+                    if now - self._last_throttle_log >= _THROTTLE_LOG_EVERY_S:
+                        self._last_throttle_log = now
+                        log.warning("Throttling generation due to I/O bottleneck.")
+                    while self._full(nbytes):
+                        self._cond.wait()
+                    self.throttled_seconds += time.perf_counter() - now
+            item = (fn, args, kwargs, nbytes, group)
+            self._unfinished += 1
+            self._bytes += nbytes
+            self.peak_bytes = max(self.peak_bytes, self._bytes)
+            if group is not None:
+                group.pending += 1
+            if not inline:
+                self._items.append(item)
+                self._cond.notify_all()
+        if inline:
+            self._run(item)
 
+    @contextlib.contextmanager
+    def group(self, on_done: Callable[[bool], None]) -> Iterator[TaskGroup]:
+        """Tag the tasks this thread schedules in the block; ``on_done(all_succeeded)`` runs when all are done.
+
+        ``on_done`` runs once, on the worker that finishes the last task (or here,
+        when the block scheduled nothing or everything already finished).
+        """
+        outer = getattr(self._local, "group", None)
+        group = TaskGroup(on_done)
+        self._local.group = group
+        try:
+            yield group
+        except BaseException:
+            with self._cond:
+                group.failed = True
+            raise
+        finally:
+            self._local.group = outer
+            with self._cond:
+                group.closed = True
+                finished = group.pending == 0
+            if finished:
+                group.on_done(not group.failed)
+
+    def configure(self, num_threads: int, max_size: int, max_bytes: int) -> None:
+        """Apply new limits to the live queue (extra workers exit once idle)."""
+        with self._cond:
+            self.max_size, self.max_bytes = max_size, max_bytes
+            if num_threads < self.num_threads and self._threads:
+                self._retire += min(self.num_threads - num_threads, len(self._threads))
+            self.num_threads = num_threads
+            self._cond.notify_all()
+
+    # ---- state -----------------------------------------------------------
     def pending(self) -> int:
-        return self._queue.unfinished_tasks
+        """Tasks scheduled and not finished (waiting or running)."""
+        return self._unfinished
+
+    def queued_bytes(self) -> int:
+        return self._bytes
 
     def is_done(self) -> bool:
-        return self._queue.unfinished_tasks == 0
+        return self._unfinished == 0
 
     def wait_until_done(self) -> None:
         """Block until every scheduled task ran, then raise the first failure if any."""
-        self._queue.join()
+        with self._cond:
+            while self._unfinished:
+                self._cond.wait()
         self.raise_errors()
 
     def raise_errors(self) -> None:
-        with self._lock:
+        with self._cond:
             errors, self._errors = self._errors, []
         if errors:
-            exc, tb = errors[0]
+            exc, what = errors[0]
             more = f" (and {len(errors) - 1} more failures)" if len(errors) > 1 else ""
-            raise WriterError(f"a background write failed: {type(exc).__name__}: {exc}{more}\n{tb}") from exc
+            # one line; the worker's traceback stays on the chained cause (``raise ... from exc``)
+            raise WriterError(f"{what} failed: {type(exc).__name__}: {exc}{more}") from exc
 
     def shutdown(self) -> None:
-        self._queue.join()
-        for _ in self._threads:
-            self._queue.put(None)
-        for t in self._threads:
+        """Finish every task, then stop the workers."""
+        with self._cond:
+            while self._unfinished:
+                self._cond.wait()
+            self._closing = True
+            self._cond.notify_all()
+            threads = list(self._threads)
+        for t in threads:
             t.join()
-        self._threads.clear()
+        with self._cond:
+            self._threads.clear()
+            self._closing = False
+            self._retire = 0
 
 
 _queue: WriteQueue | None = None
 _queue_lock = threading.Lock()
 
 
+def _configured() -> tuple[int, int, int]:
+    return (_positive_int(THREADS_KEY, settings.get(THREADS_KEY, 4)),
+            _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
+            _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30)))
+
+
 def get_write_queue() -> WriteQueue:
-    """The process-wide write queue (created on first use with the current settings)."""
+    """The process-wide write queue, with the current settings applied."""
     global _queue
+    threads, size, max_bytes = _configured()
     with _queue_lock:
         if _queue is None:
-            _queue = WriteQueue()
+            _queue = WriteQueue(threads, size, max_bytes)
+        elif (threads, size, max_bytes) != (_queue.num_threads, _queue.max_size, _queue.max_bytes):
+            _queue.configure(threads, size, max_bytes)
         return _queue
+
+
+def current_write_queue() -> WriteQueue | None:
+    """The process-wide queue if one was made (never creates one: used at interpreter exit)."""
+    return _queue
 
 
 def reset_write_queue() -> None:

@@ -29,7 +29,7 @@ from typing import Any, Iterable
 
 from graphsdg import rng
 from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry, shape_output
-from graphsdg.errors import unknown_name
+from graphsdg.errors import closest, unknown_name
 from graphsdg.io.io_functions import write_json
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
 
@@ -69,10 +69,12 @@ class Writer:
             unknown = [k for k in kwargs if k not in params]
             if unknown:
                 known = [k for k in params if k != "self"]
-                raise TypeError(f"{type(self).__name__}.initialize() got unknown parameter(s) {unknown}; "
+                hints = "".join(closest(k, known) for k in unknown)
+                raise TypeError(f"{type(self).__name__}.initialize() got unknown parameter(s) {unknown}{hints}; "
                                 f"known: {known}")
         self.__init__(**kwargs)  # type: ignore[misc]
         self._initialized = True
+        self._needs_initialize = False
 
     # ---- attachment ----------------------------------------------------
     def _annotator_objects(self) -> list[Annotator]:
@@ -115,6 +117,9 @@ class Writer:
         rps = [rp_registry.find(item) for item in items]
         annotators = self._annotator_objects()
         if not annotators:
+            if getattr(self, "_needs_initialize", False):
+                raise ValueError(f"{type(self).__name__}.attach() before initialize(): call "
+                                 f"writer.initialize(...) first (BasicWriter: e.g. output_dir='_out', rgb=True)")
             raise ValueError(f"{type(self).__name__} has no annotators to write; set self.annotators "
                              f"(e.g. rgb=True for BasicWriter)")
         self._render_products = rps
@@ -263,6 +268,7 @@ class WriterRegistry:
             raise unknown_name("writer", name, cls._writers)
         writer_cls = entry[0]
         writer = writer_cls.__new__(writer_cls)
+        writer._needs_initialize = True      # made without __init__: initialize() constructs it
         if init_params is not None:
             writer.initialize(**init_params)
         if render_products is not None:

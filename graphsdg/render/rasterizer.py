@@ -11,8 +11,9 @@ Passes:
 * ``color`` (uint8) and ``hdr`` (the same colour as linear float, before 8-bit
   rounding): one lit, shadowed, multisampled ``mjr_render``.
 * ``segmentation`` and ``depth``: one render with MuJoCo's id colours, read
-  back with its depth buffer. MuJoCo draws ids without multisampling, so ids and
-  depth are both sampled exactly at pixel centres and agree with each other
+  back with its depth buffer. It is drawn into the single-sample resolve buffer
+  (:func:`single_sample`), so ids and depth are both sampled exactly at pixel
+  centres, on every GL driver, and agree with each other
   (a multisampled colour pass resolves depth from an off-centre sample, which
   is off by up to a quarter pixel of depth slope). Depth is linearised to
   planar z in stage units (background ``inf``); ids are geom ids (background -1).
@@ -29,10 +30,11 @@ loose boxes are measured from.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 from collections import Counter
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 import cv2
 import mujoco
@@ -284,12 +286,13 @@ class Rasterizer:
         try:
             self._update_scene(sim, view, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
-            with profiling.timed(f"render:{kind}"):
-                mujoco.mjr_render(rect, scene, ctx)
             ids = np.empty((h, w, 3), dtype=np.uint8)
             raw = np.empty((h, w), dtype=np.float32) if with_depth else None
-            with profiling.timed(f"readback:{kind}"):
-                mujoco.mjr_readPixels(ids, raw, rect, ctx)
+            with single_sample(ctx):
+                with profiling.timed(f"render:{kind}"):
+                    mujoco.mjr_render(rect, scene, ctx)
+                with profiling.timed(f"readback:{kind}"):
+                    mujoco.mjr_readPixels(ids, raw, rect, ctx)
         finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
@@ -325,6 +328,31 @@ class Rasterizer:
         finally:
             group[:] = saved
         return ids
+
+
+@contextlib.contextmanager
+def single_sample(ctx: mujoco.MjrContext) -> Iterator[None]:
+    """Render into the offscreen *resolve* framebuffer (one sample per pixel) for the block.
+
+    Ids and depth must be exact at pixel centres. MuJoCo turns multisampling off
+    for its id colours, which Mesa honours; NVIDIA's driver (measured: H200,
+    driver 580, 4x MSAA) still resolves the multisampled id colours, blending
+    neighbouring ids into the colour of a third geom: labels appeared far from
+    their objects and boxes grew by up to 160 pixels. Drawing into the
+    single-sample resolve buffer (and reading it back without a resolve) gives
+    the same ids on every driver.
+    """
+    if ctx.offSamples == 0:
+        yield
+        return
+    fbo, samples = ctx.offFBO, ctx.offSamples
+    ctx.offFBO, ctx.offSamples = ctx.offFBO_r, 0
+    mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # binds the (now single-sample) FBO
+    try:
+        yield
+    finally:
+        ctx.offFBO, ctx.offSamples = fbo, samples
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)
 
 
 def effective_far(model: mujoco.MjModel, view: CameraView) -> float:

@@ -84,9 +84,11 @@ class RenderProduct:
 class RenderProductRegistry:
     """All live render products of the process, in creation order."""
 
+    KEEP_DESTROYED = 64   # destroyed products remembered for a clear "was destroyed" error (bounded: no leak)
+
     def __init__(self) -> None:
         self._products: list[RenderProduct] = []
-        self._destroyed: dict[str, RenderProduct] = {}   # path and name -> last destroyed product
+        self._destroyed: dict[str, RenderProduct] = {}   # path and name -> last destroyed product, oldest first
 
     def __iter__(self):
         return iter(list(self._products))
@@ -110,7 +112,11 @@ class RenderProductRegistry:
     def remove(self, rp: RenderProduct) -> None:
         if rp in self._products:
             self._products.remove(rp)
-            self._destroyed[rp.path] = self._destroyed[rp.name] = rp
+            for key in (rp.path, rp.name):
+                self._destroyed.pop(key, None)
+                self._destroyed[key] = rp
+            while len(self._destroyed) > 2 * self.KEEP_DESTROYED:
+                del self._destroyed[next(iter(self._destroyed))]
 
     def find(self, value: "RenderProduct | str") -> RenderProduct:
         if isinstance(value, RenderProduct):

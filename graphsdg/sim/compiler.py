@@ -74,6 +74,9 @@ DEFAULT_FRICTION = 0.5                   # PhysX's default material (static = dy
 PHYSICS_STEPS_PER_SECOND = 120.0
 
 
+UPLOAD_GUARD_MESH = "graphsdg:upload-guard"
+
+
 class CompileError(ValueError):
     """The stage holds something that cannot become a MuJoCo model."""
 
@@ -286,15 +289,24 @@ def _axis_index(axis: str) -> int:
     return "XYZ".index(axis)
 
 
+def _extent(prim: Usd.Prim, name: str, value: object) -> float:
+    """A size attribute of an implicit gprim; a CompileError naming the prim unless positive and finite."""
+    v = float(value)  # type: ignore[arg-type]
+    if not (v > 0 and np.isfinite(v)):
+        raise CompileError(f"{prim.GetTypeName()} {prim.GetPath()} has {name} {v!r}; expected a positive "
+                           f"number")
+    return v
+
+
 def primitive_size(prim: Usd.Prim, scale: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
     """(mjtGeom, size[3], local rotation) of an implicit gprim under world ``scale``."""
     s = np.abs(scale)
     t = prim.GetTypeName()
     if t == "Cube":
-        a = float(UsdGeom.Cube(prim).GetSizeAttr().Get())
+        a = _extent(prim, "size", UsdGeom.Cube(prim).GetSizeAttr().Get())
         return mujoco.mjtGeom.mjGEOM_BOX, a / 2 * s, np.eye(3)
     if t == "Sphere":
-        r = float(UsdGeom.Sphere(prim).GetRadiusAttr().Get())
+        r = _extent(prim, "radius", UsdGeom.Sphere(prim).GetRadiusAttr().Get())
         if np.allclose(s, s[0], rtol=1e-6):
             return mujoco.mjtGeom.mjGEOM_SPHERE, np.array([r * s[0], 0, 0]), np.eye(3)
         return mujoco.mjtGeom.mjGEOM_ELLIPSOID, r * s, np.eye(3)
@@ -303,13 +315,13 @@ def primitive_size(prim: Usd.Prim, scale: np.ndarray) -> tuple[int, np.ndarray, 
         axis = str(g.GetAxisAttr().Get())
         i = _axis_index(axis)
         perp = max(s[j] for j in range(3) if j != i)
-        r, h = float(g.GetRadiusAttr().Get()), float(g.GetHeightAttr().Get())
+        r, h = _extent(prim, "radius", g.GetRadiusAttr().Get()), _extent(prim, "height", g.GetHeightAttr().Get())
         kind = mujoco.mjtGeom.mjGEOM_CYLINDER if t == "Cylinder" else mujoco.mjtGeom.mjGEOM_CAPSULE
         return kind, np.array([r * perp, h / 2 * s[i], 0]), _axis_rotation(axis)
     if t == "Plane":
         g = UsdGeom.Plane(prim)
         axis = str(g.GetAxisAttr().Get())
-        w, length = float(g.GetWidthAttr().Get()), float(g.GetLengthAttr().Get())
+        w, length = _extent(prim, "width", g.GetWidthAttr().Get()), _extent(prim, "length", g.GetLengthAttr().Get())
         rot = _axis_rotation(axis)
         # USD Plane: width along the first in-plane axis, length along the second.
         in_plane = [j for j in range(3) if j != _axis_index(axis)]
@@ -796,6 +808,19 @@ class _Builder:
         self.spec.memory = max(16 << 20, 16 * nbody * nbody + (8 << 20)) if colliding else -1
 
     # ---- top level -----------------------------------------------------
+    def add_upload_guard(self) -> None:
+        """End the mesh list with a tiny mesh no geom uses, so the last mesh is never re-uploaded.
+
+        On NVIDIA's OpenGL driver (measured: H200, driver 580), ``mjr_uploadMesh`` of
+        the model's *last* mesh, which the renderer calls when a mesh prim (a cone, a
+        torus, a USD mesh) is rescaled, erases MuJoCo's built-in sphere: every sphere
+        vanishes from later frames, in colour, depth and ids alike. Mesa is not
+        affected. With this guard the meshes that get re-uploaded are never last.
+        """
+        if len(self.spec.meshes):
+            self.spec.add_mesh(name=UPLOAD_GUARD_MESH, uservert=[0, 0, 0, 1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3],
+                               userface=[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3])
+
     def build(self) -> CompiledScene:
         self.configure()
         predicate = Usd.TraverseInstanceProxies(Usd.PrimIsActive & Usd.PrimIsDefined & ~Usd.PrimIsAbstract)
@@ -822,6 +847,7 @@ class _Builder:
         self.finish_lighting()
         self.assign_masses()
         self.add_probes()
+        self.add_upload_guard()
         self.size_memory()
         try:
             model = self.spec.compile()

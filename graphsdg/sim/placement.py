@@ -129,6 +129,8 @@ class Surface:
 
 def surface_of(prims: Sequence[Usd.Prim]) -> Surface:
     """The surface of ``prims`` (every gprim at or below each, hidden ones included)."""
+    if not len(prims):
+        raise ValueError("scatter_2d needs at least one surface prim to scatter on, got none (surface_prims=[])")
     corners, owner = [], []
     for i, prim in enumerate(prims):
         found = 0

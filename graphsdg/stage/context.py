@@ -15,6 +15,7 @@ from typing import Callable
 
 from pxr import Sdf, Usd, UsdGeom
 
+from graphsdg.errors import usd_error_text
 from graphsdg.stage.changes import ChangeTracker
 
 
@@ -69,7 +70,8 @@ class StageContext:
         try:
             stage = Usd.Stage.Open(path)
         except Exception as exc:  # pxr raises Tf.ErrorException
-            raise ValueError(f"cannot open stage {path!r}: the file does not parse as USD ({exc})") from exc
+            raise ValueError(f"cannot open stage {path!r}: the file does not parse as USD: "
+                             f"{usd_error_text(exc)}") from exc
         if stage is None:
             raise ValueError(f"cannot open stage {path!r}: the file does not parse as USD")
         return self._install(stage)

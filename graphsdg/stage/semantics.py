@@ -24,6 +24,9 @@ def normalize(semantics: SemanticsLike) -> list[tuple[str, str]]:
     if semantics is None:
         return []
     pairs: list[tuple[str, str]] = []
+    if isinstance(semantics, str):
+        raise TypeError(f"semantics must be a dict {{'class': 'cube'}} or a list of (type, label) pairs such as "
+                        f"[('class', 'cube')], got the string {semantics!r}")
     if isinstance(semantics, Mapping):
         items = semantics.items()
     elif isinstance(semantics, tuple) and len(semantics) == 2 and all(isinstance(s, str) for s in semantics):

@@ -12,6 +12,8 @@ from typing import Sequence
 import numpy as np
 from pxr import Gf, Usd, UsdGeom
 
+from graphsdg.errors import describe
+
 ROTATION_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 _ROTATE_OPS = {
     "XYZ": UsdGeom.XformOp.TypeRotateXYZ, "XZY": UsdGeom.XformOp.TypeRotateXZY,
@@ -259,11 +261,14 @@ class _OpStack:
 
 def as_vec3(value: object, what: str) -> np.ndarray:
     """Validate a 3-vector argument (a scalar broadcasts for ``scale``)."""
-    arr = np.asarray(value, dtype=np.float64)
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = np.zeros(0)
     if arr.shape == () and what.startswith("scale"):
         arr = np.full(3, float(arr))
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{what} must be 3 finite numbers, got {value!r}")
+        raise ValueError(f"{what} must be 3 finite numbers, got {describe(value)}")
     return arr
 
 

@@ -1,0 +1,93 @@
+"""Ctrl-C (SIGINT) and SIGTERM during capture: finish the frame, then stop.
+
+While ``orchestrator.step()`` runs, the two signals are held until the frame has
+been handed whole to the writers, then raised (``KeyboardInterrupt``, or
+``SystemExit(143)`` for SIGTERM): a script's own step loop stops between frames,
+never with half a frame's files queued. During ``orchestrator.run()`` a signal
+asks the run to stop after the current frame; ``run()`` then flushes (writers'
+``on_final_frame``, the write queue, the run-state file with status
+``"interrupted"``) and raises the same exception. A second signal while that
+happens interrupts at once.
+
+Only the main thread receives signals, and handlers a script installed itself are
+left alone: then nothing here changes how the signal behaves.
+
+Example:
+    >>> with deferred() as held:
+    ...     pass                      # a capture that must not be cut in half
+    >>> held is None or held.received is None
+    True
+"""
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from typing import Callable, Iterator
+
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class HeldSignals:
+    """The signals that arrived while a :func:`deferred` block ran."""
+
+    def __init__(self, on_signal: Callable[[int], None] | None) -> None:
+        self.received: int | None = None
+        self.on_signal = on_signal
+        self.saved: dict[int, object] = {}
+
+    def _handler(self, signum: int, frame: object) -> None:
+        if self.received is not None:          # a second signal: do not wait any longer
+            self.restore()
+            raise_for(signum)
+        self.received = signum
+        if self.on_signal is not None:
+            self.on_signal(signum)
+
+    def restore(self) -> None:
+        for sig, handler in self.saved.items():
+            signal.signal(sig, handler)
+        self.saved.clear()
+
+
+_active: HeldSignals | None = None
+last_signal: int | None = None     # the signal :func:`raise_for` last raised (the exit hook reports it)
+
+
+def _default(sig: int, handler: object) -> bool:
+    return handler is signal.default_int_handler if sig == signal.SIGINT else handler == signal.SIG_DFL
+
+
+@contextlib.contextmanager
+def deferred(on_signal: Callable[[int], None] | None = None) -> Iterator[HeldSignals | None]:
+    """Hold SIGINT/SIGTERM during the block; yields the :class:`HeldSignals`, or ``None`` when an enclosing
+    block already holds them (or this is not the main thread). The caller decides what to do afterwards
+    (see :func:`raise_for`)."""
+    global _active
+    if _active is not None or threading.current_thread() is not threading.main_thread():
+        yield None
+        return
+    held = HeldSignals(on_signal)
+    for sig in _SIGNALS:
+        current = signal.getsignal(sig)
+        if _default(sig, current):
+            held.saved[sig] = current
+            signal.signal(sig, held._handler)
+    _active = held
+    try:
+        yield held
+    finally:
+        _active = None
+        held.restore()
+
+
+def raise_for(signum: int) -> None:
+    """Raise what the signal would have: ``KeyboardInterrupt`` for SIGINT, ``SystemExit(128 + n)`` otherwise."""
+    global last_signal
+    last_signal = signum
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise SystemExit(128 + int(signum))
+
+
+__all__ = ["deferred", "raise_for", "HeldSignals"]
