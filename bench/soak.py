@@ -175,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.what == "frames":
             samples = soak_frames(os.path.join(out, "demo"), args.frames, args.every, tuple(args.resolution),
                                   args.seed)
-            print(f"| frames | RSS MiB | frames/s so far | queued writes |\n|---|---|---|---|")
+            print("| frames | RSS MiB | frames/s so far | queued writes |\n|---|---|---|---|")
             for n, mb, fps, pending in samples:
                 print(f"| {n} | {mb:.1f} | {fps:.1f} | {pending} |")
             base, peak, pct = growth([(n, mb) for n, mb, *_ in samples], args.warmup)

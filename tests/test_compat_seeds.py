@@ -16,7 +16,6 @@ import re
 from pathlib import Path
 
 import numpy as np
-import pytest
 from PIL import Image
 
 import graphsdg as rep

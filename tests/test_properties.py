@@ -9,7 +9,6 @@ import math
 
 import mujoco
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from pxr import Usd, UsdGeom

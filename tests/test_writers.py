@@ -523,7 +523,6 @@ def test_bop_writer_reads_back(out_dir):
     # world -> camera: the world origin (the front cube's centre) is 5.1 m in front of the camera
     t_w2c = np.array(cam_info["cam_t_w2c"])
     np.testing.assert_allclose(np.linalg.norm(t_w2c), np.hypot(5, 1) * 1000, rtol=1e-6)
-    paths = {v: int(k) for k, v in seg["info"]["idToLabels"].items()}
     corners = np.array([[x, y, zz] for x in (-.5, .5) for y in (-.5, .5) for zz in (-.5, .5)])
     for gt_id, (g, i) in enumerate(zip(gt, info)):
         R, t = np.array(g["cam_R_m2c"]).reshape(3, 3), np.array(g["cam_t_m2c"])
