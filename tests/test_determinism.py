@@ -106,24 +106,3 @@ def test_every_writer_is_deterministic(tmp_path, monkeypatch, writer_name):
         rep.settings.reset()
         reset_write_queue()
     assert len(first) >= 2 and first == second
-
-
-def test_rescaled_meshes_are_never_the_models_last_mesh():
-    """NVIDIA's GL driver erases MuJoCo's built-in sphere when the model's last mesh is re-uploaded (measured on
-    an H200; docs/reproducibility.md): the compiler ends the mesh list with an unused guard mesh instead."""
-    from graphsdg.runtime import runtime
-    from graphsdg.sim.compiler import UPLOAD_GUARD_MESH
-    rep.functional.create.sphere(name="Ball")
-    torus = rep.functional.create.torus(position=(1.5, 0, 0), name="Ring")
-    cone = rep.functional.create.cone(position=(-1.5, 0, 0), name="Cone")
-    sim = runtime().sim
-    sim.sync_dirty_prims()
-    model = sim.ensure_compiled().model
-    assert model.mesh(model.nmesh - 1).name == UPLOAD_GUARD_MESH
-    rep.functional.modify.pose([torus, cone], scale_value=[(0.8, 0.8, 0.8), (1.2, 1.2, 1.2)])
-    sim.sync_dirty_prims()
-    assert sim.model is model and sim.meshes_to_upload and model.nmesh - 1 not in sim.meshes_to_upload
-    rep.stage.new_stage()
-    rep.functional.create.sphere(name="Ball")
-    runtime().sim.sync_dirty_prims()
-    assert runtime().sim.ensure_compiled().model.nmesh == 0          # no meshes, no guard

@@ -122,6 +122,7 @@ class Rasterizer:
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FREE
         self._version = -1
         self._model: mujoco.MjModel | None = None
+        self._uploaded_maps: dict[int, np.ndarray] = {}   # SimScene.mesh_maps when the meshes were uploaded
         self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
 
     # ---- contexts ------------------------------------------------------
@@ -153,14 +154,11 @@ class Rasterizer:
             self._scene = mujoco.MjvScene(model, maxgeom=max(1000, 2 * model.ngeom + 100))
             self._version = sim.model_version
             self._model = model
+            self._uploaded_maps = {mid: m.copy() for mid, m in sim.mesh_maps.items()}
         if sim.textures_to_upload:
             for tid in sorted(sim.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
             sim.textures_to_upload.clear()
-        if sim.meshes_to_upload:
-            for mid in sorted(sim.meshes_to_upload):
-                mujoco.mjr_uploadMesh(model, self._mjr, mid)
-            sim.meshes_to_upload.clear()
 
     def close(self) -> None:
         if self._mjr is not None:
@@ -180,6 +178,8 @@ class Rasterizer:
         far = effective_far(sim.model, view)
         mujoco.mjv_updateScene(sim.model, sim.data, self._option, None, self._camera,
                                mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
+        if sim.mesh_maps:
+            self._draw_rescaled_meshes(sim, scene)
         left, right, bottom, top = view.frustum_window(crop, jitter)
         forward = -view.rotation[:, 2]
         up = view.rotation[:, 1]
@@ -196,6 +196,29 @@ class Rasterizer:
             cam.frustum_far = SKY_FAR_FACTOR * far
             cam.orthographic = 1 if view.projection == "orthographic" else 0
         scene.enabletransform = 0
+
+    def _draw_rescaled_meshes(self, sim: SimScene, scene: mujoco.MjvScene) -> None:
+        """Fold meshes rescaled since their upload into their scene geoms' matrices.
+
+        The GPU holds each mesh as it was at upload; the model's vertices are that
+        copy mapped by ``current @ inverse(uploaded)`` in the geom's frame, so the
+        geom's rotation matrix times that map draws the current mesh (the fixed
+        function pipeline transforms normals by the inverse transpose).
+        """
+        deltas = {}
+        for mid, current in sim.mesh_maps.items():
+            uploaded = self._uploaded_maps.get(mid)
+            delta = current if uploaded is None else current @ np.linalg.inv(uploaded)
+            if not np.allclose(delta, np.eye(3), rtol=0, atol=1e-12):
+                deltas[mid] = delta
+        if not deltas:
+            return
+        dataid, geom_obj = sim.model.geom_dataid, int(mujoco.mjtObj.mjOBJ_GEOM)
+        for g in scene.geoms[:scene.ngeom]:
+            if g.objtype == geom_obj and g.type == mujoco.mjtGeom.mjGEOM_MESH:
+                delta = deltas.get(int(dataid[g.objid]))
+                if delta is not None:
+                    g.mat[:] = g.mat @ delta
 
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1) -> RenderOutputs:
         """Render the requested ``passes`` of ``view`` (only those: each pass costs a render)."""

@@ -74,8 +74,6 @@ DEFAULT_FRICTION = 0.5                   # PhysX's default material (static = dy
 PHYSICS_STEPS_PER_SECOND = 120.0
 
 
-UPLOAD_GUARD_MESH = "graphsdg:upload-guard"
-
 
 class CompileError(ValueError):
     """The stage holds something that cannot become a MuJoCo model."""
@@ -808,19 +806,6 @@ class _Builder:
         self.spec.memory = max(16 << 20, 16 * nbody * nbody + (8 << 20)) if colliding else -1
 
     # ---- top level -----------------------------------------------------
-    def add_upload_guard(self) -> None:
-        """End the mesh list with a tiny mesh no geom uses, so the last mesh is never re-uploaded.
-
-        On NVIDIA's OpenGL driver (measured: H200, driver 580), ``mjr_uploadMesh`` of
-        the model's *last* mesh, which the renderer calls when a mesh prim (a cone, a
-        torus, a USD mesh) is rescaled, erases MuJoCo's built-in sphere: every sphere
-        vanishes from later frames, in colour, depth and ids alike. Mesa is not
-        affected. With this guard the meshes that get re-uploaded are never last.
-        """
-        if len(self.spec.meshes):
-            self.spec.add_mesh(name=UPLOAD_GUARD_MESH, uservert=[0, 0, 0, 1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3],
-                               userface=[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3])
-
     def build(self) -> CompiledScene:
         self.configure()
         predicate = Usd.TraverseInstanceProxies(Usd.PrimIsActive & Usd.PrimIsDefined & ~Usd.PrimIsAbstract)
@@ -847,7 +832,6 @@ class _Builder:
         self.finish_lighting()
         self.assign_masses()
         self.add_probes()
-        self.add_upload_guard()
         self.size_memory()
         try:
             model = self.spec.compile()

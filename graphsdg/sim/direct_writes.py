@@ -18,7 +18,6 @@ import numpy as np
 from pxr import Usd
 
 from graphsdg.sim.compiler import primitive_size
-from graphsdg.sim.mesh_scaling import rescale_mesh_geom
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage.xform import decompose, world_matrix
 
@@ -181,7 +180,7 @@ def _write_mesh_scales(sim: SimScene, t: DirectTargets, world_scale: np.ndarray)
     for i, row in enumerate(mesh_rows):
         if changed[i]:
             b = t.bindings[row]
-            sim.meshes_to_upload.add(rescale_mesh_geom(sim.model, b.geom_id, b.scale, new[i]))
+            sim.rescale_mesh(b.geom_id, b.scale, new[i])
             b.scale = new[i]
 
 

@@ -4,7 +4,9 @@ The compiler bakes a mesh prim's world scale into its vertices, and MuJoCo store
 them in the mesh's own frame (``geom_pos``/``geom_quat`` place that frame in the
 body). Going from scale ``s0`` to ``s`` is the linear map
 ``v_mesh' = Rg^T diag(s / s0) Rg v_mesh`` with ``geom_pos' = (s / s0) * geom_pos``;
-normals take the inverse transpose. The renderer re-uploads the mesh afterwards.
+normals take the inverse transpose. Renderers do not re-upload the mesh: they draw
+their uploaded copy through the same linear map (:attr:`SimScene.mesh_maps`), which
+costs a 3x3 product per geom instead of a vertex upload per frame.
 Only visual geoms are rescaled this way: colliding meshes (convex hulls, BVHs,
 inertia) recompile.
 """
@@ -16,8 +18,13 @@ import numpy as np
 from graphsdg.stage.xform import quat_wxyz_to_matrix
 
 
-def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> int:
-    """Apply ``new_scale / old_scale`` to mesh geom ``geom_id``; returns the mesh id to re-upload."""
+def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray,
+                      new_scale: np.ndarray) -> tuple[int, np.ndarray]:
+    """Apply ``new_scale / old_scale`` to mesh geom ``geom_id``.
+
+    Returns the mesh id and the 3x3 linear map applied to its vertices (in the
+    geom's frame), so a renderer can apply it to the copy it uploaded.
+    """
     mesh_id = int(model.geom_dataid[geom_id])
     if mesh_id < 0:
         raise ValueError(f"geom {geom_id} is not a mesh geom")
@@ -30,7 +37,7 @@ def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray
         model.geom_pos[geom_id] *= k
         model.geom_aabb[geom_id] *= abs(k)
         model.geom_rbound[geom_id] *= abs(k)
-        return mesh_id
+        return mesh_id, np.eye(3) * k
     rg = quat_wxyz_to_matrix(model.geom_quat[geom_id])
     linear = rg.T @ np.diag(ratio) @ rg
     normal_map = rg.T @ np.diag(1.0 / ratio) @ rg
@@ -44,4 +51,4 @@ def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray
     half = np.abs(verts).max(axis=0) if nv else np.zeros(3)
     model.geom_aabb[geom_id] = np.concatenate([np.zeros(3), half])
     model.geom_rbound[geom_id] = float(np.linalg.norm(verts, axis=1).max()) if nv else 0.0
-    return mesh_id
+    return mesh_id, linear

@@ -82,7 +82,9 @@ class SimScene:
         self.model_version = 0              # bumps on every recompile (renderers rebuild contexts)
         self.labels_version = 0             # bumps when semantic labels may have changed
         self.textures_to_upload: set[int] = set()
-        self.meshes_to_upload: set[int] = set()
+        # mesh id -> 3x3 map from the compiled vertices to the current ones, for meshes rescaled in
+        # place since the compile; renderers draw the copy they uploaded through it (no re-upload)
+        self.mesh_maps: dict[int, np.ndarray] = {}
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
@@ -114,6 +116,12 @@ class SimScene:
                 self.compiled.model.vis.global_.offheight = h
                 self.model_version += 1
 
+    def rescale_mesh(self, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> None:
+        """Rescale visual mesh geom ``geom_id`` in place and record the map for renderers."""
+        mesh_id, linear = rescale_mesh_geom(self.model, geom_id, old_scale, new_scale)
+        previous = self.mesh_maps.get(mesh_id)
+        self.mesh_maps[mesh_id] = linear if previous is None else linear @ previous
+
     def recompile(self, keep_state: bool = True) -> CompiledScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
@@ -126,7 +134,7 @@ class SimScene:
         self.model_version += 1
         self.labels_version += 1
         self.textures_to_upload.clear()
-        self.meshes_to_upload.clear()
+        self.mesh_maps.clear()
         self.stats["compiles"] += 1
         self.stats["compile_s"] += time.perf_counter() - start
         for cb in list(self._on_recompile):
@@ -282,7 +290,7 @@ class SimScene:
                 if rescaled:
                     if np.any(np.abs(scale) < 1e-9) or path in c.collider_paths:
                         raise NeedsRecompile   # colliding meshes carry hulls and inertia
-                    self.meshes_to_upload.add(rescale_mesh_geom(m, g.geom_id, g.scale, scale))
+                    self.rescale_mesh(g.geom_id, g.scale, scale)
                     g.scale = scale
             elif g.type_name in ("Mesh", "Cone") or g.rigid_root is not None:
                 if "shape" in aspects or rescaled:
