@@ -33,7 +33,6 @@ from __future__ import annotations
 import contextlib
 import os
 from collections import Counter
-from dataclasses import dataclass
 from typing import Callable, Iterator, Sequence
 
 import cv2
@@ -42,6 +41,7 @@ import numpy as np
 
 from graphsdg import profiling
 from graphsdg.render.camera import CameraView
+from graphsdg.render.readback import PendingPixels, PixelReads
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
 
@@ -50,16 +50,46 @@ Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusi
 SKY_FAR_FACTOR = 2.0
 
 
-@dataclass
 class RenderOutputs:
-    """What one render of one camera produced (each ``None`` if not requested)."""
+    """What one render of one camera produced (each ``None`` if not requested).
 
-    color: np.ndarray | None = None          # uint8 (H, W, 3)
-    hdr: np.ndarray | None = None            # float32 (H, W, 3), linear colour in [0, 1]
-    depth: np.ndarray | None = None          # float32 (H, W), planar z, inf on background
-    geom_ids: np.ndarray | None = None       # int32 (H, W), -1 on background
-    # Follow-up renders of the same view and state: (geom ids, crop) -> int32 ids of the crop
-    render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
+    * ``color``: uint8 (H, W, 4) RGBA, alpha 255
+    * ``hdr``: float32 (H, W, 3) linear colour in [0, 1]
+    * ``depth``: float32 (H, W) planar z, inf on background
+    * ``geom_ids``: int32 (H, W) geom id per pixel, -1 on background
+    * ``render_isolated``: follow-up renders of the same view and state,
+      ``(geom ids, crop) -> int32 ids of the crop``
+
+    A pass whose pixels are still being copied off the GPU (a deferred render)
+    is finished on first access.
+    """
+
+    def __init__(self) -> None:
+        self._values: dict[str, np.ndarray | None] = {}
+        self._pending: dict[str, Callable[[], np.ndarray]] = {}
+        self.render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
+
+    def put(self, name: str, value: np.ndarray | Callable[[], np.ndarray] | None) -> None:
+        """Store a pass's pixels, or a callable that finishes them when first asked for."""
+        if callable(value):
+            self._pending[name] = value
+        else:
+            self._values[name] = value
+
+    def get(self, name: str) -> np.ndarray | None:
+        if name in self._pending:
+            self._values[name] = self._pending.pop(name)()
+        return self._values.get(name)
+
+    def finish(self) -> None:
+        """Finish every pending pass (the GL context must still exist)."""
+        for name in list(self._pending):
+            self.get(name)
+
+    color = property(lambda self: self.get("color"))
+    hdr = property(lambda self: self.get("hdr"))
+    depth = property(lambda self: self.get("depth"))
+    geom_ids = property(lambda self: self.get("geom_ids"))
 
 
 def make_gl_context():
@@ -123,12 +153,14 @@ class Rasterizer:
         self._version = -1
         self._model: mujoco.MjModel | None = None
         self._uploaded_maps: dict[int, np.ndarray] = {}   # SimScene.mesh_maps when the meshes were uploaded
+        self._reads: PixelReads | None = None
         self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
 
     # ---- contexts ------------------------------------------------------
     def _ensure_gl(self) -> None:
         if self._gl is None:
             self._gl = make_gl_context()
+            self._reads = PixelReads(self._ensure_gl)
         if not _is_current(self._gl):   # re-binding a current context can flush the GL pipeline
             self._gl.make_current()
 
@@ -161,9 +193,12 @@ class Rasterizer:
             sim.textures_to_upload.clear()
 
     def close(self) -> None:
+        if self._gl is not None:
+            self._gl.make_current()
+            if self._reads is not None:
+                self._reads.free()
+                self._reads = None
         if self._mjr is not None:
-            if self._gl is not None:
-                self._gl.make_current()
             self._mjr.free()
             self._mjr = None
         if self._gl is not None:
@@ -205,23 +240,27 @@ class Rasterizer:
         geom's rotation matrix times that map draws the current mesh (the fixed
         function pipeline transforms normals by the inverse transpose).
         """
-        deltas = {}
-        for mid, current in sim.mesh_maps.items():
-            uploaded = self._uploaded_maps.get(mid)
-            delta = current if uploaded is None else current @ np.linalg.inv(uploaded)
-            if not np.allclose(delta, np.eye(3), rtol=0, atol=1e-12):
-                deltas[mid] = delta
-        if not deltas:
-            return
-        dataid, geom_obj = sim.model.geom_dataid, int(mujoco.mjtObj.mjOBJ_GEOM)
+        maps, uploaded = sim.mesh_maps, self._uploaded_maps
+        # ints, not the enums: comparing with a pybind11 enum costs microseconds per geom
+        dataid, geom_obj, mesh = sim.model.geom_dataid, int(mujoco.mjtObj.mjOBJ_GEOM), int(mujoco.mjtGeom.mjGEOM_MESH)
         for g in scene.geoms[:scene.ngeom]:
-            if g.objtype == geom_obj and g.type == mujoco.mjtGeom.mjGEOM_MESH:
-                delta = deltas.get(int(dataid[g.objid]))
-                if delta is not None:
-                    g.mat[:] = g.mat @ delta
+            if g.type != mesh or g.objtype != geom_obj:
+                continue
+            mid = int(dataid[g.objid])
+            current = maps.get(mid)
+            if current is not None:
+                before = uploaded.get(mid)
+                g.mat[:] = g.mat @ (current if before is None else current @ np.linalg.inv(before))
 
-    def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1) -> RenderOutputs:
-        """Render the requested ``passes`` of ``view`` (only those: each pass costs a render)."""
+    def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
+               defer: bool = False) -> RenderOutputs:
+        """Render the requested ``passes`` of ``view`` (only those: each pass costs a render).
+
+        With ``defer`` the pixels are left copying off the GPU: each pass is
+        finished (mapped, decoded) when first read from the outputs, so the
+        caller can do other work meanwhile. Jittered subframes are always read
+        at once (they are summed on the CPU).
+        """
         unknown = set(passes) - set(PASSES)
         if unknown:
             raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
@@ -240,21 +279,21 @@ class Rasterizer:
         depth_with_colour = colour and "depth" in passes and "segmentation" not in passes and \
             int(model.vis.quality.offsamples) == 0
         if colour:
-            rgb, linear, depth = self._render_color(sim, view, subframes, want_linear="hdr" in passes,
-                                                    want_depth=depth_with_colour)
-            out.color = rgb if "color" in passes else None
-            out.hdr = linear
-            out.depth = depth
+            self._render_color(sim, view, subframes, out, want_color="color" in passes,
+                               want_linear="hdr" in passes, want_depth=depth_with_colour)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
             ids, depth = self._render_ids(sim, view, None, with_depth="depth" in passes)
-            out.geom_ids = ids if "segmentation" in passes else None
-            out.depth = depth
+            if "segmentation" in passes:
+                out.put("geom_ids", ids)
+            out.put("depth", depth)
+        if not defer:
+            out.finish()
         out.render_isolated = lambda geoms, crop: self.render_isolated(sim, view, geoms, crop)
         return out
 
-    def _render_color(self, sim: SimScene, view: CameraView, subframes: int, want_linear: bool,
-                      want_depth: bool = False) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
-        assert self._scene is not None and self._mjr is not None
+    def _render_color(self, sim: SimScene, view: CameraView, subframes: int, out: RenderOutputs,
+                      want_color: bool, want_linear: bool, want_depth: bool) -> None:
+        assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         w, h = view.width, view.height
         rect = mujoco.MjrRect(0, 0, w, h)
@@ -263,40 +302,40 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
-        rgb = np.empty((h, w, 3), dtype=np.uint8)
-        raw = np.empty((h, w), dtype=np.float32) if want_depth else None
         self._update_scene(sim, view, (0.0, 0.0))
         with profiling.timed("render:color"):
             mujoco.mjr_render(rect, scene, ctx)
         with profiling.timed("readback:color"):
-            mujoco.mjr_readPixels(rgb, raw, rect, ctx)
+            pixels = self._reads.read_color(ctx, w, h)
+            raw = self._reads.read_depth(ctx, w, h) if want_depth else None
         self.stats["color"] += 1
-        depth = None
         if raw is not None:
-            far = effective_far(sim.model, view)
-            depth = _linearize_depth(raw[::-1], view.near, SKY_FAR_FACTOR * far, far,
-                                     orthographic=view.projection == "orthographic")
-        linear = None
-        if subframes > 1:
-            acc = rgb.astype(np.float32)
-            for jit in jitter_offsets(subframes)[1:]:
-                self._update_scene(sim, view, jit)
-                mujoco.mjr_render(rect, scene, ctx)
-                mujoco.mjr_readPixels(rgb, None, rect, ctx)
-                self.stats["color"] += 1
-                acc += rgb
-            mean = acc / subframes
-            rgb = np.rint(mean).astype(np.uint8)
+            out.put("depth", _depth_decoder(raw, sim.model, view))
+        if subframes == 1:
+            if want_color:
+                out.put("color", lambda: _rgba_top_first(pixels.result()))
             if want_linear:
-                linear = np.ascontiguousarray(mean[::-1] / np.float32(255))
-        elif want_linear:
-            linear = np.ascontiguousarray(rgb[::-1].astype(np.float32) / np.float32(255))
-        return cv2.flip(rgb, 0), linear, depth   # GL rows run bottom-up; cv2's flip is one fast copy
+                out.put("hdr", lambda: np.ascontiguousarray(
+                    pixels.result()[::-1, :, :3].astype(np.float32) / np.float32(255)))
+            return
+        acc = pixels.result()[..., :3].astype(np.float32)
+        for jit in jitter_offsets(subframes)[1:]:
+            self._update_scene(sim, view, jit)
+            mujoco.mjr_render(rect, scene, ctx)
+            acc += self._reads.read_color(ctx, w, h).result()[..., :3]
+            self.stats["color"] += 1
+        mean = acc / subframes
+        if want_color:
+            rgba = np.full((h, w, 4), 255, dtype=np.uint8)
+            rgba[..., :3] = np.rint(mean[::-1])
+            out.put("color", rgba)
+        if want_linear:
+            out.put("hdr", np.ascontiguousarray(mean[::-1] / np.float32(255)))
 
-    def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None,
-                    with_depth: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        """Geom ids (and planar depth) of the view, or of a crop of it, top row first."""
-        assert self._scene is not None and self._mjr is not None
+    def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None, with_depth: bool
+                    ) -> tuple[Callable[[], np.ndarray], Callable[[], np.ndarray] | None]:
+        """Finishers of the geom ids (and planar depth) of the view, or of a crop of it, top row first."""
+        assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
         w, h = x1 - x0, y1 - y0
@@ -309,25 +348,22 @@ class Rasterizer:
         try:
             self._update_scene(sim, view, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
-            ids = np.empty((h, w, 3), dtype=np.uint8)
-            raw = np.empty((h, w), dtype=np.float32) if with_depth else None
             with single_sample(ctx):
                 with profiling.timed(f"render:{kind}"):
                     mujoco.mjr_render(rect, scene, ctx)
                 with profiling.timed(f"readback:{kind}"):
-                    mujoco.mjr_readPixels(ids, raw, rect, ctx)
+                    ids = self._reads.read_color(ctx, w, h)
+                    raw = self._reads.read_depth(ctx, w, h) if with_depth else None
         finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
-        self.stats["ids" if crop is None else "isolated"] += 1
-        with profiling.timed("decode:ids"):
-            geom_ids = _decode_segmentation(cv2.flip(ids, 0), scene)
-        depth = None
-        if raw is not None:
-            far = effective_far(sim.model, view)
-            depth = _linearize_depth(raw[::-1], view.near, SKY_FAR_FACTOR * far, far,
-                                     orthographic=view.projection == "orthographic")
-        return geom_ids, depth
+        self.stats[kind] += 1
+        lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
+
+        def geom_ids() -> np.ndarray:
+            with profiling.timed("decode:ids"):
+                return _decode_segmentation(ids.result(), lut)
+        return geom_ids, (_depth_decoder(raw, sim.model, view) if raw is not None else None)
 
     def render_isolated(self, sim: SimScene, view: CameraView, geoms: Sequence[int], crop: Crop) -> np.ndarray:
         """Geom ids (H', W') of the ``crop`` of ``view`` with only ``geoms`` drawn (-1 elsewhere).
@@ -348,9 +384,9 @@ class Rasterizer:
         try:
             group[~keep] = HIDDEN_GROUP
             ids, _ = self._render_ids(sim, view, (x0, y0, x1, y1), with_depth=False)
+            return ids()
         finally:
             group[:] = saved
-        return ids
 
 
 @contextlib.contextmanager
@@ -404,21 +440,39 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
     return lin
 
 
-def _decode_segmentation(rgb: np.ndarray, scene: mujoco.MjvScene) -> np.ndarray:
-    """MuJoCo's id colours (segid + 1 in 24-bit RGB) -> geom ids, -1 where no geom was drawn."""
-    if scene.ngeom + 1 < (1 << 16):
-        # Ids fit in red + green: as RGBA, each pixel's first two bytes are one little-endian
-        # uint16, read in place (cvtColor makes the 4-byte pixels in one vectorised pass).
-        rgba = cv2.cvtColor(np.ascontiguousarray(rgb), cv2.COLOR_RGB2RGBA)
-        segid = rgba.view(np.uint16).reshape(rgba.shape[0], rgba.shape[1], 2)[..., 0]
-        size = 1 << 16
-    else:
-        segid = rgb[..., 0].astype(np.int32) | (rgb[..., 1].astype(np.int32) << 8) | \
-            (rgb[..., 2].astype(np.int32) << 16)
-        size = scene.ngeom + 2
-        segid = np.clip(segid, 0, size - 1)
+def _rgba_top_first(rgba: np.ndarray) -> np.ndarray:
+    """GL's bottom-up RGBA rows -> top row first, alpha 255 (one flip, one channel write)."""
+    out = cv2.flip(rgba, 0)
+    out[..., 3] = 255
+    return out
+
+
+def _depth_decoder(raw: PendingPixels, model: mujoco.MjModel, view: CameraView) -> Callable[[], np.ndarray]:
+    """Finisher of a depth read: planar z, top row first (the projection of this render, taken now)."""
+    far = effective_far(model, view)
+    near, orthographic = view.near, view.projection == "orthographic"
+    return lambda: _linearize_depth(raw.result()[::-1], near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
+
+
+def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
+    """MuJoCo's id colours (segid + 1) -> geom id for the geoms of ``scene`` now; -1 for anything else."""
+    size = 1 << 16 if scene.ngeom + 1 < (1 << 16) else scene.ngeom + 2
     lut = np.full(size, -1, dtype=np.int32)
+    geom_obj = int(mujoco.mjtObj.mjOBJ_GEOM)   # an int: comparing with the enum costs microseconds per geom
     for g in scene.geoms[:scene.ngeom]:
-        if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
+        if g.segid >= 0 and g.objtype == geom_obj:
             lut[g.segid + 1] = g.objid
-    return lut[segid]
+    return lut
+
+
+def _decode_segmentation(rgba: np.ndarray, lut: np.ndarray) -> np.ndarray:
+    """Id colours as read (RGBA, bottom row first) -> geom ids, top row first, -1 where no geom was drawn.
+
+    The lookup reads the rows in reverse, so the flip costs no copy of its own.
+    """
+    if len(lut) == 1 << 16:
+        # Ids fit in red + green: each pixel's first two bytes are one little-endian uint16, read in place.
+        segid = rgba.view(np.uint16)[..., 0]
+    else:
+        segid = np.minimum(rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), len(lut) - 1)
+    return lut[segid[::-1]]

@@ -1,0 +1,121 @@
+"""Asynchronous reads of MuJoCo's offscreen framebuffer through pixel-buffer objects.
+
+``glReadPixels`` into client memory stalls the CPU until the GPU has drawn the
+frame and copied it over. Reading into a pixel-buffer object (PBO) instead only
+queues the copy; mapping the PBO later returns the pixels, waiting only if the
+GPU has not finished by then. The orchestrator uses that to overlap a frame's
+rendering and transfer with the script's next randomization
+(``step(wait_for_render=False)``), and every read is RGBA, the format GL drivers
+copy without repacking (MuJoCo's ``mjr_readPixels`` reads RGB).
+
+Example (inside a current GL context, after ``mjr_render``)::
+
+    reads = PixelReads()
+    pending = reads.read_color(ctx, 512, 512)
+    ...                                      # other work while the GPU copies
+    rgba = pending.result()                  # uint8 (512, 512, 4), bottom row first
+"""
+from __future__ import annotations
+
+import ctypes
+
+import mujoco
+import numpy as np
+from OpenGL import GL
+
+_FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
+    "rgba": (GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, np.uint8, 4),
+    "depth": (GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT, np.float32, 1),
+}
+
+
+class PendingPixels:
+    """One queued read; :meth:`result` maps it (once) and hands its buffer back to the pool."""
+
+    def __init__(self, reads: "PixelReads", pbo: int, nbytes: int, shape: tuple[int, ...], dtype) -> None:
+        self._reads, self._pbo, self._nbytes = reads, pbo, nbytes
+        self._shape, self._dtype = shape, dtype
+        self._array: np.ndarray | None = None
+
+    def result(self) -> np.ndarray:
+        """The pixels, bottom row first (GL's order); waits for the GPU if it is still copying."""
+        if self._array is None:
+            out = np.empty(self._shape, dtype=self._dtype)
+            self._reads.make_current()
+            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, self._pbo)
+            pointer = GL.glMapBufferRange(GL.GL_PIXEL_PACK_BUFFER, 0, self._nbytes, GL.GL_MAP_READ_BIT)
+            if not pointer:
+                GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+                raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading")
+            ctypes.memmove(out.ctypes.data, pointer, self._nbytes)
+            GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
+            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+            self._reads.release(self._pbo, self._nbytes)
+            self._array = out
+        return self._array
+
+
+class PixelReads:
+    """A pool of pixel-buffer objects for one GL context, and the reads that use them.
+
+    ``make_current`` is the context's own make-current (a no-op when it is
+    current already); buffers are reused by size, so a steady stream of frames
+    allocates none after the first two.
+    """
+
+    def __init__(self, make_current) -> None:
+        self.make_current = make_current
+        self._free: dict[int, list[int]] = {}
+        self._all: list[int] = []
+
+    def read_color(self, ctx: mujoco.MjrContext, width: int, height: int) -> PendingPixels:
+        """Queue a read of the offscreen colour buffer (resolving multisamples first)."""
+        return self._read(ctx, width, height, "rgba")
+
+    def read_depth(self, ctx: mujoco.MjrContext, width: int, height: int) -> PendingPixels:
+        """Queue a read of the offscreen depth buffer (window depth; single-sample buffers only)."""
+        if ctx.offSamples:
+            raise ValueError("depth is read from a single-sample buffer; render it under single_sample()")
+        return self._read(ctx, width, height, "depth")
+
+    def _read(self, ctx: mujoco.MjrContext, width: int, height: int, kind: str) -> PendingPixels:
+        fmt, gltype, dtype, channels = _FORMATS[kind]
+        nbytes = width * height * channels * np.dtype(dtype).itemsize
+        source = ctx.offFBO
+        if ctx.offSamples and kind == "rgba":
+            # what mjr_readPixels does: resolve the multisampled buffer into the single-sample one
+            GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, ctx.offFBO)
+            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
+            GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+            source = ctx.offFBO_r
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
+        GL.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
+        pbo = self._acquire(nbytes)
+        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, pbo)
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        GL.glReadPixels(0, 0, width, height, fmt, gltype, ctypes.c_void_p(0))
+        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # MuJoCo's own bindings back
+        shape = (height, width, channels) if channels > 1 else (height, width)
+        return PendingPixels(self, pbo, nbytes, shape, dtype)
+
+    def _acquire(self, nbytes: int) -> int:
+        free = self._free.get(nbytes)
+        if free:
+            return free.pop()
+        pbo = int(GL.glGenBuffers(1))
+        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, pbo)
+        GL.glBufferData(GL.GL_PIXEL_PACK_BUFFER, nbytes, None, GL.GL_STREAM_READ)
+        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+        self._all.append(pbo)
+        return pbo
+
+    def release(self, pbo: int, nbytes: int) -> None:
+        self._free.setdefault(nbytes, []).append(pbo)
+
+    def free(self) -> None:
+        """Delete every buffer (the context must be current)."""
+        if self._all:
+            GL.glDeleteBuffers(len(self._all), np.array(self._all, dtype=np.uint32))
+        self._all.clear()
+        self._free.clear()
