@@ -60,7 +60,7 @@ class BenchConfig:
     annotators: tuple[str, ...] = ("rgb",)
     skip_write: bool = False
     rt_subframes: int = -1
-    wait_for_render: bool = True
+    wait_for_render: bool = False       # benchmark_sdg.py's default: pipelined steps
     write_to_fabric: bool = True
     seed: int = 11
     out_dir: str | None = None

@@ -65,7 +65,7 @@ def run_bench(args: argparse.Namespace) -> None:
     config = benchmark.BenchConfig(
         frames=args.num_frames, warmup=args.warmup, num_cameras=args.num_cameras, resolution=tuple(args.resolution),
         asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
-        rt_subframes=args.rt_subframes, wait_for_render=not args.no_wait_for_render,
+        rt_subframes=args.rt_subframes, wait_for_render=args.wait_for_render,
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
         msaa_samples=args.msaa, shadow_size=args.shadow_size)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
@@ -226,7 +226,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="annotator names as in benchmark_sdg.py, or 'all'")
     bench.add_argument("--skip-write", action="store_true", help="compute annotators but write nothing")
     bench.add_argument("--rt-subframes", type=int, default=-1)
-    bench.add_argument("--no-wait-for-render", action="store_true")
+    bench.add_argument("--wait-for-render", action="store_true",
+                       help="finish each frame inside its step (default, as benchmark_sdg.py: pipelined steps)")
     bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
     bench.add_argument("--write-threads", type=int, default=4)
     bench.add_argument("--msaa", type=int, help="multisample count of the colour pass (default: graphsdg's 4)")

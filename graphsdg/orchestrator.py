@@ -18,6 +18,7 @@ from typing import Any, Callable
 from graphsdg import interrupts, profiling, settings
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
+from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import run_state
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
 from graphsdg.progress import Progress
@@ -99,24 +100,33 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
     Ctrl-C (or SIGTERM) during a step takes effect when the frame has been handed
     to the writers (:mod:`graphsdg.interrupts`).
+
+    ``wait_for_render=False`` pipelines: the step returns once the frame is drawn
+    and its pixels are copying off the GPU; its annotators and writers run at the
+    start of the next step (or at ``wait_until_complete``, ``get_data``, a
+    detach), so the GPU's work overlaps the script's next randomization. Only
+    annotators that need nothing but the capture's pixels, camera and labels are
+    deferred (``AnnotatorSpec.pixels_only``: colour, depth, segmentation, tight
+    boxes); with any other attached the step waits as with ``True``.
     """
     rt_subframes = _validate_subframes(rt_subframes)
     if delta_time is not None and (not isinstance(delta_time, (int, float)) or delta_time < 0):
         raise ValueError(f"delta_time must be None, 0 or a positive number of seconds, got {delta_time!r}")
     with interrupts.deferred() as held:
-        _step(rt_subframes, pause_timeline, delta_time)
+        _step(rt_subframes, pause_timeline, delta_time, defer=not wait_for_render)
     if held is not None and held.received is not None:
         interrupts.raise_for(held.received)
 
 
-def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None) -> None:
+def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None, defer: bool = False) -> None:
+    rt = runtime()
     queue = get_write_queue()
     try:
+        rt.complete_capture()   # the previous step's, when it was pipelined
         queue.raise_errors()
     except BaseException:
         run_state.mark_failed()
         raise
-    rt = runtime()
     rt.check_attachments()
     _state.set(Status.STEPPING)
     t = time.perf_counter()
@@ -140,7 +150,7 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None) -> 
         rt.timeline.pause()
     t = _timed("physics", t)
     subframes = capture_subframes(rt_subframes, subframes_override)
-    _capture(subframes, fired, trigger_outputs, provenance)   # times its render, annotate and write phases itself
+    _capture(subframes, fired, trigger_outputs, provenance, defer)   # times its render, annotate, write phases
     _state.frame_index += 1
     _state.stage_step += 1
     run_state.checkpoint()
@@ -184,42 +194,74 @@ def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
     return products
 
 
-def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], provenance: dict | None = None) -> None:
+def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], provenance: dict | None = None,
+             defer: bool = False) -> None:
+    """Render every active product, then annotate and write, now or (``defer``) when next asked."""
     rt = runtime()
-    sim = rt.sim
-    stage = rt.stage
     products = _active_products(rt)
-    outputs: dict[tuple[int, str], dict] = {}
-    sim_time = sim.data.time
+    defer = defer and _state.plan is None and all(a.spec.pixels_only for _, anns in products.values() for a in anns)
+    capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame)
     for path, (rp, annotators) in products.items():
-        t = time.perf_counter()
-        sim.require_offscreen(rp.width, rp.height)
-        with profiling.timed("render:camera"):
-            view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
-        passes: set[str] = set()
-        for a in annotators:
-            passes |= a.spec.passes
-        render = rt.rasterizer.render(sim, view, passes, subframes) if passes else None
-        t = _timed("render", t)
-        frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim_time,
-                          attached=frozenset(a.spec.name for a in annotators))
-        t = _timed("annotate:frame", t)
-        for a in annotators:
-            outputs[(id(a), path)] = a.compute_for(frame)
-            t = _timed(f"annotate:{a.spec.name}", t)
+        capture.frames.append((path, _render(rt, rp, annotators, subframes, defer), annotators))
+    if defer:
+        rt.pending_capture = capture.finish
+    else:
+        capture.finish()
+
+
+def _render(rt, rp, annotators: list[Annotator], subframes: int, defer: bool) -> FrameView:
     t = time.perf_counter()
-    reference_time = Fraction(sim_time).limit_denominator(1_000_000)
-    for writer in rt.writers:
-        if not writer.wants_frame(fired):
-            continue
-        extra = {"provenance": provenance} if provenance else {}
-        if _state.planned_frame is not None:   # sharded / resumed: the frame's number in the whole dataset
-            extra["frame_index"] = _state.frame_bases.get(id(writer), 0) + _state.planned_frame
-        data = writer.build_payload(outputs, trigger_outputs, (reference_time.numerator, reference_time.denominator),
-                                    extra=extra or None)
-        with run_state.frame(writer, _state.stage_step, data.get("frame_index")):   # for graphsdg_run.json
-            writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
-    _timed("write", t)
+    sim, stage = rt.sim, rt.stage
+    sim.require_offscreen(rp.width, rp.height)
+    with profiling.timed("render:camera"):
+        view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
+    passes: set[str] = set()
+    for a in annotators:
+        passes |= a.spec.passes
+    render = rt.rasterizer.render(sim, view, passes, subframes, defer=defer) if passes else None
+    t = _timed("render", t)
+    frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim.data.time,
+                      attached=frozenset(a.spec.name for a in annotators))
+    if defer:   # the labels as of this capture, before the script edits the stage for the next
+        for a in annotators:
+            frame.instance_map(SemanticFilter.from_params(a.init_params))
+    _timed("annotate:frame", t)
+    return frame
+
+
+class _Capture:
+    """One step's rendered products, and what :meth:`finish` needs to annotate and write them."""
+
+    def __init__(self, fired: set, trigger_outputs: dict[str, int], provenance: dict | None, stage_step: int,
+                 planned_frame: int | None) -> None:
+        self.frames: list[tuple[str, FrameView, list[Annotator]]] = []
+        self.fired, self.trigger_outputs, self.provenance = fired, trigger_outputs, provenance
+        self.stage_step, self.planned_frame = stage_step, planned_frame
+
+    def finish(self) -> None:
+        rt = runtime()
+        outputs: dict[tuple[int, str], dict] = {}
+        sim_time = 0.0
+        t = time.perf_counter()
+        for path, frame, annotators in self.frames:
+            sim_time = frame.sim_time
+            for a in annotators:
+                outputs[(id(a), path)] = a.compute_for(frame)
+                t = _timed(f"annotate:{a.spec.name}", t)
+        if not self.frames:
+            sim_time = rt.sim.data.time
+        reference_time = Fraction(sim_time).limit_denominator(1_000_000)
+        for writer in rt.writers:
+            if not writer.wants_frame(self.fired):
+                continue
+            extra = {"provenance": self.provenance} if self.provenance else {}
+            if self.planned_frame is not None:   # sharded / resumed: the frame's number in the whole dataset
+                extra["frame_index"] = _state.frame_bases.get(id(writer), 0) + self.planned_frame
+            data = writer.build_payload(outputs, self.trigger_outputs,
+                                        (reference_time.numerator, reference_time.denominator), extra=extra or None)
+            with run_state.frame(writer, self.stage_step, data.get("frame_index")):   # for graphsdg_run.json
+                writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
+        _timed("write", t)
 
 
 async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float | None = None,
@@ -242,6 +284,7 @@ def wait_until_complete() -> None:
 def _drain(status: str) -> None:
     """Flush writers' shared files, wait for every write, record ``status`` in the run-state files."""
     try:
+        runtime().complete_capture()
         for writer in list(runtime().writers):
             writer.flush()
         get_write_queue().wait_until_done()
@@ -572,6 +615,8 @@ def _flush_at_exit() -> None:
     if queue is None and not writers:
         return
     try:
+        if rt is not None:
+            rt.complete_capture()   # a pipelined step's frame
         for writer in writers:
             writer.flush()
         queue = current_write_queue()

@@ -61,7 +61,15 @@ class Runtime:
         self.ids = IdTables()
         self.labels = SceneLabels(self.ids)
         self.graph_hooks: list[Callable[..., object]] = []
+        # a step(wait_for_render=False) whose annotators and writers have not run yet
+        self.pending_capture: Callable[[], None] | None = None
         stage_context.subscribe_replaced(self._on_stage_replaced)
+
+    def complete_capture(self) -> None:
+        """Annotate and write the capture a ``step(wait_for_render=False)`` left pending, if any."""
+        finish, self.pending_capture = self.pending_capture, None
+        if finish is not None:
+            finish()
 
     @property
     def stage(self) -> Usd.Stage:

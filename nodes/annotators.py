@@ -39,15 +39,7 @@ RESERVED_TYPE = "class"    # Replicator labels BACKGROUND / UNLABELLED under "cl
 # ---- semantics --------------------------------------------------------------
 def semantic_filter(params: dict) -> SemanticFilter:
     """The filter an annotator's ``semanticTypes`` / ``semanticFilter`` init params select."""
-    types, predicate = params.get("semanticTypes"), params.get("semanticFilter")
-    if types is not None and predicate is not None:
-        raise ValueError(f"pass semanticTypes or semanticFilter, not both (got semanticTypes={types!r} and "
-                         f"semanticFilter={predicate!r}); semanticTypes=['a', 'b'] means the filter 'a:*; b:*'")
-    if predicate is not None:
-        return SemanticFilter.parse(predicate)
-    if types is not None:
-        return SemanticFilter.from_types(types)
-    return ALL_LABELS
+    return SemanticFilter.from_params(params)
 
 
 def _validate_semantics(params: dict) -> None:
@@ -348,23 +340,26 @@ def reference_time(frame: FrameView, params: dict) -> dict:
 
 
 # ---- registration -----------------------------------------------------------
-def _spec(name: str, passes: set[str], fn, defaults: dict | None = None, aliases=(), validate=None) -> None:
+def _spec(name: str, passes: set[str], fn, defaults: dict | None = None, aliases=(), validate=None,
+          pixels_only: bool = False) -> None:
     AnnotatorRegistry.register_spec(AnnotatorSpec(name=name, passes=frozenset(passes), compute=fn,
                                                   defaults=dict(defaults or {}), doc=fn.__doc__ or "",
-                                                  validate=validate), aliases=aliases)
+                                                  validate=validate, pixels_only=pixels_only), aliases=aliases)
 
 
 SEG = {"segmentation"}
-_spec("rgb", {"color"}, rgb, aliases=("LdrColor", "LdrColorSD"))
-_spec("HdrColor", {"hdr"}, hdr_color, aliases=("HdrColorSD",))
-_spec("distance_to_image_plane", {"depth"}, distance_to_image_plane)
-_spec("distance_to_camera", {"depth"}, distance_to_camera)
+_spec("rgb", {"color"}, rgb, aliases=("LdrColor", "LdrColorSD"), pixels_only=True)
+_spec("HdrColor", {"hdr"}, hdr_color, aliases=("HdrColorSD",), pixels_only=True)
+_spec("distance_to_image_plane", {"depth"}, distance_to_image_plane, pixels_only=True)
+_spec("distance_to_camera", {"depth"}, distance_to_camera, pixels_only=True)
 _spec("semantic_segmentation", SEG, semantic_segmentation, {**SEMANTIC_DEFAULTS, "colorize": False},
-      validate=_validate_semantics)
+      validate=_validate_semantics, pixels_only=True)
 _spec("instance_segmentation", SEG, instance_segmentation, {**SEMANTIC_DEFAULTS, "colorize": False},
-      validate=_validate_semantics)
+      validate=_validate_semantics, pixels_only=True)
 _spec("instance_id_segmentation", SEG, instance_id_segmentation, {"colorize": False})
-_spec("bounding_box_2d_tight", SEG, bounding_box_2d_tight, SEMANTIC_DEFAULTS, validate=_validate_semantics)
+# occlusion ratios in tight boxes need live renders, but only when an occlusion user (not pixels-only) is attached
+_spec("bounding_box_2d_tight", SEG, bounding_box_2d_tight, SEMANTIC_DEFAULTS, validate=_validate_semantics,
+      pixels_only=True)
 _spec("bounding_box_2d_loose", SEG, bounding_box_2d_loose, SEMANTIC_DEFAULTS, validate=_validate_semantics)
 _spec("bounding_box_3d", SEG, bounding_box_3d, SEMANTIC_DEFAULTS, validate=_validate_semantics)
 _spec("bounding_box_3d_360", SEG, bounding_box_3d_360, SEMANTIC_DEFAULTS, validate=_validate_semantics)
@@ -375,7 +370,7 @@ _spec("motion_vectors", SEG | {"depth"}, motion_vectors, aliases=("MotionVectors
 _spec("pointcloud", SEG | {"depth", "color"}, pointcloud, {**SEMANTIC_DEFAULTS, "includeUnlabelled": False},
       validate=_validate_semantics)
 _spec("skeleton_data", SEG, skeleton_data, {"useSkelJoints": False})
-_spec("ReferenceTime", set(), reference_time)
+_spec("ReferenceTime", set(), reference_time, pixels_only=True)
 
 # Raw outputs users can register annotators from (AnnotatorRegistry.register_annotator_from_aov).
 for _source, _aliases in [

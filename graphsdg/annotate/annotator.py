@@ -34,6 +34,9 @@ class AnnotatorSpec:
     defaults: dict[str, Any] = field(default_factory=dict)
     doc: str = ""
     validate: Callable[[dict], None] | None = None
+    # Computed from the capture's pixels, camera and labels alone (no live scene state), so it may
+    # run after the script has moved the scene on: what lets step(wait_for_render=False) pipeline.
+    pixels_only: bool = False
 
 
 @dataclass(frozen=True)
@@ -268,6 +271,7 @@ class Annotator:
     def detach(self, render_products=None) -> None:
         """Detach from ``render_products`` (default: all)."""
         from graphsdg.runtime import runtime
+        runtime().complete_capture()
         if render_products is None:
             self._render_products.clear()
         else:
@@ -294,6 +298,8 @@ class Annotator:
         if not self._render_products:
             raise RuntimeError(f"annotator {self.name!r} is not attached to a render product; call "
                                f"attach(render_product) and step first")
+        from graphsdg.runtime import runtime
+        runtime().complete_capture()   # a pipelined step's outputs are computed when first asked for
         results = {}
         for rp in self._render_products:
             out = self._latest.get(rp.path)

@@ -22,7 +22,7 @@ from pxr import Usd
 
 from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, labels_key
 from graphsdg.annotate.motion import PoseSnapshot, history
-from graphsdg.annotate.semantic_filter import SemanticFilter
+from graphsdg.annotate.semantic_filter import ALL_LABELS, SemanticFilter
 from graphsdg.render.camera import CameraView
 from graphsdg.render.rasterizer import RenderOutputs
 from graphsdg.render.raycast import surface_normals
@@ -31,7 +31,6 @@ from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage import semantics as semlib
 
-ALL_LABELS = SemanticFilter.parse("*:*")
 
 
 @dataclass
@@ -167,7 +166,9 @@ class FrameView:
 
     # ---- instances -----------------------------------------------------
     def instance_map(self, semantic_filter: SemanticFilter = ALL_LABELS) -> InstanceMap:
-        return self.labels.instance_map(self.sim, self.stage, semantic_filter)
+        """Labelled instances and their geoms, as of this capture (kept for the frame once looked up)."""
+        return self.cached(("instance_map", semantic_filter.text),
+                           lambda: self.labels.instance_map(self.sim, self.stage, semantic_filter))
 
     def instance_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """int32 (H, W): instance index into ``instance_map(f).paths`` per pixel, -1 if none."""
@@ -217,11 +218,12 @@ class FrameView:
         return lut[self.require("geom_ids")]   # one lookup per pixel
 
     def present_geoms(self) -> np.ndarray:
-        """Geom ids drawn in this frame (-1 included when background shows)."""
-        def build():
-            counts = np.bincount(self.require("geom_ids").ravel() + 1)
-            return np.flatnonzero(counts) - 1
-        return self.cached("present_geoms", build)
+        """Geom ids drawn in this frame (-1 included when background shows), from the runs, not every pixel."""
+        return self.cached("present_geoms", lambda: np.unique(self.runs()[2]))
+
+    def runs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Horizontal runs of equal geom id in the id image: (flat start, flat end inclusive, geom id)."""
+        return self.cached("runs", lambda: _runs(self.require("geom_ids")))
 
     def present_ids(self, kind: str, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """Sorted distinct ``"semantic"`` or ``"instance"`` ids in this frame, from the drawn geoms
@@ -266,7 +268,7 @@ class FrameView:
 
     def geom_boxes(self) -> np.ndarray:
         """(ngeom, 4) inclusive pixel bounds of every geom drawn in the id pass (-1 rows if not drawn)."""
-        return self.cached("geom_boxes", lambda: _mask_boxes(self.require("geom_ids"), self.sim.model.ngeom))
+        return self.cached("geom_boxes", lambda: _run_boxes(self.runs(), self.width, self.sim.model.ngeom))
 
     def footprints(self, semantic_filter: SemanticFilter = ALL_LABELS) -> Footprints:
         """Unoccluded footprint of every instance in view, from isolated id renders.
@@ -360,25 +362,31 @@ class FrameView:
         return self.cached("normals", lambda: surface_normals(self.sim, self.camera, self.require("geom_ids")))
 
 
-def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
-    """(n, 4) inclusive pixel bounds of each label in ``inst`` (-1 rows for absent labels).
+def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Horizontal runs of equal label in a (H, W) label image: flat start, flat end (inclusive), label."""
+    h, w = labels.shape
+    if h == 0 or w == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, empty.astype(labels.dtype)
+    flat = labels.ravel()
+    # run starts: where the label changes along the row-major pixel order, and every row start
+    starts = np.union1d(np.flatnonzero(flat[1:] != flat[:-1]) + 1, np.arange(0, h * w, w))
+    ends = np.append(starts[1:] - 1, h * w - 1)   # a run ends where the next one starts
+    return starts, ends, flat[starts]
+
+
+def _run_boxes(runs: tuple[np.ndarray, np.ndarray, np.ndarray], w: int, n: int) -> np.ndarray:
+    """(n, 4) inclusive pixel bounds of each label >= 0 of an image of width ``w``, from its runs.
 
     Only the ends of horizontal runs can be extreme: the left end of every run gives
     x_min (and every row a label touches has one, so y_min / y_max), the right end
     gives x_max. Scanning run ends instead of every labelled pixel makes the
     scatter-min/max work proportional to the objects' outlines, not their areas.
     """
-    h, w = inst.shape
     boxes = np.full((n, 4), -1, dtype=np.int32)
-    if n == 0 or h == 0 or w == 0:
-        return boxes
-    flat = inst.ravel()
-    # run starts: where the label changes along the row-major pixel order, and every row start
-    starts = np.union1d(np.flatnonzero(flat[1:] != flat[:-1]) + 1, np.arange(0, h * w, w))
-    ends = np.append(starts[1:] - 1, h * w - 1)   # a run ends where the next one starts
-    labels = flat[starts]
+    starts, ends, labels = runs
     keep = labels >= 0
-    if not keep.any():
+    if n == 0 or not keep.any():
         return boxes
     starts, ends, labels = starts[keep], ends[keep], labels[keep]
     sy, sx = np.divmod(starts, w)
@@ -393,7 +401,6 @@ def _mask_boxes(inst: np.ndarray, n: int) -> np.ndarray:
     present = hi_x >= 0
     boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
     return boxes
-
 
 
 def _disjoint_groups(members: list) -> list[list]:

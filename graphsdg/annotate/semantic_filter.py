@@ -130,6 +130,19 @@ class SemanticFilter:
         return {t: [v for v in labels[t] if v in result[t]] for t in labels if t in result}
 
     @classmethod
+    def from_params(cls, params: Mapping) -> "SemanticFilter":
+        """The filter an annotator's ``semanticTypes`` / ``semanticFilter`` init params select (all labels if neither)."""
+        types, predicate = params.get("semanticTypes"), params.get("semanticFilter")
+        if types is not None and predicate is not None:
+            raise ValueError(f"pass semanticTypes or semanticFilter, not both (got semanticTypes={types!r} and "
+                             f"semanticFilter={predicate!r}); semanticTypes=['a', 'b'] means the filter 'a:*; b:*'")
+        if predicate is not None:
+            return cls.parse(predicate)
+        if types is not None:
+            return cls.from_types(types)
+        return ALL_LABELS
+
+    @classmethod
     def from_types(cls, types: Iterable[str]) -> "SemanticFilter":
         """The predicate ``"typeA:*; typeB:*"`` (Replicator's translation of ``semanticTypes``)."""
         if isinstance(types, str):
@@ -235,3 +248,6 @@ class _Parser:
         if negated and name == ANY:
             raise SemanticFilterError(f"semanticFilter {self.text!r}: '!*' matches nothing; grammar: {GRAMMAR}")
         return Literal(name, negated)
+
+
+ALL_LABELS = SemanticFilter.parse("*:*")   # every label of every type (annotators' default)

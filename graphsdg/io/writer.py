@@ -139,6 +139,7 @@ class Writer:
         """Stop receiving frames (aggregate files are flushed first); the writer's annotators detach."""
         from graphsdg.runtime import runtime
         if self in runtime().writers:
+            runtime().complete_capture()   # the frame a pipelined step left pending is this writer's too
             self.flush()
         for a in self._annotator_objects():
             a.detach(self.render_products) if self.render_products else None

@@ -23,6 +23,8 @@ import mujoco
 import numpy as np
 from OpenGL import GL
 
+from graphsdg import profiling
+
 _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
     "rgba": (GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, np.uint8, 4),
     "depth": (GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT, np.float32, 1),
@@ -40,19 +42,23 @@ class PendingPixels:
     def result(self) -> np.ndarray:
         """The pixels, bottom row first (GL's order); waits for the GPU if it is still copying."""
         if self._array is None:
-            out = np.empty(self._shape, dtype=self._dtype)
-            self._reads.make_current()
-            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, self._pbo)
-            pointer = GL.glMapBufferRange(GL.GL_PIXEL_PACK_BUFFER, 0, self._nbytes, GL.GL_MAP_READ_BIT)
-            if not pointer:
-                GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
-                raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading")
-            ctypes.memmove(out.ctypes.data, pointer, self._nbytes)
-            GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
-            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
-            self._reads.release(self._pbo, self._nbytes)
-            self._array = out
+            with profiling.timed("readback:map"):
+                self._array = self._map()
         return self._array
+
+    def _map(self) -> np.ndarray:
+        out = np.empty(self._shape, dtype=self._dtype)
+        self._reads.make_current()
+        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, self._pbo)
+        pointer = GL.glMapBufferRange(GL.GL_PIXEL_PACK_BUFFER, 0, self._nbytes, GL.GL_MAP_READ_BIT)
+        if not pointer:
+            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+            raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading")
+        ctypes.memmove(out.ctypes.data, pointer, self._nbytes)
+        GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
+        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+        self._reads.release(self._pbo, self._nbytes)
+        return out
 
 
 class PixelReads:
