@@ -158,6 +158,17 @@ class FrameView:
                                f"annotator spec must list it in its passes")
         return value
 
+    def ids_through(self, per_geom: np.ndarray) -> np.ndarray:
+        """``per_geom[geom id]`` at every pixel (the background, id -1, reads the table's last entry).
+
+        One lookup of the codes as read back, through ``per_geom`` composed with
+        the code -> geom table, instead of a geom-id image and then a lookup.
+        """
+        codes, code_to_geom = getattr(self.outputs, "id_codes", None), getattr(self.outputs, "id_lut", None)
+        if codes is None or code_to_geom is None:
+            return per_geom[self.require("geom_ids")]
+        return per_geom[code_to_geom][codes]
+
     def cached(self, key: object, build):
         """Compute ``build()`` once per frame under ``key``."""
         if key not in self._cache:
@@ -173,10 +184,8 @@ class FrameView:
     def instance_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """int32 (H, W): instance index into ``instance_map(f).paths`` per pixel, -1 if none."""
         def build():
-            geom_ids = self.require("geom_ids")
             imap = self.instance_map(semantic_filter)
-            lut = np.append(imap.geom_instance, -1).astype(np.int32)   # index -1 -> -1
-            return lut[geom_ids]
+            return self.ids_through(np.append(imap.geom_instance, -1).astype(np.int32))   # index -1 -> -1
         return self.cached(("instance_image", semantic_filter.text), build)
 
     def semantic_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
@@ -210,12 +219,12 @@ class FrameView:
         palette = np.zeros((len(ids), 4), dtype=np.uint8)
         for i, value in enumerate(ids):
             palette[i] = colors[int(value)]
-        packed = palette.view(np.uint32)[:, 0][self.require("geom_ids")]
+        packed = self.ids_through(palette.view(np.uint32)[:, 0])
         return packed.view(np.uint8).reshape(*packed.shape, 4)
 
     def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
         lut = self._id_lut(per_instance, self.instance_map(semantic_filter))
-        return lut[self.require("geom_ids")]   # one lookup per pixel
+        return self.ids_through(lut)   # one lookup per pixel
 
     def present_geoms(self) -> np.ndarray:
         """Geom ids drawn in this frame (-1 included when background shows), from the runs, not every pixel."""
@@ -223,7 +232,13 @@ class FrameView:
 
     def runs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Horizontal runs of equal geom id in the id image: (flat start, flat end inclusive, geom id)."""
-        return self.cached("runs", lambda: _runs(self.require("geom_ids")))
+        def build():
+            codes, code_to_geom = getattr(self.outputs, "id_codes", None), getattr(self.outputs, "id_lut", None)
+            if codes is None or code_to_geom is None:
+                return _runs(self.require("geom_ids"))
+            starts, ends, run_codes = _runs(codes)   # runs of equal code are runs of equal geom
+            return starts, ends, code_to_geom[run_codes]
+        return self.cached("runs", build)
 
     def present_ids(self, kind: str, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """Sorted distinct ``"semantic"`` or ``"instance"`` ids in this frame, from the drawn geoms

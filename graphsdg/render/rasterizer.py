@@ -35,7 +35,6 @@ import os
 from collections import Counter
 from typing import Callable, Iterator, Sequence
 
-import cv2
 import mujoco
 import numpy as np
 
@@ -57,6 +56,9 @@ class RenderOutputs:
     * ``hdr``: float32 (H, W, 3) linear colour in [0, 1]
     * ``depth``: float32 (H, W) planar z, inf on background
     * ``geom_ids``: int32 (H, W) geom id per pixel, -1 on background
+    * ``id_codes`` and ``id_lut``: the same ids as read back, uint16/uint32 (H, W)
+      codes, and the table ``id_lut[code]`` -> geom id (so a per-geom table can
+      be applied to the pixels in one lookup: ``table[id_lut][id_codes]``)
     * ``render_isolated``: follow-up renders of the same view and state,
       ``(geom ids, crop) -> int32 ids of the crop``
 
@@ -67,6 +69,7 @@ class RenderOutputs:
     def __init__(self) -> None:
         self._values: dict[str, np.ndarray | None] = {}
         self._pending: dict[str, Callable[[], np.ndarray]] = {}
+        self.id_lut: np.ndarray | None = None
         self.render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
 
     def put(self, name: str, value: np.ndarray | Callable[[], np.ndarray] | None) -> None:
@@ -90,6 +93,7 @@ class RenderOutputs:
     hdr = property(lambda self: self.get("hdr"))
     depth = property(lambda self: self.get("depth"))
     geom_ids = property(lambda self: self.get("geom_ids"))
+    id_codes = property(lambda self: self.get("id_codes"))
 
 
 def make_gl_context():
@@ -282,9 +286,11 @@ class Rasterizer:
             self._render_color(sim, view, subframes, out, want_color="color" in passes,
                                want_linear="hdr" in passes, want_depth=depth_with_colour)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
-            ids, depth = self._render_ids(sim, view, None, with_depth="depth" in passes)
+            codes, lut, depth = self._render_ids(sim, view, None, with_depth="depth" in passes)
             if "segmentation" in passes:
-                out.put("geom_ids", ids)
+                out.put("id_codes", codes)
+                out.id_lut = lut
+                out.put("geom_ids", lambda: lut[out.id_codes])
             out.put("depth", depth)
         if not defer:
             out.finish()
@@ -313,10 +319,9 @@ class Rasterizer:
             out.put("depth", _depth_decoder(raw, sim.model, view))
         if subframes == 1:
             if want_color:
-                out.put("color", lambda: _rgba_top_first(pixels.result()))
+                out.put("color", lambda: _opaque(pixels.result()))
             if want_linear:
-                out.put("hdr", lambda: np.ascontiguousarray(
-                    pixels.result()[::-1, :, :3].astype(np.float32) / np.float32(255)))
+                out.put("hdr", lambda: pixels.result()[..., :3].astype(np.float32) / np.float32(255))
             return
         acc = pixels.result()[..., :3].astype(np.float32)
         for jit in jitter_offsets(subframes)[1:]:
@@ -327,14 +332,15 @@ class Rasterizer:
         mean = acc / subframes
         if want_color:
             rgba = np.full((h, w, 4), 255, dtype=np.uint8)
-            rgba[..., :3] = np.rint(mean[::-1])
+            rgba[..., :3] = np.rint(mean)
             out.put("color", rgba)
         if want_linear:
-            out.put("hdr", np.ascontiguousarray(mean[::-1] / np.float32(255)))
+            out.put("hdr", mean / np.float32(255))
 
     def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None, with_depth: bool
-                    ) -> tuple[Callable[[], np.ndarray], Callable[[], np.ndarray] | None]:
-        """Finishers of the geom ids (and planar depth) of the view, or of a crop of it, top row first."""
+                    ) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:
+        """Id codes (a finisher), their code -> geom id table, and a depth finisher, of the view or a
+        crop of it, top row first."""
         assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
@@ -360,10 +366,10 @@ class Rasterizer:
         self.stats[kind] += 1
         lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
 
-        def geom_ids() -> np.ndarray:
+        def codes() -> np.ndarray:
             with profiling.timed("decode:ids"):
-                return _decode_segmentation(ids.result(), lut)
-        return geom_ids, (_depth_decoder(raw, sim.model, view) if raw is not None else None)
+                return _id_codes(ids.result(), len(lut))
+        return codes, lut, (_depth_decoder(raw, sim.model, view) if raw is not None else None)
 
     def render_isolated(self, sim: SimScene, view: CameraView, geoms: Sequence[int], crop: Crop) -> np.ndarray:
         """Geom ids (H', W') of the ``crop`` of ``view`` with only ``geoms`` drawn (-1 elsewhere).
@@ -383,8 +389,8 @@ class Rasterizer:
         keep[np.asarray(list(geoms), dtype=np.int64)] = True
         try:
             group[~keep] = HIDDEN_GROUP
-            ids, _ = self._render_ids(sim, view, (x0, y0, x1, y1), with_depth=False)
-            return ids()
+            codes, lut, _ = self._render_ids(sim, view, (x0, y0, x1, y1), with_depth=False)
+            return lut[codes()]
         finally:
             group[:] = saved
 
@@ -440,18 +446,17 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
     return lin
 
 
-def _rgba_top_first(rgba: np.ndarray) -> np.ndarray:
-    """GL's bottom-up RGBA rows -> top row first, alpha 255 (one flip, one channel write)."""
-    out = cv2.flip(rgba, 0)
-    out[..., 3] = 255
-    return out
+def _opaque(rgba: np.ndarray) -> np.ndarray:
+    """The colour read back with alpha 255 (blending leaves other values in the buffer's alpha)."""
+    rgba[..., 3] = 255
+    return rgba
 
 
 def _depth_decoder(raw: PendingPixels, model: mujoco.MjModel, view: CameraView) -> Callable[[], np.ndarray]:
     """Finisher of a depth read: planar z, top row first (the projection of this render, taken now)."""
     far = effective_far(model, view)
     near, orthographic = view.near, view.projection == "orthographic"
-    return lambda: _linearize_depth(raw.result()[::-1], near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
+    return lambda: _linearize_depth(raw.result(), near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
 
 
 def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
@@ -465,14 +470,9 @@ def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
     return lut
 
 
-def _decode_segmentation(rgba: np.ndarray, lut: np.ndarray) -> np.ndarray:
-    """Id colours as read (RGBA, bottom row first) -> geom ids, top row first, -1 where no geom was drawn.
-
-    The lookup reads the rows in reverse, so the flip costs no copy of its own.
-    """
-    if len(lut) == 1 << 16:
+def _id_codes(rgba: np.ndarray, size: int) -> np.ndarray:
+    """Id colours as read (RGBA) -> codes (segid + 1) < ``size``."""
+    if size == 1 << 16:
         # Ids fit in red + green: each pixel's first two bytes are one little-endian uint16, read in place.
-        segid = rgba.view(np.uint16)[..., 0]
-    else:
-        segid = np.minimum(rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), len(lut) - 1)
-    return lut[segid[::-1]]
+        return np.ascontiguousarray(rgba.view(np.uint16)[..., 0])
+    return np.minimum(rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), np.uint32(size - 1))

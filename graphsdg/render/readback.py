@@ -13,7 +13,7 @@ Example (inside a current GL context, after ``mjr_render``)::
     reads = PixelReads()
     pending = reads.read_color(ctx, 512, 512)
     ...                                      # other work while the GPU copies
-    rgba = pending.result()                  # uint8 (512, 512, 4), bottom row first
+    rgba = pending.result()                  # uint8 (512, 512, 4), top row first
 """
 from __future__ import annotations
 
@@ -40,7 +40,8 @@ class PendingPixels:
         self._array: np.ndarray | None = None
 
     def result(self) -> np.ndarray:
-        """The pixels, bottom row first (GL's order); waits for the GPU if it is still copying."""
+        """The pixels, top row first (GL's rows run bottom-up: flipped in the one copy out of the
+        buffer); waits for the GPU if it is still copying."""
         if self._array is None:
             with profiling.timed("readback:map"):
                 self._array = self._map()
@@ -54,7 +55,8 @@ class PendingPixels:
         if not pointer:
             GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
             raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading")
-        ctypes.memmove(out.ctypes.data, pointer, self._nbytes)
+        mapped = np.frombuffer((ctypes.c_ubyte * self._nbytes).from_address(pointer), dtype=self._dtype)
+        np.copyto(out, mapped.reshape(self._shape)[::-1])
         GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
         GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
         self._reads.release(self._pbo, self._nbytes)

@@ -94,18 +94,28 @@ def matrix_to_quat_wxyz(r: np.ndarray) -> np.ndarray:
 def look_at_matrix(eye: Sequence[float], target: Sequence[float],
                    up: Sequence[float] = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Rotation whose local -Z points from ``eye`` to ``target`` and local +Y leans to ``up``."""
-    eye, target, up = (np.asarray(v, dtype=np.float64) for v in (eye, target, up))
-    fwd = target - eye
-    if np.linalg.norm(fwd) < 1e-12:
+    # Plain float arithmetic: numpy's per-call overhead on 3-vectors was most of a camera's pose edit.
+    ex, ey, ez = (float(v) for v in eye)
+    tx, ty, tz = (float(v) for v in target)
+    fx, fy, fz = tx - ex, ty - ey, tz - ez
+    length = math.sqrt(fx * fx + fy * fy + fz * fz)
+    if length < 1e-12:
         raise ValueError(f"look_at target {tuple(target)} coincides with the position {tuple(eye)}")
-    z = -fwd / np.linalg.norm(fwd)
-    x = np.cross(up, z)
-    if np.linalg.norm(x) < 1e-9:  # looking along the up axis: pick any perpendicular up
-        alt = np.array([0.0, 1.0, 0.0]) if abs(z[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
-        x = np.cross(alt, z)
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    return np.stack([x, y, z], axis=1)
+    z = (-fx / length, -fy / length, -fz / length)
+    x = _cross(tuple(float(v) for v in up), z)
+    if math.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2) < 1e-9:  # looking along the up axis: any perpendicular up
+        x = _cross((0.0, 1.0, 0.0) if abs(z[1]) < 0.9 else (1.0, 0.0, 0.0), z)
+    n = math.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+    x = (x[0] / n, x[1] / n, x[2] / n)
+    y = _cross(z, x)
+    return np.array([x, y, z], dtype=np.float64).T
+
+
+_IDENTITY3 = np.eye(3)
+
+
+def _cross(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def up_axis_vector(stage: Usd.Stage) -> tuple[float, float, float]:
@@ -308,5 +318,8 @@ def set_local_pose(prim: Usd.Prim, position: Sequence[float] | None = None,
         local_t = np.array(ops.translate.Get()) if ops.translate is not None else np.zeros(3)
         eye = np.append(local_t, 1.0) @ parent_m
         r_world = look_at_matrix(eye[:3], as_vec3(look_at, "look_at"), as_vec3(up, "look_at_up_axis"))
-        _, r_parent, _ = decompose(parent_m)
-        ops.set_rotation_matrix(r_parent.T @ r_world)
+        if np.array_equal(parent_m[:3, :3], _IDENTITY3):   # the common case: no rotation above
+            ops.set_rotation_matrix(r_world)
+        else:
+            _, r_parent, _ = decompose(parent_m)
+            ops.set_rotation_matrix(r_parent.T @ r_world)
