@@ -6,12 +6,12 @@
 set -euo pipefail
 report=${1:-perf.md}
 shift || true
-procs=("${@:-16}")
+procs=("${@:-16 32}")
 export MUJOCO_GL=egl
 four=(--annotators rgb distance_to_image_plane semantic_segmentation bounding_box_2d_tight)
 python3 -m graphsdg.cli bench --num-frames 300 --resolution 512 512 "${four[@]}" --profile --report "$report"
 python3 -m graphsdg.cli bench --num-frames 300 --resolution 1280 720 --annotators rgb --report "$report"
-for n in "${procs[@]}"; do
+for n in ${procs[@]}; do
   python3 -m graphsdg.cli bench --num-frames 400 --resolution 512 512 "${four[@]}" --processes "$n" \
     --report "$report"
 done

@@ -79,6 +79,8 @@ class BenchResult:
     frame_times: list[float] = field(default_factory=list)
     wall_seconds: float = 0.0
     drain_seconds: float = 0.0
+    started_at: float = 0.0               # wall clock (time.time()) when the timed frames began
+    cpu_seconds: float = 0.0              # process CPU time (all threads) over the timed frames and the drain
     peak_rss_mb: float = 0.0
     profile: dict[str, float] = field(default_factory=dict)
 
@@ -100,7 +102,13 @@ class BenchResult:
         return {"run": self.label, "frames/s": round(self.fps, 2), "images/s": round(self.images_per_second, 2),
                 "frames/s incl. drain": round(self.fps_with_drain, 2), "min ms": round(float(ft.min()), 2),
                 "mean ms": round(float(ft.mean()), 2), "max ms": round(float(ft.max()), 2),
+                "CPU ms/frame": round(1000 * self.cpu_seconds / self.frames, 1) if self.frames else 0.0,
                 "peak RSS MB": round(self.peak_rss_mb, 1)}
+
+
+def _cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
 
 
 def _peak_rss_mb() -> float:
@@ -159,8 +167,8 @@ def _apply(draw: dict[str, np.ndarray], assets, cams) -> None:
                                    look_at_up_axis=(0.0, 0.0, 1.0))
 
 
-def run_graphsdg(config: BenchConfig) -> BenchResult:
-    """Time graphsdg on the benchmark scene."""
+def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
+    """Time graphsdg on the benchmark scene; ``before_timing()`` runs after the warm-up (a barrier, say)."""
     import graphsdg as rep
     from graphsdg import profiling
     from graphsdg.io.write_queue import reset_write_queue
@@ -186,7 +194,11 @@ def run_graphsdg(config: BenchConfig) -> BenchResult:
         _apply(draws.draw(), assets, cams)
         rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
     rep.orchestrator.wait_until_complete()
+    if before_timing is not None:
+        before_timing()
     rep.orchestrator.reset_profile()
+    result.started_at = time.time()
+    cpu_start = _cpu_seconds()
     start = last = time.perf_counter()
     for _ in range(config.frames):
         t = time.perf_counter()
@@ -200,6 +212,7 @@ def run_graphsdg(config: BenchConfig) -> BenchResult:
     t = time.perf_counter()
     rep.orchestrator.wait_until_complete()
     result.drain_seconds = time.perf_counter() - t
+    result.cpu_seconds = _cpu_seconds() - cpu_start
     result.profile = rep.orchestrator.get_profile()
     result.peak_rss_mb = _peak_rss_mb()
     if writer is not None:
@@ -316,6 +329,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     concurrent.futures.wait(pending)
     pending.clear()
     profiling.reset()
+    cpu_start = _cpu_seconds()
     start = last = time.perf_counter()
     for i in range(config.frames):
         frame(draws.draw(), i)
@@ -329,6 +343,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     for f in pending:
         f.result()
     result.drain_seconds = time.perf_counter() - t
+    result.cpu_seconds = _cpu_seconds() - cpu_start
     result.peak_rss_mb = _peak_rss_mb()
     result.profile = profiling.snapshot()
     pool.shutdown()
@@ -345,23 +360,37 @@ def run_pair(config: BenchConfig) -> tuple[BenchResult, BenchResult]:
     return run_graphsdg(config), run_handwritten(config)
 
 
-def _worker(config_dict: dict) -> dict:
+def _worker(config_dict: dict, barrier) -> dict:
     config = BenchConfig(**config_dict)
-    r = run_graphsdg(config)
-    return {"frames": r.frames, "wall": r.wall_seconds, "drain": r.drain_seconds}
+    r = run_graphsdg(config, before_timing=barrier.wait)
+    return {"frames": r.frames, "wall": r.wall_seconds, "start": r.started_at, "cpu": r.cpu_seconds}
 
 
 def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
-    """``processes`` independent graphsdg benchmark processes at once (seeds differ); aggregate frames/s."""
-    ctx = __import__("multiprocessing").get_context("spawn")
+    """``processes`` independent graphsdg benchmark processes at once (seeds differ); aggregate frames/s.
+
+    Every process builds its scene and warms up, then all start their timed
+    frames together (a barrier). The aggregate is all frames over the window
+    from the first start to the last finish, so a straggler counts against it.
+    """
+    import multiprocessing
+    ctx = multiprocessing.get_context("spawn")
     configs = [dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)) for i in range(processes)]
     start = time.perf_counter()
-    with concurrent.futures.ProcessPoolExecutor(processes, mp_context=ctx) as ex:
-        results = list(ex.map(_worker, configs))
+    with ctx.Manager() as manager:
+        barrier = manager.Barrier(processes)
+        with concurrent.futures.ProcessPoolExecutor(processes, mp_context=ctx) as ex:
+            results = list(ex.map(_worker, configs, [barrier] * processes))
     elapsed = time.perf_counter() - start
     per_process = [r["frames"] / r["wall"] for r in results]
-    return {"processes": processes, "aggregate frames/s (sum of per-process)": round(sum(per_process), 1),
-            "slowest process frames/s": round(min(per_process), 1), "wall s (incl. start-up)": round(elapsed, 1),
+    window = max(r["start"] + r["wall"] for r in results) - min(r["start"] for r in results)
+    return {"processes": processes,
+            "aggregate frames/s (all frames / common window)": round(sum(r["frames"] for r in results) / window, 1),
+            "sum of per-process frames/s": round(sum(per_process), 1),
+            "slowest process frames/s": round(min(per_process), 1),
+            "CPU ms per frame (all threads)": round(1000 * sum(r["cpu"] for r in results) /
+                                                    sum(r["frames"] for r in results), 1),
+            "wall s (incl. start-up)": round(elapsed, 1),
             "cpu count": os.cpu_count() or 0}
 
 
