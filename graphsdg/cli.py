@@ -69,7 +69,9 @@ def run_bench(args: argparse.Namespace) -> None:
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
         msaa_samples=args.msaa, shadow_size=args.shadow_size)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
-                       f", shadow map {args.shadow_size}" if args.shadow_size is not None else ""])
+                       f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
+                       f", {args.write_threads} write threads" if args.write_threads != 4 else "",
+                       ", wait_for_render" if args.wait_for_render else ""])
     settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
                      f"{'skip-write' if args.skip_write else 'written'}")
