@@ -1,0 +1,61 @@
+"""PNG files compressed with Intel's ISA-L deflate (``isal``): the same images, ~6x less CPU.
+
+A PNG is a signature, an ``IHDR`` chunk, the zlib stream of the filtered rows
+(``IDAT``) and ``IEND`` (PNG spec, ISO/IEC 15948). Encoding the frame's images
+was the largest CPU cost of a written frame: OpenCV's libpng + zlib spends
+~3.5 ms on a 512x512 RGBA render, ISA-L level 1 ~0.6 ms for a slightly smaller
+file, and it releases the GIL, so writer threads run in parallel. Every row
+uses the ``Sub`` filter (each byte minus the byte one pixel to the left, mod 256),
+which is what OpenCV picks for rendered images too, computed in one numpy pass.
+
+Files decode to the same pixels with any PNG reader (tests compare OpenCV's and
+Pillow's decodes); the compressed bytes are deterministic for a given ``isal``
+build.
+
+Example:
+    >>> import numpy as np, cv2
+    >>> img = np.arange(48, dtype=np.uint8).reshape(4, 4, 3)
+    >>> back = cv2.imdecode(np.frombuffer(encode_png(img), np.uint8), cv2.IMREAD_UNCHANGED)
+    >>> bool((back[..., ::-1] == img).all())
+    True
+"""
+from __future__ import annotations
+
+import struct
+import zlib
+
+import numpy as np
+from isal import isal_zlib
+
+SIGNATURE = b"\x89PNG\r\n\x1a\n"
+COLOR_TYPES = {1: 0, 2: 4, 3: 2, 4: 6}   # channels -> PNG colour type (grey, grey+alpha, RGB, RGBA)
+SUB_FILTER = 1
+LEVEL = 1                                # ISA-L level 1: fastest of the levels that compress well
+
+
+def encode_png(image: np.ndarray) -> bytes:
+    """PNG bytes of a uint8 or uint16 image: (H, W) grey, or (H, W, C) with C = 2 (grey+alpha), 3 (RGB), 4 (RGBA)."""
+    arr = np.asarray(image)
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    if arr.ndim != 3 or arr.shape[2] not in COLOR_TYPES or arr.dtype not in (np.uint8, np.uint16):
+        raise ValueError(f"cannot write a PNG of shape {arr.shape} and dtype {arr.dtype}; expected uint8 or "
+                         f"uint16 (H, W) or (H, W, 1-4)")
+    h, w, c = arr.shape
+    if h == 0 or w == 0:
+        raise ValueError(f"cannot write a PNG of shape {arr.shape}: it has no pixels")
+    depth = 8 * arr.dtype.itemsize
+    rows = np.ascontiguousarray(arr.astype(">u2", copy=False) if depth == 16 else arr).view(np.uint8)
+    rows = rows.reshape(h, w * c * arr.dtype.itemsize)
+    step = c * arr.dtype.itemsize                     # bytes per pixel: Sub subtracts the pixel to the left
+    filtered = np.empty((h, rows.shape[1] + 1), dtype=np.uint8)
+    filtered[:, 0] = SUB_FILTER
+    filtered[:, 1:step + 1] = rows[:, :step]
+    np.subtract(rows[:, step:], rows[:, :-step], out=filtered[:, step + 1:])   # uint8 arithmetic wraps mod 256
+    header = struct.pack(">IIBBBBB", w, h, depth, COLOR_TYPES[c], 0, 0, 0)
+    return b"".join([SIGNATURE, _chunk(b"IHDR", header), _chunk(b"IDAT", isal_zlib.compress(filtered, LEVEL)),
+                     _chunk(b"IEND", b"")])
+
+
+def _chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(data, zlib.crc32(kind)))
