@@ -7,6 +7,9 @@ Two measurements, each printed as a table of samples and a verdict:
   resident set size (RSS) is sampled every ``--every`` frames. Growth is measured
   from the first sample after ``--warmup`` frames to the largest later sample and
   must stay under ``--limit`` percent.
+* ``pipelined``: the same for the ``graphsdg bench`` scene stepped with
+  ``wait_for_render=False`` (pixel-buffer readback, captures finished at the
+  next step).
 * ``cycles``: ``--cycles`` times: create a render product (resolutions rotate
   through a few sizes), get annotators and a BasicWriter, attach, capture one
   frame, detach, destroy.
@@ -17,6 +20,7 @@ Two measurements, each printed as a table of samples and a verdict:
   new GPU uploads each time).
 
     python bench/soak.py frames --frames 10000 --resolution 128 96
+    python bench/soak.py pipelined --frames 10000 --resolution 128 96
     python bench/soak.py cycles --cycles 1000
 
 Both run in this process; ``--out`` is deleted at the end unless ``--keep``.
@@ -99,6 +103,32 @@ def soak_frames(out: str, frames: int, every: int, resolution: tuple[int, int], 
     return samples
 
 
+def soak_pipelined(out: str, frames: int, every: int, resolution: tuple[int, int], seed: int) -> list[tuple]:
+    """The ``graphsdg bench`` scene written by BasicWriter with pipelined steps (``wait_for_render=False``):
+    the pixel-buffer pool and the pending captures, for ``frames`` frames."""
+    from graphsdg import benchmark
+    config = benchmark.BenchConfig(frames=frames, resolution=resolution, seed=seed,
+                                   annotators=("rgb", "distance_to_image_plane", "semantic_segmentation",
+                                               "bounding_box_2d_tight"))
+    assets, cams, rps = benchmark.build_scene(config)
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir=out, rgb=True, distance_to_image_plane=True, semantic_segmentation=True,
+                      bounding_box_2d_tight=True)
+    writer.attach(rps)
+    draws = benchmark.Randomization(config)
+    samples: list[tuple] = [(0, rss_mb(), 0.0, 0)]
+    t0 = time.perf_counter()
+    for n in range(1, frames + 1):
+        benchmark._apply(draws.draw(), assets, cams)
+        rep.orchestrator.step(wait_for_render=False)
+        if n % every == 0:
+            gc.collect()
+            samples.append((n, rss_mb(), n / (time.perf_counter() - t0), rep.orchestrator.get_write_queue().pending()))
+    rep.orchestrator.wait_until_complete()
+    writer.detach()
+    return samples
+
+
 RESOLUTIONS = [(64, 48), (96, 64), (48, 48), (80, 60)]
 ANNOTATORS = ["rgb", "semantic_segmentation", "bounding_box_2d_tight", "distance_to_image_plane"]
 
@@ -151,17 +181,19 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="what", required=True)
     f = sub.add_parser("frames", help="the demo job for many frames")
-    f.add_argument("--frames", type=int, default=10000)
-    f.add_argument("--every", type=int, default=500)
-    f.add_argument("--warmup", type=int, default=1000)
-    f.add_argument("--resolution", type=int, nargs=2, default=(128, 96))
-    f.add_argument("--seed", type=int, default=0)
+    pl = sub.add_parser("pipelined", help="the bench scene with step(wait_for_render=False) for many frames")
+    for p in (f, pl):
+        p.add_argument("--frames", type=int, default=10000)
+        p.add_argument("--every", type=int, default=500)
+        p.add_argument("--warmup", type=int, default=1000)
+        p.add_argument("--resolution", type=int, nargs=2, default=(128, 96))
+        p.add_argument("--seed", type=int, default=0)
     c = sub.add_parser("cycles", help="render products, annotators and writers attached and detached")
     c.add_argument("--cycles", type=int, default=1000)
     c.add_argument("--every", type=int, default=100)
     c.add_argument("--warmup", type=int, default=100)
     c.add_argument("--new-stage", action="store_true", help="build the scene on a new stage every cycle")
-    for p in (f, c):
+    for p in (f, pl, c):
         p.add_argument("--limit", type=float, default=5.0, help="allowed RSS growth after warm-up, percent")
         p.add_argument("--out", help="output folder (default: a temporary one)")
         p.add_argument("--keep", action="store_true", help="keep the written dataset")
@@ -172,9 +204,9 @@ def main(argv: list[str] | None = None) -> int:
     out = args.out or tempfile.mkdtemp(prefix="graphsdg-soak-")
     start = time.perf_counter()
     try:
-        if args.what == "frames":
-            samples = soak_frames(os.path.join(out, "demo"), args.frames, args.every, tuple(args.resolution),
-                                  args.seed)
+        if args.what in ("frames", "pipelined"):
+            soak = soak_frames if args.what == "frames" else soak_pipelined
+            samples = soak(os.path.join(out, args.what), args.frames, args.every, tuple(args.resolution), args.seed)
             print("| frames | RSS MiB | frames/s so far | queued writes |\n|---|---|---|---|")
             for n, mb, fps, pending in samples:
                 print(f"| {n} | {mb:.1f} | {fps:.1f} | {pending} |")

@@ -248,6 +248,8 @@ class _Capture:
             for a in annotators:
                 outputs[(id(a), path)] = a.compute_for(frame)
                 t = _timed(f"annotate:{a.spec.name}", t)
+            if frame.outputs is not None:
+                frame.outputs.finish()   # a pass no annotator read still holds a pixel buffer: hand it back
         if not self.frames:
             sim_time = rt.sim.data.time
         reference_time = Fraction(sim_time).limit_denominator(1_000_000)
