@@ -229,7 +229,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--skip-write", action="store_true", help="compute annotators but write nothing")
     bench.add_argument("--rt-subframes", type=int, default=-1)
     bench.add_argument("--wait-for-render", action="store_true",
-                       help="finish each frame inside its step (default, as benchmark_sdg.py: pipelined steps)")
+                       help="finish each frame inside its step (off by default, as in benchmark_sdg.py: steps are pipelined)")
     bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
     bench.add_argument("--write-threads", type=int, default=4)
     bench.add_argument("--msaa", type=int, help="multisample count of the colour pass (default: graphsdg's 4)")

@@ -200,7 +200,7 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
     rt = runtime()
     products = _active_products(rt)
     defer = defer and _state.plan is None and all(a.spec.pixels_only for _, anns in products.values() for a in anns)
-    capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame)
+    capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame, rt.sim.data.time)
     for path, (rp, annotators) in products.items():
         capture.frames.append((path, _render(rt, rp, annotators, subframes, defer), annotators))
     if defer:
@@ -224,7 +224,8 @@ def _render(rt, rp, annotators: list[Annotator], subframes: int, defer: bool) ->
                       attached=frozenset(a.spec.name for a in annotators))
     if defer:   # the labels as of this capture, before the script edits the stage for the next
         for a in annotators:
-            frame.instance_map(SemanticFilter.from_params(a.init_params))
+            if "segmentation" in a.spec.passes:
+                frame.instance_map(SemanticFilter.from_params(a.init_params))
     _timed("annotate:frame", t)
     return frame
 
@@ -233,26 +234,22 @@ class _Capture:
     """One step's rendered products, and what :meth:`finish` needs to annotate and write them."""
 
     def __init__(self, fired: set, trigger_outputs: dict[str, int], provenance: dict | None, stage_step: int,
-                 planned_frame: int | None) -> None:
+                 planned_frame: int | None, sim_time: float) -> None:
         self.frames: list[tuple[str, FrameView, list[Annotator]]] = []
         self.fired, self.trigger_outputs, self.provenance = fired, trigger_outputs, provenance
-        self.stage_step, self.planned_frame = stage_step, planned_frame
+        self.stage_step, self.planned_frame, self.sim_time = stage_step, planned_frame, sim_time
 
     def finish(self) -> None:
         rt = runtime()
         outputs: dict[tuple[int, str], dict] = {}
-        sim_time = 0.0
         t = time.perf_counter()
         for path, frame, annotators in self.frames:
-            sim_time = frame.sim_time
             for a in annotators:
                 outputs[(id(a), path)] = a.compute_for(frame)
                 t = _timed(f"annotate:{a.spec.name}", t)
             if frame.outputs is not None:
                 frame.outputs.finish()   # a pass no annotator read still holds a pixel buffer: hand it back
-        if not self.frames:
-            sim_time = rt.sim.data.time
-        reference_time = Fraction(sim_time).limit_denominator(1_000_000)
+        reference_time = Fraction(self.sim_time).limit_denominator(1_000_000)
         for writer in rt.writers:
             if not writer.wants_frame(self.fired):
                 continue
