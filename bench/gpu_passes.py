@@ -44,7 +44,7 @@ def main() -> None:
     mjr_render = mujoco.mjr_render
     mujoco.mjr_render = lambda *a: timed(next(renders, "render:other"), mjr_render)(*a)
     read = readback.PixelReads._read
-    readback.PixelReads._read = lambda self, ctx, w, h, kind: timed(f"copy:{kind}", read)(self, ctx, w, h, kind)
+    readback.PixelReads._read = lambda self, ctx, w, h, kind, *rest: timed(f"copy:{kind}", read)(self, ctx, w, h, kind, *rest)
     config = benchmark.BenchConfig(frames=args.frames, warmup=5, resolution=(512, 512), msaa_samples=args.msaa,
                                    annotators=("rgb", "distance_to_image_plane", "semantic_segmentation",
                                                "bounding_box_2d_tight"), wait_for_render=True)
