@@ -5,13 +5,14 @@ frame and copied it over. Reading into a pixel-buffer object (PBO) instead only
 queues the copy; mapping the PBO later returns the pixels, waiting only if the
 GPU has not finished by then. The orchestrator uses that to overlap a frame's
 rendering and transfer with the script's next randomization
-(``step(wait_for_render=False)``), and every read is RGBA, the format GL drivers
-copy without repacking (MuJoCo's ``mjr_readPixels`` reads RGB).
+(``step(wait_for_render=False)``). Colour is read as RGBA, the format GL drivers
+copy without repacking (MuJoCo's ``mjr_readPixels`` reads RGB), and depth as the
+buffer stores it.
 
 Example (inside a current GL context, after ``mjr_render``)::
 
-    reads = PixelReads()
-    pending = reads.read_color(ctx, 512, 512)
+    reads = PixelReads(gl_context.make_current)
+    pending = reads.read_color(mjr_context, 512, 512)
     ...                                      # other work while the GPU copies
     rgba = pending.result()                  # uint8 (512, 512, 4), top row first
 """
