@@ -200,7 +200,8 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
     rt = runtime()
     products = _active_products(rt)
     defer = defer and _state.plan is None and all(a.spec.pixels_only for _, anns in products.values() for a in anns)
-    capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame, rt.sim.data.time)
+    capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame, rt.sim.data.time,
+                       list(rt.writers))
     for path, (rp, annotators) in products.items():
         capture.frames.append((path, _render(rt, rp, annotators, subframes, defer), annotators))
     if defer:
@@ -234,8 +235,9 @@ class _Capture:
     """One step's rendered products, and what :meth:`finish` needs to annotate and write them."""
 
     def __init__(self, fired: set, trigger_outputs: dict[str, int], provenance: dict | None, stage_step: int,
-                 planned_frame: int | None, sim_time: float) -> None:
+                 planned_frame: int | None, sim_time: float, writers: list) -> None:
         self.frames: list[tuple[str, FrameView, list[Annotator]]] = []
+        self.writers = writers   # those attached when the frame was rendered (a writer attached later skips it)
         self.fired, self.trigger_outputs, self.provenance = fired, trigger_outputs, provenance
         self.stage_step, self.planned_frame, self.sim_time = stage_step, planned_frame, sim_time
 
@@ -250,8 +252,8 @@ class _Capture:
             if frame.outputs is not None:
                 frame.outputs.finish()   # a pass no annotator read still holds a pixel buffer: hand it back
         reference_time = Fraction(self.sim_time).limit_denominator(1_000_000)
-        for writer in rt.writers:
-            if not writer.wants_frame(self.fired):
+        for writer in self.writers:
+            if writer not in rt.writers or not writer.wants_frame(self.fired):
                 continue
             extra = {"provenance": self.provenance} if self.provenance else {}
             if self.planned_frame is not None:   # sharded / resumed: the frame's number in the whole dataset

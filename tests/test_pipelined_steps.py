@@ -82,3 +82,18 @@ def test_annotators_that_read_the_scene_are_not_deferred():
     occlusion.attach(rp)              # isolated renders of the live scene: cannot wait for the next step
     rep.orchestrator.step(wait_for_render=False)
     assert runtime().pending_capture is None and len(occlusion.get_data()) == 3
+
+
+def test_a_writer_attached_after_a_pipelined_step_starts_with_the_next_frame(tmp_path):
+    _, rp = _scene()
+    first = rep.writers.get("BasicWriter")
+    first.initialize(output_dir=str(tmp_path / "first"), rgb=True)
+    first.attach(rp)
+    rep.orchestrator.step(wait_for_render=False)
+    late = rep.writers.get("BasicWriter")
+    late.initialize(output_dir=str(tmp_path / "late"), rgb=True, bounding_box_2d_tight=True)
+    late.attach(rp)                   # its annotators were not rendered for the pending frame
+    rep.orchestrator.step(wait_for_render=False)
+    rep.orchestrator.wait_until_complete()
+    assert sorted(f for f in os.listdir(tmp_path / "first") if f.startswith("rgb")) == ["rgb_0000.png", "rgb_0001.png"]
+    assert sorted(f for f in os.listdir(tmp_path / "late") if f.startswith("rgb")) == ["rgb_0000.png"]
