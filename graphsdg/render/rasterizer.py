@@ -156,7 +156,8 @@ class Rasterizer:
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FREE
         self._version = -1
         self._model: mujoco.MjModel | None = None
-        self._uploaded_maps: dict[int, np.ndarray] = {}   # SimScene.mesh_maps when the meshes were uploaded
+        # inverse of SimScene.mesh_maps when the meshes were uploaded (a mesh absent: identity)
+        self._uploaded_inverse: dict[int, np.ndarray] = {}
         self._reads: PixelReads | None = None
         self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
 
@@ -190,7 +191,7 @@ class Rasterizer:
             self._scene = mujoco.MjvScene(model, maxgeom=max(1000, 2 * model.ngeom + 100))
             self._version = sim.model_version
             self._model = model
-            self._uploaded_maps = {mid: m.copy() for mid, m in sim.mesh_maps.items()}
+            self._uploaded_inverse = {mid: np.linalg.inv(m) for mid, m in sim.mesh_maps.items()}
         if sim.textures_to_upload:
             for tid in sorted(sim.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
@@ -244,7 +245,7 @@ class Rasterizer:
         geom's rotation matrix times that map draws the current mesh (the fixed
         function pipeline transforms normals by the inverse transpose).
         """
-        maps, uploaded = sim.mesh_maps, self._uploaded_maps
+        maps, uploaded_inverse = sim.mesh_maps, self._uploaded_inverse
         # ints, not the enums: comparing with a pybind11 enum costs microseconds per geom
         dataid, geom_obj, mesh = sim.model.geom_dataid, int(mujoco.mjtObj.mjOBJ_GEOM), int(mujoco.mjtGeom.mjGEOM_MESH)
         for g in scene.geoms[:scene.ngeom]:
@@ -253,8 +254,8 @@ class Rasterizer:
             mid = int(dataid[g.objid])
             current = maps.get(mid)
             if current is not None:
-                before = uploaded.get(mid)
-                g.mat[:] = g.mat @ (current if before is None else current @ np.linalg.inv(before))
+                undo = uploaded_inverse.get(mid)
+                g.mat[:] = g.mat @ (current if undo is None else current @ undo)
 
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
                defer: bool = False) -> RenderOutputs:
