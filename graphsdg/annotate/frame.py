@@ -164,10 +164,18 @@ class FrameView:
         One lookup of the codes as read back, through ``per_geom`` composed with
         the code -> geom table, instead of a geom-id image and then a lookup.
         """
-        codes, code_to_geom = getattr(self.outputs, "id_codes", None), getattr(self.outputs, "id_lut", None)
-        if codes is None or code_to_geom is None:
+        coded = self._id_codes()
+        if coded is None:
             return per_geom[self.require("geom_ids")]
+        codes, code_to_geom = coded
         return per_geom[code_to_geom][codes]
+
+    def _id_codes(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The id pass as read back: (codes, code -> geom table), or None when only geom ids exist."""
+        if self.outputs is None or self.outputs.id_lut is None:
+            return None
+        codes = self.outputs.id_codes
+        return None if codes is None else (codes, self.outputs.id_lut)
 
     def cached(self, key: object, build):
         """Compute ``build()`` once per frame under ``key``."""
@@ -233,9 +241,10 @@ class FrameView:
     def runs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Horizontal runs of equal geom id in the id image: (flat start, flat end inclusive, geom id)."""
         def build():
-            codes, code_to_geom = getattr(self.outputs, "id_codes", None), getattr(self.outputs, "id_lut", None)
-            if codes is None or code_to_geom is None:
+            coded = self._id_codes()
+            if coded is None:
                 return _runs(self.require("geom_ids"))
+            codes, code_to_geom = coded
             starts, ends, run_codes = _runs(codes)   # runs of equal code are runs of equal geom
             return starts, ends, code_to_geom[run_codes]
         return self.cached("runs", build)
