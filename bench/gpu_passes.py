@@ -1,6 +1,6 @@
 """GPU time per render pass of the benchmark frame, from OpenGL timer queries.
 
-Run: ``MUJOCO_GL=egl python bench/gpu_passes.py [--frames N] [--msaa K]``. Builds the
+Run: ``MUJOCO_GL=egl python bench/gpu_passes.py [--frames N] [--msaa K] [--shadow-size S]``. Builds the
 ``graphsdg bench`` scene (512x512, rgb + depth + semantic segmentation + tight
 boxes), then times every ``mjr_render`` and every pixel-buffer read with
 ``GL_TIME_ELAPSED`` queries and prints the mean GPU milliseconds per frame of each.
@@ -22,6 +22,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=100)
     parser.add_argument("--msaa", type=int)
+    parser.add_argument("--shadow-size", type=int)
     args = parser.parse_args()
     import mujoco
     from OpenGL import GL
@@ -44,8 +45,10 @@ def main() -> None:
     mjr_render = mujoco.mjr_render
     mujoco.mjr_render = lambda *a: timed(next(renders, "render:other"), mjr_render)(*a)
     read = readback.PixelReads._read
-    readback.PixelReads._read = lambda self, ctx, w, h, kind, *rest: timed(f"copy:{kind}", read)(self, ctx, w, h, kind, *rest)
+    readback.PixelReads._read = lambda self, ctx, w, h, kind, *rest, **kw: timed(f"copy:{kind}", read)(
+        self, ctx, w, h, kind, *rest, **kw)
     config = benchmark.BenchConfig(frames=args.frames, warmup=5, resolution=(512, 512), msaa_samples=args.msaa,
+                                   shadow_size=args.shadow_size,
                                    annotators=("rgb", "distance_to_image_plane", "semantic_segmentation",
                                                "bounding_box_2d_tight"), wait_for_render=True)
     assets, cams, rps = benchmark.build_scene(config)

@@ -24,6 +24,7 @@ from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, labels
 from graphsdg.annotate.motion import PoseSnapshot, history
 from graphsdg.annotate.semantic_filter import ALL_LABELS, SemanticFilter
 from graphsdg.render.camera import CameraView
+from graphsdg.render.lookup import lookup
 from graphsdg.render.rasterizer import RenderOutputs
 from graphsdg.render.raycast import surface_normals
 from graphsdg.render.render_product import RenderProduct
@@ -168,7 +169,7 @@ class FrameView:
         if coded is None:
             return per_geom[self.require("geom_ids")]
         codes, code_to_geom = coded
-        return per_geom[code_to_geom][codes]
+        return lookup(per_geom[code_to_geom], codes)
 
     def _id_codes(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The id pass as read back: (codes, code -> geom table), or None when only geom ids exist."""
@@ -392,11 +393,15 @@ def _runs(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if h == 0 or w == 0:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty, empty.astype(labels.dtype)
-    flat = labels.ravel()
-    # run starts: where the label changes along the row-major pixel order, and every row start
-    starts = np.union1d(np.flatnonzero(flat[1:] != flat[:-1]) + 1, np.arange(0, h * w, w))
-    ends = np.append(starts[1:] - 1, h * w - 1)   # a run ends where the next one starts
-    return starts, ends, flat[starts]
+    # run starts: every row's first pixel, and where the label changes along a row
+    change = np.empty((h, w), dtype=bool)
+    change[:, 0] = True
+    np.not_equal(labels[:, 1:], labels[:, :-1], out=change[:, 1:])
+    starts = np.flatnonzero(change)
+    ends = np.empty_like(starts)
+    ends[:-1] = starts[1:] - 1   # a run ends where the next one starts
+    ends[-1] = h * w - 1
+    return starts, ends, labels.ravel()[starts]
 
 
 def _run_boxes(runs: tuple[np.ndarray, np.ndarray, np.ndarray], w: int, n: int) -> np.ndarray:

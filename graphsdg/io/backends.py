@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import inspect
+import itertools
 import os
 import re
 import threading
@@ -140,6 +141,18 @@ def _check_writable(path: str) -> None:
 
 _counter_lock = threading.Lock()
 _written = {"files": 0, "bytes": 0}
+_folders_made: set[str] = set()
+_temp_serial = itertools.count()
+_process_token = (-1, "")
+
+
+def _temp_token() -> str:
+    """A name part no other write (thread, process, or host sharing the folder) uses at the same time:
+    a random token per process (made again after a fork) and a serial number."""
+    global _process_token
+    if _process_token[0] != os.getpid():
+        _process_token = (os.getpid(), uuid.uuid4().hex[:10])
+    return f"{_process_token[1]}{next(_temp_serial)}"
 
 
 def files_written() -> int:
@@ -204,11 +217,18 @@ def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
     if writes_discarded():
         return
     directory = os.path.dirname(full_path)
-    os.makedirs(directory, exist_ok=True)
-    tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{uuid.uuid4().hex[:12]}.tmp")
+    if directory not in _folders_made:   # one makedirs per folder, not per file
+        os.makedirs(directory, exist_ok=True)
+        _folders_made.add(directory)
+    tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{_temp_token()}.tmp")
     durable = bool(settings.get("/graphsdg/io/fsync", False))
     try:
-        with open(tmp, "wb") as f:
+        try:
+            f = open(tmp, "wb")
+        except FileNotFoundError:   # the folder was removed since: make it again
+            os.makedirs(directory, exist_ok=True)
+            f = open(tmp, "wb")
+        with f:
             f.write(data)
             if durable:
                 f.flush()

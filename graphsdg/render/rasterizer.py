@@ -40,7 +40,8 @@ import numpy as np
 
 from graphsdg import profiling
 from graphsdg.render.camera import CameraView
-from graphsdg.render.readback import PendingPixels, PixelReads
+from graphsdg.render.lookup import lookup
+from graphsdg.render.readback import PixelReads
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
 
@@ -291,7 +292,7 @@ class Rasterizer:
             if "segmentation" in passes:
                 out.put("id_codes", codes)
                 out.id_lut = lut
-                out.put("geom_ids", lambda: lut[out.id_codes])
+                out.put("geom_ids", lambda: lookup(lut, out.id_codes))
             out.put("depth", depth)
         if not defer:
             out.finish()
@@ -313,14 +314,14 @@ class Rasterizer:
         with profiling.timed("render:color"):
             mujoco.mjr_render(rect, scene, ctx)
         with profiling.timed("readback:color"):
-            pixels = self._reads.read_color(ctx, w, h)
-            raw = self._reads.read_depth(ctx, w, h) if want_depth else None
+            pixels = self._reads.read_color(ctx, w, h, opaque=subframes == 1)
+            raw = self._reads.read_depth(ctx, w, h, _depth_decoder(sim.model, view)) if want_depth else None
         self.stats["color"] += 1
         if raw is not None:
-            out.put("depth", _depth_decoder(raw, sim.model, view))
+            out.put("depth", raw.result)
         if subframes == 1:
             if want_color:
-                out.put("color", lambda: _opaque(pixels.result()))
+                out.put("color", pixels.result)
             if want_linear:
                 out.put("hdr", lambda: pixels.result()[..., :3].astype(np.float32) / np.float32(255))
             return
@@ -358,19 +359,18 @@ class Rasterizer:
             with single_sample(ctx):
                 with profiling.timed(f"render:{kind}"):
                     mujoco.mjr_render(rect, scene, ctx)
+                lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
+                bits = _code_bits(len(lut))
                 with profiling.timed(f"readback:{kind}"):
-                    ids = self._reads.read_color(ctx, w, h)
-                    raw = self._reads.read_depth(ctx, w, h) if with_depth else None
+                    codes = self._reads.read_codes(ctx, w, h, bits, _id_codes_of_rgba(len(lut)) if bits == 24
+                                                   else _copy_codes)
+                    raw = self._reads.read_depth(ctx, w, h, _depth_decoder(sim.model, view)) if with_depth \
+                        else None
         finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
             flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         self.stats[kind] += 1
-        lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
-
-        def codes() -> np.ndarray:
-            with profiling.timed("decode:ids"):
-                return _id_codes(ids.result(), len(lut))
-        return codes, lut, (_depth_decoder(raw, sim.model, view) if raw is not None else None)
+        return codes.result, lut, (raw.result if raw is not None else None)
 
     def render_isolated(self, sim: SimScene, view: CameraView, geoms: Sequence[int], crop: Crop) -> np.ndarray:
         """Geom ids (H', W') of the ``crop`` of ``view`` with only ``geoms`` drawn (-1 elsewhere).
@@ -391,7 +391,7 @@ class Rasterizer:
         try:
             group[~keep] = HIDDEN_GROUP
             codes, lut, _ = self._render_ids(sim, view, (x0, y0, x1, y1), with_depth=False)
-            return lut[codes()]
+            return lookup(lut, codes())
         finally:
             group[:] = saved
 
@@ -434,35 +434,40 @@ def effective_far(model: mujoco.MjModel, view: CameraView) -> float:
 
 def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
                      orthographic: bool = False) -> np.ndarray:
-    """Reversed-Z window depth -> planar z (the algebra of ``mujoco.Renderer``); beyond ``clip`` -> inf."""
+    """Reversed-Z window depth -> planar z (the algebra of ``mujoco.Renderer``); beyond ``clip`` -> inf.
+
+    A new array, computed in place after the first operation (``raw`` may be a
+    strided view of a mapped pixel buffer: it is read once per operation).
+    """
     if orthographic:   # window depth is linear: 1 at near, 0 at far
         lin = (far - raw.astype(np.float64) * (far - near)).astype(np.float32)
         lin[(raw <= 0.0) | (lin > clip)] = np.inf
         return lin
     # Reversed Z: window depth w = near * (far - z) / (z * (far - near)), so z = near * far / (w * (far - near) + near).
     # In float32 the relative error stays ~1e-7 (w itself is a float32 read from GL).
+    lin = np.multiply(raw, np.float32(far - near))
+    lin += np.float32(near)
     with np.errstate(divide="ignore"):
-        lin = np.float32(near * far) / (raw * np.float32(far - near) + np.float32(near))
-    lin[(raw <= 0.0) | (lin > clip)] = np.inf   # nothing drawn, or the sky
+        np.divide(np.float32(near * far), lin, out=lin)
+    # nothing drawn (w = 0 gives z = far, beyond clip) or the sky
+    np.putmask(lin, lin > np.float32(clip), np.float32(np.inf))
     return lin
 
 
-def _opaque(rgba: np.ndarray) -> np.ndarray:
-    """The colour read back with alpha 255 (blending leaves other values in the buffer's alpha)."""
-    rgba[..., 3] = 255
-    return rgba
-
-
-def _depth_decoder(raw: PendingPixels, model: mujoco.MjModel, view: CameraView) -> Callable[[], np.ndarray]:
-    """Finisher of a depth read: planar z, top row first (the projection of this render, taken now)."""
+def _depth_decoder(model: mujoco.MjModel, view: CameraView) -> Callable[[np.ndarray], np.ndarray]:
+    """Window depths (top row first) -> planar z, with the projection of this render, taken now."""
     far = effective_far(model, view)
     near, orthographic = view.near, view.projection == "orthographic"
-    return lambda: _linearize_depth(raw.result(), near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
+    return lambda raw: _linearize_depth(raw, near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
 
 
 def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
-    """MuJoCo's id colours (segid + 1) -> geom id for the geoms of ``scene`` now; -1 for anything else."""
-    size = 1 << 16 if scene.ngeom + 1 < (1 << 16) else scene.ngeom + 2
+    """MuJoCo's id colours (segid + 1) -> geom id for the geoms of ``scene`` now; -1 for anything else.
+
+    Sized 2^8 or 2^16 when the codes (1..ngeom, 0 the background) fit in those
+    bits, so every code read back indexes it.
+    """
+    size = next((1 << b for b in (8, 16) if scene.ngeom < (1 << b)), scene.ngeom + 2)
     lut = np.full(size, -1, dtype=np.int32)
     geom_obj = int(mujoco.mjtObj.mjOBJ_GEOM)   # an int: comparing with the enum costs microseconds per geom
     for g in scene.geoms[:scene.ngeom]:
@@ -471,9 +476,16 @@ def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
     return lut
 
 
-def _id_codes(rgba: np.ndarray, size: int) -> np.ndarray:
-    """Id colours as read (RGBA) -> codes (segid + 1) < ``size``."""
-    if size == 1 << 16:
-        # Ids fit in red + green: each pixel's first two bytes are one little-endian uint16, read in place.
-        return np.ascontiguousarray(rgba.view(np.uint16)[..., 0])
-    return np.minimum(rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), np.uint32(size - 1))
+def _code_bits(size: int) -> int:
+    """The bits of id colour that carry codes below ``size`` (8, 16, or 24: MuJoCo's whole RGB)."""
+    return next(b for b in (8, 16, 24) if size <= 1 << b or b == 24)
+
+
+def _copy_codes(codes: np.ndarray) -> np.ndarray:
+    return codes.copy()
+
+
+def _id_codes_of_rgba(size: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Id colours read as RGBA -> codes (segid + 1), clipped below ``size``."""
+    return lambda rgba: np.minimum(np.ascontiguousarray(rgba).view(np.uint32)[..., 0] & np.uint32(0xFFFFFF),
+                                   np.uint32(size - 1))

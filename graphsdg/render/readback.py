@@ -19,6 +19,7 @@ Example (inside a current GL context, after ``mjr_render``)::
 from __future__ import annotations
 
 import ctypes
+from typing import Callable
 
 import mujoco
 import numpy as np
@@ -29,6 +30,10 @@ from graphsdg import profiling
 
 _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
     "rgba": (GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, np.uint8, 4),
+    # id colours of fewer than 2^8 / 2^16 codes: only the red / red and green bytes carry them
+    # (the driver drops the rest on the GPU; two bytes read as one little-endian uint16)
+    "red": (GL.GL_RED, GL.GL_UNSIGNED_BYTE, np.uint8, 1),
+    "red_green": (GL.GL_RG, GL.GL_UNSIGNED_BYTE, np.uint16, 1),
     "depth": (GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT, np.float32, 1),
     # MuJoCo's depth buffers are DEPTH32F_STENCIL8: read as stored (float depth, then stencil in the
     # second word), a plain copy; asking for depth alone makes NVIDIA's driver unpack it on the GPU
@@ -37,37 +42,46 @@ _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
 }
 
 
+def _copy(pixels: np.ndarray) -> np.ndarray:
+    return pixels.copy()
+
+
 class PendingPixels:
-    """One queued read; :meth:`result` maps it (once) and hands its buffer back to the pool."""
+    """One queued read; :meth:`result` maps it (once) and hands its buffer back to the pool.
+
+    ``decode`` turns the mapped pixels (a view of the buffer, top row first) into
+    the result, which must not share the buffer's memory; by default a copy.
+    Decoding straight from the mapping (depth linearised, say) saves a copy.
+    """
 
     def __init__(self, reads: "PixelReads", pbo: int, nbytes: int, shape: tuple[int, ...], dtype,
-                 view=None) -> None:
+                 decode: Callable[[np.ndarray], np.ndarray] = _copy) -> None:
         self._reads, self._pbo, self._nbytes = reads, pbo, nbytes
-        self._shape, self._dtype, self._view = shape, dtype, view
+        self._shape, self._dtype, self._decode = shape, dtype, decode
         self._array: np.ndarray | None = None
 
     def result(self) -> np.ndarray:
-        """The pixels, top row first (GL's rows run bottom-up: flipped in the one copy out of the
-        buffer); waits for the GPU if it is still copying."""
+        """The decoded pixels, top row first (GL's rows run bottom-up: flipped as they are decoded
+        out of the buffer); waits for the GPU if it is still copying."""
         if self._array is None:
             with profiling.timed("readback:map"):
-                pixels = self._map()
-            self._array = pixels if self._view is None else self._view(pixels)
+                self._array = self._map()
         return self._array
 
     def _map(self) -> np.ndarray:
-        out = np.empty(self._shape, dtype=self._dtype)
         self._reads.make_current()
         GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, self._pbo)
         pointer = GL.glMapBufferRange(GL.GL_PIXEL_PACK_BUFFER, 0, self._nbytes, GL.GL_MAP_READ_BIT)
         if not pointer:
             GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
             raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading")
-        mapped = np.frombuffer((ctypes.c_ubyte * self._nbytes).from_address(pointer), dtype=self._dtype)
-        np.copyto(out, mapped.reshape(self._shape)[::-1])
-        GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
-        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
-        self._reads.release(self._pbo, self._nbytes)
+        try:
+            mapped = np.frombuffer((ctypes.c_ubyte * self._nbytes).from_address(pointer), dtype=self._dtype)
+            out = self._decode(mapped.reshape(self._shape)[::-1])
+        finally:
+            GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
+            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+            self._reads.release(self._pbo, self._nbytes)
         return out
 
 
@@ -85,21 +99,37 @@ class PixelReads:
         self._all: list[int] = []
         self._packed_depth: bool | None = None   # the depth buffers are DEPTH32F_STENCIL8 (asked once)
 
-    def read_color(self, ctx: mujoco.MjrContext, width: int, height: int) -> PendingPixels:
-        """Queue a read of the offscreen colour buffer (resolving multisamples first)."""
-        return self._read(ctx, width, height, "rgba")
+    def read_color(self, ctx: mujoco.MjrContext, width: int, height: int, opaque: bool = False) -> PendingPixels:
+        """Queue a read of the offscreen colour buffer as RGBA (resolving multisamples first).
 
-    def read_depth(self, ctx: mujoco.MjrContext, width: int, height: int) -> PendingPixels:
-        """Queue a read of the offscreen depth buffer (window depth; single-sample buffers only)."""
+        ``opaque`` sets alpha to 255 on the GPU first (MuJoCo's blending leaves
+        other values there), instead of a pass over the pixels on the CPU.
+        """
+        return self._read(ctx, width, height, "rgba", opaque=opaque)
+
+    def read_codes(self, ctx: mujoco.MjrContext, width: int, height: int, bits: int,
+                   decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
+        """Queue a read of id colours that fit in ``bits`` (8, 16 or 24) bits: uint8, uint16 or, for
+        24, the RGBA pixels (``decode`` takes them to codes)."""
+        kinds = {8: "red", 16: "red_green", 24: "rgba"}
+        if bits not in kinds:
+            raise ValueError(f"id codes are 8, 16 or 24 bits, got {bits!r}")
+        return self._read(ctx, width, height, kinds[bits], decode)
+
+    def read_depth(self, ctx: mujoco.MjrContext, width: int, height: int,
+                   decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
+        """Queue a read of the offscreen depth buffer (window depth; single-sample buffers only);
+        ``decode`` gets the float32 (H, W) window depths, top row first."""
         if ctx.offSamples:
             raise ValueError("depth is read from a single-sample buffer; render it under single_sample()")
         if self._packed_depth is None:
             self._packed_depth = _is_depth32f_stencil8(ctx.offFBO)
         if not self._packed_depth:
-            return self._read(ctx, width, height, "depth")
-        return self._read(ctx, width, height, "depth_stencil", lambda packed: packed[..., 0])
+            return self._read(ctx, width, height, "depth", decode)
+        return self._read(ctx, width, height, "depth_stencil", lambda packed: decode(packed[..., 0]))
 
-    def _read(self, ctx: mujoco.MjrContext, width: int, height: int, kind: str, view=None) -> PendingPixels:
+    def _read(self, ctx: mujoco.MjrContext, width: int, height: int, kind: str,
+              decode: Callable[[np.ndarray], np.ndarray] = _copy, opaque: bool = False) -> PendingPixels:
         fmt, gltype, dtype, channels = _FORMATS[kind]
         nbytes = width * height * channels * np.dtype(dtype).itemsize
         source = ctx.offFBO
@@ -109,6 +139,8 @@ class PixelReads:
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
             GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
             source = ctx.offFBO_r
+        if opaque:
+            _clear_alpha(source)
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
         GL.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
         pbo = self._acquire(nbytes)
@@ -118,7 +150,7 @@ class PixelReads:
         GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # MuJoCo's own bindings back
         shape = (height, width, channels) if channels > 1 else (height, width)
-        return PendingPixels(self, pbo, nbytes, shape, dtype, view)
+        return PendingPixels(self, pbo, nbytes, shape, dtype, decode)
 
     def _acquire(self, nbytes: int) -> int:
         free = self._free.get(nbytes)
@@ -140,6 +172,18 @@ class PixelReads:
             GL.glDeleteBuffers(len(self._all), np.array(self._all, dtype=np.uint32))
         self._all.clear()
         self._free.clear()
+
+
+def _clear_alpha(fbo: int) -> None:
+    """Set framebuffer ``fbo``'s alpha to 1 everywhere, leaving its colour (and GL's clear state) as it was."""
+    GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, fbo)
+    GL.glDrawBuffer(GL.GL_COLOR_ATTACHMENT0)
+    clear = GL.glGetFloatv(GL.GL_COLOR_CLEAR_VALUE)
+    GL.glColorMask(GL.GL_FALSE, GL.GL_FALSE, GL.GL_FALSE, GL.GL_TRUE)
+    GL.glClearColor(0.0, 0.0, 0.0, 1.0)
+    GL.glClear(GL.GL_COLOR_BUFFER_BIT)
+    GL.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
+    GL.glClearColor(*(float(c) for c in clear))
 
 
 def _is_depth32f_stencil8(fbo: int) -> bool:

@@ -1,0 +1,100 @@
+"""Id passes read back at 8, 16 or 24 bits per pixel, and the per-pixel lookups through them."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import graphsdg as rep
+from graphsdg.render import rasterizer
+from graphsdg.render.lookup import lookup
+
+W, H = 96, 64
+
+
+def _two_balls_and_a_box():
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=600, parent="/World")
+    rep.functional.create.sphere(parent="/World", name="Left", position=(-1.2, 0, 0), scale=0.5,
+                                 semantics={"class": "ball"})
+    rep.functional.create.sphere(parent="/World", name="Right", position=(1.2, 0, 0), scale=0.5,
+                                 semantics={"class": "ball"})
+    rep.functional.create.cube(parent="/World", name="Box", position=(0, 1.0, 0), scale=0.8,
+                               semantics={"class": "box"})
+    cam = rep.functional.create.camera(position=(0, -5, 0), look_at=(0, 0, 0), parent="/World")
+    return rep.create.render_product(cam, (W, H))
+
+
+def _capture():
+    rp = _two_balls_and_a_box()
+    names = ("instance_segmentation", "bounding_box_2d_tight", "distance_to_image_plane")
+    anns = [rep.annotators.get(n) for n in names]
+    for a in anns:
+        a.attach(rp)
+    rep.orchestrator.step()
+    return [a.get_data() for a in anns]
+
+
+@pytest.mark.parametrize("bits", [16, 24])
+def test_wider_codes_give_the_same_ids_boxes_and_depth(monkeypatch, bits):
+    seg8, boxes8, depth8 = _capture()
+    assert rasterizer._code_bits(len(rasterizer._segid_lut(rasterizer_scene()))) == 8   # this scene reads 8 bits
+    rep.stage.new_stage()
+    monkeypatch.setattr(rasterizer, "_code_bits", lambda size: bits)
+    monkeypatch.setattr(rasterizer, "_segid_lut", _widened(rasterizer._segid_lut, bits))
+    seg, boxes, depth = _capture()
+    np.testing.assert_array_equal(seg["data"], seg8["data"])
+    np.testing.assert_array_equal(boxes["data"], boxes8["data"])
+    np.testing.assert_array_equal(depth, depth8)
+    assert len(boxes["data"]) == 3 and len(np.unique(seg["data"])) == 4   # three objects and the background
+
+
+def rasterizer_scene():
+    from graphsdg.runtime import runtime
+    return runtime().rasterizer._scene
+
+
+def _widened(segid_lut, bits):
+    """The code -> geom table padded to ``bits`` codes (a scene of that many geoms, without drawing them)."""
+    def lut(scene):
+        small = segid_lut(scene)
+        size = 1 << 16 if bits == 16 else len(small) + 300
+        out = np.full(size, -1, dtype=small.dtype)
+        out[:len(small)] = small
+        return out
+    return lut
+
+
+def test_scene_of_more_than_255_geoms_reads_16_bit_codes():
+    rep.functional.create.xform(name="World")
+    rep.functional.create.dome_light(intensity=600, parent="/World")
+    # a 20 x 15 wall of small boxes facing the camera: 300 geoms, one per cell
+    cells = [(x, z) for z in range(15) for x in range(20)]
+    boxes = rep.functional.create_batch.cube(count=len(cells), parent="/World", name="Cell",
+                                             semantics={"class": "cell"})
+    rep.functional.modify.pose(boxes, position_value=[(0.5 * x - 4.75, 0.0, 0.5 * z - 3.5) for x, z in cells],
+                               scale_value=0.4)
+    cam = rep.functional.create.camera(position=(0, -14, 0), look_at=(0, 0, 0), parent="/World")
+    rp = rep.create.render_product(cam, (200, 150))
+    tight = rep.annotators.get("bounding_box_2d_tight")
+    tight.attach(rp)
+    rep.orchestrator.step()
+    assert rasterizer._code_bits(len(rasterizer._segid_lut(rasterizer_scene()))) == 16
+    rows = tight.get_data()["data"]
+    assert len(rows) == len(cells)                            # every box seen, each its own instance
+    widths = rows["x_max"] - rows["x_min"] + 1
+    assert widths.min() >= 5 and widths.max() <= 10   # ~6.5 px cubes: none merged with a cell 256 codes away
+
+
+def test_lookup_matches_indexing_for_every_kernel():
+    rng = np.random.default_rng(0)
+    for shape in ((64, 48), (1024, 512)):             # the second passes OpenCV's threading size: split in blocks
+        codes = rng.integers(0, 200, shape).astype(np.uint8)
+        for dtype in (np.uint8, np.int32, np.uint32, np.float32, np.int64, bool):
+            table = (rng.random(200) * 100).astype(dtype)
+            out = lookup(table, codes)
+            assert out.dtype == table.dtype and np.array_equal(out, table[codes])
+    wide = rng.integers(0, 70000, (32, 16)).astype(np.uint32)
+    table = np.arange(70000, dtype=np.int32)[::-1].copy()
+    assert np.array_equal(lookup(table, wide), table[wide])
+    empty = np.zeros((0, 5), dtype=np.uint8)
+    assert lookup(np.arange(3), empty).shape == (0, 5)
