@@ -23,6 +23,7 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=100)
     parser.add_argument("--msaa", type=int)
     parser.add_argument("--shadow-size", type=int)
+    parser.add_argument("--report", metavar="MD", help="append the table to this Markdown file")
     args = parser.parse_args()
     import mujoco
     from OpenGL import GL
@@ -66,9 +67,17 @@ def main() -> None:
         rep.orchestrator.step()
     rep.orchestrator.wait_until_complete()
     total = sum(gpu_ms.values()) / config.frames
-    for name, ms in sorted(gpu_ms.items(), key=lambda kv: -kv[1]):
-        print(f"{name:45s} {ms / config.frames:7.3f} ms GPU per frame")
-    print(f"{'total':45s} {total:7.3f} ms -> at most {1000 / total:.0f} frames/s on this GPU")
+    rows = [{"pass": name, "GPU ms/frame": round(ms / config.frames, 3)}
+            for name, ms in sorted(gpu_ms.items(), key=lambda kv: -kv[1])]
+    rows.append({"pass": f"total (at most {1000 / total:.0f} frames/s on this GPU)", "GPU ms/frame": round(total, 3)})
+    quality = (f"MSAA {rep.settings.get('/graphsdg/render/msaaSamples', 4)}, "
+               f"shadow map {rep.settings.get('/graphsdg/render/shadowSize', 1024)}")
+    table = (f"#### GPU time per pass, {config.frames} frames, 512x512, {quality}\n\n"
+             f"GL: {GL.glGetString(GL.GL_RENDERER).decode()}\n\n{benchmark.format_table(rows)}\n")
+    print(table)
+    if args.report:
+        with open(args.report, "a") as f:
+            f.write(table + "\n")
 
 
 if __name__ == "__main__":
