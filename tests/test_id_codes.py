@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg.render import rasterizer
+from graphsdg.render import rasterizer, readback
 from graphsdg.render.lookup import lookup
 
 W, H = 96, 64
@@ -37,9 +37,8 @@ def _capture():
 @pytest.mark.parametrize("bits", [16, 24])
 def test_wider_codes_give_the_same_ids_boxes_and_depth(monkeypatch, bits):
     seg8, boxes8, depth8 = _capture()
-    assert rasterizer._code_bits(len(rasterizer._segid_lut(rasterizer_scene()))) == 8   # this scene reads 8 bits
+    assert readback.code_bits(len(rasterizer._segid_lut(rasterizer_scene()))) == 8   # this scene reads 8 bits
     rep.stage.new_stage()
-    monkeypatch.setattr(rasterizer, "_code_bits", lambda size: bits)
     monkeypatch.setattr(rasterizer, "_segid_lut", _widened(rasterizer._segid_lut, bits))
     seg, boxes, depth = _capture()
     np.testing.assert_array_equal(seg["data"], seg8["data"])
@@ -54,10 +53,11 @@ def rasterizer_scene():
 
 
 def _widened(segid_lut, bits):
-    """The code -> geom table padded to ``bits`` codes (a scene of that many geoms, without drawing them)."""
+    """The code -> geom table padded past 2^8 (16 bits) or 2^16 (24 bits) codes: read as if the scene had
+    that many geoms, without drawing them."""
     def lut(scene):
         small = segid_lut(scene)
-        size = 1 << 16 if bits == 16 else len(small) + 300
+        size = 1 << 16 if bits == 16 else (1 << 16) + 300
         out = np.full(size, -1, dtype=small.dtype)
         out[:len(small)] = small
         return out
@@ -78,11 +78,15 @@ def test_scene_of_more_than_255_geoms_reads_16_bit_codes():
     tight = rep.annotators.get("bounding_box_2d_tight")
     tight.attach(rp)
     rep.orchestrator.step()
-    assert rasterizer._code_bits(len(rasterizer._segid_lut(rasterizer_scene()))) == 16
+    assert readback.code_bits(len(rasterizer._segid_lut(rasterizer_scene()))) == 16
     rows = tight.get_data()["data"]
     assert len(rows) == len(cells)                            # every box seen, each its own instance
     widths = rows["x_max"] - rows["x_min"] + 1
     assert widths.min() >= 5 and widths.max() <= 10   # ~6.5 px cubes: none merged with a cell 256 codes away
+
+
+def test_code_bits():
+    assert [readback.code_bits(n) for n in (2, 256, 257, 1 << 16, (1 << 16) + 1)] == [8, 8, 16, 16, 24]
 
 
 def test_lookup_matches_indexing_for_every_kernel():

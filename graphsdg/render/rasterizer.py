@@ -360,10 +360,8 @@ class Rasterizer:
                 with profiling.timed(f"render:{kind}"):
                     mujoco.mjr_render(rect, scene, ctx)
                 lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
-                bits = _code_bits(len(lut))
                 with profiling.timed(f"readback:{kind}"):
-                    codes = self._reads.read_codes(ctx, w, h, bits, _id_codes_of_rgba(len(lut)) if bits == 24
-                                                   else _copy_codes)
+                    codes = self._reads.read_codes(ctx, w, h, len(lut))
                     raw = self._reads.read_depth(ctx, w, h, _depth_decoder(sim.model, view)) if with_depth \
                         else None
         finally:
@@ -474,18 +472,3 @@ def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
         if g.segid >= 0 and g.objtype == geom_obj:
             lut[g.segid + 1] = g.objid
     return lut
-
-
-def _code_bits(size: int) -> int:
-    """The bits of id colour that carry codes below ``size`` (8, 16, or 24: MuJoCo's whole RGB)."""
-    return next(b for b in (8, 16, 24) if size <= 1 << b or b == 24)
-
-
-def _copy_codes(codes: np.ndarray) -> np.ndarray:
-    return codes.copy()
-
-
-def _id_codes_of_rgba(size: int) -> Callable[[np.ndarray], np.ndarray]:
-    """Id colours read as RGBA -> codes (segid + 1), clipped below ``size``."""
-    return lambda rgba: np.minimum(np.ascontiguousarray(rgba).view(np.uint32)[..., 0] & np.uint32(0xFFFFFF),
-                                   np.uint32(size - 1))

@@ -107,14 +107,17 @@ class PixelReads:
         """
         return self._read(ctx, width, height, "rgba", opaque=opaque)
 
-    def read_codes(self, ctx: mujoco.MjrContext, width: int, height: int, bits: int,
-                   decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
-        """Queue a read of id colours that fit in ``bits`` (8, 16 or 24) bits: uint8, uint16 or, for
-        24, the RGBA pixels (``decode`` takes them to codes)."""
-        kinds = {8: "red", 16: "red_green", 24: "rgba"}
-        if bits not in kinds:
-            raise ValueError(f"id codes are 8, 16 or 24 bits, got {bits!r}")
-        return self._read(ctx, width, height, kinds[bits], decode)
+    def read_codes(self, ctx: mujoco.MjrContext, width: int, height: int, size: int) -> PendingPixels:
+        """Queue a read of MuJoCo's id colours (``mjRND_IDCOLOR``: segid + 1 in red, green, blue) as
+        codes below ``size``: uint8 or uint16 when they fit (one or two bytes a pixel cross the bus),
+        else uint32 from the whole colour, clipped below ``size``."""
+        bits = code_bits(size)
+        if bits == 8:
+            return self._read(ctx, width, height, "red")
+        if bits == 16:
+            return self._read(ctx, width, height, "red_green")
+        return self._read(ctx, width, height, "rgba", lambda rgba: np.minimum(
+            rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), np.uint32(size - 1)))
 
     def read_depth(self, ctx: mujoco.MjrContext, width: int, height: int,
                    decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
@@ -172,6 +175,11 @@ class PixelReads:
             GL.glDeleteBuffers(len(self._all), np.array(self._all, dtype=np.uint32))
         self._all.clear()
         self._free.clear()
+
+
+def code_bits(size: int) -> int:
+    """The bits of id colour a read must keep for codes below ``size``: 8, 16, or 24 (all of RGB)."""
+    return next(b for b in (8, 16) if size <= 1 << b) if size <= 1 << 16 else 24
 
 
 def _clear_alpha(fbo: int) -> None:
