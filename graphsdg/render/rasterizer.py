@@ -213,14 +213,17 @@ class Rasterizer:
 
     # ---- one render ----------------------------------------------------
     def _update_scene(self, sim: SimScene, view: CameraView, jitter: tuple[float, float],
-                      crop: Crop | None = None) -> None:
+                      crop: Crop | None = None) -> float:
+        """Fill the scene for one render of ``view``; returns the far plane used (see :func:`effective_far`)."""
         scene = self._scene
-        assert scene is not None
-        far = effective_far(sim.model, view)
+        assert scene is not None and self._mjr is not None
+        center, radius = geometry_bounds(sim.model, sim.data)
+        far = effective_far(center, radius, view)
         mujoco.mjv_updateScene(sim.model, sim.data, self._option, None, self._camera,
                                mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
         if sim.mesh_maps:
             self._draw_rescaled_meshes(sim, scene)
+        self._fit_directional_shadows(scene, center, radius)
         left, right, bottom, top = view.frustum_window(crop, jitter)
         forward = -view.rotation[:, 2]
         up = view.rotation[:, 1]
@@ -237,6 +240,28 @@ class Rasterizer:
             cam.frustum_far = SKY_FAR_FACTOR * far
             cam.orthographic = 1 if view.projection == "orthographic" else 0
         scene.enabletransform = 0
+        return far
+
+    def _fit_directional_shadows(self, scene: mujoco.MjvScene, center: np.ndarray, radius: float) -> None:
+        """Aim every shadow-casting directional light's shadow map at the geometry as it is now.
+
+        MuJoCo draws a directional light's shadow map as a box of half-width
+        ``MjrContext.shadowClip`` around the light's position, fixed when the context
+        is made (from the model's extent at compile time); geometry that moved out
+        of it since (randomized poses are written straight into MuJoCo) would cast
+        no shadow. Each render puts the light up-light of the current bounding
+        sphere and sizes the box to it.
+        """
+        assert self._mjr is not None
+        directional = int(mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+        fitted = False
+        for light in scene.lights[:scene.nlight]:
+            if light.castshadow and int(light.type) == directional:
+                d = np.asarray(light.dir, dtype=np.float64)
+                light.pos[:] = center - 2.0 * radius * d / max(float(np.linalg.norm(d)), 1e-12)
+                fitted = True
+        if fitted:
+            self._mjr.shadowClip = radius
 
     def _draw_rescaled_meshes(self, sim: SimScene, scene: mujoco.MjvScene) -> None:
         """Fold meshes rescaled since their upload into their scene geoms' matrices.
@@ -310,12 +335,12 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
-        self._update_scene(sim, view, (0.0, 0.0))
+        far = self._update_scene(sim, view, (0.0, 0.0))
         with profiling.timed("render:color"):
             mujoco.mjr_render(rect, scene, ctx)
         with profiling.timed("readback:color"):
             pixels = self._reads.read_color(ctx, w, h, opaque=subframes == 1)
-            raw = self._reads.read_depth(ctx, w, h, _depth_decoder(sim.model, view)) if want_depth else None
+            raw = self._reads.read_depth(ctx, w, h, _depth_decoder(far, view)) if want_depth else None
         self.stats["color"] += 1
         if raw is not None:
             out.put("depth", raw.result)
@@ -354,7 +379,7 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
         try:
-            self._update_scene(sim, view, (0.0, 0.0), crop)
+            far = self._update_scene(sim, view, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
             with single_sample(ctx):
                 with profiling.timed(f"render:{kind}"):
@@ -362,7 +387,7 @@ class Rasterizer:
                 lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
                 with profiling.timed(f"readback:{kind}"):
                     codes = self._reads.read_codes(ctx, w, h, len(lut))
-                    raw = self._reads.read_depth(ctx, w, h, _depth_decoder(sim.model, view)) if with_depth \
+                    raw = self._reads.read_depth(ctx, w, h, _depth_decoder(far, view)) if with_depth \
                         else None
         finally:
             flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
@@ -419,14 +444,32 @@ def single_sample(ctx: mujoco.MjrContext) -> Iterator[None]:
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)
 
 
-def effective_far(model: mujoco.MjModel, view: CameraView) -> float:
-    """The far plane actually used: the camera's, tightened to just beyond the scene.
+def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, float]:
+    """(centre, radius) of a sphere around every drawn, bounded geom where it is now.
 
-    MuJoCo fits directional shadow maps to the view frustum and draws the skybox at
-    ~0.6-0.7 of the far plane. A tight far plane (the scene's bounding sphere plus
-    margin) keeps shadows sharp; rendering to twice it keeps the sky behind all geometry.
+    Poses written since the compile (randomization, physics) move geoms away
+    from the model's compile-time ``stat.center`` / ``stat.extent``, which are
+    the fallback when no geom is bounded (planes alone).
     """
-    reach = float(np.linalg.norm(view.position - model.stat.center)) + 4.0 * float(model.stat.extent)
+    radii = np.asarray(model.geom_rbound)
+    group = np.asarray(model.geom_group)
+    bounded = (radii > 0) & (group != HIDDEN_GROUP) & (group != COLLISION_ONLY_GROUP)
+    if not bounded.any():
+        return np.asarray(model.stat.center, dtype=np.float64), float(model.stat.extent)
+    pos, r = np.asarray(data.geom_xpos)[bounded], radii[bounded][:, None]
+    center = 0.5 * ((pos - r).min(axis=0) + (pos + r).max(axis=0))
+    return center, float((np.linalg.norm(pos - center, axis=1) + r[:, 0]).max())
+
+
+def effective_far(center: np.ndarray, radius: float, view: CameraView) -> float:
+    """The far plane actually used: the camera's, tightened to just beyond the geometry.
+
+    MuJoCo's shadow maps take their depth range from the camera's frustum and its
+    skybox is drawn at ~0.6-0.7 of the far plane. A tight far plane (the
+    geometry's bounding sphere, from :func:`geometry_bounds`, plus margin) keeps
+    shadows sharp; rendering to twice it keeps the sky behind all geometry.
+    """
+    reach = float(np.linalg.norm(view.position - center)) + 4.0 * float(radius)
     return max(min(view.far, reach), view.near * 10)
 
 
@@ -452,9 +495,8 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
     return lin
 
 
-def _depth_decoder(model: mujoco.MjModel, view: CameraView) -> Callable[[np.ndarray], np.ndarray]:
-    """Window depths (top row first) -> planar z, with the projection of this render, taken now."""
-    far = effective_far(model, view)
+def _depth_decoder(far: float, view: CameraView) -> Callable[[np.ndarray], np.ndarray]:
+    """Window depths (top row first) -> planar z, for a render of ``view`` with far plane ``far``."""
     near, orthographic = view.near, view.projection == "orthographic"
     return lambda raw: _linearize_depth(raw, near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
 
