@@ -472,3 +472,21 @@ def test_validate_reports_an_unfinished_run(tmp_path):
     found = [str(v) for v in validate(str(tmp_path / "out")) if "did not finish" in str(v)]
     assert found == ["-: [complete] the run that wrote this folder did not finish (graphsdg_run.json: BasicWriter "
                      "exited, complete frames 0-2); resume or rerun it"]
+
+
+def test_temporaries_of_interrupted_writes_are_recognised_and_removed(tmp_path, monkeypatch):
+    from graphsdg.io import backends
+
+    def die_before_rename(src, dst):
+        raise KeyboardInterrupt   # the process stops between writing the temporary and renaming it
+    monkeypatch.setattr(backends.os, "replace", die_before_rename)
+    monkeypatch.setattr(backends.os, "unlink", lambda path: None)   # and never gets to clean up
+    with contextlib.suppress(KeyboardInterrupt):
+        backends.write_file_atomic(str(tmp_path / "rgb_0007.png"), b"pixels")
+    monkeypatch.undo()
+    left = os.listdir(tmp_path)
+    assert len(left) == 1 and left[0].startswith(".rgb_0007.png.") and left[0].endswith(".tmp")
+    (tmp_path / "notes.tmp").write_text("a user's file")               # not ours: kept
+    (tmp_path / ".rgb_0001.png.0123456789ab.tmp").write_bytes(b"x")    # an earlier build's temporary
+    assert backends.remove_temporaries(str(tmp_path)) == 2
+    assert os.listdir(tmp_path) == ["notes.tmp"]

@@ -164,7 +164,8 @@ def bytes_written() -> int:
     return _written["bytes"]
 
 
-_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{12}\.tmp$")
+# ".<file name>.<token>.tmp": a 10-hex-digit process token and a serial (earlier builds: 12 hex digits)
+_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{10,}\.tmp$")
 
 
 def remove_temporaries(output_dir: str) -> int:
