@@ -130,3 +130,24 @@ def test_saving_over_the_builtin_pack_is_refused(tmp_path):
         rep.stage.save()
     copy = rep.stage.save(str(tmp_path / "copy.usda"))
     assert os.path.getsize(copy) > 100
+
+
+def test_direct_writes_on_a_new_stage_never_reuse_the_previous_stages_indices():
+    """A new stage's scene may get the freed scene's id(); cached geom indices must not carry over."""
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", True)
+    first = [rep.functional.create.cube(name="A"), rep.functional.create.sphere(name="B")]
+    rep.functional.modify.pose(first, position_value=[(1, 0, 0), (2, 0, 0)])   # caches the indices
+    versions = {runtime().sim.model_version}
+    for _ in range(5):
+        rep.stage.new_stage()
+        rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", True)
+        # the same paths, made in the other order: other geom and mocap indices
+        b = rep.functional.create.sphere(name="B")
+        a = rep.functional.create.cube(name="A")
+        rep.functional.modify.pose([a, b], position_value=[(3, 0, 0), (4, 0, 0)])
+        sim = runtime().sim
+        versions.add(sim.model_version)
+        for prim, x in ((a, 3.0), (b, 4.0)):
+            body = sim.compiled.geoms[str(prim.GetPath())].body_id
+            assert sim.data.xpos[body][0] == x
+    assert len(versions) == 6          # every scene's compile is told apart, whatever its id()

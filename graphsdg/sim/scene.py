@@ -19,6 +19,7 @@ implement the timeline's stop (bodies return to where they were at play).
 """
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from typing import Callable
@@ -46,6 +47,8 @@ class NeedsRecompile(Exception):
 ALL_ASPECTS = frozenset({"pose", "shape", "visibility", "material", "color"})
 # Aspects an ancestor's edit passes down to the gprims below it.
 INHERITED_ASPECTS = frozenset({"pose", "visibility", "material"})
+_model_versions = itertools.count()
+
 _SHAPE_ATTRS = {"size", "radius", "height", "width", "length", "axis", "points", "faceVertexCounts",
                 "faceVertexIndices", "extent", "orientation", "primvars:st"}
 
@@ -79,7 +82,9 @@ class SimScene:
         self.tracker = tracker
         self.compiled: CompiledScene | None = None
         self.offscreen = (64, 64)
-        self.model_version = 0              # bumps on every recompile (renderers rebuild contexts)
+        # changes on every recompile (renderers rebuild contexts); drawn from one process-wide counter so
+        # that (id(sim), model_version) keys stay unique when a freed scene's id is reused by a new one
+        self.model_version = next(_model_versions)
         self.labels_version = 0             # bumps when semantic labels may have changed
         self.textures_to_upload: set[int] = set()
         # mesh id -> 3x3 map from the compiled vertices to the current ones, for meshes rescaled in
@@ -114,7 +119,7 @@ class SimScene:
             if self.compiled is not None:
                 self.compiled.model.vis.global_.offwidth = w
                 self.compiled.model.vis.global_.offheight = h
-                self.model_version += 1
+                self.model_version = next(_model_versions)
 
     def rescale_mesh(self, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> None:
         """Rescale visual mesh geom ``geom_id`` in place and record the map for renderers."""
@@ -131,7 +136,7 @@ class SimScene:
             carry_state(old, new)
             mujoco.mj_forward(new.model, new.data)
         self.compiled = new
-        self.model_version += 1
+        self.model_version = next(_model_versions)
         self.labels_version += 1
         self.textures_to_upload.clear()
         self.mesh_maps.clear()
