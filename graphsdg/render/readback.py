@@ -46,6 +46,16 @@ def _copy(pixels: np.ndarray) -> np.ndarray:
     return pixels.copy()
 
 
+_ALPHA_BITS = np.array([0, 0, 0, 255], dtype=np.uint8).view(np.uint32)[0]   # alpha of one RGBA pixel as a word
+
+
+def _opaque_copy(rgba: np.ndarray) -> np.ndarray:
+    """A copy of RGBA pixels with alpha 255, in the one pass of the copy (each pixel ORed as a 32-bit word)."""
+    out = np.empty(rgba.shape, dtype=np.uint8)
+    np.bitwise_or(rgba.view(np.uint32), _ALPHA_BITS, out=out.view(np.uint32))
+    return out
+
+
 class PendingPixels:
     """One queued read; :meth:`result` maps it (once) and hands its buffer back to the pool.
 
@@ -102,10 +112,11 @@ class PixelReads:
     def read_color(self, ctx: mujoco.MjrContext, width: int, height: int, opaque: bool = False) -> PendingPixels:
         """Queue a read of the offscreen colour buffer as RGBA (resolving multisamples first).
 
-        ``opaque`` sets alpha to 255 on the GPU first (MuJoCo's blending leaves
-        other values there), instead of a pass over the pixels on the CPU.
+        ``opaque`` sets alpha to 255 (MuJoCo's blending leaves other values there)
+        as the pixels are copied out of the buffer, at no extra pass. (Clearing
+        alpha on the GPU instead cost 4 ms per 1280x720 frame on Mesa's llvmpipe.)
         """
-        return self._read(ctx, width, height, "rgba", opaque=opaque)
+        return self._read(ctx, width, height, "rgba", _opaque_copy if opaque else _copy)
 
     def read_codes(self, ctx: mujoco.MjrContext, width: int, height: int, size: int) -> PendingPixels:
         """Queue a read of MuJoCo's id colours (``mjRND_IDCOLOR``: segid + 1 in red, green, blue) as
@@ -132,7 +143,7 @@ class PixelReads:
         return self._read(ctx, width, height, "depth_stencil", lambda packed: decode(packed[..., 0]))
 
     def _read(self, ctx: mujoco.MjrContext, width: int, height: int, kind: str,
-              decode: Callable[[np.ndarray], np.ndarray] = _copy, opaque: bool = False) -> PendingPixels:
+              decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
         fmt, gltype, dtype, channels = _FORMATS[kind]
         nbytes = width * height * channels * np.dtype(dtype).itemsize
         source = ctx.offFBO
@@ -142,8 +153,6 @@ class PixelReads:
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
             GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
             source = ctx.offFBO_r
-        if opaque:
-            _clear_alpha(source)
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
         GL.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
         pbo = self._acquire(nbytes)
@@ -180,18 +189,6 @@ class PixelReads:
 def code_bits(size: int) -> int:
     """The bits of id colour a read must keep for codes below ``size``: 8, 16, or 24 (all of RGB)."""
     return next(b for b in (8, 16) if size <= 1 << b) if size <= 1 << 16 else 24
-
-
-def _clear_alpha(fbo: int) -> None:
-    """Set framebuffer ``fbo``'s alpha to 1 everywhere, leaving its colour (and GL's clear state) as it was."""
-    GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, fbo)
-    GL.glDrawBuffer(GL.GL_COLOR_ATTACHMENT0)
-    clear = GL.glGetFloatv(GL.GL_COLOR_CLEAR_VALUE)
-    GL.glColorMask(GL.GL_FALSE, GL.GL_FALSE, GL.GL_FALSE, GL.GL_TRUE)
-    GL.glClearColor(0.0, 0.0, 0.0, 1.0)
-    GL.glClear(GL.GL_COLOR_BUFFER_BIT)
-    GL.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
-    GL.glClearColor(*(float(c) for c in clear))
 
 
 def _is_depth32f_stencil8(fbo: int) -> bool:
