@@ -1,6 +1,7 @@
 """graphsdg graph / view (all formats) / run --workers (Ray) / run --resume, and the CLI's exit codes."""
 from __future__ import annotations
 
+import io
 import json
 import os
 import signal
@@ -197,15 +198,32 @@ def test_resume_after_sigkill_writes_the_uninterrupted_dataset(job_script, tmp_p
     written = len([n for n in os.listdir(cut / "basic") if n.startswith("rgb_")])
     assert 32 <= written < frames, "the run was not killed mid-way"
     first = os.stat(cut / "basic" / "rgb_0000.png").st_mtime_ns
+    killed = _datasets(cut)     # what the killed run left, to tell who wrote a file that differs
     capsys.readouterr()
     assert main(["run", job_script, "--seed", "9", "--frames", str(frames), "--out", str(cut), "--resume"]) == 0
     rep.orchestrator.wait_until_complete()
     redone = int(capsys.readouterr().out.split("graphsdg run: ")[-1].split(" frames")[0])
     full, resumed = _datasets(tmp_path / "full"), _datasets(cut)
     assert sorted(full) == sorted(resumed)
-    assert [k for k in full if full[k] != resumed[k]] == []
+    differing = [k for k in full if full[k] != resumed[k]]
+    assert differing == [], _explain(differing, full, resumed, killed, redone, written)
     assert redone <= frames - 25                       # frames complete on disk were not captured again
     assert os.stat(cut / "basic" / "rgb_0000.png").st_mtime_ns == first
+
+
+def _explain(keys, full, resumed, killed, redone, written) -> str:
+    """Who wrote each differing file and, for images, where they differ (for a failure report)."""
+    lines = [f"killed after {written} rgb files; the resumed run captured {redone} frames"]
+    for k in keys:
+        line = f"{k}: killed run wrote it: {k in killed}, kept from it: {killed.get(k) == resumed[k]}"
+        if k.endswith(".png"):
+            a, b = (np.array(Image.open(io.BytesIO(d))) for d in (full[k], resumed[k]))
+            if a.shape == b.shape:
+                where = np.argwhere((a != b).reshape(a.shape[0], a.shape[1], -1).any(-1))
+                line += f"; {len(where)} pixels differ, first at {where[:3].tolist()}: " \
+                        f"{a[tuple(where[0])].tolist()} vs {b[tuple(where[0])].tolist()}" if len(where) else ""
+        lines.append(line)
+    return "\n".join(lines)
 
 
 def test_resume_refuses_another_job(job_script, tmp_path, capsys):
