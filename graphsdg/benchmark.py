@@ -374,8 +374,8 @@ def _steady_rate(results: list[dict]) -> float:
     hi = min(r["start"] + r["wall"] for r in results)
     if hi <= lo:
         return float("nan")
-    done = sum(int(np.count_nonzero((np.asarray(r["frame_ends"]) > lo) & (np.asarray(r["frame_ends"]) <= hi)))
-               for r in results)
+    ends = [np.asarray(r["frame_ends"]) for r in results]
+    done = sum(int(np.count_nonzero((e > lo) & (e <= hi))) for e in ends)
     return done / (hi - lo)
 
 

@@ -212,18 +212,20 @@ class Rasterizer:
             self._gl = None
 
     # ---- one render ----------------------------------------------------
-    def _update_scene(self, sim: SimScene, view: CameraView, jitter: tuple[float, float],
-                      crop: Crop | None = None) -> float:
-        """Fill the scene for one render of ``view``; returns the far plane used (see :func:`effective_far`)."""
+    def _update_scene(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float],
+                      jitter: tuple[float, float], crop: Crop | None = None) -> float:
+        """Fill the scene for one render of ``view`` with the geometry inside ``bounds`` (from
+        :func:`geometry_bounds`); returns the far plane used (see :func:`effective_far`)."""
         scene = self._scene
         assert scene is not None and self._mjr is not None
-        center, radius = geometry_bounds(sim.model, sim.data)
+        center, radius = bounds
         far = effective_far(center, radius, view)
         mujoco.mjv_updateScene(sim.model, sim.data, self._option, None, self._camera,
                                mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
         if sim.mesh_maps:
             self._draw_rescaled_meshes(sim, scene)
-        self._fit_directional_shadows(scene, center, radius)
+        if scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW]:
+            self._fit_directional_shadows(scene, center, radius)
         left, right, bottom, top = view.frustum_window(crop, jitter)
         forward = -view.rotation[:, 2]
         up = view.rotation[:, 1]
@@ -303,6 +305,7 @@ class Rasterizer:
             raise ValueError(f"resolution {view.width}x{view.height} exceeds the offscreen buffer "
                              f"{model.vis.global_.offwidth}x{model.vis.global_.offheight}")
         out = RenderOutputs()
+        bounds = geometry_bounds(model, sim.data)   # one state for all of this render's passes
         colour = "color" in passes or "hdr" in passes
         # Without MSAA the colour pass's depth buffer is sampled at pixel centres, so colour and
         # depth come from one render; with MSAA it holds an off-centre sample, so depth is read
@@ -310,10 +313,10 @@ class Rasterizer:
         depth_with_colour = colour and "depth" in passes and "segmentation" not in passes and \
             int(model.vis.quality.offsamples) == 0
         if colour:
-            self._render_color(sim, view, subframes, out, want_color="color" in passes,
+            self._render_color(sim, view, bounds, subframes, out, want_color="color" in passes,
                                want_linear="hdr" in passes, want_depth=depth_with_colour)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
-            codes, lut, depth = self._render_ids(sim, view, None, with_depth="depth" in passes)
+            codes, lut, depth = self._render_ids(sim, view, bounds, None, with_depth="depth" in passes)
             if "segmentation" in passes:
                 out.put("id_codes", codes)
                 out.id_lut = lut
@@ -324,8 +327,8 @@ class Rasterizer:
         out.render_isolated = lambda geoms, crop: self.render_isolated(sim, view, geoms, crop)
         return out
 
-    def _render_color(self, sim: SimScene, view: CameraView, subframes: int, out: RenderOutputs,
-                      want_color: bool, want_linear: bool, want_depth: bool) -> None:
+    def _render_color(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], subframes: int,
+                      out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool) -> None:
         assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         w, h = view.width, view.height
@@ -335,7 +338,7 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
-        far = self._update_scene(sim, view, (0.0, 0.0))
+        far = self._update_scene(sim, view, bounds, (0.0, 0.0))
         with profiling.timed("render:color"):
             mujoco.mjr_render(rect, scene, ctx)
         with profiling.timed("readback:color"):
@@ -352,7 +355,7 @@ class Rasterizer:
             return
         acc = pixels.result()[..., :3].astype(np.float32)
         for jit in jitter_offsets(subframes)[1:]:
-            self._update_scene(sim, view, jit)
+            self._update_scene(sim, view, bounds, jit)
             mujoco.mjr_render(rect, scene, ctx)
             acc += self._reads.read_color(ctx, w, h).result()[..., :3]
             self.stats["color"] += 1
@@ -364,8 +367,8 @@ class Rasterizer:
         if want_linear:
             out.put("hdr", mean / np.float32(255))
 
-    def _render_ids(self, sim: SimScene, view: CameraView, crop: Crop | None, with_depth: bool
-                    ) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:
+    def _render_ids(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], crop: Crop | None,
+                    with_depth: bool) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:
         """Id codes (a finisher), their code -> geom id table, and a depth finisher, of the view or a
         crop of it, top row first."""
         assert self._scene is not None and self._mjr is not None and self._reads is not None
@@ -379,7 +382,7 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
         try:
-            far = self._update_scene(sim, view, (0.0, 0.0), crop)
+            far = self._update_scene(sim, view, bounds, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
             with single_sample(ctx):
                 with profiling.timed(f"render:{kind}"):
@@ -413,7 +416,8 @@ class Rasterizer:
         keep[np.asarray(list(geoms), dtype=np.int64)] = True
         try:
             group[~keep] = HIDDEN_GROUP
-            codes, lut, _ = self._render_ids(sim, view, (x0, y0, x1, y1), with_depth=False)
+            codes, lut, _ = self._render_ids(sim, view, geometry_bounds(model, sim.data), (x0, y0, x1, y1),
+                                             with_depth=False)
             return lookup(lut, codes())
         finally:
             group[:] = saved
