@@ -41,6 +41,7 @@ import numpy as np
 from graphsdg import profiling
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
+from graphsdg.render import sky
 from graphsdg.render.readback import PixelReads
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
@@ -48,6 +49,7 @@ from graphsdg.sim.scene import SimScene
 PASSES = ("color", "hdr", "depth", "segmentation")
 Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)
 SKY_FAR_FACTOR = 2.0
+UNDRAWN_GROUPS = (HIDDEN_GROUP, COLLISION_ONLY_GROUP)
 
 
 class RenderOutputs:
@@ -160,7 +162,9 @@ class Rasterizer:
         # inverse of SimScene.mesh_maps when the meshes were uploaded (a mesh absent: identity)
         self._uploaded_inverse: dict[int, np.ndarray] = {}
         self._reads: PixelReads | None = None
+        self._flat_sky: tuple[float, float, float] | None = None   # the skybox's colour when uniform
         self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
+        self.skies_composited = 0           # colour renders whose one-colour sky was blended in (no skybox draw)
 
     # ---- contexts ------------------------------------------------------
     def _ensure_gl(self) -> None:
@@ -193,10 +197,12 @@ class Rasterizer:
             self._version = sim.model_version
             self._model = model
             self._uploaded_inverse = {mid: np.linalg.inv(m) for mid, m in sim.mesh_maps.items()}
+            self._flat_sky = sky.uniform_sky(model)
         if sim.textures_to_upload:
             for tid in sorted(sim.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
             sim.textures_to_upload.clear()
+            self._flat_sky = sky.uniform_sky(model)
 
     def close(self) -> None:
         if self._gl is not None:
@@ -336,13 +342,17 @@ class Rasterizer:
         flags = scene.flags
         flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
-        flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 1
+        # a one-colour sky is blended under the resolved frame, cheaper than MuJoCo's skybox draw
+        background = self._flat_sky if self._flat_sky is not None and sky.composites_exactly(sim.model, UNDRAWN_GROUPS) else None
+        flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = background is None
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
+        if background is not None:
+            self.skies_composited += 1
         far = self._update_scene(sim, view, bounds, (0.0, 0.0))
         with profiling.timed("render:color"):
             mujoco.mjr_render(rect, scene, ctx)
         with profiling.timed("readback:color"):
-            pixels = self._reads.read_color(ctx, w, h, opaque=subframes == 1)
+            pixels = self._reads.read_color(ctx, w, h, opaque=subframes == 1, background=background)
             raw = self._reads.read_depth(ctx, w, h, _depth_decoder(far, view)) if want_depth else None
         self.stats["color"] += 1
         if raw is not None:
@@ -357,7 +367,7 @@ class Rasterizer:
         for jit in jitter_offsets(subframes)[1:]:
             self._update_scene(sim, view, bounds, jit)
             mujoco.mjr_render(rect, scene, ctx)
-            acc += self._reads.read_color(ctx, w, h).result()[..., :3]
+            acc += self._reads.read_color(ctx, w, h, background=background).result()[..., :3]
             self.stats["color"] += 1
         mean = acc / subframes
         if want_color:
