@@ -64,7 +64,7 @@ class BenchConfig:
     write_to_fabric: bool = True
     seed: int = 11
     out_dir: str | None = None
-    write_threads: int = 4
+    write_threads: int | None = None     # None: 4, or each process's share of the cores with --processes
     msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
     shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
 
@@ -130,6 +130,11 @@ class Randomization:
                 "camera": g.uniform(5, 10, (self.cameras, 3))}
 
 
+def _write_threads(config: BenchConfig) -> int:
+    from graphsdg.io.write_queue import DEFAULT_THREADS
+    return DEFAULT_THREADS if config.write_threads is None else config.write_threads
+
+
 def build_scene(config: BenchConfig):
     """The benchmark stage; returns (asset prims, camera prims, render products)."""
     import graphsdg as rep
@@ -173,7 +178,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     from graphsdg import profiling
     from graphsdg.io.write_queue import reset_write_queue
 
-    rep.settings.set("/omni/replicator/backend/writeThreads", config.write_threads)
+    rep.settings.set("/omni/replicator/backend/writeThreads", _write_threads(config))
     reset_write_queue()
     assets, cams, rps = build_scene(config)
     flags = {ANNOTATOR_FLAGS[a]: True for a in config.annotators}
@@ -251,7 +256,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     want = set(config.annotators)
     need_depth = bool(want & {"distance_to_image_plane", "distance_to_camera"})
     need_seg = bool(want - {"rgb", "distance_to_image_plane", "distance_to_camera"})
-    pool = concurrent.futures.ThreadPoolExecutor(config.write_threads)
+    pool = concurrent.futures.ThreadPoolExecutor(_write_threads(config))
     tmp = tempfile.mkdtemp(prefix="mujoco_bench_")
     pending: list[concurrent.futures.Future] = []
     draws = Randomization(config)
@@ -388,7 +393,11 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     the steady rate counts only the frames finished while every process ran.
     """
     import multiprocessing
+
+    from graphsdg.io.write_queue import threads_per_process
     ctx = multiprocessing.get_context("spawn")
+    if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
+        config = dataclasses.replace(config, write_threads=threads_per_process(processes))
     configs = [dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)) for i in range(processes)]
     start = time.perf_counter()
     with ctx.Manager() as manager:
@@ -406,7 +415,7 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
             "CPU ms per frame (all threads)": round(1000 * sum(r["cpu"] for r in results) /
                                                     sum(r["frames"] for r in results), 1),
             "wall s (incl. start-up)": round(elapsed, 1),
-            "cpu count": os.cpu_count() or 0}
+            "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads}
 
 
 def format_table(rows: list[dict]) -> str:

@@ -70,7 +70,7 @@ def run_bench(args: argparse.Namespace) -> None:
         msaa_samples=args.msaa, shadow_size=args.shadow_size)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
-                       f", {args.write_threads} write threads" if args.write_threads != 4 else "",
+                       f", {args.write_threads} write threads" if args.write_threads is not None else "",
                        ", wait_for_render" if args.wait_for_render else ""])
     settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
@@ -231,7 +231,8 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--wait-for-render", action="store_true",
                        help="finish each frame inside its step (off by default, as in benchmark_sdg.py: steps are pipelined)")
     bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
-    bench.add_argument("--write-threads", type=int, default=4)
+    bench.add_argument("--write-threads", type=int, help="writer threads per process (default: 4, or with "
+                       "--processes each process's share of the cores, at least 1)")
     bench.add_argument("--msaa", type=int, help="multisample count of the colour pass (default: graphsdg's 4)")
     bench.add_argument("--shadow-size", type=int, help="shadow map size (default: graphsdg's 1024)")
     bench.add_argument("--processes", type=int, default=0,

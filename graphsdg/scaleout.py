@@ -22,6 +22,7 @@ import os
 import time
 from dataclasses import replace
 
+from graphsdg.io.write_queue import threads_per_process
 from graphsdg.job import JobSpec, run_job
 
 log = logging.getLogger("graphsdg.scaleout")
@@ -51,10 +52,17 @@ class ShardWorker:
         self.gpu_ids = list(ray.get_gpu_ids())
         self.egl_device = follow_assigned_gpu(self.gpu_ids)   # before the first GL context
 
-    def run(self, job: JobSpec, index: int, count: int) -> dict:
+    def run(self, job: JobSpec, index: int, count: int, write_threads: int | None = None) -> dict:
+        """Run shard ``index`` of ``count``; ``write_threads`` is the default writer pool size here
+        (the script may still set ``/omni/replicator/backend/writeThreads`` itself)."""
+        from graphsdg import settings
         from graphsdg.frame_plan import FramePlan
+        from graphsdg.io.write_queue import THREADS_KEY, get_write_queue
+        if write_threads is not None:
+            settings.set(THREADS_KEY, write_threads)
         summary = run_job(job, FramePlan(index, count, job.resume))
-        summary.update(pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device)
+        summary.update(pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
+                       write_threads=get_write_queue().num_threads)
         return summary
 
 
@@ -86,7 +94,9 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         job = replace(job, out=os.path.abspath(job.out), script=os.path.abspath(job.script), env=env)
         actor = ray.remote(num_cpus=1, num_gpus=per_worker)(ShardWorker)
         actors = [actor.remote() for _ in range(workers)]
-        pending = {a.run.remote(job, i, workers): i for i, a in enumerate(actors)}
+        # shards of a local cluster share this machine's cores: a writer pool each of their share of them
+        threads = None if address else threads_per_process(workers, num_cpus or os.cpu_count())
+        pending = {a.run.remote(job, i, workers, threads): i for i, a in enumerate(actors)}
         results: list[dict] = []
         try:
             while pending:
@@ -114,7 +124,7 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
                "bytes": sum(r["bytes"] for r in results), "seconds": round(seconds, 3),
                "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0, "workers": workers,
                "gpus_per_worker": per_worker,
-               "shards": [{k: r[k] for k in ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device")}
+               "shards": [{k: r[k] for k in ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device", "write_threads")}
                           for r in results]}
     job_info = {k: v for k, v in results[0]["job"].items() if k != "env"} if results else {}
     summary["index"] = merge.write_index(job.out, {**job_info, "workers": workers, "shards": summary["shards"]},

@@ -3,7 +3,10 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from graphsdg.benchmark import _steady_rate
+from graphsdg.io.write_queue import threads_per_process
 
 
 def _process(start: float, period: float, frames: int) -> dict:
@@ -20,3 +23,15 @@ def test_steady_rate_counts_only_frames_while_every_process_runs():
 
 def test_steady_rate_is_undefined_when_the_processes_never_overlap():
     assert math.isnan(_steady_rate([_process(0.0, 0.1, 10), _process(5.0, 0.1, 10)]))
+
+
+@pytest.mark.parametrize("processes, cores, threads", [(1, 16, 4), (2, 16, 4), (5, 16, 3), (16, 16, 1), (32, 16, 1),
+                                                       (1, 2, 2), (1, 1, 1)])
+def test_processes_sharing_the_cores_get_their_share_of_writer_threads(processes, cores, threads):
+    assert threads_per_process(processes, cores) == threads
+
+
+@pytest.mark.parametrize("bad", [0, -2, 1.5, True, "4"])
+def test_writer_threads_need_a_positive_process_count(bad):
+    with pytest.raises(ValueError, match=repr(bad).replace("(", r"\(")):
+        threads_per_process(bad, 16)

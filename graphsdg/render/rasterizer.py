@@ -164,7 +164,7 @@ class Rasterizer:
         self._reads: PixelReads | None = None
         self._flat_sky: tuple[float, float, float] | None = None   # the skybox's colour when uniform
         self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
-        self.skies_composited = 0           # colour renders whose one-colour sky was blended in (no skybox draw)
+        self.skies_filled = 0               # colour renders whose one-colour sky was a flat fill (no skybox draw)
 
     # ---- contexts ------------------------------------------------------
     def _ensure_gl(self) -> None:
@@ -342,17 +342,17 @@ class Rasterizer:
         flags = scene.flags
         flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
-        # a one-colour sky is blended under the resolved frame, cheaper than MuJoCo's skybox draw
-        background = self._flat_sky if self._flat_sky is not None and sky.composites_exactly(sim.model, UNDRAWN_GROUPS) else None
+        # a one-colour sky is one flat rectangle behind the geometry, cheaper than MuJoCo's skybox draw
+        background = self._flat_sky if self._flat_sky is not None and sky.fill_is_exact(sim.model, UNDRAWN_GROUPS) else None
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = background is None
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
         if background is not None:
-            self.skies_composited += 1
+            self.skies_filled += 1
         far = self._update_scene(sim, view, bounds, (0.0, 0.0))
         with profiling.timed("render:color"):
-            mujoco.mjr_render(rect, scene, ctx)
+            self._draw_color(rect, background)
         with profiling.timed("readback:color"):
-            pixels = self._reads.read_color(ctx, w, h, opaque=subframes == 1, background=background)
+            pixels = self._reads.read_color(ctx, w, h, opaque=subframes == 1)
             raw = self._reads.read_depth(ctx, w, h, _depth_decoder(far, view)) if want_depth else None
         self.stats["color"] += 1
         if raw is not None:
@@ -366,8 +366,8 @@ class Rasterizer:
         acc = pixels.result()[..., :3].astype(np.float32)
         for jit in jitter_offsets(subframes)[1:]:
             self._update_scene(sim, view, bounds, jit)
-            mujoco.mjr_render(rect, scene, ctx)
-            acc += self._reads.read_color(ctx, w, h, background=background).result()[..., :3]
+            self._draw_color(rect, background)
+            acc += self._reads.read_color(ctx, w, h).result()[..., :3]
             self.stats["color"] += 1
         mean = acc / subframes
         if want_color:
@@ -376,6 +376,12 @@ class Rasterizer:
             out.put("color", rgba)
         if want_linear:
             out.put("hdr", mean / np.float32(255))
+
+    def _draw_color(self, rect: mujoco.MjrRect, background: tuple[float, float, float] | None) -> None:
+        """MuJoCo's colour render, then the one-colour sky behind the geometry when it is not drawn as a skybox."""
+        mujoco.mjr_render(rect, self._scene, self._mjr)
+        if background is not None:
+            sky.fill_background(rect.width, rect.height, background)
 
     def _render_ids(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], crop: Crop | None,
                     with_depth: bool) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:

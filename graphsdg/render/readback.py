@@ -27,7 +27,6 @@ from OpenGL import GL
 from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no client-array wrapping: a PBO offset
 
 from graphsdg import profiling
-from graphsdg.render import sky
 
 _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
     "rgba": (GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, np.uint8, 4),
@@ -110,17 +109,14 @@ class PixelReads:
         self._all: list[int] = []
         self._packed_depth: bool | None = None   # the depth buffers are DEPTH32F_STENCIL8 (asked once)
 
-    def read_color(self, ctx: mujoco.MjrContext, width: int, height: int, opaque: bool = False,
-                   background: tuple[float, float, float] | None = None) -> PendingPixels:
+    def read_color(self, ctx: mujoco.MjrContext, width: int, height: int, opaque: bool = False) -> PendingPixels:
         """Queue a read of the offscreen colour buffer as RGBA (resolving multisamples first).
 
         ``opaque`` sets alpha to 255 (MuJoCo's blending leaves other values there)
         as the pixels are copied out of the buffer, at no extra pass. (Clearing
         alpha on the GPU instead cost 4 ms per 1280x720 frame on Mesa's llvmpipe.)
-        ``background`` (RGB in [0, 1]) is composited under the resolved pixels
-        first, by their alpha (see :mod:`graphsdg.render.sky`).
         """
-        return self._read(ctx, width, height, "rgba", _opaque_copy if opaque else _copy, background)
+        return self._read(ctx, width, height, "rgba", _opaque_copy if opaque else _copy)
 
     def read_codes(self, ctx: mujoco.MjrContext, width: int, height: int, size: int) -> PendingPixels:
         """Queue a read of MuJoCo's id colours (``mjRND_IDCOLOR``: segid + 1 in red, green, blue) as
@@ -147,8 +143,7 @@ class PixelReads:
         return self._read(ctx, width, height, "depth_stencil", lambda packed: decode(packed[..., 0]))
 
     def _read(self, ctx: mujoco.MjrContext, width: int, height: int, kind: str,
-              decode: Callable[[np.ndarray], np.ndarray] = _copy,
-              background: tuple[float, float, float] | None = None) -> PendingPixels:
+              decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
         fmt, gltype, dtype, channels = _FORMATS[kind]
         nbytes = width * height * channels * np.dtype(dtype).itemsize
         source = ctx.offFBO
@@ -158,8 +153,6 @@ class PixelReads:
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
             GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
             source = ctx.offFBO_r
-        if background is not None:
-            sky.composite_under(source, width, height, background)
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
         GL.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
         pbo = self._acquire(nbytes)

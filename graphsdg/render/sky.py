@@ -1,27 +1,23 @@
-"""A uniform sky drawn as a blend under the finished frame instead of MuJoCo's skybox.
+"""A one-colour sky drawn as one flat rectangle behind the geometry instead of MuJoCo's skybox.
 
 MuJoCo draws its skybox as a textured cylinder around the camera after the
 opaque geometry: on the H200 (whose GH100 die has few graphics units) that draw
 was 0.14 of the 0.58 GPU milliseconds of a 512x512 4x-MSAA colour pass of the
 benchmark scene. When the sky is one colour (an untextured dome light) the same
-image comes from compositing that colour *under* the frame once it is resolved:
-MuJoCo clears to transparent black and opaque geometry writes alpha 1, so after
-the multisample resolve each pixel's alpha is the fraction of it the geometry
-covers, and ``colour + (1 - alpha) * sky`` is what the skybox would have filled
-in behind it (to a rounding step on anti-aliased edges). One single-sample
-rectangle with blending does it.
+samples come from one untextured rectangle drawn where the depth buffer still
+holds its clear value, i.e. where no geometry was drawn, sample by sample, so
+anti-aliased edges resolve exactly as they do over the skybox.
 
-That identity needs every drawn geom opaque (a transparent one blends over the
-background and leaves alpha below its coverage) and no infinite plane (MuJoCo
-draws its horizon haze with the skybox); :func:`composites_exactly` checks both,
-and the renderer keeps MuJoCo's skybox otherwise.
+MuJoCo draws transparent geoms after the skybox, blended over it, and its
+horizon haze with it; a fill after ``mjr_render`` would paint over the first
+and miss the second, so :func:`fill_is_exact` requires every drawn geom opaque
+and no infinite plane, and the renderer keeps MuJoCo's skybox otherwise.
 
-Example (inside a current GL context, after ``mjr_render`` without the skybox
-flag and a resolve into ``fbo``)::
+Example (inside a current GL context, after ``mjr_render`` without the skybox flag)::
 
     sky = uniform_sky(model)          # (r, g, b) in [0, 1], or None for a textured sky
-    if sky is not None and composites_exactly(model):
-        composite_under(fbo, 512, 512, sky)
+    if sky is not None and fill_is_exact(model):
+        fill_background(512, 512, sky)
 """
 from __future__ import annotations
 
@@ -53,8 +49,8 @@ def uniform_sky(model: mujoco.MjModel) -> tuple[float, float, float] | None:
     return r, g, b
 
 
-def composites_exactly(model: mujoco.MjModel, undrawn_groups: tuple[int, ...] = ()) -> bool:
-    """Whether compositing the sky under a frame of ``model`` gives MuJoCo's skybox image.
+def fill_is_exact(model: mujoco.MjModel, undrawn_groups: tuple[int, ...] = ()) -> bool:
+    """Whether filling the background of a frame of ``model`` after ``mjr_render`` gives MuJoCo's skybox image.
 
     Conservative, from the model's arrays (a few microseconds): no drawn geom
     (group not in ``undrawn_groups``, below MuJoCo's 6 groups) whose colour or
@@ -75,23 +71,25 @@ def composites_exactly(model: mujoco.MjModel, undrawn_groups: tuple[int, ...] = 
     return not (plane & (size[:, 0] == 0) & (size[:, 1] == 0)).any()
 
 
-def composite_under(fbo: int, width: int, height: int, rgb: tuple[float, float, float]) -> None:
-    """Blend ``rgb`` under the single-sample colour of framebuffer ``fbo`` by its alpha; alpha ends at 1.
+def fill_background(width: int, height: int, rgb: tuple[float, float, float]) -> None:
+    """Fill the pixels (samples) of the bound framebuffer that no geometry covered with ``rgb``.
 
-    ``dst = dst + (1 - dst_alpha) * (rgb, 1)``. GL state is saved and restored.
+    One rectangle at window depth 0 (MuJoCo's reversed-Z clear value, the far end)
+    with MuJoCo's ``GL_GEQUAL`` depth test passes exactly where the depth buffer
+    still holds the clear value, sample by sample. GL state is saved and restored.
     """
-    GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, fbo)
     GL.glPushAttrib(GL.GL_ALL_ATTRIB_BITS)
     try:
-        GL.glDrawBuffer(GL.GL_COLOR_ATTACHMENT0)
         GL.glViewport(0, 0, width, height)
-        for cap in (GL.GL_DEPTH_TEST, GL.GL_LIGHTING, GL.GL_TEXTURE_2D, GL.GL_TEXTURE_CUBE_MAP, GL.GL_FOG,
-                    GL.GL_CULL_FACE, GL.GL_SCISSOR_TEST, GL.GL_ALPHA_TEST, GL.GL_STENCIL_TEST):
+        GL.glDepthRange(0.0, 0.0)            # every fragment at window depth 0, whatever the clip convention
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glDepthFunc(GL.GL_GEQUAL)
+        GL.glDepthMask(GL.GL_FALSE)
+        for cap in (GL.GL_LIGHTING, GL.GL_TEXTURE_2D, GL.GL_TEXTURE_CUBE_MAP, GL.GL_FOG, GL.GL_CULL_FACE,
+                    GL.GL_SCISSOR_TEST, GL.GL_ALPHA_TEST, GL.GL_STENCIL_TEST, GL.GL_BLEND):
             GL.glDisable(cap)
         GL.glPolygonMode(GL.GL_FRONT_AND_BACK, GL.GL_FILL)
         GL.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
-        GL.glEnable(GL.GL_BLEND)
-        GL.glBlendFunc(GL.GL_ONE_MINUS_DST_ALPHA, GL.GL_ONE)
         GL.glMatrixMode(GL.GL_PROJECTION)
         GL.glPushMatrix()
         GL.glLoadIdentity()

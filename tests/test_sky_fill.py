@@ -1,4 +1,4 @@
-"""A one-colour sky blended under the resolved frame gives MuJoCo's skybox image, and is used only then."""
+"""A one-colour sky filled in behind the geometry gives MuJoCo's skybox image, and is used only then."""
 from __future__ import annotations
 
 import mujoco
@@ -35,39 +35,39 @@ def _render(rgb) -> np.ndarray:
 
 @pytest.fixture(autouse=True)
 def _count_from_zero():
-    runtime().rasterizer.skies_composited = 0   # the renderer outlives each test's stage
+    runtime().rasterizer.skies_filled = 0   # the renderer outlives each test's stage
 
 
-def _composited() -> int:
-    """Colour renders that composited the sky since the test began."""
-    return runtime().rasterizer.skies_composited
+def _filled() -> int:
+    """Colour renders that filled the sky in since the test began."""
+    return runtime().rasterizer.skies_filled
 
 
-def test_composited_sky_matches_the_skybox_draw(monkeypatch):
+@pytest.mark.parametrize("msaa", [4, 0])
+def test_filled_sky_is_the_skybox_image(monkeypatch, msaa):
+    rep.settings.set("/graphsdg/render/msaaSamples", msaa)
     rgb = _cubes_under_a_dome()
-    composited = _render(rgb)
-    assert _composited() == 1
-    monkeypatch.setattr(rasterizer.sky, "composites_exactly", lambda *a: False)   # MuJoCo's skybox instead
+    filled = _render(rgb)
+    assert _filled() == 1
+    monkeypatch.setattr(rasterizer.sky, "fill_is_exact", lambda *a: False)   # MuJoCo's skybox instead
     drawn = _render(rgb)
-    assert _composited() == 1
-    diff = np.abs(composited - drawn).max(-1)
-    assert diff.max() <= 1                                # a rounding step on anti-aliased edges at most
-    assert (diff == 0).mean() > 0.97
+    assert _filled() == 1
+    assert (filled == drawn).all()                     # anti-aliased edges included
     background = runtime().rasterizer._flat_sky
     assert background is not None
-    assert (composited[0, 0] == np.rint(np.array(background) * 255)).all()     # the sky's own bytes
-    assert (composited[..., 0] > composited[..., 2] + 100).sum() > 50          # the red cube is there, lit
-    assert not (composited.sum(-1) == 0).any()                                 # no unfilled (black) pixel
+    assert (filled[0, 0] == np.rint(np.array(background) * 255)).all()     # the sky's own bytes
+    assert (filled[..., 0] > filled[..., 2] + 100).sum() > 50              # the red cube is there, lit
+    assert not (filled.sum(-1) == 0).any()                                 # no unfilled (black) pixel
 
 
 def test_a_transparent_geom_keeps_the_skybox_draw(monkeypatch):
     rgb = _cubes_under_a_dome(opacity=0.4)
     kept = _render(rgb)
-    assert _composited() == 0
-    # what the rule prevents: under a transparent geom, alpha is not coverage, so the composite is wrong
-    monkeypatch.setattr(rasterizer.sky, "composites_exactly", lambda *a: True)
+    assert _filled() == 0
+    # what the rule prevents: a fill after mjr_render paints the sky over the transparent cube
+    monkeypatch.setattr(rasterizer.sky, "fill_is_exact", lambda *a: True)
     forced = _render(rgb)
-    assert _composited() == 1
+    assert _filled() == 1
     assert np.abs(forced - kept).max() > 10
 
 
@@ -77,7 +77,7 @@ def test_a_dome_colour_edit_changes_the_composited_sky():
     dome = [p for p in rep.stage.get_stage().Traverse() if p.GetTypeName() == "DomeLight"][0]
     rep.functional.modify.attribute(dome, "inputs:color", (0.9, 0.5, 0.2))
     after = _render(rgb)[0, 0]
-    assert _composited() == 2
+    assert _filled() == 2
     assert after[0] > after[2] + 50 and before[2] > before[0]
 
 
@@ -102,5 +102,5 @@ def test_uniform_sky_reads_the_texture_bytes():
     ('<geom type="plane" size="0 0 .1"/>', False),                                  # infinite: horizon haze
     ('<geom type="plane" size="2 2 .1"/>', True),
 ])
-def test_composites_exactly(body, exact):
-    assert sky.composites_exactly(_model(body), undrawn_groups=(5,)) is exact
+def test_fill_is_exact(body, exact):
+    assert sky.fill_is_exact(_model(body), undrawn_groups=(5,)) is exact
