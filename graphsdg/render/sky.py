@@ -56,19 +56,20 @@ def fill_is_exact(model: mujoco.MjModel, undrawn_groups: tuple[int, ...] = ()) -
     (group not in ``undrawn_groups``, below MuJoCo's 6 groups) whose colour or
     material has an alpha below MuJoCo's opaque threshold, and no infinite plane.
     """
-    group = np.asarray(model.geom_group)
-    drawn = (group >= 0) & (group < mujoco.mjNGROUP) & ~np.isin(group, undrawn_groups)
+    group = model.geom_group
+    drawn = (group >= 0) & (group < mujoco.mjNGROUP)
+    for g in undrawn_groups:
+        drawn &= group != g
     if not drawn.any():
         return True
-    if (np.asarray(model.geom_rgba)[drawn, 3] < OPAQUE_ALPHA).any():
+    if (model.geom_rgba[drawn, 3] < OPAQUE_ALPHA).any():
         return False
-    matid = np.asarray(model.geom_matid)[drawn]
-    matid = matid[matid >= 0]
-    if matid.size and (np.asarray(model.mat_rgba)[matid, 3] < OPAQUE_ALPHA).any():
+    matid = model.geom_matid[drawn]
+    if model.nmat and (model.mat_rgba[matid[matid >= 0], 3] < OPAQUE_ALPHA).any():
         return False
-    size = np.asarray(model.geom_size)[drawn]
-    plane = np.asarray(model.geom_type)[drawn] == int(mujoco.mjtGeom.mjGEOM_PLANE)
-    return not (plane & (size[:, 0] == 0) & (size[:, 1] == 0)).any()
+    infinite = (model.geom_type == int(mujoco.mjtGeom.mjGEOM_PLANE)) & (model.geom_size[:, 0] == 0) & \
+        (model.geom_size[:, 1] == 0)
+    return not (infinite & drawn).any()
 
 
 def fill_background(width: int, height: int, rgb: tuple[float, float, float]) -> None:
