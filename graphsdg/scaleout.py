@@ -27,6 +27,7 @@ from graphsdg.job import JobSpec, run_job
 
 log = logging.getLogger("graphsdg.scaleout")
 RAY_HINT = "pip install 'graphsdg[ray]'"
+SHARD_COLUMNS = ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device", "write_threads")   # per-shard summary
 
 
 class RayMissingError(ImportError):
@@ -124,8 +125,7 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
                "bytes": sum(r["bytes"] for r in results), "seconds": round(seconds, 3),
                "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0, "workers": workers,
                "gpus_per_worker": per_worker,
-               "shards": [{k: r[k] for k in ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device", "write_threads")}
-                          for r in results]}
+               "shards": [{k: r[k] for k in SHARD_COLUMNS} for r in results]}
     job_info = {k: v for k, v in results[0]["job"].items() if k != "env"} if results else {}
     summary["index"] = merge.write_index(job.out, {**job_info, "workers": workers, "shards": summary["shards"]},
                                          datasets)

@@ -90,7 +90,8 @@ def test_uniform_sky_reads_the_texture_bytes():
     model = _model('<geom type="box" size=".1 .1 .1"/>')
     r, g, b = sky.uniform_sky(model)
     assert (round(r * 255), round(g * 255), round(b * 255)) == tuple(model.tex_data[:3])
-    gradient = _model("", '<texture type="skybox" builtin="gradient" rgb1=".2 .4 .6" rgb2="0 0 0" width="8" height="8"/>')
+    gradient = _model("", '<texture type="skybox" builtin="gradient" rgb1=".2 .4 .6" rgb2="0 0 0" '
+                          'width="8" height="8"/>')
     assert sky.uniform_sky(gradient) is None
     assert sky.uniform_sky(_model("", "")) is None
 

@@ -44,6 +44,7 @@ from graphsdg.errors import WriterError
 log = logging.getLogger("graphsdg.io")
 
 THREADS_KEY = "/omni/replicator/backend/writeThreads"
+DEFAULT_THREADS = 4
 SIZE_KEY = "/omni/replicator/backend/queueSize"
 BYTES_KEY = "/graphsdg/io/queueMaxBytes"
 _THROTTLE_LOG_EVERY_S = 10.0
@@ -282,16 +283,13 @@ _queue: WriteQueue | None = None
 _queue_lock = threading.Lock()
 
 
-DEFAULT_THREADS = 4
-
-
 def threads_per_process(processes: int, cores: int | None = None) -> int:
     """Writer threads for each of ``processes`` processes sharing ``cores`` (default: this machine's).
 
     The default of 4, or the processes' share of the cores when that is smaller,
     at least 1: 16 processes on 16 cores each get one writer thread. More would
     only queue for the same cores (measured on a 16-core GPU host, 16 benchmark
-    processes: 930-980 frames/s with one writer thread each, 880-930 with four).
+    processes: 950-980 frames/s with one writer thread each, 880-930 with four).
 
     Example:
         >>> threads_per_process(16, cores=16), threads_per_process(2, cores=16), threads_per_process(1, cores=2)

@@ -39,9 +39,9 @@ import mujoco
 import numpy as np
 
 from graphsdg import profiling
+from graphsdg.render import sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
-from graphsdg.render import sky
 from graphsdg.render.readback import PixelReads
 from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
 from graphsdg.sim.scene import SimScene
@@ -343,7 +343,9 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         # a one-colour sky is one flat rectangle behind the geometry, cheaper than MuJoCo's skybox draw
-        background = self._flat_sky if self._flat_sky is not None and sky.fill_is_exact(sim.model, UNDRAWN_GROUPS) else None
+        background = self._flat_sky
+        if background is not None and not sky.fill_is_exact(sim.model, UNDRAWN_GROUPS):
+            background = None
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = background is None
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
         if background is not None:
