@@ -28,10 +28,9 @@ from graphsdg.render.lookup import lookup
 from graphsdg.render.rasterizer import RenderOutputs
 from graphsdg.render.raycast import surface_normals
 from graphsdg.render.render_product import RenderProduct
-from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
+from graphsdg.sim.compiler import drawn_geom_mask
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage import semantics as semlib
-
 
 
 @dataclass
@@ -364,8 +363,7 @@ class FrameView:
 
     def drawn_geoms(self) -> np.ndarray:
         """Ids of the geoms the rasteriser draws (not hidden, not collision-only)."""
-        group = self.sim.model.geom_group
-        return np.nonzero((group != HIDDEN_GROUP) & (group != COLLISION_ONLY_GROUP))[0]
+        return np.flatnonzero(drawn_geom_mask(self.sim.model))
 
     def _geom_rects(self) -> np.ndarray:
         """(ngeom, 4) conservative pixel rectangles of every geom's bounding sphere (NaN: behind)."""

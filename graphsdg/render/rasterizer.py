@@ -43,13 +43,12 @@ from graphsdg.render import sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
 from graphsdg.render.readback import PixelReads
-from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP, render_quality
+from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 from graphsdg.sim.scene import SimScene
 
 PASSES = ("color", "hdr", "depth", "segmentation")
 Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)
 SKY_FAR_FACTOR = 2.0
-UNDRAWN_GROUPS = (HIDDEN_GROUP, COLLISION_ONLY_GROUP)
 
 
 class RenderOutputs:
@@ -153,8 +152,8 @@ class Rasterizer:
         self._mjr: mujoco.MjrContext | None = None
         self._scene: mujoco.MjvScene | None = None
         self._option = mujoco.MjvOption()
-        self._option.geomgroup[HIDDEN_GROUP] = 0
-        self._option.geomgroup[COLLISION_ONLY_GROUP] = 0
+        for group in UNDRAWN_GROUPS:
+            self._option.geomgroup[group] = 0
         self._camera = mujoco.MjvCamera()
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FREE
         self._version = -1
@@ -344,7 +343,7 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         # a one-colour sky is one flat rectangle behind the geometry, cheaper than MuJoCo's skybox draw
         background = self._flat_sky
-        if background is not None and not sky.fill_is_exact(sim.model, UNDRAWN_GROUPS):
+        if background is not None and not sky.fill_is_exact(sim.model, drawn_geom_mask(sim.model)):
             background = None
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = background is None
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
@@ -474,8 +473,7 @@ def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndar
     the fallback when no geom is bounded (planes alone).
     """
     radii = np.asarray(model.geom_rbound)
-    group = np.asarray(model.geom_group)
-    bounded = (radii > 0) & (group != HIDDEN_GROUP) & (group != COLLISION_ONLY_GROUP)
+    bounded = (radii > 0) & drawn_geom_mask(model)
     if not bounded.any():
         return np.asarray(model.stat.center, dtype=np.float64), float(model.stat.extent)
     pos, r = np.asarray(data.geom_xpos)[bounded], radii[bounded][:, None]

@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from graphsdg.render.camera import CameraView
-from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, HIDDEN_GROUP
+from graphsdg.sim.compiler import UNDRAWN_GROUPS
 from graphsdg.sim.scene import SimScene
 
 SILHOUETTE_GROWTH = 1.05
@@ -32,8 +32,7 @@ _CURVED = {int(mujoco.mjtGeom.mjGEOM_SPHERE), int(mujoco.mjtGeom.mjGEOM_ELLIPSOI
 def drawn_groups() -> np.ndarray:
     """The geom groups the rasteriser draws, as ``mj_ray``'s ``geomgroup`` mask."""
     groups = np.ones(6, dtype=np.uint8)
-    groups[HIDDEN_GROUP] = 0
-    groups[COLLISION_ONLY_GROUP] = 0
+    groups[list(UNDRAWN_GROUPS)] = 0
     return groups
 
 

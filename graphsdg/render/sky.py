@@ -16,7 +16,7 @@ and no infinite plane, and the renderer keeps MuJoCo's skybox otherwise.
 Example (inside a current GL context, after ``mjr_render`` without the skybox flag)::
 
     sky = uniform_sky(model)          # (r, g, b) in [0, 1], or None for a textured sky
-    if sky is not None and fill_is_exact(model):
+    if sky is not None and fill_is_exact(model, drawn_geom_mask(model)):   # graphsdg.sim.compiler
         fill_background(512, 512, sky)
 """
 from __future__ import annotations
@@ -49,17 +49,13 @@ def uniform_sky(model: mujoco.MjModel) -> tuple[float, float, float] | None:
     return r, g, b
 
 
-def fill_is_exact(model: mujoco.MjModel, undrawn_groups: tuple[int, ...] = ()) -> bool:
+def fill_is_exact(model: mujoco.MjModel, drawn: np.ndarray) -> bool:
     """Whether filling the background of a frame of ``model`` after ``mjr_render`` gives MuJoCo's skybox image.
 
-    Conservative, from the model's arrays (a few microseconds): no drawn geom
-    (group not in ``undrawn_groups``, below MuJoCo's 6 groups) whose colour or
-    material has an alpha below MuJoCo's opaque threshold, and no infinite plane.
+    Conservative, from the model's arrays (a few microseconds): no ``drawn`` geom
+    (a mask over the geoms) whose colour or material has an alpha below MuJoCo's
+    opaque threshold, and no infinite plane.
     """
-    group = model.geom_group
-    drawn = (group >= 0) & (group < mujoco.mjNGROUP)
-    for g in undrawn_groups:
-        drawn &= group != g
     if not drawn.any():
         return True
     if (model.geom_rgba[drawn, 3] < OPAQUE_ALPHA).any():

@@ -59,6 +59,7 @@ from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
 
 HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)
 COLLISION_ONLY_GROUP = 4    # proxy collision shapes (not drawn)
+UNDRAWN_GROUPS = (COLLISION_ONLY_GROUP, HIDDEN_GROUP)
 DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
 MUJOCO_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)   # geom rgba that lets a bound material show through
 GPRIM_TYPES = ("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh")
@@ -162,6 +163,15 @@ def clean_scale(scale: np.ndarray) -> np.ndarray:
     however the body is turned when the stage is compiled.
     """
     return np.array([float(f"{v:.12g}") for v in np.asarray(scale, dtype=np.float64)])
+
+
+def drawn_geom_mask(model: mujoco.MjModel) -> np.ndarray:
+    """Which geoms renders draw: those in MuJoCo's groups 0-5 other than :data:`UNDRAWN_GROUPS`."""
+    group = model.geom_group
+    drawn = (group >= 0) & (group < mujoco.mjNGROUP)
+    for g in UNDRAWN_GROUPS:
+        drawn &= group != g
+    return drawn
 
 
 def render_quality(largest_image: int = 4096) -> tuple[int, int]:
