@@ -102,3 +102,30 @@ def test_lookup_matches_indexing_for_every_kernel():
     assert np.array_equal(lookup(table, wide), table[wide])
     empty = np.zeros((0, 5), dtype=np.uint8)
     assert lookup(np.arange(3), empty).shape == (0, 5)
+
+
+def test_id_pass_after_the_colour_pass_matches_an_id_pass_alone():
+    """The id pass draws the scene the colour pass just updated (no second mjv_updateScene): the ids and
+    depth are byte-identical to an id pass that updates the scene itself, rescaled meshes included."""
+    from graphsdg.render.camera import camera_view
+    from graphsdg.runtime import runtime
+
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", True)
+    rp = _two_balls_and_a_box()
+    shapes = rep.functional.create_batch.torus(count=3, parent="/World") + \
+        rep.functional.create_batch.cone(count=3, parent="/World")
+    rng = np.random.default_rng(4)
+    rt = runtime()
+    for _ in range(3):
+        rep.functional.modify.pose(shapes, position_value=rng.uniform(-1.5, 1.5, (6, 3)),
+                                   rotation_value=rng.uniform(0, 360, (6, 3)),
+                                   scale_value=rng.uniform(0.3, 0.9, 6))
+        rt.sim.require_offscreen(W, H)
+        rt.sim.sync_dirty_prims()
+        view = camera_view(rp.camera_prim(), W, H)
+        both = rt.rasterizer.render(rt.sim, view, {"color", "segmentation", "depth"})
+        alone = rt.rasterizer.render(rt.sim, view, {"segmentation", "depth"})
+        np.testing.assert_array_equal(both.geom_ids, alone.geom_ids)
+        np.testing.assert_array_equal(both.depth, alone.depth)
+        torus_geoms = {rt.sim.compiled.geoms[str(p.GetPath())].geom_id for p in shapes}
+        assert torus_geoms & set(np.unique(alone.geom_ids).tolist())     # the rescaled meshes are in view

@@ -18,24 +18,37 @@ import numpy as np
 from graphsdg.functional import create
 
 
-def per_prim(value: Any, count: int, what: str, width: int = 3) -> list:
-    """Split ``value`` into ``count`` per-prim values (rows of an (N, width) array, or one shared value)."""
+def per_prim_array(value: Any, count: int, what: str, width: int = 3) -> np.ndarray:
+    """``value`` as a (count, width) float array: its rows, or one shared value repeated.
+
+    ``width`` is the width expected of rows (3, or 4 for quaternions); a shared
+    value may be 3 or 4 wide, and a scale may also be one number, or one number
+    per prim (uniform scales, as the seed's Workflow 1 passes them).
+    """
     if value is None:
-        return [None] * count
+        raise ValueError(f"{what} is None; expected one {width}-vector or an (N, {width}) array")
     arr = np.asarray(value, dtype=np.float64)
     if arr.ndim == 2:
         if arr.shape[0] != count:
             raise ValueError(f"{what} has {arr.shape[0]} rows but count/prims is {count}")
-        return [row for row in arr]
+        return arr
     is_scale = what.startswith("scale")
     if arr.ndim == 0 and is_scale:
-        return [np.full(3, float(arr))] * count
+        return np.full((count, 3), float(arr))
     if arr.ndim == 1 and is_scale and arr.shape[0] == count:
-        # one uniform scale per prim (as the seed's Workflow 1 passes them)
-        return [np.full(3, float(v)) for v in arr]
+        return np.repeat(arr[:, None], 3, axis=1)
     if arr.ndim == 1 and arr.shape[0] in (3, 4):
-        return [arr] * count
+        return np.broadcast_to(arr, (count, arr.shape[0]))
     raise ValueError(f"{what} must be one {width}-vector or an (N, {width}) array, got shape {arr.shape}")
+
+
+def per_prim(value: Any, count: int, what: str, width: int = 3) -> list:
+    """Split ``value`` into ``count`` per-prim values (rows of :func:`per_prim_array`); ``None`` for each
+    prim when ``value`` is None."""
+    if value is None:
+        return [None] * count
+    rows = per_prim_array(value, count, what, width)
+    return [rows[0]] * count if rows.strides[0] == 0 else list(rows)   # a shared value: one array, not N views
 
 
 def _batch(shape: str):

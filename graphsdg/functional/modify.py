@@ -20,7 +20,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from graphsdg import settings
 from graphsdg.errors import closest
-from graphsdg.functional.create_batch import per_prim
+from graphsdg.functional.create_batch import per_prim, per_prim_array
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.prims import resolve_prim, resolve_prims
@@ -56,7 +56,7 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
             and _write_to_fabric():
         from graphsdg.runtime import runtime
         from graphsdg.sim import direct_writes
-        arrays = [None if v is None else np.array(per_prim(v, n, name, width=np.shape(v)[-1] if np.ndim(v) else 3))
+        arrays = [None if v is None else per_prim_array(v, n, name, width=np.shape(v)[-1] if np.ndim(v) else 3)
                   for v, name in ((position_value, "position_value"), (rotation_value, "rotation_value"),
                                   (scale_value, "scale_value"))]
         if direct_writes.write_poses(runtime().sim, targets, *arrays):
@@ -200,11 +200,11 @@ def visibility(prims: Any, value: bool | list[bool]) -> None:
 def display_color(prims: Any, value: Any) -> None:
     """Set ``primvars:displayColor`` (one colour for all, or (N, 3))."""
     targets = resolve_prims(prims)
-    colors = per_prim(value, len(targets), "display color")
+    colors = per_prim_array(value, len(targets), "display color")
     if _write_to_fabric():
         from graphsdg.runtime import runtime
         from graphsdg.sim import direct_writes
-        if direct_writes.write_colors(runtime().sim, targets, np.array(colors)[:, :3]):
+        if direct_writes.write_colors(runtime().sim, targets, colors[:, :3]):
             return
     for prim, c in zip(targets, colors):
         gprim = UsdGeom.Gprim(prim)

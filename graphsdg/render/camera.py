@@ -200,7 +200,8 @@ def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCac
     if focal <= 0 or h_ap <= 0:
         raise ValueError(f"camera {prim.GetPath()} has focal length {focal} and horizontal aperture {h_ap}; "
                          f"both must be positive")
-    near, far = (float(v) for v in cam.GetClippingRangeAttr().Get())
+    clipping = cam.GetClippingRangeAttr().Get()
+    near, far = float(clipping[0]), float(clipping[1])
     if not 0 < near < far:
         raise ValueError(f"camera {prim.GetPath()} clipping range ({near}, {far}) must satisfy 0 < near < far")
     proj = str(cam.GetProjectionAttr().Get())

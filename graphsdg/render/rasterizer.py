@@ -35,6 +35,7 @@ import os
 from collections import Counter
 from typing import Callable, Iterator, Sequence
 
+import cv2
 import mujoco
 import numpy as np
 
@@ -317,11 +318,13 @@ class Rasterizer:
         # from the (single-sample) id render instead.
         depth_with_colour = colour and "depth" in passes and "segmentation" not in passes and \
             int(model.vis.quality.offsamples) == 0
+        scene_far = None   # set while the scene holds this frame's unjittered geometry (reused by the id pass)
         if colour:
-            self._render_color(sim, view, bounds, subframes, out, want_color="color" in passes,
-                               want_linear="hdr" in passes, want_depth=depth_with_colour)
+            scene_far = self._render_color(sim, view, bounds, subframes, out, want_color="color" in passes,
+                                           want_linear="hdr" in passes, want_depth=depth_with_colour)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
-            codes, lut, depth = self._render_ids(sim, view, bounds, None, with_depth="depth" in passes)
+            codes, lut, depth = self._render_ids(sim, view, bounds, None, with_depth="depth" in passes,
+                                                 scene_far=scene_far)
             if "segmentation" in passes:
                 out.put("id_codes", codes)
                 out.id_lut = lut
@@ -333,7 +336,9 @@ class Rasterizer:
         return out
 
     def _render_color(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], subframes: int,
-                      out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool) -> None:
+                      out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool) -> float | None:
+        """Draw and queue the colour pass; returns the far plane when the scene is left as updated for
+        the unjittered view (one subframe), else None."""
         assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         w, h = view.width, view.height
@@ -363,7 +368,7 @@ class Rasterizer:
                 out.put("color", pixels.result)
             if want_linear:
                 out.put("hdr", lambda: pixels.result()[..., :3].astype(np.float32) / np.float32(255))
-            return
+            return far
         acc = pixels.result()[..., :3].astype(np.float32)
         for jit in jitter_offsets(subframes)[1:]:
             self._update_scene(sim, view, bounds, jit)
@@ -377,6 +382,7 @@ class Rasterizer:
             out.put("color", rgba)
         if want_linear:
             out.put("hdr", mean / np.float32(255))
+        return None
 
     def _draw_color(self, rect: mujoco.MjrRect, background: tuple[float, float, float] | None) -> None:
         """MuJoCo's colour render, then the one-colour sky behind the geometry when it is not drawn as a skybox."""
@@ -385,9 +391,16 @@ class Rasterizer:
             sky.fill_background(rect.width, rect.height, background)
 
     def _render_ids(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], crop: Crop | None,
-                    with_depth: bool) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:
+                    with_depth: bool, scene_far: float | None = None
+                    ) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:
         """Id codes (a finisher), their code -> geom id table, and a depth finisher, of the view or a
-        crop of it, top row first."""
+        crop of it, top row first.
+
+        ``scene_far``: the scene already holds this view's geometry, uncropped and unjittered, with that
+        far plane (the colour pass just updated it): drawn again as it is. The render flags are
+        not inputs of ``mjv_updateScene``, and the shadow fit it skips only moves lights, which the
+        id colours ignore.
+        """
         assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
@@ -399,7 +412,10 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
         try:
-            far = self._update_scene(sim, view, bounds, (0.0, 0.0), crop)
+            if scene_far is not None and crop is None:
+                far = scene_far
+            else:
+                far = self._update_scene(sim, view, bounds, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
             with single_sample(ctx):
                 with profiling.timed(f"render:{kind}"):
@@ -508,10 +524,11 @@ def _linearize_depth(raw: np.ndarray, near: float, far: float, clip: float,
     # In float32 the relative error stays ~1e-7 (w itself is a float32 read from GL).
     lin = np.multiply(raw, np.float32(far - near))
     lin += np.float32(near)
+    # Nothing drawn (w = 0 gives z = far, beyond clip) or the sky: z > clip, i.e. a denominator below
+    # near * far / clip, is set to 0 so the division gives inf (one OpenCV pass instead of a mask and a put)
+    cv2.threshold(lin, float(np.float32(near * far / clip)), 0.0, cv2.THRESH_TOZERO, dst=lin)
     with np.errstate(divide="ignore"):
         np.divide(np.float32(near * far), lin, out=lin)
-    # nothing drawn (w = 0 gives z = far, beyond clip) or the sky
-    np.putmask(lin, lin > np.float32(clip), np.float32(np.inf))
     return lin
 
 

@@ -55,9 +55,50 @@ def matrices_to_quats(r: np.ndarray) -> np.ndarray:
     q[sel[1]] = np.stack([(d(2, 1) - d(1, 2)) / s, s / 4, (d(0, 1) + d(1, 0)) / s, (d(0, 2) + d(2, 0)) / s], 1)[sel[1]]
     q[sel[2]] = np.stack([(d(0, 2) - d(2, 0)) / s, (d(0, 1) + d(1, 0)) / s, s / 4, (d(1, 2) + d(2, 1)) / s], 1)[sel[2]]
     q[sel[3]] = np.stack([(d(1, 0) - d(0, 1)) / s, (d(0, 2) + d(2, 0)) / s, (d(1, 2) + d(2, 1)) / s, s / 4], 1)[sel[3]]
+    return _canonical(q)
+
+
+def euler_xyz_to_quats(angles_deg: np.ndarray) -> np.ndarray:
+    """(N, 3) Euler XYZ degrees -> (N, 4) unit quaternions (w, x, y, z) of R = Rz Ry Rx, w >= 0.
+
+    The product qz qy qx of the three axis rotations, written out: the same
+    rotations as :func:`euler_xyz_to_matrices` without building the matrices.
+    """
+    half = np.radians(np.asarray(angles_deg, dtype=np.float64)) * 0.5
+    cx, cy, cz = np.cos(half).T
+    sx, sy, sz = np.sin(half).T
+    q = np.empty((len(half), 4))
+    czcy, szsy, czsy, szcy = cz * cy, sz * sy, cz * sy, sz * cy
+    q[:, 0] = czcy * cx + szsy * sx
+    q[:, 1] = czcy * sx - szsy * cx
+    q[:, 2] = czsy * cx + szcy * sx
+    q[:, 3] = szcy * cx - czsy * sx
+    return _canonical(q)
+
+
+def quat_products(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise Hamilton products ``a[i] * b[i]`` of (N, 4) quaternions (w, x, y, z): rotation b, then a."""
+    aw, ax, ay, az = a.T
+    bw, bx, by, bz = b.T
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz,
+                     aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw], axis=1)
+
+
+def _canonical(q: np.ndarray) -> np.ndarray:
+    """Quaternions normalised, with w >= 0 (one of the two for each rotation), in place."""
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     q[q[:, 0] < 0] *= -1
     return q
+
+
+def _unit_quats(q: np.ndarray) -> np.ndarray:
+    """(N, 4) quaternions as given (any length, not all zero) -> unit, w >= 0."""
+    norms = np.linalg.norm(q, axis=1)
+    if np.any(norms < 1e-12):
+        raise ValueError(f"rotation quaternions must not be zero, got {q[norms < 1e-12][0].tolist()}")
+    return _canonical(np.array(q, dtype=np.float64))
 
 
 class DirectTargets:
@@ -70,13 +111,19 @@ class DirectTargets:
         self.eligible = all(b is not None and b.rigid_root is None and b.mocap_id >= 0 for b in self.bindings)
         if not self.eligible:
             return
+        self.has_material = any(b.material for b in self.bindings)
         self.geom_ids = np.array([b.geom_id for b in self.bindings])
         self.mocap_ids = np.array([b.mocap_id for b in self.bindings])
         parents = [p.GetParent() for p in prims]
         mats = [world_matrix(p) if p and not p.IsPseudoRoot() else np.eye(4) for p in parents]
         self.parent_t = np.array([m[3, :3] for m in mats])
         self.parent_r = np.array([decompose(m)[1] for m in mats])
+        self.parent_q = matrices_to_quats(self.parent_r)
         self.parent_s = np.array([decompose(m)[2] for m in mats])
+        # most batches sit under an untransformed parent: their local poses are world poses
+        self.parent_is_identity = bool(np.allclose(self.parent_t, 0.0, atol=0.0) and
+                                       np.allclose(self.parent_r, np.eye(3), atol=0.0) and
+                                       np.allclose(self.parent_s, 1.0, atol=0.0))
         self.is_mesh = np.array([b.type_name in ("Mesh", "Cone") for b in self.bindings])
         self.prims = list(prims)
         # Unit-scale sizes let box, sphere and z-axis cylinder/capsule scales be array products.
@@ -89,20 +136,51 @@ class DirectTargets:
                 self.unit_size[i] = primitive_size(p, np.ones(3))[1]
                 self.simple[i] = True
         self.kind = np.array([sim.model.geom_type[b.geom_id] for b in self.bindings])
+        g = mujoco.mjtGeom
+        self.is_sphere = self.simple & (self.kind == int(g.mjGEOM_SPHERE))
+        self.is_tube = self.simple & np.isin(self.kind, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
+        self.is_capsule = self.kind == int(g.mjGEOM_CAPSULE)
+        self.mesh_rows = np.flatnonzero(self.is_mesh)
 
 
-_cache: dict[tuple, DirectTargets] = {}
+class _TargetsCache:
+    """:class:`DirectTargets` by scene, compile and prim list.
+
+    A script passes the same prims every frame: the last lists are kept and
+    compared element by element (identity first, so ~1 us for 50 prims) before
+    falling back to a key of paths.
+    """
+
+    def __init__(self) -> None:
+        self.by_key: dict[tuple, DirectTargets] = {}
+        self.recent: list[tuple[int, int, list, DirectTargets]] = []
+
+    def get(self, sim: SimScene, prims: Sequence[Usd.Prim]) -> DirectTargets:
+        version = sim.model_version
+        for sim_id, v, listed, found in self.recent:
+            if sim_id == id(sim) and v == version and listed == prims:
+                return found
+        key = (id(sim), version, tuple(map(Usd.Prim.GetPath, prims)))
+        found = self.by_key.get(key)
+        if found is None:
+            if len(self.by_key) > 64:
+                self.by_key.clear()
+            found = self.by_key[key] = DirectTargets(sim, prims)
+        self.recent = [(id(sim), version, list(prims), found)] + self.recent[:7]
+        return found
+
+    def clear(self) -> None:
+        self.by_key.clear()
+        self.recent.clear()
+
+
+_cache = _TargetsCache()
 
 
 def targets_for(sim: SimScene, prims: Sequence[Usd.Prim]) -> DirectTargets:
+    """The model indices of ``prims`` in ``sim``'s compiled model (cached per compile)."""
     sim.sync_dirty_prims()   # structure first: the indices must be current
-    key = (id(sim), sim.model_version, tuple(p.GetPath() for p in prims))
-    found = _cache.get(key)
-    if found is None:
-        if len(_cache) > 64:
-            _cache.clear()
-        found = _cache[key] = DirectTargets(sim, prims)
-    return found
+    return _cache.get(sim, prims)
 
 
 def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray | None,
@@ -116,36 +194,33 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
         return False
     m, d = sim.model, sim.data
     n = len(prims)
-    sizes = {}
     if scales is not None:
-        world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3) * t.parent_s
-        sizes.update(_simple_sizes(t, world_scale))
-        for i in range(n):
-            if i in sizes:
-                continue
-            if not t.is_mesh[i]:
-                kind, size, _ = primitive_size(t.prims[i], world_scale[i])
-                if int(kind) != int(m.geom_type[t.geom_ids[i]]):
-                    return False   # e.g. a sphere scaled unevenly becomes an ellipsoid: recompile via USD
-                sizes[i] = size
+        world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3)
+        if not t.parent_is_identity:
+            world_scale = world_scale * t.parent_s
+        sized, sizes = _simple_sizes(t, world_scale)
+        for i in np.flatnonzero(~sized & ~t.is_mesh):   # unevenly scaled spheres, x/y-axis tubes
+            kind, size, _ = primitive_size(t.prims[i], world_scale[i])
+            if int(kind) != int(m.geom_type[t.geom_ids[i]]):
+                return False   # e.g. a sphere scaled unevenly becomes an ellipsoid: recompile via USD
+            sizes[i] = size
+            sized[i] = True
     if positions is not None:
         local = np.asarray(positions, dtype=np.float64).reshape(n, 3)
-        d.mocap_pos[t.mocap_ids] = t.parent_t + np.einsum("nij,nj->ni", t.parent_r, local * t.parent_s)
+        d.mocap_pos[t.mocap_ids] = local if t.parent_is_identity else \
+            t.parent_t + np.einsum("nij,nj->ni", t.parent_r, local * t.parent_s)
     if rotations is not None:
         rot = np.asarray(rotations, dtype=np.float64)
-        if rot.shape[-1] == 4:
-            local_r = np.array([_quat_matrix(q) for q in rot.reshape(n, 4)])
-        else:
-            local_r = euler_xyz_to_matrices(rot.reshape(n, 3))
-        d.mocap_quat[t.mocap_ids] = matrices_to_quats(np.einsum("nij,njk->nik", t.parent_r, local_r))
+        local_q = _unit_quats(rot.reshape(n, 4)) if rot.shape[-1] == 4 else euler_xyz_to_quats(rot.reshape(n, 3))
+        d.mocap_quat[t.mocap_ids] = local_q if t.parent_is_identity else \
+            _canonical(quat_products(t.parent_q, local_q))
     if scales is not None:
         _write_mesh_scales(sim, t, world_scale)
-        rows = np.array(sorted(sizes), dtype=np.int64)
+        rows = np.flatnonzero(sized)
         if rows.size:
-            size_arr = np.array([sizes[i] for i in rows])
             gids = t.geom_ids[rows]
-            m.geom_size[gids] = size_arr
-            m.geom_rbound[gids] = np.linalg.norm(_half_extents(t.kind[rows], size_arr), axis=1)
+            m.geom_size[gids] = sizes[rows]
+            m.geom_rbound[gids] = np.linalg.norm(_half_extents(t, rows, sizes[rows]), axis=1)
             for i in rows:
                 t.bindings[i].scale = world_scale[i]
     mujoco.mj_kinematics(m, d)
@@ -155,7 +230,7 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
 def write_colors(sim: SimScene, prims: Sequence[Usd.Prim], rgb: np.ndarray) -> bool:
     """Write per-prim display colours into ``geom_rgba``; ``False`` if not eligible."""
     t = targets_for(sim, prims)
-    if not t.eligible or any(b.material for b in t.bindings):
+    if not t.eligible or t.has_material:
         return False
     rgba = np.ones((len(prims), 4))
     rgba[:, :3] = np.asarray(rgb, dtype=np.float64).reshape(len(prims), 3)
@@ -163,57 +238,46 @@ def write_colors(sim: SimScene, prims: Sequence[Usd.Prim], rgb: np.ndarray) -> b
     return True
 
 
-def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    out = np.empty(9)
-    mujoco.mju_quat2Mat(out, np.asarray(q, dtype=np.float64) / max(np.linalg.norm(q), 1e-12))
-    return out.reshape(3, 3)
-
-
 def _write_mesh_scales(sim: SimScene, t: DirectTargets, world_scale: np.ndarray) -> None:
     """Rescale the mesh geoms whose scale changed (compared as one array, not per prim)."""
-    mesh_rows = np.flatnonzero(t.is_mesh)
-    if not mesh_rows.size:
+    rows = t.mesh_rows
+    if not rows.size:
         return
-    old = np.array([t.bindings[i].scale for i in mesh_rows])
-    new = world_scale[mesh_rows]
+    old = np.array([t.bindings[i].scale for i in rows])
+    new = world_scale[rows]
     changed = np.any(np.abs(new - old) > 1e-12 * np.maximum(1.0, np.abs(old)), axis=1)
-    for i, row in enumerate(mesh_rows):
-        if changed[i]:
-            b = t.bindings[row]
-            sim.rescale_mesh(b.geom_id, b.scale, new[i])
-            b.scale = new[i]
+    if not changed.any():
+        return
+    rows, old, new = rows[changed], old[changed], new[changed]
+    sim.rescale_meshes(t.geom_ids[rows], old, new)
+    for i, row in enumerate(rows):
+        t.bindings[row].scale = new[i]
 
 
-def _half_extents(kinds: np.ndarray, sizes: np.ndarray) -> np.ndarray:
-    """(N, 3) half extents of primitive geoms of ``kinds`` with ``sizes`` (MuJoCo size convention)."""
-    g = mujoco.mjtGeom
+def _half_extents(t: DirectTargets, rows: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """(len(rows), 3) half extents of the primitive geoms of ``t``'s ``rows`` with ``sizes`` (MuJoCo's size
+    convention)."""
     out = np.array(sizes, dtype=np.float64, copy=True)
-    sphere = kinds == int(g.mjGEOM_SPHERE)
+    sphere, tube, capsule = t.is_sphere[rows], t.is_tube[rows], t.is_capsule[rows]
     out[sphere] = sizes[sphere, :1]
-    tube = np.isin(kinds, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
     out[tube, 1] = sizes[tube, 0]
     out[tube, 2] = sizes[tube, 1]
-    capsule = kinds == int(g.mjGEOM_CAPSULE)
     out[capsule, 2] += sizes[capsule, 0]
     return out
 
 
-def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> dict[int, np.ndarray]:
-    """Sizes of boxes, uniformly scaled spheres and z-axis cylinders/capsules, as array products."""
-    g = mujoco.mjtGeom
+def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(which rows, (N, 3) sizes) of boxes, uniformly scaled spheres and z-axis cylinders/capsules, as array
+    products; other rows are zero."""
     s = np.abs(world_scale)
-    out = {}
-    box = t.simple & (t.kind == int(g.mjGEOM_BOX))
-    sphere = t.simple & (t.kind == int(g.mjGEOM_SPHERE)) & np.all(s == s[:, :1], axis=1)
-    tube = t.simple & np.isin(t.kind, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
+    sphere = t.is_sphere & (s[:, 0] == s[:, 1]) & (s[:, 0] == s[:, 2])
+    box, tube = t.is_box & t.simple, t.is_tube
     sizes = np.zeros_like(s)
     sizes[box] = t.unit_size[box] * s[box]
     sizes[sphere, 0] = t.unit_size[sphere, 0] * s[sphere, 0]
     sizes[tube, 0] = t.unit_size[tube, 0] * np.maximum(s[tube, 0], s[tube, 1])
     sizes[tube, 1] = t.unit_size[tube, 1] * s[tube, 2]
-    for i in np.flatnonzero(box | sphere | tube):
-        out[int(i)] = sizes[i]
-    return out
+    return box | sphere | tube, sizes
 
 
-__all__ = ["write_poses", "write_colors", "euler_xyz_to_matrices"]
+__all__ = ["write_poses", "write_colors", "euler_xyz_to_matrices", "euler_xyz_to_quats", "quat_products"]

@@ -33,7 +33,7 @@ from graphsdg.sim import joints as jointmap
 from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size,
                                    rigid_root)
-from graphsdg.sim.mesh_scaling import rescale_mesh_geom
+from graphsdg.sim.mesh_scaling import rescale_mesh_geoms
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
@@ -123,9 +123,15 @@ class SimScene:
 
     def rescale_mesh(self, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> None:
         """Rescale visual mesh geom ``geom_id`` in place and record the map for renderers."""
-        mesh_id, linear = rescale_mesh_geom(self.model, geom_id, old_scale, new_scale)
-        previous = self.mesh_maps.get(mesh_id)
-        self.mesh_maps[mesh_id] = linear if previous is None else linear @ previous
+        self.rescale_meshes(np.array([geom_id]), np.array([old_scale]), np.array([new_scale]))
+
+    def rescale_meshes(self, geom_ids: np.ndarray, old_scales: np.ndarray, new_scales: np.ndarray) -> None:
+        """:meth:`rescale_mesh` for many visual mesh geoms at once (their scales as (N, 3) arrays)."""
+        mesh_ids, linears = rescale_mesh_geoms(self.model, geom_ids, old_scales, new_scales)
+        maps = self.mesh_maps
+        for mesh_id, linear in zip(mesh_ids.tolist(), linears):
+            previous = maps.get(mesh_id)
+            maps[mesh_id] = linear if previous is None else linear @ previous
 
     def recompile(self, keep_state: bool = True) -> CompiledScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""

@@ -39,6 +39,9 @@ def resolve_prims(value: PrimLike | Iterable[PrimLike], stage: Usd.Stage | None 
         return [resolve_prim(value, stage)]
     if value is None:
         raise InvalidPrimError("expected a prim or a list of prims, got None")
+    if isinstance(value, (list, tuple)) and all(type(v) is Usd.Prim for v in value) and \
+            all(map(Usd.Prim.IsValid, value)):
+        return list(value)   # the common case of a batch of live prims, without a Python call per prim
     return [resolve_prim(v, stage) for v in value]
 
 

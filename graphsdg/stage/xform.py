@@ -138,16 +138,21 @@ def decompose(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Shear is dropped (the rotation is orthonormalised).
     """
     m = np.asarray(m, dtype=np.float64)
-    rows = m[:3, :3]
-    scale = np.linalg.norm(rows, axis=1)
-    scale = np.where(scale < 1e-12, 1e-12, scale)
-    r = (rows / scale[:, None]).T
-    if np.linalg.det(r) < 0:
+    rows = m[:3, :3].tolist()
+    scale = [max(math.sqrt(x * x + y * y + z * z), 1e-12) for x, y, z in rows]
+    u = [[v / s for v in row] for row, s in zip(rows, scale)]   # unit rows: the rotation's columns
+    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = u
+    if a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0) < 0:
         scale[0] = -scale[0]
-        r[:, 0] = -r[:, 0]
-    u, _, vt = np.linalg.svd(r)
-    r = u @ vt
-    return m[3, :3].copy(), r, scale
+        u[0] = [-a0, -a1, -a2]
+        a0, a1, a2 = u[0]
+    r = np.array(u).T
+    # rows already orthogonal (no shear, the usual case): r is a rotation up to rounding, no SVD needed
+    if max(abs(a0 * b0 + a1 * b1 + a2 * b2), abs(a0 * c0 + a1 * c1 + a2 * c2),
+           abs(b0 * c0 + b1 * c1 + b2 * c2)) > 1e-12:
+        left, _, right = np.linalg.svd(r)
+        r = left @ right
+    return m[3, :3].copy(), r, np.array(scale)
 
 
 UNITS_RESOLVE_SUFFIX = ":unitsResolve"

@@ -1,0 +1,146 @@
+"""Randomized poses written straight into MuJoCo (write-to-fabric): the vectorised arithmetic and caches."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import graphsdg as rep
+from graphsdg.runtime import runtime
+from graphsdg.sim import direct_writes, mesh_scaling
+from graphsdg.stage import xform
+
+
+def test_euler_quaternions_match_the_matrix_route():
+    angles = np.random.default_rng(1).uniform(-720, 720, (300, 3))
+    angles[:5] = [[0, 0, 0], [180, 0, 0], [0, 180, 0], [0, 0, 180], [90, 90, 90]]
+    quats = direct_writes.euler_xyz_to_quats(angles)
+    ref = direct_writes.matrices_to_quats(direct_writes.euler_xyz_to_matrices(angles))
+    assert np.all(quats[:, 0] >= 0) and np.allclose(np.linalg.norm(quats, axis=1), 1.0)
+    for q, r, a in zip(quats, ref, angles):
+        # the same rotation: q and r agree, or are opposite where w = 0 leaves the sign open
+        assert np.allclose(q, r, atol=1e-12) or np.allclose(q, -r, atol=1e-12), a
+        assert np.allclose(xform.quat_wxyz_to_matrix(q), xform.euler_to_matrix(a, "XYZ"), atol=1e-12)
+
+
+def test_quaternion_products_compose_rotations():
+    rng = np.random.default_rng(2)
+    a = direct_writes.euler_xyz_to_quats(rng.uniform(0, 360, (20, 3)))
+    b = direct_writes.euler_xyz_to_quats(rng.uniform(0, 360, (20, 3)))
+    for p, qa, qb in zip(direct_writes.quat_products(a, b), a, b):
+        want = xform.quat_wxyz_to_matrix(qa) @ xform.quat_wxyz_to_matrix(qb)
+        assert np.allclose(xform.quat_wxyz_to_matrix(p), want, atol=1e-12)
+
+
+def test_decompose_keeps_rotation_scale_and_mirror():
+    r = xform.euler_to_matrix((30, -50, 110), "XYZ")
+    for s in ([1, 1, 1], [0.5, 2, 3], [-1, 2, 2]):
+        m = np.eye(4)
+        m[:3, :3] = (r * np.array(s)).T       # row-vector convention: rows are the scaled axes
+        m[3, :3] = (1, 2, 3)
+        t, rot, scale = xform.decompose(m)
+        assert np.allclose(t, (1, 2, 3))
+        assert np.allclose(np.abs(scale), np.abs(s)) and np.isclose(np.prod(scale), np.prod(s))
+        assert np.allclose(rot @ rot.T, np.eye(3), atol=1e-12) and np.isclose(np.linalg.det(rot), 1.0)
+        assert np.allclose((rot * scale).T, m[:3, :3], atol=1e-12)
+
+
+def test_decompose_drops_shear():
+    m = np.eye(4)
+    m[1, 0] = 0.3                             # y axis leans towards x
+    _, rot, _ = xform.decompose(m)
+    assert np.allclose(rot @ rot.T, np.eye(3), atol=1e-12) and np.isclose(np.linalg.det(rot), 1.0)
+
+
+@pytest.mark.parametrize("contiguous", [True, False])
+def test_vertex_blocks_scale_like_one_mesh_at_a_time(contiguous):
+    rng = np.random.default_rng(3)
+    vert = rng.uniform(-1, 1, (40, 3)).astype(np.float32)
+    starts, counts = (np.array([10, 0, 4]), np.array([6, 4, 6])) if contiguous else \
+        (np.array([30, 2, 12]), np.array([5, 4, 9]))
+    k = rng.uniform(0.1, 2.0, 3)
+    want = vert.copy()
+    for s, c, f in zip(starts, counts, k):
+        want[s:s + c] *= float(f)
+    mesh_scaling._scale_vertex_blocks(vert, starts, counts, k)
+    np.testing.assert_array_equal(vert, want)
+
+
+def _batch_scene():
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", True)
+    rep.functional.create.xform(name="World")
+    return rep.functional.create_batch.torus(count=3, parent="/World") + \
+        rep.functional.create_batch.cone(count=2, parent="/World") + \
+        rep.functional.create_batch.sphere(count=2, parent="/World")
+
+
+def test_batched_mesh_rescale_matches_rescaling_one_by_one():
+    prims = _batch_scene()
+    sim = runtime().sim
+    rep.functional.modify.pose(prims, scale_value=0.5)
+    mesh_prims = prims[:5]
+    geoms = np.array([sim.compiled.geoms[str(p.GetPath())].geom_id for p in mesh_prims])
+    model = sim.model
+    before = model.mesh_vert.copy(), model.geom_pos.copy(), model.geom_rbound.copy()
+    new = np.repeat(np.linspace(0.3, 1.1, 5)[:, None], 3, axis=1)
+    rep.functional.modify.pose(mesh_prims, scale_value=new)
+    batched = model.mesh_vert.copy(), model.geom_pos.copy(), model.geom_rbound.copy()
+    model.mesh_vert[:], model.geom_pos[:], model.geom_rbound[:] = before
+    for g, s in zip(geoms, new):
+        mesh_scaling.rescale_mesh_geom(model, int(g), np.full(3, 0.5), s)
+    for got, want in zip(batched, (model.mesh_vert, model.geom_pos, model.geom_rbound)):
+        np.testing.assert_allclose(got, want, rtol=1e-6)
+    assert not np.allclose(batched[0], before[0])
+
+
+def test_unevenly_scaled_sphere_falls_back_to_the_stage():
+    prims = _batch_scene()
+    sphere = prims[-1]
+    assert direct_writes.write_poses(runtime().sim, [sphere], None, None, np.array([[1.0, 1.0, 1.0]]))
+    assert not direct_writes.write_poses(runtime().sim, [sphere], None, None, np.array([[1.0, 2.0, 1.0]]))
+    rep.functional.modify.pose([sphere], scale_value=[(1.0, 2.0, 1.0)])   # authored on the stage instead
+    assert tuple(sphere.GetAttribute("xformOp:scale").Get()) == (1.0, 2.0, 1.0)
+
+
+def test_cached_targets_follow_the_prims_passed():
+    prims = _batch_scene()
+    sim = runtime().sim
+    a = direct_writes.targets_for(sim, prims)
+    assert direct_writes.targets_for(sim, list(prims)) is a          # an equal list: the cached indices
+    b = direct_writes.targets_for(sim, prims[::-1])
+    assert b is not a and list(b.geom_ids) == list(a.geom_ids)[::-1]
+    rep.functional.modify.pose(prims[::-1], position_value=np.arange(21.0).reshape(7, 3))
+    for i, p in enumerate(prims[::-1]):
+        body = sim.compiled.geoms[str(p.GetPath())].body_id
+        assert np.allclose(sim.data.xpos[body], np.arange(21.0).reshape(7, 3)[i])
+
+
+def test_zero_quaternion_is_refused():
+    prims = _batch_scene()
+    with pytest.raises(ValueError, match="must not be zero"):
+        direct_writes.write_poses(runtime().sim, prims[:1], None, np.zeros((1, 4)), None)
+
+
+def test_poses_under_a_transformed_parent_match_authored_ones():
+    """Direct writes compose with the parent's pose as the stage does (the quaternion product route)."""
+    def world_poses(fabric: bool):
+        rep.stage.new_stage()
+        rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", fabric)
+        parent = rep.functional.create.xform(name="Rig", position=(1, -2, 0.5), rotation=(20, 40, -70), scale=2.0)
+        cubes = rep.functional.create_batch.cube(count=4, parent=parent)
+        rng = np.random.default_rng(5)
+        rep.functional.modify.pose(cubes, position_value=rng.uniform(-1, 1, (4, 3)),
+                                   rotation_value=rng.uniform(0, 360, (4, 3)))
+        authored = cubes[0].GetAttribute("xformOp:translate").Get()
+        moved_on_stage = authored is not None and tuple(authored) != (0, 0, 0)
+        assert moved_on_stage == (not fabric)                  # with fabric the poses go to MuJoCo only
+        sim = runtime().sim
+        sim.sync_dirty_prims()
+        import mujoco
+        mujoco.mj_kinematics(sim.model, sim.data)
+        bodies = [sim.compiled.geoms[str(c.GetPath())].geom_id for c in cubes]
+        return sim.data.geom_xpos[bodies].copy(), sim.data.geom_xmat[bodies].copy()
+
+    pos_usd, mat_usd = world_poses(False)
+    pos_fab, mat_fab = world_poses(True)
+    np.testing.assert_allclose(pos_fab, pos_usd, atol=1e-9)
+    np.testing.assert_allclose(mat_fab, mat_usd, atol=1e-9)
