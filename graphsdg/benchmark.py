@@ -67,6 +67,7 @@ class BenchConfig:
     write_threads: int | None = None     # None: 4, or each process's share of the cores with --processes
     msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
     shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
+    image_threads: int | None = None     # OpenCV's pool; None: its default, or with --processes each one's share
 
 
 @dataclass
@@ -180,6 +181,9 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
 
     rep.settings.set("/omni/replicator/backend/writeThreads", _write_threads(config))
     reset_write_queue()
+    if config.image_threads is not None:
+        from graphsdg.cpu_share import limit_image_threads
+        limit_image_threads(config.image_threads)
     assets, cams, rps = build_scene(config)
     flags = {ANNOTATOR_FLAGS[a]: True for a in config.annotators}
     tmp = None
@@ -394,10 +398,13 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     """
     import multiprocessing
 
+    from graphsdg.cpu_share import cores_per_process
     from graphsdg.io.write_queue import threads_per_process
     ctx = multiprocessing.get_context("spawn")
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(processes))
+    if config.image_threads is None:
+        config = dataclasses.replace(config, image_threads=cores_per_process(processes))
     configs = [dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)) for i in range(processes)]
     start = time.perf_counter()
     with ctx.Manager() as manager:
@@ -415,7 +422,8 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
             "CPU ms per frame (all threads)": round(1000 * sum(r["cpu"] for r in results) /
                                                     sum(r["frames"] for r in results), 1),
             "wall s (incl. start-up)": round(elapsed, 1),
-            "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads}
+            "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads,
+            "OpenCV threads per process": config.image_threads}
 
 
 def format_table(rows: list[dict]) -> str:

@@ -22,12 +22,13 @@ import os
 import time
 from dataclasses import replace
 
+from graphsdg.cpu_share import cores_per_process
 from graphsdg.io.write_queue import threads_per_process
 from graphsdg.job import JobSpec, run_job
 
 log = logging.getLogger("graphsdg.scaleout")
 RAY_HINT = "pip install 'graphsdg[ray]'"
-SHARD_COLUMNS = ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device", "write_threads")   # per-shard summary
+SHARD_COLUMNS = ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device", "write_threads", "image_threads")   # per-shard summary
 
 
 class RayMissingError(ImportError):
@@ -53,17 +54,22 @@ class ShardWorker:
         self.gpu_ids = list(ray.get_gpu_ids())
         self.egl_device = follow_assigned_gpu(self.gpu_ids)   # before the first GL context
 
-    def run(self, job: JobSpec, index: int, count: int, write_threads: int | None = None) -> dict:
+    def run(self, job: JobSpec, index: int, count: int, write_threads: int | None = None,
+            image_threads: int | None = None) -> dict:
         """Run shard ``index`` of ``count``; ``write_threads`` is the default writer pool size here
-        (the script may still set ``/omni/replicator/backend/writeThreads`` itself)."""
+        (the script may still set ``/omni/replicator/backend/writeThreads`` itself), ``image_threads``
+        OpenCV's pool size (None: its default)."""
         from graphsdg import settings
+        from graphsdg.cpu_share import limit_image_threads
         from graphsdg.frame_plan import FramePlan
         from graphsdg.io.write_queue import THREADS_KEY, get_write_queue
         if write_threads is not None:
             settings.set(THREADS_KEY, write_threads)
+        if image_threads is not None:
+            limit_image_threads(image_threads)
         summary = run_job(job, FramePlan(index, count, job.resume))
         summary.update(pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
-                       write_threads=get_write_queue().num_threads)
+                       write_threads=get_write_queue().num_threads, image_threads=image_threads)
         return summary
 
 
@@ -97,7 +103,8 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         actors = [actor.remote() for _ in range(workers)]
         # shards of a local cluster share this machine's cores: a writer pool each of their share of them
         threads = None if address else threads_per_process(workers, num_cpus or os.cpu_count())
-        pending = {a.run.remote(job, i, workers, threads): i for i, a in enumerate(actors)}
+        image_threads = None if address else cores_per_process(workers, num_cpus or os.cpu_count())
+        pending = {a.run.remote(job, i, workers, threads, image_threads): i for i, a in enumerate(actors)}
         results: list[dict] = []
         try:
             while pending:

@@ -6,6 +6,7 @@ import math
 import pytest
 
 from graphsdg.benchmark import _steady_rate
+from graphsdg.cpu_share import cores_per_process, limit_image_threads
 from graphsdg.io.write_queue import threads_per_process
 
 
@@ -35,3 +36,26 @@ def test_processes_sharing_the_cores_get_their_share_of_writer_threads(processes
 def test_writer_threads_need_a_positive_process_count(bad):
     with pytest.raises(ValueError, match=repr(bad).replace("(", r"\(")):
         threads_per_process(bad, 16)
+
+
+@pytest.mark.parametrize("processes, cores, share", [(1, 16, 16), (3, 16, 5), (16, 16, 1), (32, 16, 1), (1, 1, 1)])
+def test_processes_sharing_the_cores_get_their_share_of_image_threads(processes, cores, share):
+    assert cores_per_process(processes, cores) == share
+
+
+@pytest.mark.parametrize("bad", [0, -1, 2.0, False])
+def test_image_threads_need_positive_counts(bad):
+    with pytest.raises(ValueError, match="positive integer"):
+        cores_per_process(bad, 16)
+    with pytest.raises(ValueError, match="positive integer"):
+        limit_image_threads(bad)
+
+
+def test_image_threads_set_opencvs_pool():
+    import cv2
+    before = cv2.getNumThreads()
+    try:
+        limit_image_threads(1)
+        assert cv2.getNumThreads() == 1
+    finally:
+        cv2.setNumThreads(before)

@@ -138,6 +138,7 @@ def test_two_ray_workers_write_the_single_process_dataset(job_script, tmp_path):
     assert summary["frames"] == 7 and [s["frames"] for s in summary["shards"]] == [4, 3]
     assert len({s["pid"] for s in summary["shards"]}) == 2            # two processes
     assert [s["write_threads"] for s in summary["shards"]] == [1, 1]   # two shards sharing 2 cores
+    assert [s["image_threads"] for s in summary["shards"]] == [1, 1]
     a, b = _datasets(tmp_path / "single"), _datasets(tmp_path / "sharded")
     assert sorted(a) == sorted(b) and len([k for k in a if os.path.basename(k).startswith("rgb_")]) == 14
     assert all(a[k] == b[k] for k in a), [k for k in a if a[k] != b[k]]

@@ -129,3 +129,29 @@ def test_id_pass_after_the_colour_pass_matches_an_id_pass_alone():
         np.testing.assert_array_equal(both.depth, alone.depth)
         torus_geoms = {rt.sim.compiled.geoms[str(p.GetPath())].geom_id for p in shapes}
         assert torus_geoms & set(np.unique(alone.geom_ids).tolist())     # the rescaled meshes are in view
+
+
+def test_id_framebuffer_depth_is_read_unpacked_and_matches_mujocos_buffer():
+    """Id passes draw into graphsdg's own framebuffer (float depth, no stencil: read back as stored, 4
+    bytes a pixel); its depth is byte-identical to the depth of MuJoCo's own single-sample buffer."""
+    from graphsdg.render.camera import camera_view
+    from graphsdg.runtime import runtime
+
+    rep.settings.set("/graphsdg/render/msaaSamples", 0)   # colour + depth from MuJoCo's buffer, in one pass
+    rp = _two_balls_and_a_box()
+    rt = runtime()
+    rt.sim.require_offscreen(W, H)
+    view = camera_view(rp.camera_prim(), W, H)
+    from_mujoco = rt.rasterizer.render(rt.sim, view, {"color", "depth"}).depth
+    from_ids = rt.rasterizer.render(rt.sim, view, {"segmentation", "depth"}).depth
+    np.testing.assert_array_equal(from_ids, from_mujoco)
+    assert np.isfinite(from_ids).sum() > 300 and np.isinf(from_ids).sum() > 3000   # objects and background
+    packed = rt.rasterizer._reads._packed_depth
+    assert packed[rt.rasterizer._ids.fbo] is False          # DEPTH_COMPONENT32F: a plain copy
+    assert True in packed.values()                          # MuJoCo's DEPTH32F_STENCIL8, read as stored
+
+
+def test_id_framebuffer_refuses_an_empty_size():
+    from graphsdg.render.id_framebuffer import IdFramebuffer
+    with pytest.raises(ValueError, match="must be positive, got 0x64"):
+        IdFramebuffer(0, 64)

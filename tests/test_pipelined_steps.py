@@ -5,6 +5,7 @@ import hashlib
 import os
 
 import numpy as np
+import pytest
 
 import graphsdg as rep
 from graphsdg.runtime import runtime
@@ -97,3 +98,32 @@ def test_a_writer_attached_after_a_pipelined_step_starts_with_the_next_frame(tmp
     rep.orchestrator.wait_until_complete()
     assert sorted(f for f in os.listdir(tmp_path / "first") if f.startswith("rgb")) == ["rgb_0000.png", "rgb_0001.png"]
     assert sorted(f for f in os.listdir(tmp_path / "late") if f.startswith("rgb")) == ["rgb_0000.png"]
+
+
+def test_pixel_reads_wait_for_their_fence_by_polling(monkeypatch):
+    """A map first polls the read's fence (never a blocking driver wait), sleeping between polls."""
+    from OpenGL import GL
+
+    from graphsdg.render import readback
+    statuses = iter([GL.GL_TIMEOUT_EXPIRED, GL.GL_TIMEOUT_EXPIRED, GL.GL_TIMEOUT_EXPIRED, GL.GL_CONDITION_SATISFIED])
+    calls, sleeps = [], []
+    monkeypatch.setattr(readback.GL, "glClientWaitSync",
+                        lambda fence, flags, timeout: calls.append((flags, timeout)) or next(statuses))
+    monkeypatch.setattr(readback.time, "sleep", sleeps.append)
+    readback.wait_for_fence(object())
+    assert [t for _, t in calls] == [0, 0, 0, 0]                         # never a blocking wait
+    assert calls[0][0] == GL.GL_SYNC_FLUSH_COMMANDS_BIT and all(f == 0 for f, _ in calls[1:])
+    assert sleeps == [20e-6, 40e-6, 80e-6]                             # doubling pauses in between
+    monkeypatch.setattr(readback.GL, "glClientWaitSync", lambda *a: GL.GL_WAIT_FAILED)
+    with pytest.raises(RuntimeError, match="glClientWaitSync failed"):
+        readback.wait_for_fence(object())
+
+
+def test_renders_are_read_behind_fences():
+    rgb = rep.annotators.get("rgb")
+    cam = rep.functional.create.camera(position=(0, -5, 0), look_at=(0, 0, 0))
+    rep.functional.create.cube()
+    rgb.attach(rep.create.render_product(cam, (32, 32)))
+    rep.orchestrator.step()
+    assert rgb.get_data().shape == (32, 32, 4)
+    assert runtime().rasterizer._reads._fences is True      # this context has fences and used them

@@ -11,9 +11,10 @@ Passes:
 * ``color`` (uint8) and ``hdr`` (the same colour as linear float, before 8-bit
   rounding): one lit, shadowed, multisampled ``mjr_render``.
 * ``segmentation`` and ``depth``: one render with MuJoCo's id colours, read
-  back with its depth buffer. It is drawn into the single-sample resolve buffer
-  (:func:`single_sample`), so ids and depth are both sampled exactly at pixel
-  centres, on every GL driver, and agree with each other
+  back with its depth buffer. It is drawn into a single-sample framebuffer of
+  its own (:class:`~graphsdg.render.id_framebuffer.IdFramebuffer`), so ids and
+  depth are both sampled exactly at pixel centres, on every GL driver, and
+  agree with each other
   (a multisampled colour pass resolves depth from an off-centre sample, which
   is off by up to a quarter pixel of depth slope). Depth is linearised to
   planar z in stage units (background ``inf``); ids are geom ids (background -1).
@@ -30,10 +31,9 @@ loose boxes are measured from.
 """
 from __future__ import annotations
 
-import contextlib
 import os
 from collections import Counter
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Sequence
 
 import cv2
 import mujoco
@@ -42,6 +42,7 @@ import numpy as np
 from graphsdg import profiling
 from graphsdg.render import sky
 from graphsdg.render.camera import CameraView
+from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
 from graphsdg.render.readback import PixelReads
 from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
@@ -163,6 +164,7 @@ class Rasterizer:
         self._uploaded_inverse: dict[int, np.ndarray] = {}
         self._reads: PixelReads | None = None
         self._flat_sky: tuple[float, float, float] | None = None   # the skybox's colour when uniform
+        self._ids: IdFramebuffer | None = None   # where id passes draw (single-sample, float depth)
         self.stats: Counter = Counter()     # renders drawn, by kind (colour, ids, isolated)
         self.skies_filled = 0               # colour renders whose one-colour sky was a flat fill (no skybox draw)
 
@@ -191,6 +193,11 @@ class Rasterizer:
             if self._mjr is not None:
                 self._mjr.free()
             self._mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+            if self._ids is not None:
+                self._ids.free()
+            self._ids = IdFramebuffer(int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
+            assert self._reads is not None
+            self._reads.forget_framebuffers()
             mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
             self._mjr.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
             self._scene = mujoco.MjvScene(model, maxgeom=max(1000, 2 * model.ngeom + 100))
@@ -210,6 +217,9 @@ class Rasterizer:
             if self._reads is not None:
                 self._reads.free()
                 self._reads = None
+            if self._ids is not None:
+                self._ids.free()
+                self._ids = None
         if self._mjr is not None:
             self._mjr.free()
             self._mjr = None
@@ -402,6 +412,7 @@ class Rasterizer:
         id colours ignore.
         """
         assert self._scene is not None and self._mjr is not None and self._reads is not None
+        assert self._ids is not None
         scene, ctx = self._scene, self._mjr
         x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
         w, h = x1 - x0, y1 - y0
@@ -417,7 +428,7 @@ class Rasterizer:
             else:
                 far = self._update_scene(sim, view, bounds, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
-            with single_sample(ctx):
+            with self._ids.bound(ctx):
                 with profiling.timed(f"render:{kind}"):
                     mujoco.mjr_render(rect, scene, ctx)
                 lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
@@ -454,31 +465,6 @@ class Rasterizer:
             return lookup(lut, codes())
         finally:
             group[:] = saved
-
-
-@contextlib.contextmanager
-def single_sample(ctx: mujoco.MjrContext) -> Iterator[None]:
-    """Render into the offscreen *resolve* framebuffer (one sample per pixel) for the block.
-
-    Ids and depth must be exact at pixel centres. MuJoCo turns multisampling off
-    for its id colours, which Mesa honours; NVIDIA's driver (measured: H200,
-    driver 580, 4x MSAA) still resolves the multisampled id colours, blending
-    neighbouring ids into the colour of a third geom: labels appeared far from
-    their objects and boxes grew by up to 160 pixels. Drawing into the
-    single-sample resolve buffer (and reading it back without a resolve) gives
-    the same ids on every driver.
-    """
-    if ctx.offSamples == 0:
-        yield
-        return
-    fbo, samples = ctx.offFBO, ctx.offSamples
-    ctx.offFBO, ctx.offSamples = ctx.offFBO_r, 0
-    mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # binds the (now single-sample) FBO
-    try:
-        yield
-    finally:
-        ctx.offFBO, ctx.offSamples = fbo, samples
-        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)
 
 
 def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, float]:
