@@ -142,8 +142,8 @@ def test_id_framebuffer_depth_is_read_unpacked_and_matches_mujocos_buffer():
     rt = runtime()
     rt.sim.require_offscreen(W, H)
     view = camera_view(rp.camera_prim(), W, H)
-    from_mujoco = rt.rasterizer.render(rt.sim, view, {"color", "depth"}).depth
     from_ids = rt.rasterizer.render(rt.sim, view, {"segmentation", "depth"}).depth
+    from_mujoco = rt.rasterizer.render(rt.sim, view, {"color", "depth"}).depth
     np.testing.assert_array_equal(from_ids, from_mujoco)
     assert np.isfinite(from_ids).sum() > 300 and np.isinf(from_ids).sum() > 3000   # objects and background
     packed = rt.rasterizer._reads._packed_depth
@@ -155,3 +155,27 @@ def test_id_framebuffer_refuses_an_empty_size():
     from graphsdg.render.id_framebuffer import IdFramebuffer
     with pytest.raises(ValueError, match="must be positive, got 0x64"):
         IdFramebuffer(0, 64)
+
+
+@pytest.mark.parametrize("bits, size", [(8, 1), (16, 2), (24, 4)])
+def test_id_framebuffer_stores_only_the_code_bytes(bits, size):
+    """R8 / RG8 / RGBA8 colour for 8 / 16 / 24-bit codes: reading the codes back is a plain copy."""
+    from OpenGL import GL
+
+    from graphsdg.render.id_framebuffer import IdFramebuffer
+    from graphsdg.runtime import runtime
+    rep.functional.create.cube()
+    rep.orchestrator.step()          # a GL context, current
+    runtime().rasterizer._ensure_gl()
+    ids = IdFramebuffer(8, 8, bits)
+    try:
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, ids.fbo)
+        got = [int(GL.glGetFramebufferAttachmentParameteriv(GL.GL_READ_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0, p))
+               for p in (GL.GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE, GL.GL_FRAMEBUFFER_ATTACHMENT_GREEN_SIZE,
+                         GL.GL_FRAMEBUFFER_ATTACHMENT_BLUE_SIZE)]
+        assert sum(1 for b in got if b) == min(size, 3) and all(b in (0, 8) for b in got)
+    finally:
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
+        ids.free()
+    with pytest.raises(ValueError, match="8, 16 or 24 bits, got 12"):
+        IdFramebuffer(8, 8, 12)

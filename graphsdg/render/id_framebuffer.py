@@ -16,9 +16,15 @@ read as stored, 4 bytes a pixel, in one copy. (Measured on the H200 host with
 16 processes sharing the GPU: every extra byte read back costs throughput,
 768 KB more a frame cut it by 12 %.)
 
+Its colour holds only the bytes of id colour the codes need (:func:`colour_format`):
+one (R8) for scenes of fewer than 255 geoms, so reading the codes back is a plain
+copy of one byte a pixel; reading the red byte out of RGBA8 made the GPU repack
+every pixel (0.078 ms of GPU time per 512x512 frame on the H200, more than the
+copy of the whole 4-byte colour image).
+
 Example (inside a current GL context)::
 
-    ids = IdFramebuffer(512, 512)
+    ids = IdFramebuffer(512, 512, code_bits=8)
     with ids.bound(mjr_context):      # mjr_render now draws into it, single-sample
         mujoco.mjr_render(rect, scene, mjr_context)
     ids.free()
@@ -32,17 +38,29 @@ import mujoco
 from OpenGL import GL
 
 
-class IdFramebuffer:
-    """An RGBA8 + DEPTH_COMPONENT32F framebuffer of ``width`` x ``height`` in the current GL context."""
+_COLOUR_FORMATS = {8: GL.GL_R8, 16: GL.GL_RG8, 24: GL.GL_RGBA8}
 
-    def __init__(self, width: int, height: int) -> None:
+
+def colour_format(code_bits: int):
+    """The colour storage for id codes of ``code_bits`` bits (8, 16 or 24: see ``readback.code_bits``)."""
+    if code_bits not in _COLOUR_FORMATS:
+        raise ValueError(f"id codes are 8, 16 or 24 bits, got {code_bits!r}")
+    return _COLOUR_FORMATS[code_bits]
+
+
+class IdFramebuffer:
+    """A framebuffer of ``width`` x ``height`` for id codes of ``code_bits`` bits, with DEPTH_COMPONENT32F
+    depth, in the current GL context."""
+
+    def __init__(self, width: int, height: int, code_bits: int = 24) -> None:
         if width < 1 or height < 1:
             raise ValueError(f"id framebuffer size must be positive, got {width}x{height}")
-        self.width, self.height = int(width), int(height)
+        colour = colour_format(code_bits)
+        self.width, self.height, self.code_bits = int(width), int(height), code_bits
         self.fbo = int(GL.glGenFramebuffers(1))
         self._renderbuffers = [int(b) for b in GL.glGenRenderbuffers(2)]
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.fbo)
-        for rb, fmt, attachment in zip(self._renderbuffers, (GL.GL_RGBA8, GL.GL_DEPTH_COMPONENT32F),
+        for rb, fmt, attachment in zip(self._renderbuffers, (colour, GL.GL_DEPTH_COMPONENT32F),
                                        (GL.GL_COLOR_ATTACHMENT0, GL.GL_DEPTH_ATTACHMENT)):
             GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, rb)
             GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, fmt, self.width, self.height)
@@ -52,8 +70,8 @@ class IdFramebuffer:
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
         if status != GL.GL_FRAMEBUFFER_COMPLETE:
             self.free()
-            raise RuntimeError(f"the GL driver cannot make an RGBA8 + DEPTH_COMPONENT32F framebuffer of "
-                               f"{width}x{height} (status 0x{int(status):x})")
+            raise RuntimeError(f"the GL driver cannot make a {code_bits}-bit id + DEPTH_COMPONENT32F "
+                               f"framebuffer of {width}x{height} (status 0x{int(status):x})")
 
     @contextlib.contextmanager
     def bound(self, ctx: mujoco.MjrContext) -> Iterator[None]:

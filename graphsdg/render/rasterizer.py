@@ -44,7 +44,7 @@ from graphsdg.render import sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
-from graphsdg.render.readback import PixelReads
+from graphsdg.render.readback import PixelReads, code_bits
 from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 from graphsdg.sim.scene import SimScene
 
@@ -195,9 +195,7 @@ class Rasterizer:
             self._mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
             if self._ids is not None:
                 self._ids.free()
-            self._ids = IdFramebuffer(int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
-            assert self._reads is not None
-            self._reads.forget_framebuffers()
+                self._ids = None
             mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
             self._mjr.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
             self._scene = mujoco.MjvScene(model, maxgeom=max(1000, 2 * model.ngeom + 100))
@@ -210,6 +208,19 @@ class Rasterizer:
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
             sim.textures_to_upload.clear()
             self._flat_sky = sky.uniform_sky(model)
+
+    def _id_framebuffer(self, bits: int) -> IdFramebuffer:
+        """The id framebuffer for codes of ``bits`` bits at the model's offscreen size (made when either
+        changes)."""
+        assert self._model is not None and self._reads is not None
+        size = (int(self._model.vis.global_.offwidth), int(self._model.vis.global_.offheight))
+        ids = self._ids
+        if ids is None or ids.code_bits != bits or (ids.width, ids.height) != size:
+            if ids is not None:
+                ids.free()
+            self._ids = ids = IdFramebuffer(size[0], size[1], bits)
+            self._reads.forget_framebuffers()   # GL may give the new one a freed framebuffer's name
+        return ids
 
     def close(self) -> None:
         if self._gl is not None:
@@ -412,7 +423,6 @@ class Rasterizer:
         id colours ignore.
         """
         assert self._scene is not None and self._mjr is not None and self._reads is not None
-        assert self._ids is not None
         scene, ctx = self._scene, self._mjr
         x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
         w, h = x1 - x0, y1 - y0
@@ -428,10 +438,10 @@ class Rasterizer:
             else:
                 far = self._update_scene(sim, view, bounds, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
-            with self._ids.bound(ctx):
+            lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
+            with self._id_framebuffer(code_bits(len(lut))).bound(ctx):
                 with profiling.timed(f"render:{kind}"):
                     mujoco.mjr_render(rect, scene, ctx)
-                lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
                 with profiling.timed(f"readback:{kind}"):
                     codes = self._reads.read_codes(ctx, w, h, len(lut))
                     raw = self._reads.read_depth(ctx, w, h, _depth_decoder(far, view)) if with_depth \
