@@ -144,3 +144,22 @@ def test_poses_under_a_transformed_parent_match_authored_ones():
     pos_fab, mat_fab = world_poses(True)
     np.testing.assert_allclose(pos_fab, pos_usd, atol=1e-9)
     np.testing.assert_allclose(mat_fab, mat_usd, atol=1e-9)
+
+
+def test_bounding_radius_of_an_x_axis_cylinder_matches_a_compile():
+    """Tubes not along z are sized one by one from USD; their bounding radius still uses the tube's
+    half extents (radius, radius, half height), as the compiler's does."""
+    def rbound(fabric: bool) -> float:
+        rep.stage.new_stage()
+        rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", fabric)
+        cyl = rep.functional.create.cylinder(name="Tube")
+        cyl.GetAttribute("axis").Set("X")
+        sim = runtime().sim
+        sim.sync_dirty_prims()
+        sim.ensure_compiled()
+        rep.functional.modify.pose([cyl], scale_value=[(1.0, 1.0, 3.0)])
+        sim.sync_dirty_prims()
+        return float(sim.model.geom_rbound[sim.compiled.geoms[str(cyl.GetPath())].geom_id])
+
+    compiled = rbound(False)
+    assert compiled > 1.0 and rbound(True) == pytest.approx(compiled, rel=1e-9)

@@ -127,7 +127,6 @@ class DirectTargets:
         self.is_mesh = np.array([b.type_name in ("Mesh", "Cone") for b in self.bindings])
         self.prims = list(prims)
         # Unit-scale sizes let box, sphere and z-axis cylinder/capsule scales be array products.
-        self.is_box = np.array([b.type_name == "Cube" for b in self.bindings])
         self.unit_size = np.zeros((len(self.prims), 3))
         self.simple = np.zeros(len(self.prims), dtype=bool)
         for i, (p, b) in enumerate(zip(self.prims, self.bindings)):
@@ -136,9 +135,10 @@ class DirectTargets:
                 self.unit_size[i] = primitive_size(p, np.ones(3))[1]
                 self.simple[i] = True
         self.kind = np.array([sim.model.geom_type[b.geom_id] for b in self.bindings])
-        g = mujoco.mjtGeom
-        self.is_sphere = self.simple & (self.kind == int(g.mjGEOM_SPHERE))
-        self.is_tube = self.simple & np.isin(self.kind, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
+        g = mujoco.mjtGeom   # geom kinds (size conventions), whether or not sized by array products
+        self.is_box = self.kind == int(g.mjGEOM_BOX)
+        self.is_sphere = self.kind == int(g.mjGEOM_SPHERE)
+        self.is_tube = np.isin(self.kind, [int(g.mjGEOM_CYLINDER), int(g.mjGEOM_CAPSULE)])
         self.is_capsule = self.kind == int(g.mjGEOM_CAPSULE)
         self.mesh_rows = np.flatnonzero(self.is_mesh)
 
@@ -270,8 +270,8 @@ def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> tuple[np.ndarray
     """(which rows, (N, 3) sizes) of boxes, uniformly scaled spheres and z-axis cylinders/capsules, as array
     products; other rows are zero."""
     s = np.abs(world_scale)
-    sphere = t.is_sphere & (s[:, 0] == s[:, 1]) & (s[:, 0] == s[:, 2])
-    box, tube = t.is_box & t.simple, t.is_tube
+    sphere = t.simple & t.is_sphere & (s[:, 0] == s[:, 1]) & (s[:, 0] == s[:, 2])
+    box, tube = t.simple & t.is_box, t.simple & t.is_tube
     sizes = np.zeros_like(s)
     sizes[box] = t.unit_size[box] * s[box]
     sizes[sphere, 0] = t.unit_size[sphere, 0] * s[sphere, 0]
