@@ -31,7 +31,6 @@ from __future__ import annotations
 import collections
 import contextlib
 import logging
-import os
 import threading
 import time
 from typing import Any, Callable, Iterator
@@ -39,6 +38,7 @@ from typing import Any, Callable, Iterator
 import numpy as np
 
 from graphsdg import profiling, settings
+from graphsdg.cpu_share import cores_per_process
 from graphsdg.errors import WriterError
 
 log = logging.getLogger("graphsdg.io")
@@ -295,10 +295,7 @@ def threads_per_process(processes: int, cores: int | None = None) -> int:
         >>> threads_per_process(16, cores=16), threads_per_process(2, cores=16), threads_per_process(1, cores=2)
         (1, 4, 2)
     """
-    if isinstance(processes, bool) or not isinstance(processes, int) or processes < 1:
-        raise ValueError(f"processes must be a positive integer, got {processes!r}")
-    cores = cores if cores is not None else (os.cpu_count() or 1)
-    return max(1, min(DEFAULT_THREADS, cores // processes))
+    return min(DEFAULT_THREADS, cores_per_process(processes, cores))
 
 
 def _configured() -> tuple[int, int, int]:

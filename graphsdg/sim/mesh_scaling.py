@@ -36,11 +36,16 @@ def rescale_mesh_geoms(model: mujoco.MjModel, geom_ids: np.ndarray, old_scales: 
         pairs = [rescale_mesh_geom(model, int(g), o, n) for g, o, n in zip(geom_ids, old_scales, new_scales)]
         return mesh_ids, np.array([linear for _, linear in pairs])
     k = ratios[:, 0]
+    _scale_uniformly(model, geom_ids, mesh_ids, k)
+    return mesh_ids, k[:, None, None] * np.eye(3)
+
+
+def _scale_uniformly(model: mujoco.MjModel, geom_ids: np.ndarray, mesh_ids: np.ndarray, k: np.ndarray) -> None:
+    """Scale mesh geoms by one factor each: vertices, offset and bounds (normals are unchanged)."""
     _scale_vertex_blocks(model.mesh_vert, model.mesh_vertadr[mesh_ids], model.mesh_vertnum[mesh_ids], k)
     model.geom_pos[geom_ids] *= k[:, None]
     model.geom_aabb[geom_ids] *= np.abs(k)[:, None]
     model.geom_rbound[geom_ids] *= np.abs(k)
-    return mesh_ids, k[:, None, None] * np.eye(3)
 
 
 def _scale_vertex_blocks(vert: np.ndarray, starts: np.ndarray, counts: np.ndarray, factors: np.ndarray) -> None:
@@ -75,13 +80,8 @@ def rescale_mesh_geom(model: mujoco.MjModel, geom_id: int, old_scale: np.ndarray
     ratio = np.asarray(new_scale, dtype=np.float64) / np.asarray(old_scale, dtype=np.float64)
     v0, nv = model.mesh_vertadr[mesh_id], model.mesh_vertnum[mesh_id]
     if ratio[0] == ratio[1] == ratio[2]:
-        # Uniform: vertices, offset and bounds scale by one factor; normals are unchanged.
-        k = float(ratio[0])
-        model.mesh_vert[v0:v0 + nv] *= k
-        model.geom_pos[geom_id] *= k
-        model.geom_aabb[geom_id] *= abs(k)
-        model.geom_rbound[geom_id] *= abs(k)
-        return mesh_id, np.eye(3) * k
+        _scale_uniformly(model, np.array([geom_id]), np.array([mesh_id]), ratio[:1])
+        return mesh_id, np.eye(3) * float(ratio[0])
     rg = quat_wxyz_to_matrix(model.geom_quat[geom_id])
     linear = rg.T @ np.diag(ratio) @ rg
     normal_map = rg.T @ np.diag(1.0 / ratio) @ rg
