@@ -15,8 +15,16 @@ from __future__ import annotations
 import sys
 import types
 
+import importlib
+
 from graphsdg.compat import isaac_core, kit
-from graphsdg.compat.modules import CompatFinder, CompatModule, ForwardingModule
+from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, ForwardingModule
+
+# Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
+# CompatModules named by their full Isaac name. :func:`_mount` links them under their parents.
+AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
+         "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
+         "graphsdg.compat.simulation_manager")
 
 _installed: dict[str, types.ModuleType] = {}
 _finder: CompatFinder | None = None
@@ -97,7 +105,42 @@ def _modules() -> dict[str, types.ModuleType]:
             "does not have."))]
     isaacsim.examples = scenario[-1]  # type: ignore[attr-defined]
     modules += scenario
-    return {m.__name__: m for m in modules}
+    for area in AREAS:
+        modules += importlib.import_module(area).modules()
+    return _mount(modules)
+
+
+def _mount(modules: list[types.ModuleType]) -> dict[str, types.ModuleType]:
+    """Index ``modules`` by name, adding any missing ancestor package and setting each module as an
+    attribute of its parent (``isaacsim.test.utils`` becomes ``isaacsim.test``'s ``utils``)."""
+    by_name: dict[str, types.ModuleType] = {}
+    for m in modules:
+        if m.__name__ in by_name and by_name[m.__name__] is not m:
+            # two areas add names to one module: merge the later one's names into the first
+            by_name[m.__name__].__dict__.update({k: v for k, v in m.__dict__.items() if not k.startswith("__")
+                                                 and k != "_hint"})
+        else:
+            by_name[m.__name__] = m
+    for name in sorted(by_name, key=lambda n: n.count(".")):
+        parent, _, leaf = name.rpartition(".")
+        if not parent:
+            continue
+        if parent not in by_name and parent.split(".")[0] not in ROOTS:
+            continue   # a name added to a real package (pxr.PhysxSchema): install() sets it there
+        if parent not in by_name:
+            _add_ancestors(by_name, parent)
+        setattr(by_name[parent], leaf, by_name[name])
+    return by_name
+
+
+def _add_ancestors(by_name: dict[str, types.ModuleType], name: str) -> None:
+    parts = name.split(".")
+    for i in range(1, len(parts) + 1):
+        path = ".".join(parts[:i])
+        if path not in by_name:
+            by_name[path] = CompatModule(path)
+            if i > 1:
+                setattr(by_name[".".join(parts[:i - 1])], parts[i - 1], by_name[path])
 
 
 def _palletizing_module() -> list[types.ModuleType] | None:
@@ -127,6 +170,10 @@ def install() -> None:
                            f"(a real Omniverse install?)")
     sys.modules.update(modules)
     _installed.update(modules)
+    for name, module in modules.items():
+        parent, _, leaf = name.rpartition(".")
+        if parent and parent.split(".")[0] not in ROOTS:   # e.g. pxr.PhysxSchema on the real pxr package
+            setattr(importlib.import_module(parent), leaf, module)
     global _finder
     _finder = CompatFinder(_installed)
     sys.meta_path.insert(0, _finder)
@@ -139,6 +186,10 @@ def uninstall() -> None:
     for name in list(_installed):
         if sys.modules.get(name) is _installed[name]:
             del sys.modules[name]
+        parent, _, leaf = name.rpartition(".")
+        if parent and parent.split(".")[0] not in ROOTS and getattr(sys.modules.get(parent), leaf, None) is \
+                _installed[name]:
+            delattr(sys.modules[parent], leaf)
     _installed.clear()
     kit.get_context()._stop_listening()
     if _finder is not None and _finder in sys.meta_path:
