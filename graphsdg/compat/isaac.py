@@ -17,7 +17,7 @@ import types
 
 import importlib
 
-from graphsdg.compat import isaac_core, kit
+from graphsdg.compat import extensions, isaac_core, kit
 from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, ForwardingModule
 
 # Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
@@ -168,14 +168,17 @@ def install() -> None:
     if clash:
         raise RuntimeError(f"cannot install graphsdg's Isaac compat modules: {clash[0]!r} is already imported "
                            f"(a real Omniverse install?)")
-    sys.modules.update(modules)
+    manager = extensions.get_extension_manager()
+    manager._reset()
+    # modules of extensions Isaac leaves off import only once enabled (the finder loads them then)
+    sys.modules.update({n: m for n, m in modules.items() if manager.providing(n) is None})
     _installed.update(modules)
     for name, module in modules.items():
         parent, _, leaf = name.rpartition(".")
         if parent and parent.split(".")[0] not in ROOTS:   # e.g. pxr.PhysxSchema on the real pxr package
             setattr(importlib.import_module(parent), leaf, module)
     global _finder
-    _finder = CompatFinder(_installed)
+    _finder = CompatFinder(_installed, manager.providing)
     sys.meta_path.insert(0, _finder)
     kit.get_context()._listen()   # stage events from here on
 

@@ -24,6 +24,7 @@ from typing import Any, Callable
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg import orchestrator, settings, stage
+from graphsdg.compat import extensions
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
 from graphsdg.runtime import runtime
 
@@ -241,6 +242,9 @@ class App(CompatObject):
 
     def is_running(self) -> bool:
         return True
+
+    def get_extension_manager(self) -> "extensions.ExtensionManager":
+        return extensions.get_extension_manager()
 
     def get_message_bus_event_stream(self) -> EventStream:
         return self._message_bus

@@ -20,7 +20,7 @@ from __future__ import annotations
 import importlib.abc
 import importlib.util
 import types
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 ROOTS = ("omni", "carb", "isaacsim")
 PORTING = "See docs/porting.md for the mapped Isaac Sim API."
@@ -67,12 +67,20 @@ class CompatFinder(importlib.abc.MetaPathFinder):
     that into one clear error naming the symbol and what the parent provides.
     """
 
-    def __init__(self, provided: dict) -> None:
+    def __init__(self, provided: dict, disabled_by: Callable[[str], str | None] = lambda name: None) -> None:
         self.provided = provided
+        self.disabled_by = disabled_by   # module name -> the disabled extension that provides it, if any
 
     def find_spec(self, fullname: str, path=None, target=None):
-        if fullname.split(".")[0] not in ROOTS or fullname in self.provided:
+        if fullname.split(".")[0] not in ROOTS:
             return None
+        if fullname in self.provided:   # not in sys.modules: its extension was off when installed
+            extension = self.disabled_by(fullname)
+            if extension is not None:
+                raise CompatImportError(f"{fullname} is provided by the extension {extension!r}, which is not "
+                                        f"enabled; call isaacsim.core.utils.extensions.enable_extension("
+                                        f"{extension!r}) first, as in Isaac Sim.", name=fullname)
+            return importlib.util.spec_from_loader(fullname, _ExistingModule(self.provided[fullname]))
         parent, _, leaf = fullname.rpartition(".")
         owner = self.provided.get(parent)
         if owner is not None:
