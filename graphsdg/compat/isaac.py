@@ -24,7 +24,7 @@ from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, Forwardin
 # CompatModules named by their full Isaac name. :func:`_mount` links them under their parents.
 AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
          "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
-         "graphsdg.compat.simulation_manager")
+         "graphsdg.compat.simulation_manager", "graphsdg.compat.deformables")
 
 _installed: dict[str, types.ModuleType] = {}
 _finder: CompatFinder | None = None
