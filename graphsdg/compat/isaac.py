@@ -24,7 +24,8 @@ from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, Forwardin
 # CompatModules named by their full Isaac name. :func:`_mount` links them under their parents.
 AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
          "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
-         "graphsdg.compat.simulation_manager", "graphsdg.compat.deformables")
+         "graphsdg.compat.simulation_manager", "graphsdg.compat.deformables",
+         "graphsdg.compat.viewport", "graphsdg.compat.core_utils")
 
 _installed: dict[str, types.ModuleType] = {}
 _finder: CompatFinder | None = None
@@ -57,7 +58,7 @@ def _modules() -> dict[str, types.ModuleType]:
     commands = CompatModule("omni.kit.commands", execute=kit.execute)
     kit_test = CompatModule("omni.kit.test", AsyncTestCase=kit.AsyncTestCase)
     omni_kit = CompatModule("omni.kit", app=app, commands=commands, test=kit_test)
-    usd = CompatModule("omni.usd", get_context=kit.get_context, StageEventType=kit.StageEventType,
+    usd = CompatModule("omni.usd", get_context=kit.get_context, StageEventType=kit.StageEventType, StageState=kit.StageState,
                        get_world_transform_matrix=kit.get_world_transform_matrix,
                        get_local_transform_matrix=kit.get_local_transform_matrix)
     physx = CompatModule("omni.physx", get_physx_scene_query_interface=isaac_core.get_physx_scene_query_interface)

@@ -24,7 +24,7 @@ from typing import Any, Callable
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg import orchestrator, settings, stage
-from graphsdg.compat import extensions
+from graphsdg.compat import extensions, viewport
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
 from graphsdg.runtime import runtime
 
@@ -318,6 +318,15 @@ class StageEventType(enum.IntEnum):
     CLOSED = 6
 
 
+class StageState(enum.IntEnum):
+    """omni.usd.StageState."""
+
+    CLOSED = 0
+    CLOSING = 1
+    OPENING = 2
+    OPENED = 3
+
+
 class UsdContext(CompatObject):
     """omni.usd's context: graphsdg's current stage and its events.
 
@@ -333,6 +342,8 @@ class UsdContext(CompatObject):
         self._listening = False
 
     def _listen(self) -> None:
+        if stage.stage_context.stage is not None:
+            viewport.author_viewport_cameras(stage.stage_context.stage)
         if not self._listening:
             stage.stage_context.subscribe_replacing(self._on_replacing)
             stage.stage_context.subscribe_replaced(self._on_replaced)
@@ -347,6 +358,8 @@ class UsdContext(CompatObject):
         self._stream.push(StageEventType.CLOSING)
 
     def _on_replaced(self, new: Usd.Stage | None) -> None:
+        if new is not None:
+            viewport.author_viewport_cameras(new)   # as Kit does for every stage it opens
         self._stream.push(StageEventType.OPENED if new is not None else StageEventType.CLOSED)
 
     def new_stage(self) -> bool:
@@ -376,6 +389,14 @@ class UsdContext(CompatObject):
     def get_stage_url(self) -> str:
         layer = stage.get_stage().GetRootLayer()
         return layer.realPath or layer.identifier
+
+    def get_stage_loading_status(self) -> tuple[str, int, int]:
+        """``(message, files loaded, files to load)``: graphsdg opens stages and their references
+        synchronously, so nothing is ever still loading (``("", 0, 0)``)."""
+        return "", 0, 0
+
+    def get_stage_state(self) -> "StageState":
+        return StageState.OPENED if stage.stage_context.stage is not None else StageState.CLOSED
 
     def get_stage_event_stream(self) -> EventStream:
         return self._stream

@@ -328,6 +328,14 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
     ``ValueError`` for a file that does not parse as USD.
     """
     path_str = os.fspath(usd_path)
+    layer = _reference_layer(path_str)
+    default = os.path.splitext(os.path.basename(path_str))[0]
+    prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, default, parent)).GetPrim()
+    add_reference(prim, path_str, layer, remove_on_error=True)
+    return _finish(prim, position, rotation, scale, None, None, semantics, visible)
+
+
+def _reference_layer(path_str: str) -> Sdf.Layer:
     if "://" not in path_str and not os.path.isfile(path_str):
         raise FileNotFoundError(f"reference usd_path {path_str!r} does not exist")
     try:
@@ -336,20 +344,31 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
         raise ValueError(f"reference usd_path {path_str!r} does not parse as USD: {usd_error_text(exc)}") from exc
     if layer is None:
         raise ValueError(f"reference usd_path {path_str!r} does not parse as USD")
+    return layer
+
+
+def add_reference(prim: Usd.Prim, usd_path: str, layer: Sdf.Layer | None = None,
+                  remove_on_error: bool = False) -> Usd.Prim:
+    """Reference ``usd_path`` (its default prim) on ``prim``, with the units resolved as in :func:`reference`.
+
+    Raises ``FileNotFoundError`` naming files that do not exist (the prim is removed
+    if ``remove_on_error``, else the reference is taken back).
+    """
+    path_str = os.fspath(usd_path)
+    layer = layer or _reference_layer(path_str)
     target = _reference_target(layer, path_str)
-    default = os.path.splitext(os.path.basename(path_str))[0]
-    stage = get_stage()
+    stage = prim.GetStage()
     known_errors = {str(e) for e in stage.GetCompositionErrors()}
-    prim = UsdGeom.Xform.Define(stage, _new_path(name, default, parent)).GetPrim()
-    if target is None:
-        prim.GetReferences().AddReference(path_str)
-    else:
-        prim.GetReferences().AddReference(path_str, target)
+    ref = Sdf.Reference(path_str) if target is None else Sdf.Reference(path_str, target)
+    prim.GetReferences().AddReference(ref)
     missing = [str(e) for e in stage.GetCompositionErrors()
                if isinstance(e, Pcp.ErrorInvalidAssetPath) and str(e) not in known_errors]
     if missing:
-        stage.RemovePrim(prim.GetPath())
+        if remove_on_error:
+            stage.RemovePrim(prim.GetPath())
+        else:
+            prim.GetReferences().RemoveReference(ref)
         raise FileNotFoundError(f"reference usd_path {path_str!r} names files that do not exist: "
                                 + "; ".join(missing))
     _resolve_units(prim, layer)
-    return _finish(prim, position, rotation, scale, None, None, semantics, visible)
+    return prim

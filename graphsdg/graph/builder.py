@@ -113,12 +113,13 @@ _graph_stage: Usd.Stage | None = None
 def current_graph(create: bool = True) -> Graph | None:
     """The graph new nodes join (a new one after a clear, a new stage, or ``/Replicator`` removal)."""
     global _graph, _graph_stage
-    stage = stage_context.stage
+    # make the stage first: making one releases the graph, which must not be the graph made here
+    stage = get_stage() if create else stage_context.stage
     if _graph is not None and (_graph_stage is not stage or _graph.is_released(stage)):
         release_graph(remove_prims=False)
     if _graph is None and create:
         _graph = Graph()
-        _graph_stage = get_stage()
+        _graph_stage = stage
     return _graph
 
 

@@ -1,0 +1,298 @@
+"""isaacsim.core.utils.stage / .prims / .semantics: Isaac's stage and prim helpers over graphsdg's stage.
+
+Every function acts on graphsdg's current stage (the USD context's). Stages open
+and reference synchronously here, so ``is_stage_loading()`` is always False and
+``update_stage()`` is one app update (the orchestrator's).
+
+Example:
+    >>> from graphsdg.compat import isaac
+    >>> isaac.install()
+    >>> from isaacsim.core.utils.stage import create_new_stage, get_current_stage
+    >>> from isaacsim.core.utils.prims import create_prim
+    >>> _ = create_new_stage()
+    >>> create_prim("/World/Box", "Cube", position=(0, 0, 1), semantic_label="box").GetTypeName()
+    'Cube'
+    >>> isaac.uninstall()
+"""
+from __future__ import annotations
+
+import re
+import types
+from typing import Any, Callable, Iterable, Sequence
+
+from pxr import Sdf, Usd, UsdGeom
+
+from graphsdg.compat.modules import CompatModule
+from graphsdg.stage import context as stage_context
+from graphsdg.stage import semantics as semlib
+from graphsdg.stage.xform import set_local_pose
+
+
+# ---- isaacsim.core.utils.stage -------------------------------------------------------------------
+def get_current_stage(fabric: bool = False) -> Usd.Stage:
+    """The current stage (graphsdg has no Fabric stage: ``fabric=True`` returns the same USD stage)."""
+    return stage_context.get_stage()
+
+
+def get_current_stage_id() -> int:
+    """The stage's id in USD's stage cache (inserted on first call)."""
+    from pxr import UsdUtils
+    cache = UsdUtils.StageCache.Get()
+    return cache.Insert(get_current_stage()).ToLongInt()
+
+
+def create_new_stage() -> Usd.Stage:
+    return stage_context.new_stage()
+
+
+async def create_new_stage_async() -> None:
+    stage_context.new_stage()
+
+
+def open_stage(usd_path: str) -> bool:
+    """Open ``usd_path`` as the current stage; raises FileNotFoundError / ValueError naming a bad path."""
+    stage_context.open_stage(usd_path)
+    return True
+
+
+async def open_stage_async(usd_path: str) -> tuple[bool, str]:
+    return open_stage(usd_path), ""
+
+
+def close_stage(callback_fn: Callable | None = None) -> bool:
+    stage_context.close_stage()
+    if callback_fn is not None:
+        callback_fn(True, "")
+    return True
+
+
+def save_stage(usd_path: str, save_and_reload_in_place: bool = True) -> bool:
+    """Save the current stage's root layer to ``usd_path`` (.usd, .usda or .usdc)."""
+    if not str(usd_path).endswith((".usd", ".usda", ".usdc")):
+        raise ValueError(f"save_stage usd_path {usd_path!r} must end in .usd, .usda or .usdc")
+    stage_context.save(usd_path)
+    if save_and_reload_in_place:
+        stage_context.open_stage(usd_path)
+    return True
+
+
+def is_stage_loading() -> bool:
+    """False: graphsdg loads stages and references synchronously."""
+    return False
+
+
+def update_stage() -> None:
+    """One app update (Kit renders and steps the app here; graphsdg runs the orchestrator's update)."""
+    from graphsdg.compat.kit import get_app
+    get_app().update()
+
+
+async def update_stage_async() -> None:
+    from graphsdg.compat.kit import get_app
+    await get_app().next_update_async()
+
+
+def clear_stage(predicate: Callable[[str], bool] | None = None) -> None:
+    """Remove every root prim's tree (those for which ``predicate(path)`` is True, when given),
+    leaving the viewport cameras and other session-layer prims as Kit does."""
+    stage = get_current_stage()
+    session = stage.GetSessionLayer()
+    for prim in list(stage.GetPseudoRoot().GetChildren()):
+        path = prim.GetPath()
+        if session.GetPrimAtPath(path) is not None and not stage.GetRootLayer().GetPrimAtPath(path):
+            continue
+        if predicate is None or predicate(str(path)):
+            stage.RemovePrim(path)
+
+
+def add_reference_to_stage(usd_path: str, prim_path: str, prim_type: str = "Xform") -> Usd.Prim:
+    """Reference ``usd_path`` at ``prim_path`` (defined as ``prim_type`` if it does not exist)."""
+    from graphsdg.functional.create import add_reference
+    stage = get_current_stage()
+    prim = stage.GetPrimAtPath(prim_path)
+    created = not prim
+    if created:
+        prim = stage.DefinePrim(Sdf.Path(prim_path), prim_type)
+    try:
+        return add_reference(prim, usd_path)
+    except (FileNotFoundError, ValueError):
+        if created:   # nothing half-made stays on the stage
+            stage.RemovePrim(prim.GetPath())
+        raise
+
+
+def get_stage_units() -> float:
+    """Metres per stage unit."""
+    return UsdGeom.GetStageMetersPerUnit(get_current_stage())
+
+
+def set_stage_units(stage_units_in_meters: float) -> None:
+    value = float(stage_units_in_meters)
+    if not value > 0:
+        raise ValueError(f"stage units must be metres per unit > 0, got {stage_units_in_meters!r}")
+    UsdGeom.SetStageMetersPerUnit(get_current_stage(), value)
+
+
+def get_stage_up_axis() -> str:
+    return str(UsdGeom.GetStageUpAxis(get_current_stage()))
+
+
+def set_stage_up_axis(axis: str = "z") -> None:
+    token = {"y": UsdGeom.Tokens.y, "z": UsdGeom.Tokens.z}.get(str(axis).lower())
+    if token is None:
+        raise ValueError(f"stage up axis must be 'y' or 'z', got {axis!r}")
+    UsdGeom.SetStageUpAxis(get_current_stage(), token)
+
+
+def traverse_stage(fabric: bool = False) -> Iterable[Usd.Prim]:
+    return get_current_stage().Traverse()
+
+
+def print_stage_prim_paths(fabric: bool = False) -> None:
+    for prim in traverse_stage():
+        print(prim.GetPath())
+
+
+def get_next_free_path(path: str, parent: str | None = None) -> str:
+    """``path`` (under ``parent``), or with ``_01``, ``_02``, ... appended until no prim has it."""
+    if parent is not None:
+        path = Sdf.Path(parent).AppendPath(Sdf.Path(path.lstrip("/"))).pathString
+    stage = get_current_stage()
+    candidate, n = path, 0
+    base = re.sub(r"_\d+$", "", path)
+    while stage.GetPrimAtPath(candidate):
+        n += 1
+        candidate = f"{base}_{n:02d}"
+    return candidate
+
+
+# ---- isaacsim.core.utils.prims ------------------------------------------------------------------
+def get_prim_at_path(prim_path: str, fabric: bool = False) -> Usd.Prim:
+    return get_current_stage().GetPrimAtPath(prim_path)
+
+
+def is_prim_path_valid(prim_path: str, fabric: bool = False) -> bool:
+    return bool(get_current_stage().GetPrimAtPath(prim_path))
+
+
+def define_prim(prim_path: str, prim_type: str = "Xform", fabric: bool = False) -> Usd.Prim:
+    """Define a prim; raises ValueError if one with another type is already there."""
+    existing = get_prim_at_path(prim_path)
+    if existing and existing.GetTypeName() != prim_type:
+        raise ValueError(f"a prim already exists at {prim_path!r} with type {existing.GetTypeName()!r}, "
+                         f"not {prim_type!r}")
+    return get_current_stage().DefinePrim(Sdf.Path(prim_path), prim_type)
+
+
+def create_prim(prim_path: str, prim_type: str = "Xform", position: Sequence[float] | None = None,
+                translation: Sequence[float] | None = None, orientation: Sequence[float] | None = None,
+                scale: Sequence[float] | None = None, usd_path: str | None = None,
+                semantic_label: str | None = None, semantic_type: str = "class",
+                attributes: dict[str, Any] | None = None) -> Usd.Prim:
+    """Isaac's create_prim: define, set attributes, reference ``usd_path``, pose
+    (``orientation`` is a w, x, y, z quaternion), and label."""
+    if position is not None and translation is not None:
+        raise ValueError("create_prim takes position (world) or translation (local), not both")
+    prim = define_prim(prim_path, prim_type)
+    for name, value in (attributes or {}).items():
+        attr = prim.GetAttribute(name)
+        if not attr:
+            raise ValueError(f"create_prim: {prim_type} prim {prim_path!r} has no attribute {name!r}")
+        attr.Set(value)
+    if usd_path is not None:
+        from graphsdg.functional.create import add_reference
+        add_reference(prim, usd_path)
+    if translation is not None or orientation is not None or scale is not None:
+        rotation = None if orientation is None else tuple(float(v) for v in orientation)   # w, x, y, z
+        set_local_pose(prim, position=translation, rotation=rotation, scale=scale)
+    if position is not None:
+        from graphsdg.sim.transforms import set_world_pose
+        set_world_pose(prim, position, None)
+    if semantic_label is not None:
+        semlib.apply(prim, {semantic_type: [semantic_label]}, mode="add")
+    return prim
+
+
+def delete_prim(prim_path: str) -> bool:
+    stage = get_current_stage()
+    if not stage.GetPrimAtPath(prim_path):
+        raise ValueError(f"delete_prim: no prim at {prim_path!r}")
+    return stage.RemovePrim(Sdf.Path(prim_path))
+
+
+def get_prim_type_name(prim_path: str, fabric: bool = False) -> str:
+    return _existing(prim_path).GetTypeName()
+
+
+def get_prim_children(prim: Usd.Prim) -> list[Usd.Prim]:
+    return list(prim.GetChildren())
+
+
+def get_prim_parent(prim: Usd.Prim) -> Usd.Prim:
+    return prim.GetParent()
+
+
+def get_prim_path(prim: Usd.Prim) -> str:
+    return str(prim.GetPath())
+
+
+def find_matching_prim_paths(prim_path_regex: str, prim_type: str | None = None) -> list[str]:
+    """Paths of prims whose full path matches ``prim_path_regex`` (of ``prim_type`` if given)."""
+    pattern = re.compile(f"^{prim_path_regex}$")
+    return [str(p.GetPath()) for p in get_current_stage().Traverse()
+            if pattern.match(str(p.GetPath())) and (prim_type is None or p.GetTypeName() == prim_type)]
+
+
+def set_prim_visibility(prim: Usd.Prim, visible: bool) -> None:
+    imageable = UsdGeom.Imageable(prim)
+    imageable.MakeVisible() if visible else imageable.MakeInvisible()
+
+
+def _existing(prim_path: str) -> Usd.Prim:
+    prim = get_prim_at_path(prim_path)
+    if not prim:
+        raise ValueError(f"no prim at {prim_path!r}")
+    return prim
+
+
+# ---- isaacsim.core.utils.semantics ----------------------------------------------------------------
+def add_labels(prim: Usd.Prim, labels: Sequence[str], instance_name: str = "class", overwrite: bool = True) -> None:
+    """UsdSemantics labels ``labels`` of taxonomy ``instance_name`` on ``prim`` (replacing the old ones
+    of that taxonomy when ``overwrite``)."""
+    semlib.apply(prim, {instance_name: list(labels)}, mode="replace" if overwrite else "add")
+
+
+def get_labels(prim: Usd.Prim) -> dict[str, list[str]]:
+    return semlib.direct_labels(prim)
+
+
+def remove_labels(prim: Usd.Prim, instance_name: str | None = None, include_descendants: bool = False) -> None:
+    prims = Usd.PrimRange(prim) if include_descendants else [prim]
+    for p in prims:
+        if instance_name is None:
+            semlib.apply(p, None, mode="clear")
+        else:
+            kept = {k: v for k, v in semlib.direct_labels(p).items() if k != instance_name}
+            semlib.apply(p, kept, mode="clear")
+
+
+def modules() -> list[types.ModuleType]:
+    """``isaacsim.core.utils.stage``, ``.prims`` and ``.semantics``."""
+    stage_names = dict(
+        get_current_stage=get_current_stage, get_current_stage_id=get_current_stage_id,
+        create_new_stage=create_new_stage, create_new_stage_async=create_new_stage_async, open_stage=open_stage,
+        open_stage_async=open_stage_async, close_stage=close_stage, save_stage=save_stage,
+        is_stage_loading=is_stage_loading, update_stage=update_stage, update_stage_async=update_stage_async,
+        clear_stage=clear_stage, add_reference_to_stage=add_reference_to_stage, get_stage_units=get_stage_units,
+        set_stage_units=set_stage_units, get_stage_up_axis=get_stage_up_axis, set_stage_up_axis=set_stage_up_axis,
+        traverse_stage=traverse_stage, print_stage_prim_paths=print_stage_prim_paths,
+        get_next_free_path=get_next_free_path)
+    prim_names = dict(
+        get_prim_at_path=get_prim_at_path, is_prim_path_valid=is_prim_path_valid, define_prim=define_prim,
+        create_prim=create_prim, delete_prim=delete_prim, get_prim_type_name=get_prim_type_name,
+        get_prim_children=get_prim_children, get_prim_parent=get_prim_parent, get_prim_path=get_prim_path,
+        find_matching_prim_paths=find_matching_prim_paths, set_prim_visibility=set_prim_visibility)
+    return [CompatModule("isaacsim.core.utils.stage", **stage_names),
+            CompatModule("isaacsim.core.utils.prims", **prim_names),
+            CompatModule("isaacsim.core.utils.semantics", add_labels=add_labels, get_labels=get_labels,
+                         remove_labels=remove_labels)]
