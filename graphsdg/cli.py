@@ -170,6 +170,16 @@ def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
     return 0
 
 
+def run_folder_command(args: argparse.Namespace, script_args: list[str]) -> int:
+    """``graphsdg run-folder``: a verdict line per script, then the totals; 1 if any failed."""
+    from graphsdg.script_suite import run_folder, summary_line
+    extra = [] if args.resolution_scale is None else ["--resolution-scale", str(args.resolution_scale)]
+    results = run_folder(args.folder, args.compat, script_args, args.out, args.timeout, args.pattern, extra,
+                         report=lambda r: print(r.line(), flush=True))
+    print(summary_line(results))
+    return 0 if all(r.passed for r in results) else 1
+
+
 def _hint(exc: BaseException) -> str:
     """The hint line printed under a one-line error."""
     from graphsdg.job import JobMismatchError
@@ -264,6 +274,21 @@ def build_parser() -> argparse.ArgumentParser:
                           "most 1; 0 without GPUs)")
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: frames complete on disk are kept, the rest are captured")
+    folder = sub.add_parser("run-folder", parents=[common],
+                            help="run every script of a folder, one process each; one verdict line per script",
+                            usage="graphsdg run-folder FOLDER [options] [-- SCRIPT_ARGS ...]",
+                            description="Runs each FOLDER/*.py with 'graphsdg run' in its own process and "
+                                        "working folder (OUT/<name>/). A script passes when it exits 0, prints "
+                                        "no '[Test][FAIL]' line and, if its source prints [SDG][Test][PASS], "
+                                        "prints it. Prints one line per script (verdict, seconds, reason) and "
+                                        "'N passed, M failed'; exit 1 if any failed.", epilog=EPILOG)
+    folder.add_argument("folder")
+    folder.add_argument("--compat", choices=["isaac"], help="provide Isaac Sim's module names to the scripts")
+    folder.add_argument("--out", help="folder for the scripts' working folders (default: a new temporary one)")
+    folder.add_argument("--pattern", default="*.py", help="which files to run (default: *.py)")
+    folder.add_argument("--timeout", type=float, default=600.0, help="seconds per script (default 600)")
+    folder.add_argument("--resolution-scale", type=float, metavar="F",
+                        help="scale every render product's resolution by F in every script")
     view = sub.add_parser("view", parents=[common],
                           help="contact sheet (and HTML gallery) of a dataset, with statistics",
                           description="Draws boxes, class names and masks over the frames of a BasicWriter, "
@@ -316,6 +341,8 @@ def main(argv: list[str] | None = None) -> int:
             return run_job_command(args, script_args)
         elif args.command == "graph":
             return run_graph(args, script_args)
+        elif args.command == "run-folder":
+            return run_folder_command(args, script_args)
         elif args.command == "bench":
             run_bench(args)
         elif args.command == "view":

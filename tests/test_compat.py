@@ -91,18 +91,18 @@ def test_unsupported_names_fail_with_what_is_missing_and_what_exists(compat, cod
 
 
 def test_unsupported_call_in_a_script_run_prints_one_clear_line(tmp_path, capsys):
-    script = tmp_path / "uses_viewport.py"
+    script = tmp_path / "uses_window.py"
     script.write_text(textwrap.dedent('''
         from isaacsim import SimulationApp
         simulation_app = SimulationApp({"headless": True})
         import omni.replicator.core as rep
-        from omni.kit.viewport.utility import get_active_viewport
-        get_active_viewport()
+        from omni.kit.window.file import save
+        save()
     '''))
     assert main(["run", "--compat", "isaac", str(script)]) == 1
     err = capsys.readouterr().err
-    assert "graphsdg: error: omni.kit.viewport is not available in graphsdg's compat mode" in err
-    assert "omni.kit provides: app, commands, test" in err
+    assert "graphsdg: error: omni.kit.window is not available in graphsdg's compat mode" in err
+    assert "omni.kit provides: app, commands, " in err
     assert "omni" not in sys.modules                        # the names lived for that script only
 
 
