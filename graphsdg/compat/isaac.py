@@ -206,5 +206,10 @@ def installed_names() -> list[str]:
     return sorted(_installed)
 
 
+def installed_module(name: str) -> types.ModuleType:
+    """The installed compat module ``name`` (also those an extension that is off keeps out of ``sys.modules``)."""
+    return _installed[name]
+
+
 def is_installed() -> bool:
     return bool(_installed)
