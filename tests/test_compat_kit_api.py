@@ -195,3 +195,19 @@ def test_compat_names_leave_no_trace_after_uninstall():
     isaac.uninstall()
     assert not [n for n in sys.modules if n.split(".")[0] in ("omni", "carb", "isaacsim")]
     assert os.environ.get("GRAPHSDG_COMPAT") is None
+
+
+def test_rotation_utils_match_scipy_extrinsic_and_intrinsic(compat):
+    from scipy.spatial.transform import Rotation
+    from isaacsim.core.utils.rotations import (euler_angles_to_quat, gf_quat_to_np_array, quat_to_euler_angles,
+                                               quat_to_rot_matrix)
+    from pxr import Gf
+    angles = np.array([0.3, -0.7, 1.9])
+    for extrinsic, seq in ((True, "xyz"), (False, "XYZ")):
+        x, y, z, w = Rotation.from_euler(seq, angles).as_quat()
+        q = euler_angles_to_quat(angles, extrinsic=extrinsic)
+        assert np.allclose(q, np.sign(w) * np.array([w, x, y, z]))
+        assert np.allclose(quat_to_euler_angles(q, extrinsic=extrinsic), angles)
+        assert np.allclose(quat_to_rot_matrix(q), Rotation.from_euler(seq, angles).as_matrix())
+    assert np.allclose(euler_angles_to_quat([0, 0, 90], degrees=True), [np.sqrt(0.5), 0, 0, np.sqrt(0.5)])
+    assert np.allclose(gf_quat_to_np_array(Gf.Quatd(0.5, 0.5, -0.5, 0.5)), [0.5, 0.5, -0.5, 0.5])

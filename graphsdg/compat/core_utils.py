@@ -1,4 +1,4 @@
-"""isaacsim.core.utils.stage / .prims / .semantics: Isaac's stage and prim helpers over graphsdg's stage.
+"""isaacsim.core.utils.stage / .prims / .semantics / .rotations: Isaac's stage, prim and rotation helpers.
 
 Every function acts on graphsdg's current stage (the USD context's). Stages open
 and reference synchronously here, so ``is_stage_loading()`` is always False and
@@ -20,12 +20,14 @@ import re
 import types
 from typing import Any, Callable, Iterable, Sequence
 
+import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from graphsdg.compat.modules import CompatModule
 from graphsdg.stage import context as stage_context
 from graphsdg.stage import semantics as semlib
-from graphsdg.stage.xform import set_local_pose
+from graphsdg.stage.xform import (euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
+                                  set_local_pose)
 
 
 # ---- isaacsim.core.utils.stage -------------------------------------------------------------------
@@ -276,8 +278,51 @@ def remove_labels(prim: Usd.Prim, instance_name: str | None = None, include_desc
             semlib.apply(p, kept, mode="clear")
 
 
+# ---- isaacsim.core.utils.rotations -------------------------------------------------------------------
+def euler_to_rot_matrix(euler_angles: Sequence[float], degrees: bool = False, extrinsic: bool = True) -> np.ndarray:
+    """Rotation matrix of X, Y, Z angles: extrinsic (fixed axes, R = Rz Ry Rx) or intrinsic (R = Rx Ry Rz)."""
+    angles = np.asarray(euler_angles, dtype=np.float64).reshape(3)
+    degs = angles if degrees else np.degrees(angles)
+    # euler_to_matrix applies the order's first axis first: "XYZ" is Rz Ry Rx, "ZYX" is Rx Ry Rz
+    return euler_to_matrix(degs, "XYZ" if extrinsic else "ZYX")
+
+
+def euler_angles_to_quat(euler_angles: Sequence[float], degrees: bool = False, extrinsic: bool = True) -> np.ndarray:
+    """Quaternion (w, x, y, z) of X, Y, Z Euler angles (radians unless ``degrees``)."""
+    return matrix_to_quat_wxyz(euler_to_rot_matrix(euler_angles, degrees, extrinsic))
+
+
+def rot_matrix_to_quat(mat: np.ndarray) -> np.ndarray:
+    return matrix_to_quat_wxyz(np.asarray(mat, dtype=np.float64)[:3, :3])
+
+
+def quat_to_rot_matrix(quat: Sequence[float]) -> np.ndarray:
+    """3x3 rotation matrix of a (w, x, y, z) quaternion."""
+    return quat_wxyz_to_matrix(quat)
+
+
+def matrix_to_euler_angles(mat: np.ndarray, degrees: bool = False, extrinsic: bool = True) -> np.ndarray:
+    """X, Y, Z angles whose :func:`euler_to_rot_matrix` is ``mat``."""
+    r = np.asarray(mat, dtype=np.float64)[:3, :3]
+    if extrinsic:
+        angles = np.array(matrix_to_euler_xyz(r))
+    else:   # R = Rx(a) Ry(b) Rz(c), so R^T = Rz(-c) Ry(-b) Rx(-a)
+        angles = -np.array(matrix_to_euler_xyz(r.T))
+    return angles if degrees else np.radians(angles)
+
+
+def quat_to_euler_angles(quat: Sequence[float], degrees: bool = False, extrinsic: bool = True) -> np.ndarray:
+    return matrix_to_euler_angles(quat_wxyz_to_matrix(quat), degrees, extrinsic)
+
+
+def gf_quat_to_np_array(orientation: Any) -> np.ndarray:
+    """(w, x, y, z) of a Gf quaternion."""
+    imaginary = orientation.GetImaginary()
+    return np.array([orientation.GetReal(), *imaginary], dtype=np.float64)
+
+
 def modules() -> list[types.ModuleType]:
-    """``isaacsim.core.utils.stage``, ``.prims`` and ``.semantics``."""
+    """``isaacsim.core.utils.stage``, ``.prims``, ``.semantics`` and ``.rotations``."""
     stage_names = dict(
         get_current_stage=get_current_stage, get_current_stage_id=get_current_stage_id,
         create_new_stage=create_new_stage, create_new_stage_async=create_new_stage_async, open_stage=open_stage,
@@ -295,4 +340,8 @@ def modules() -> list[types.ModuleType]:
     return [CompatModule("isaacsim.core.utils.stage", **stage_names),
             CompatModule("isaacsim.core.utils.prims", **prim_names),
             CompatModule("isaacsim.core.utils.semantics", add_labels=add_labels, get_labels=get_labels,
-                         remove_labels=remove_labels)]
+                         remove_labels=remove_labels),
+            CompatModule("isaacsim.core.utils.rotations", euler_angles_to_quat=euler_angles_to_quat,
+                         euler_to_rot_matrix=euler_to_rot_matrix, quat_to_euler_angles=quat_to_euler_angles,
+                         quat_to_rot_matrix=quat_to_rot_matrix, rot_matrix_to_quat=rot_matrix_to_quat,
+                         matrix_to_euler_angles=matrix_to_euler_angles, gf_quat_to_np_array=gf_quat_to_np_array)]

@@ -75,6 +75,8 @@ def _modules() -> dict[str, types.ModuleType]:
                                   get_assets_root_path_async=lambda *a, **k: _assets().get_assets_root_path_async(
                                       *a, **k))
     storage = CompatModule("isaacsim.storage", native=storage_native)
+    replicator_writers = CompatModule("isaacsim.replicator.writers",
+                                      PoseWriter=graphsdg.WriterRegistry.get_writers()["PoseWriter"])
     bounds = CompatModule("isaacsim.core.utils.bounds", create_bbox_cache=isaac_core.create_bbox_cache,
                           compute_aabb=isaac_core.compute_aabb,
                           compute_combined_aabb=isaac_core.compute_combined_aabb,
@@ -97,7 +99,8 @@ def _modules() -> dict[str, types.ModuleType]:
 
     modules = [omni, replicator, rep, rep_functional, scripts, scripts_functional, utils, usd, timeline,
                omni_kit, app, commands, kit_test, physx, carb, carb_settings, carb_events, isaacsim, storage,
-               storage_native, core, core_utils, bounds, experimental, exp_utils, exp_bounds, exp_stage,
+               storage_native, replicator_writers, core, core_utils, bounds, experimental, exp_utils, exp_bounds,
+               exp_stage,
                exp_semantics, exp_prims]
     scenario = _palletizing_module()
     if scenario is None:
