@@ -30,6 +30,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import joints as jointmap
+from graphsdg.sim import physics_steps
 from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size,
                                    rigid_root)
@@ -440,7 +441,9 @@ class SimScene:
                 raise RuntimeError("a physics callback recompiled the stage in the middle of a physics step; "
                                    "physics callbacks may write simulation state (joint targets, constraints) "
                                    "but not edit the stage's structure")
+            physics_steps.notify(True, float(m.opt.timestep))
             mujoco.mj_step(m, d)
+            physics_steps.notify(False, float(m.opt.timestep))
             steps += 1
         # mj_step leaves positions-derived quantities one step behind; renders,
         # queries and contacts need them (and the contacts) for the new state.
