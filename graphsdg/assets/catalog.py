@@ -20,7 +20,7 @@ from typing import Callable
 
 from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
 
-from graphsdg.assets import authoring, geometry, skies, textures
+from graphsdg.assets import authoring, geometry, packing_table, skies, textures, ycb
 from graphsdg.assets.noise import hash01
 
 PROPS = "/Isaac/Environments/Simple_Warehouse/Props"
@@ -341,10 +341,27 @@ IMAGE_ASSETS: dict[str, ImageAsset] = {
        for n in skies.INDOOR_SKIES},
 }
 
+# Stand-ins of Isaac's prop library (YCB objects, packing-table props): sizes in metres as loaded by Isaac
+# scripts (the crate is authored in centimetres; scripts load it with scale=0.01).
+PROP_ASSETS: dict[str, UsdAsset] = {
+    **{f"ycb_{o.id}": UsdAsset(f"ycb_{o.id}", f"{ycb.YCB_DIR}/{o.id}.usd", o.size,
+                               f"YCB {o.label.replace('_', ' ')}: procedural shape of the real size; origin at the "
+                               f"centre", lambda root, o=o: ycb.build_visual(o, root))
+       for o in ycb.YCB_OBJECTS.values()},
+    **{f"ycb_physics_{o.id}": UsdAsset(f"ycb_physics_{o.id}", f"{ycb.YCB_PHYSICS_DIR}/{o.id}.usd", o.size,
+                                       f"YCB {o.label.replace('_', ' ')} with rigid body ({o.mass} kg) and convex "
+                                       f"hull colliders", lambda root, o=o: ycb.build_physics(o, root))
+       for o in ycb.YCB_OBJECTS.values()},
+    "crate_a08_blue": UsdAsset("crate_a08_blue", packing_table.CRATE_PATH, packing_table.CRATE_SIZE_M,
+                               "open-top blue plastic crate, centimetre values without metersPerUnit (load with "
+                               "scale=0.01); origin at the bottom centre", packing_table.build_crate),
+}
+
 # Images first: the warehouse's rack decks use the plywood texture.
 BUILD_ORDER: list[Callable[[str], list[str]]] = [a.build for a in IMAGE_ASSETS.values()] + \
     [USD_ASSETS[k].build for k in ("pallet", "sm_cardboxc_01", "sm_cardboxd_01", "sm_cardboxd_04", "grid",
-                                   "warehouse")]
+                                   "warehouse")] + \
+    [a.build for a in PROP_ASSETS.values()]
 
 
 def build_all(root: str) -> list[str]:

@@ -156,3 +156,117 @@ def shipping_box(length: float, width: float, height: float) -> MeshData:
              [(2 * L + W, W / 2), (L + W, W / 2), (L + W, 0), (2 * L + W, 0)]),
     ]
     return _polygons_to_mesh([f[0] for f in faces], [f[1] for f in faces])
+
+
+def _oriented(polys: list[np.ndarray], outward: list[np.ndarray]) -> list[np.ndarray]:
+    """``polys`` with each one's winding flipped where its normal points against ``outward``."""
+    out = []
+    for p, o in zip(polys, outward):
+        n = np.cross(p[1] - p[0], p[2] - p[0])
+        out.append(p[::-1].copy() if np.dot(n, o) < 0 else p)
+    return out
+
+
+def lathe(profile: Sequence[tuple[float, float]], segments: int = 32) -> MeshData:
+    """A solid of revolution about +Z from ``profile``: (radius, z) points walked counter-clockwise in the
+    (r, z) half-plane (out along the bottom, up the outside, back in over the top; a bowl's or mug's inner
+    wall comes back down before the profile ends). A radius of 0 closes the surface on the axis.
+
+    UVs: ``u`` goes once around (0 to 1), ``v`` along the profile's length (0 to 1).
+    """
+    prof = np.asarray(profile, dtype=np.float64)
+    if prof.ndim != 2 or prof.shape[1] != 2 or len(prof) < 2:
+        raise ValueError(f"lathe profile must be two or more (radius, z) points, got {profile!r}")
+    if np.any(prof[:, 0] < 0):
+        raise ValueError(f"lathe profile radii must be >= 0, got {prof[:, 0].tolist()}")
+    if segments < 3:
+        raise ValueError(f"lathe needs at least 3 segments, got {segments}")
+    seg_len = np.linalg.norm(np.diff(prof, axis=0), axis=1)
+    v = np.concatenate([[0.0], np.cumsum(seg_len)]) / max(seg_len.sum(), 1e-12)
+    theta = np.linspace(0.0, 2 * np.pi, segments + 1)
+    cos, sin = np.cos(theta), np.sin(theta)
+    cos[-1], sin[-1] = 1.0, 0.0   # the seam closes exactly
+
+    def point(i: int, j: int) -> np.ndarray:
+        r, z = prof[i]
+        return np.array([r * cos[j], r * sin[j], z])
+
+    polys, uvs = [], []
+    for i in range(len(prof) - 1):
+        if seg_len[i] < 1e-12:
+            continue
+        for j in range(segments):
+            corners = [(i, j), (i, j + 1), (i + 1, j + 1), (i + 1, j)]
+            if prof[i, 0] == 0.0:
+                corners = [(i, j), (i + 1, j + 1), (i + 1, j)]
+            elif prof[i + 1, 0] == 0.0:
+                corners = [(i, j), (i, j + 1), (i + 1, j)]
+            polys.append(np.array([point(a, b) for a, b in corners]))
+            uvs.append(np.array([(b / segments, v[a]) for a, b in corners]))
+    return _polygons_to_mesh(polys, uvs)
+
+
+def tube(centerline: Sequence[Sequence[float]], radii: Sequence[float], segments: int = 16) -> MeshData:
+    """A closed tube swept along ``centerline`` (N points) with radius ``radii[k]`` at point k.
+
+    The cross-section frame is parallel-transported along the line, so the tube
+    does not twist; both ends are capped. UVs: ``u`` around, ``v`` along the length.
+    """
+    line = np.asarray(centerline, dtype=np.float64)
+    rad = np.asarray(radii, dtype=np.float64)
+    if line.ndim != 2 or line.shape[1] != 3 or len(line) < 2 or rad.shape != (len(line),):
+        raise ValueError(f"tube needs N >= 2 centre-line points (x, y, z) and N radii, got {line.shape} points "
+                         f"and {rad.shape} radii")
+    if np.any(rad <= 0):
+        raise ValueError(f"tube radii must be > 0, got {rad.tolist()}")
+    tangents = np.gradient(line, axis=0)
+    tangents /= np.linalg.norm(tangents, axis=1, keepdims=True)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(tangents[0, 2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    normal = np.cross(tangents[0], helper)
+    normal /= np.linalg.norm(normal)
+    frames = []
+    for k, t in enumerate(tangents):
+        normal = normal - np.dot(normal, t) * t    # parallel transport: drop the component along the tangent
+        normal /= np.linalg.norm(normal)
+        frames.append((normal, np.cross(t, normal)))
+    theta = np.linspace(0.0, 2 * np.pi, segments + 1)
+    rings = np.array([[line[k] + rad[k] * (np.cos(a) * frames[k][0] + np.sin(a) * frames[k][1])
+                       for a in theta] for k in range(len(line))])
+    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))])
+    v = length / length[-1]
+    polys, uvs, outward = [], [], []
+    for k in range(len(line) - 1):
+        for j in range(segments):
+            quad = np.array([rings[k, j], rings[k, j + 1], rings[k + 1, j + 1], rings[k + 1, j]])
+            polys.append(quad)
+            uvs.append(np.array([(j / segments, v[k]), ((j + 1) / segments, v[k]),
+                                 ((j + 1) / segments, v[k + 1]), (j / segments, v[k + 1])]))
+            outward.append(quad.mean(axis=0) - (line[k] + line[k + 1]) / 2)
+    for k, sign in ((0, -1.0), (len(line) - 1, 1.0)):
+        for j in range(segments):
+            tri = np.array([line[k], rings[k, j], rings[k, j + 1]])
+            polys.append(tri)
+            uvs.append(np.array([(0.5, 0.5), (0.5 + 0.5 * np.cos(theta[j]), 0.5 + 0.5 * np.sin(theta[j])),
+                                 (0.5 + 0.5 * np.cos(theta[j + 1]), 0.5 + 0.5 * np.sin(theta[j + 1]))]))
+            outward.append(sign * tangents[k])
+    flipped = _oriented(polys, outward)
+    uvs = [u[::-1].copy() if f is not p else u for f, p, u in zip(flipped, polys, uvs)]
+    return _polygons_to_mesh(flipped, uvs)
+
+
+def transformed(mesh: MeshData, matrix: np.ndarray) -> MeshData:
+    """``mesh`` moved by the 4x4 row-vector ``matrix`` (``p' = [p, 1] @ matrix``); normals follow."""
+    m = np.asarray(matrix, dtype=np.float64)
+    pts = np.c_[mesh.points, np.ones(len(mesh.points))] @ m
+    normals = mesh.normals @ np.linalg.inv(m[:3, :3]).T
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    counts, indices = mesh.counts, mesh.indices
+    if np.linalg.det(m[:3, :3]) < 0:   # a mirror turns faces inside out: reverse each face's winding
+        order, start = [], 0
+        for c in counts:
+            order.extend(range(start + c - 1, start - 1, -1))
+            start += c
+        order = np.array(order)
+        indices, st, normals = indices[order], mesh.st[order], normals[order]
+        return MeshData(points=pts[:, :3], counts=counts, indices=indices, st=st, normals=normals)
+    return MeshData(points=pts[:, :3], counts=counts, indices=indices, st=mesh.st.copy(), normals=normals)
