@@ -18,7 +18,12 @@ SEGMENTS = 32
 
 
 def define_shape(stage: Usd.Stage, path: Sdf.Path, shape: str) -> Usd.Prim:
-    """Define a unit-sized ``shape`` prim at ``path`` and return it."""
+    """Define a unit-sized ``shape`` prim at ``path`` and return it.
+
+    Axial shapes (cylinder, cone, capsule, plane normal, disk, torus) point along the
+    stage's up axis, as Kit's shape commands make them: +Z on a Z-up stage, +Y on a Y-up one.
+    """
+    up = UsdGeom.GetStageUpAxis(stage)
     if shape == "cube":
         g = UsdGeom.Cube.Define(stage, path)
         g.CreateSizeAttr(1.0)
@@ -29,24 +34,26 @@ def define_shape(stage: Usd.Stage, path: Sdf.Path, shape: str) -> Usd.Prim:
         g = UsdGeom.Cylinder.Define(stage, path)
         g.CreateRadiusAttr(0.5)
         g.CreateHeightAttr(1.0)
-        g.CreateAxisAttr(UsdGeom.Tokens.z)
+        g.CreateAxisAttr(up)
     elif shape == "cone":
         g = UsdGeom.Cone.Define(stage, path)
         g.CreateRadiusAttr(0.5)
         g.CreateHeightAttr(1.0)
-        g.CreateAxisAttr(UsdGeom.Tokens.z)
+        g.CreateAxisAttr(up)
     elif shape == "capsule":
         g = UsdGeom.Capsule.Define(stage, path)
         g.CreateRadiusAttr(0.25)
         g.CreateHeightAttr(0.5)
-        g.CreateAxisAttr(UsdGeom.Tokens.z)
+        g.CreateAxisAttr(up)
     elif shape == "plane":
         g = UsdGeom.Plane.Define(stage, path)
         g.CreateWidthAttr(1.0)
         g.CreateLengthAttr(1.0)
-        g.CreateAxisAttr(UsdGeom.Tokens.z)
+        g.CreateAxisAttr(up)
     elif shape in ("disk", "torus"):
         pts, counts, idx = disk_mesh(0.5) if shape == "disk" else torus_mesh(TORUS_MAJOR, TORUS_MINOR)
+        if up == UsdGeom.Tokens.y:   # the rotation taking +Z to +Y: (x, y, z) -> (x, z, -y)
+            pts = np.stack([pts[:, 0], pts[:, 2], -pts[:, 1]], 1)
         g = UsdGeom.Mesh.Define(stage, path)
         g.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(pts.astype(np.float32)))
         g.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))

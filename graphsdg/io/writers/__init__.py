@@ -3,13 +3,15 @@ from graphsdg.io.writer import WriterRegistry
 from graphsdg.io.writers.basic import BasicWriter
 from graphsdg.io.writers.bop import BopWriter
 from graphsdg.io.writers.coco import CocoWriter
+from graphsdg.io.writers.cosmos import CosmosWriter
 from graphsdg.io.writers.kitti import KittiWriter
 from graphsdg.io.writers.pose import PoseWriter
 from graphsdg.io.writers.webdataset import WebDatasetWriter
 from graphsdg.io.writers.yolo import YoloWriter
 
-for _writer in (BasicWriter, BopWriter, CocoWriter, KittiWriter, PoseWriter, WebDatasetWriter, YoloWriter):
+for _writer in (BasicWriter, BopWriter, CocoWriter, CosmosWriter, KittiWriter, PoseWriter, WebDatasetWriter,
+                YoloWriter):
     WriterRegistry.register(_writer, category="default")
 
-__all__ = ["BasicWriter", "BopWriter", "CocoWriter", "KittiWriter", "PoseWriter", "WebDatasetWriter",
-           "YoloWriter"]
+__all__ = ["BasicWriter", "BopWriter", "CocoWriter", "CosmosWriter", "KittiWriter", "PoseWriter",
+           "WebDatasetWriter", "YoloWriter"]
