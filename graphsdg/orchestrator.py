@@ -204,6 +204,9 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
                        list(rt.writers))
     for path, (rp, annotators) in products.items():
         capture.frames.append((path, _render(rt, rp, annotators, subframes, defer), annotators))
+    if products:
+        for observer in list(rt.render_observers):
+            observer(list(products))
     if defer:
         rt.pending_capture = capture.finish
     else:

@@ -61,6 +61,8 @@ class Runtime:
         self.ids = IdTables()
         self.labels = SceneLabels(self.ids)
         self.graph_hooks: list[Callable[..., object]] = []
+        # called with the render product paths of every capture that rendered (Kit's new-frame events)
+        self.render_observers: list[Callable[[list[str]], None]] = []
         # a step(wait_for_render=False) whose annotators and writers have not run yet
         self.pending_capture: Callable[[], None] | None = None
         stage_context.subscribe_replaced(self._on_stage_replaced)

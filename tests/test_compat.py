@@ -74,8 +74,8 @@ UNSUPPORTED = [
     ("import carb\ncarb.tokens.get_tokens_interface()", CompatError, "carb.tokens is not available"),
     ("import omni.usd\nomni.usd.get_context().get_selection()", CompatError,
      "omni.usd.UsdContext.get_selection is not available"),
-    ("import omni.timeline\nomni.timeline.get_timeline_interface().set_looping(False)", CompatError,
-     "omni.timeline.ITimeline.set_looping is not available"),
+    ("import omni.timeline\nomni.timeline.get_timeline_interface().get_director()", CompatError,
+     "omni.timeline.ITimeline.get_director is not available"),
     ("import omni.kit.commands\nomni.kit.commands.execute('CreatePrimCommand', prim_type='Cube')", CompatError,
      "'CreatePrimCommand' is not available"),
 ]

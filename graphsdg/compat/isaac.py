@@ -23,6 +23,7 @@ from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, Forwardin
 # Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
 # CompatModules named by their full Isaac name. :func:`_mount` links them under their parents.
 AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
+         "graphsdg.compat.physics_core",
          "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
          "graphsdg.compat.simulation_manager", "graphsdg.compat.deformables",
          "graphsdg.compat.viewport", "graphsdg.compat.core_utils")

@@ -146,6 +146,13 @@ class TimelineInterface(CompatObject):
     def get_timeline_event_stream(self) -> TimelineEventStream:
         return TimelineEventStream()
 
+    def set_time_codes_per_second(self, time_codes_per_second: float) -> None:
+        """Kit's timeline rate is the stage's ``timeCodesPerSecond``: author it there too, so the stage's
+        simulation (made later from the stage) keeps the rate."""
+        runtime().timeline.set_time_codes_per_second(time_codes_per_second)
+        if stage.stage_context.stage is not None:
+            stage.get_stage().SetTimeCodesPerSecond(float(time_codes_per_second))
+
     def commit(self) -> None:
         """Kit applies pending timeline changes here; graphsdg applies them at once."""
 
@@ -400,6 +407,27 @@ class UsdContext(CompatObject):
 
     def get_stage_event_stream(self) -> EventStream:
         return self._stream
+
+    # Kit 107+ also sends these events by name through carb.eventdispatcher (graphsdg.compat.event_dispatch)
+    def stage_event_name(self, event: "StageEventType") -> str:
+        """The event-dispatcher name of a stage event."""
+        from graphsdg.compat import event_dispatch
+        return event_dispatch.stage_event_name(event)
+
+    def stage_event_type(self, event: str) -> "StageEventType":
+        """The stage event a dispatcher name stands for."""
+        from graphsdg.compat import event_dispatch
+        return event_dispatch.stage_event_type(event)
+
+    def stage_rendering_event_name(self, event: int, immediate: bool = False) -> str:
+        """The event-dispatcher name of a rendering event (``omni.usd.StageRenderingEventType``)."""
+        from graphsdg.compat import event_dispatch
+        return event_dispatch.stage_rendering_event_name(event, immediate)
+
+    def stage_rendering_event_type(self, event: str) -> int:
+        """The rendering event a dispatcher name stands for."""
+        from graphsdg.compat import event_dispatch
+        return event_dispatch.stage_rendering_event_type(event)
 
     def save_as_stage(self, url: str) -> bool:
         stage.save(url)
