@@ -55,7 +55,7 @@ from graphsdg.sim import texture_images
 from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import shapes
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, up_axis_vector, world_matrix
 
 HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)
 COLLISION_ONLY_GROUP = 4    # proxy collision shapes (not drawn)
@@ -732,7 +732,8 @@ class _Builder:
         wb = self.spec.worldbody
         made = []
         if params.kind == "dome":
-            color, direction = params.color, np.array([0.0, 0.0, -1.0])
+            up = np.array(up_axis_vector(self.stage))    # the sky light shines down the stage's up axis
+            color, direction = params.color, -up
             if params.texture:
                 try:
                     env = environment_map.load(params.texture)
@@ -743,13 +744,14 @@ class _Builder:
                 self.sky_maps.append((env, r, params.color))     # display value of radiance 1
                 # Light mostly arrives from the map's bright side; keep it from grazing the floor.
                 d = r @ env.dominant_direction
-                d[2] = max(d[2], 0.5)
+                k = int(np.argmax(up))
+                d[k] = max(d[k], 0.5)
                 direction = -d / np.linalg.norm(d)
             else:
                 self.sky_flat = self.sky_flat + params.color
             self.ambient += 0.5 * color
             sky = wb.add_light(name=f"{path}#sky", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-                               pos=[0, 0, 10], dir=direction.tolist(), castshadow=False)
+                               pos=(10 * up).tolist(), dir=direction.tolist(), castshadow=False)
             _set_light_color(sky, 0.5 * color)
             made.append(sky)
             self.sky_rgb = color if self.sky_rgb is None else self.sky_rgb + color
