@@ -203,6 +203,10 @@ class Rasterizer:
             self._model = model
             self._uploaded_inverse = {mid: np.linalg.inv(m) for mid, m in sim.mesh_maps.items()}
             self._flat_sky = sky.uniform_sky(model)
+        if sim.meshes_to_upload:   # deformables' meshes moved by physics
+            for mid in sorted(sim.meshes_to_upload):
+                mujoco.mjr_uploadMesh(model, self._mjr, mid)
+            sim.meshes_to_upload.clear()
         if sim.textures_to_upload:
             for tid in sorted(sim.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)

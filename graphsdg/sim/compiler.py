@@ -48,7 +48,7 @@ import numpy as np
 from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
-from graphsdg.sim import colliders, environment_map
+from graphsdg.sim import colliders, deformables, environment_map
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import texture_images
@@ -153,6 +153,7 @@ class CompiledScene:
     collider_paths: set[str] = field(default_factory=set)          # gprims that collide (own geom or proxies)
     probe_box: int = -1              # geom ids of the query probes
     probe_sphere: int = -1
+    deformables: list = field(default_factory=list)   # graphsdg.sim.deformables.FlexBinding per deformable
 
 
 def clean_scale(scale: np.ndarray) -> np.ndarray:
@@ -841,6 +842,7 @@ class _Builder:
                 except Exception as exc:  # pxr / mujoco errors: say which prim
                     raise CompileError(f"cannot compile prim {prim.GetPath()} ({type_name}): {exc}") from exc
         self.add_joint_elements()
+        self.flex_plans = deformables.add_to_spec(self.spec, prims, self.cache)
         self.finish_lighting()
         self.assign_masses()
         self.add_probes()
@@ -928,6 +930,7 @@ class _Builder:
                 data.qpos[b.qpos_adr:b.qpos_adr + 7] = self.free_poses[path]
         self._bind_joints(scene)
         mujoco.mj_forward(model, data)
+        scene.deformables = deformables.bind(self.flex_plans, model, data, scene.geoms, self.stage)
         return scene
 
 

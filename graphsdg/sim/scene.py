@@ -28,6 +28,7 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
+from graphsdg.sim import deformables
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
@@ -88,6 +89,7 @@ class SimScene:
         self.model_version = next(_model_versions)
         self.labels_version = 0             # bumps when semantic labels may have changed
         self.textures_to_upload: set[int] = set()
+        self.meshes_to_upload: set[int] = set()   # meshes whose vertices moved (deformables), for renderers
         # mesh id -> 3x3 map from the compiled vertices to the current ones, for meshes rescaled in
         # place since the compile; renderers draw the copy they uploaded through it (no re-upload)
         self.mesh_maps: dict[int, np.ndarray] = {}
@@ -147,6 +149,8 @@ class SimScene:
         self.labels_version += 1
         self.textures_to_upload.clear()
         self.mesh_maps.clear()
+        self.meshes_to_upload.clear()
+        self.follow_deformables()
         self.stats["compiles"] += 1
         self.stats["compile_s"] += time.perf_counter() - start
         for cb in list(self._on_recompile):
@@ -234,6 +238,8 @@ class SimScene:
     def _apply_edits(self, changes: ChangeSet) -> None:
         c = self.compiled
         assert c is not None
+        if deformables.edits_touch(c.deformables, changes.edited):
+            raise NeedsRecompile   # a deformable's nodes are placed from its pose at compile time
         geoms, lights, bodies, mats = self._affected(changes.edited)
         cache = UsdGeom.XformCache(Usd.TimeCode.Default())
         for path in bodies:
@@ -449,6 +455,7 @@ class SimScene:
         # queries and contacts need them (and the contacts) for the new state.
         mujoco.mj_forward(m, d)
         self.write_back_rigid_bodies()
+        self.follow_deformables()
 
     def add_physics_callback(self, name: str, callback: Callable[[float], None]) -> None:
         """Call ``callback(step_size)`` before every physics step (Isaac's ``World.add_physics_callback``).
@@ -466,6 +473,14 @@ class SimScene:
 
     def has_physics_callback(self, name: str) -> bool:
         return str(name) in self._physics_callbacks
+
+    def follow_deformables(self) -> None:
+        """Move deformables' render meshes with their flexes (MuJoCo vertices and USD points)."""
+        c = self.compiled
+        if c is None or not c.deformables:
+            return
+        with self.tracker.muted():
+            deformables.follow(c.deformables, c.model, c.data, self.stage, self.meshes_to_upload)
 
     def write_back_rigid_bodies(self) -> None:
         """Author simulated rigid-body poses on the stage (as PhysX does for USD readers)."""
