@@ -179,17 +179,27 @@ def test_timeline_events_reach_observers_with_their_payload(compat):
 
 def test_app_update_events_fire_once_per_update(compat):
     import omni.kit.app
+    import omni.timeline
     d = _dispatcher()
     seen = []
     g1 = d.observe_event(event_name=omni.kit.app.GLOBAL_EVENT_UPDATE, on_event=lambda e: seen.append(e.event_name))
     g2 = d.observe_event(event_name=omni.kit.app.GLOBAL_EVENT_POST_UPDATE, on_event=lambda e: seen.append("post"))
+    g3 = d.observe_event(event_name=omni.kit.app.GLOBAL_EVENT_PRE_UPDATE, on_event=lambda e: seen.append(
+        ("pre", round(tl.get_current_time() * 60))))
+    tick = d.observe_event(event_name=omni.timeline.GLOBAL_EVENT_CURRENT_TIME_TICKED, on_event=lambda e: seen.append(
+        "tick"))
+    tl = omni.timeline.get_timeline_interface()
+    tl.play()
     app = omni.kit.app.get_app()
-    for _ in range(3):
+    for _ in range(2):
         app.update()
-    assert seen == [omni.kit.app.GLOBAL_EVENT_UPDATE, "post"] * 3
+    # pre-update before the timeline moves, update and post-update after its tick
+    assert seen == [("pre", 0), "tick", omni.kit.app.GLOBAL_EVENT_UPDATE, "post",
+                    ("pre", 1), "tick", omni.kit.app.GLOBAL_EVENT_UPDATE, "post"]
     g1.reset()
+    del g3, tick
     app.update()
-    assert seen[6:] == ["post"]
+    assert seen[8:] == ["post"]
     del g2
 
 

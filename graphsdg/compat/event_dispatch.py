@@ -16,8 +16,9 @@ time anything observes or waits for an event:
 * timeline (``omni.timeline.GLOBAL_EVENT_*``): graphsdg's
   :class:`~graphsdg.sim.timeline.Timeline` events, their payloads included
   (``currentTime`` and ``dt`` on ticks);
-* app updates (``omni.kit.app.GLOBAL_EVENT_UPDATE``, ``GLOBAL_EVENT_POST_UPDATE``):
-  after every app update, payload ``dt`` (the frame's seconds);
+* app updates: ``omni.kit.app.GLOBAL_EVENT_PRE_UPDATE`` before the timeline moves,
+  ``GLOBAL_EVENT_UPDATE`` and ``GLOBAL_EVENT_POST_UPDATE`` after, payload ``dt``
+  (the frame's seconds);
 * stage events (``omni.usd.get_context().stage_event_name(StageEventType.X)``):
   the USD context's CLOSING / OPENED / CLOSED / SAVED;
 * rendering (``stage_rendering_event_name(StageRenderingEventType.NEW_FRAME,
@@ -74,6 +75,7 @@ TIMELINE_EVENT_NAMES: dict[TimelineEventType, tuple[str, str]] = {
 }
 
 # omni.kit.app's names (Kit's run-loop event names)
+APP_PRE_UPDATE = "preUpdate"
 APP_UPDATE = "update"
 APP_POST_UPDATE = "postUpdate"
 
@@ -334,6 +336,7 @@ class _KitEventSources:
         self._timeline_subscription: Any = None
         self._runtime: Any = None
         self._app_subscription: Any = None
+        self._app_pre_subscription: Any = None
         self._stage_subscription: Any = None
 
     def connect(self) -> None:
@@ -350,6 +353,9 @@ class _KitEventSources:
         if self._app_subscription is None:
             self._app_subscription = kit.get_app().get_update_event_stream().create_subscription_to_pop(
                 self._on_app_update)
+        if self._app_pre_subscription is None:
+            self._app_pre_subscription = kit.get_app().get_pre_update_event_stream().create_subscription_to_pop(
+                self._on_app_pre_update)
         if self._stage_subscription is None:
             self._stage_subscription = kit.get_context().get_stage_event_stream().create_subscription_to_pop(
                 self._on_stage_event)
@@ -363,6 +369,9 @@ class _KitEventSources:
         payload = {"dt": float(event.payload.get("dt", 0.0))}
         self._dispatcher.dispatch_event(APP_UPDATE, payload)
         self._dispatcher.dispatch_event(APP_POST_UPDATE, payload)
+
+    def _on_app_pre_update(self, event: Any) -> None:
+        self._dispatcher.dispatch_event(APP_PRE_UPDATE, {"dt": float(event.payload.get("dt", 0.0))})
 
     def _on_stage_event(self, event: Any) -> None:
         self._dispatcher.dispatch_event(stage_event_name(event.type), dict(event.payload))
@@ -392,6 +401,7 @@ def modules() -> list[types.ModuleType]:
                               acquire_eventdispatcher_interface=acquire_eventdispatcher_interface, Event=Event,
                               IEventDispatcher=EventDispatcher, Observer=Observer, ObserverGuard=ObserverGuard)
     timeline = CompatModule("omni.timeline", **{const: name for const, name in TIMELINE_EVENT_NAMES.values()})
-    app = CompatModule("omni.kit.app", GLOBAL_EVENT_UPDATE=APP_UPDATE, GLOBAL_EVENT_POST_UPDATE=APP_POST_UPDATE)
+    app = CompatModule("omni.kit.app", GLOBAL_EVENT_PRE_UPDATE=APP_PRE_UPDATE, GLOBAL_EVENT_UPDATE=APP_UPDATE,
+                       GLOBAL_EVENT_POST_UPDATE=APP_POST_UPDATE)
     usd = CompatModule("omni.usd", StageRenderingEventType=StageRenderingEventType)
     return [dispatcher, timeline, app, usd]

@@ -179,6 +179,7 @@ class App(CompatObject):
         self._pumping = False
         self._message_bus = EventStream()
         self._update_stream = EventStream()
+        self._pre_update_stream = EventStream()
 
     def update(self) -> None:
         """One app update; coroutines waiting for it resume (and run up to their next wait)."""
@@ -192,6 +193,7 @@ class App(CompatObject):
         # waiters of an event loop that was closed meanwhile (a finished asyncio.run) have no one to wake
         waiters, self._waiters = [f for f in self._waiters if not f.get_loop().is_closed()], []
         try:
+            self._pre_update_stream.push(0, {"dt": runtime().timeline.frame_duration})
             orchestrator.update()
             self._update_stream.push(0, {"dt": runtime().timeline.frame_duration})
         except BaseException as exc:
@@ -258,6 +260,10 @@ class App(CompatObject):
 
     def get_update_event_stream(self) -> EventStream:
         return self._update_stream
+
+    def get_pre_update_event_stream(self) -> EventStream:
+        """Events pushed at the start of every app update, before the timeline moves."""
+        return self._pre_update_stream
 
     def post_quit(self, return_code: int = 0) -> None:
         """Nothing to quit: the script ends when it returns."""
