@@ -57,6 +57,9 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/rtx/pathtracing/spp": (1, "samples per pixel per frame in PathTracing mode (see totalSpp)"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
+    "/app/player/timelineSubsampleRate": (1, "timeline ticks per frame: each app update's frame is split into this "
+                                              "many ticks, each with its physics and tick events "
+                                              "(omni.timeline set_ticks_per_frame)"),
     "/graphsdg/render/maxSubframes": (0, "upper bound on accumulated subframes per capture (rt_subframes and "
                                          "path-tracing samples); 0 means no bound (CI-sized runs of full scripts)"),
 }
@@ -108,6 +111,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/msaaSamples": _integer(0),
     "/graphsdg/render/exposure": _positive_number,
     "/graphsdg/render/maxResolution": _integer(1),
+    "/app/player/timelineSubsampleRate": _integer(1),
 }
 
 _values: dict[str, Any] = {}

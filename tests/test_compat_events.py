@@ -313,6 +313,14 @@ def test_ticks_per_frame_split_each_frame(compat):
     tl.play()
     rep.orchestrator.update()
     assert dts == [round(1 / 90, 9)] * 3 and tl.get_current_time() == pytest.approx(1 / 30)
+    import carb.settings                               # Kit: the same as the timeline's sub-stepping setting
+    assert carb.settings.get_settings().get("/app/player/timelineSubsampleRate") == 3
+    carb.settings.get_settings().set("/app/player/timelineSubsampleRate", 2)
+    dts.clear()
+    rep.orchestrator.update()
+    assert tl.get_ticks_per_frame() == 2 and dts == [round(1 / 60, 9)] * 2
+    with pytest.raises(ValueError, match="timelineSubsampleRate"):
+        carb.settings.get_settings().set("/app/player/timelineSubsampleRate", 0)
     del guard
 
 

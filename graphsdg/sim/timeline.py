@@ -46,8 +46,13 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable
 
+from graphsdg import settings
+
 if TYPE_CHECKING:
     from graphsdg.sim.scene import SimScene
+
+# Kit's timeline reads its sub-stepping from this setting (set_ticks_per_frame writes it)
+TICKS_PER_FRAME_SETTING = "/app/player/timelineSubsampleRate"
 
 
 class TimelineEventType(enum.IntEnum):
@@ -107,7 +112,6 @@ class Timeline:
         self.start_time = 0.0
         self.end_time: float | None = None   # None: no end, the timeline plays on without bound
         self.looping = False
-        self.ticks_per_frame = 1
         self.play_every_frame = True
 
     def attach_simulation(self, simulation: Callable[[], "SimScene"] | None) -> None:
@@ -226,17 +230,22 @@ class Timeline:
         self.looping = bool(looping)
         self._emit(TimelineEventType.LOOP_MODE_CHANGED, looping=self.looping)
 
+    @property
+    def ticks_per_frame(self) -> int:
+        """Ticks in one frame: the setting ``/app/player/timelineSubsampleRate``, as in Kit."""
+        return int(settings.get(TICKS_PER_FRAME_SETTING, 1))
+
     def get_ticks_per_frame(self) -> int:
         """Ticks (tick events, physics advances) in one frame."""
         return self.ticks_per_frame
 
     def set_ticks_per_frame(self, ticks: int) -> None:
-        """Split each frame into ``ticks`` ticks of equal length."""
+        """Split each frame into ``ticks`` ticks of equal length (sets ``/app/player/timelineSubsampleRate``)."""
         if isinstance(ticks, bool) or not isinstance(ticks, int) or ticks < 1:
             raise ValueError(f"ticks per frame must be a positive integer, got {ticks!r}")
         if ticks == self.ticks_per_frame:
             return
-        self.ticks_per_frame = ticks
+        settings.set(TICKS_PER_FRAME_SETTING, ticks)
         self._emit(TimelineEventType.TICKS_PER_FRAME_CHANGED, ticksPerFrame=ticks)
 
     def get_play_every_frame(self) -> bool:
