@@ -193,6 +193,9 @@ def test_pack_regenerates_identically(tmp_path):
         if rel.endswith(".usd"):
             a, b = Usd.Stage.Open(new), Usd.Stage.Open(old)      # keep the stages: they own the layers
             assert a.GetRootLayer().ExportToString() == b.GetRootLayer().ExportToString(), rel
+        elif rel.endswith(".json"):
+            with open(new, encoding="utf-8") as fa, open(old, encoding="utf-8") as fb:
+                assert fa.read() == fb.read(), rel
         elif rel.endswith(".hdr"):
             a, b = (cv2.imread(p, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_COLOR) for p in (new, old))
             np.testing.assert_allclose(a, b, rtol=0.02, atol=1e-3, err_msg=rel)

@@ -20,7 +20,7 @@ from typing import Callable
 
 from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
 
-from graphsdg.assets import authoring, geometry, packing_table, skies, textures, ycb
+from graphsdg.assets import authoring, geometry, packing_table, simready, skies, textures, ycb
 from graphsdg.assets.noise import hash01
 
 PROPS = "/Isaac/Environments/Simple_Warehouse/Props"
@@ -361,7 +361,7 @@ PROP_ASSETS: dict[str, UsdAsset] = {
 BUILD_ORDER: list[Callable[[str], list[str]]] = [a.build for a in IMAGE_ASSETS.values()] + \
     [USD_ASSETS[k].build for k in ("pallet", "sm_cardboxc_01", "sm_cardboxd_01", "sm_cardboxd_04", "grid",
                                    "warehouse")] + \
-    [a.build for a in PROP_ASSETS.values()]
+    [a.build for a in PROP_ASSETS.values()] + [simready.build_catalog]
 
 
 def build_all(root: str) -> list[str]:

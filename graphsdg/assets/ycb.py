@@ -74,7 +74,8 @@ def _bottle(color, cap, neck=0.35, shoulder=0.75) -> list[Part]:
     return [Part("Body", body, color, 0.4), Part("Cap", top, cap, 0.5)]
 
 
-def _banana() -> list[Part]:
+def banana_parts() -> list[Part]:
+    """A banana: a tapering tube along a 100 degree arc, yellow peel (unit-less: fit it to a size)."""
     t = np.linspace(0.0, 1.0, 17)
     angle = (t - 0.5) * math.radians(100)          # a 100 degree arc
     line = np.c_[0.11 * (1 - np.cos(angle)), 0.11 * np.sin(angle), np.zeros_like(t)]
@@ -158,7 +159,7 @@ def _objects() -> list[YcbObject]:
         YcbObject("009_gelatin_box", (0.085, 0.028, 0.073), 0.097, "gelatin_box", lambda: _box((0.85, 0.20, 0.25))),
         YcbObject("010_potted_meat_can", (0.097, 0.050, 0.082), 0.370, "potted_meat_can",
                   lambda: _box((0.20, 0.30, 0.62), "Label", 0.4)),
-        YcbObject("011_banana", (0.036, 0.190, 0.036), 0.066, "banana", _banana),
+        YcbObject("011_banana", (0.036, 0.190, 0.036), 0.066, "banana", banana_parts),
         YcbObject("019_pitcher_base", (0.188, 0.108, 0.242), 0.178, "pitcher_base", _pitcher),
         YcbObject("021_bleach_cleanser", (0.098, 0.065, 0.250), 1.131, "bleach_cleanser",
                   lambda: _bottle((0.93, 0.93, 0.90), (0.15, 0.35, 0.80), neck=0.3, shoulder=0.8)),

@@ -332,6 +332,8 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
     default = os.path.splitext(os.path.basename(path_str))[0]
     prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, default, parent)).GetPrim()
     add_reference(prim, path_str, layer, remove_on_error=True)
+    # Kit authors xformOp:translate on every prim it creates (scripts Set() it without creating it first)
+    position = (0.0, 0.0, 0.0) if position is None else position
     return _finish(prim, position, rotation, scale, None, None, semantics, visible)
 
 
