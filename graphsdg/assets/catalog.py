@@ -20,7 +20,7 @@ from typing import Callable
 
 from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
 
-from graphsdg.assets import authoring, geometry, packing_table, simready, skies, textures, ycb
+from graphsdg.assets import authoring, geometry, outdoor_skies, packing_table, simready, skies, textures, ycb
 from graphsdg.assets.noise import hash01
 
 PROPS = "/Isaac/Environments/Simple_Warehouse/Props"
@@ -356,6 +356,21 @@ PROP_ASSETS: dict[str, UsdAsset] = {
                                "open-top blue plastic crate, centimetre values without metersPerUnit (load with "
                                "scale=0.01); origin at the bottom centre", packing_table.build_crate),
 }
+
+def _outdoor_sky_builder(name: str) -> Callable[[str], list[str]]:
+    def build(root: str) -> list[str]:
+        rel = f"{outdoor_skies.SKIES_ROOT}/{name}.hdr"
+        skies.write_hdr(_abs(root, rel), outdoor_skies.render_outdoor(outdoor_skies.OUTDOOR_SKIES[name]))
+        return [rel]
+    return build
+
+
+IMAGE_ASSETS.update({
+    f"sky_{n.replace('/', '_').lower()}": ImageAsset(
+        f"sky_{n.replace('/', '_').lower()}", f"{outdoor_skies.SKIES_ROOT}/{n}.hdr", outdoor_skies.OUTDOOR_SKY_SIZE,
+        f"outdoor HDR lat-long sky ({n.split('/')[0].lower()}: {n.split('/')[1].replace('_4k', '').replace('_', ' ')})",
+        _outdoor_sky_builder(n))
+    for n in outdoor_skies.OUTDOOR_SKIES})
 
 # Images first: the warehouse's rack decks use the plywood texture.
 BUILD_ORDER: list[Callable[[str], list[str]]] = [a.build for a in IMAGE_ASSETS.values()] + \
