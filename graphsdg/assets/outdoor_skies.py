@@ -4,10 +4,11 @@ Each sky is a gradient from the horizon colour to the zenith colour, a sun (or
 moon) disc with a glow around it, clouds from fractal noise and a ground below
 the horizon that reflects the light falling on it. The layout is
 :mod:`graphsdg.assets.skies`'s (UsdLux lat-long, Z up), and so is the
-normalisation: the map puts irradiance ``pi * brightness`` on an upward-facing
-surface, so a dome of intensity ``I`` with a day sky (``brightness`` 1) lights a
-floor as brightly as an untextured dome of intensity ``I``; evening and night
-skies are dimmer, as the real ones are.
+normalisation: every map puts irradiance ``pi`` on an upward-facing surface, so
+a dome of intensity ``I`` with any of them lights a floor as brightly as an
+untextured dome of intensity ``I`` (an evening or night sky differs in colour
+and in how much of its light comes from the sun or moon; scripts set the dome's
+intensity for the time of day, as with Isaac's maps).
 
 The maps are small (128 x 64): a sky is smooth, and the pack ships nine of them.
 
@@ -33,7 +34,7 @@ SKIES_ROOT = "/NVIDIA/Assets/Skies"
 
 @dataclass(frozen=True)
 class OutdoorSky:
-    """An outdoor sky: colours, the sun's direction (degrees), size and strength, cloud cover (0..1)."""
+    """An outdoor sky: colours, the sun's direction (degrees), size and share of the light, cloud cover (0..1)."""
 
     zenith: RGB
     horizon: RGB
@@ -45,7 +46,6 @@ class OutdoorSky:
     clouds: float
     cloud_color: RGB
     seed: int
-    brightness: float = 1.0       # upward irradiance as a multiple of pi
     sun_radius: float = 2.5       # degrees (drawn larger than the real sun so the small map holds it)
 
 
@@ -77,14 +77,14 @@ def render_outdoor(sky: OutdoorSky, width: int = OUTDOOR_SKY_SIZE[1], height: in
     ground = np.asarray(sky.ground)[None, None, :] * (0.9 + 0.2 * fbm((height, width), (8, 16), 3, sky.seed + 1)
                                                     )[..., None]
     radiance = np.where(below[..., None], ground, sky_rgb)
-    # Split the upward irradiance between the sun disc and the rest as sun_share says, totalling pi * brightness.
+    # Split the upward irradiance between the sun disc and the rest as sun_share says, totalling pi.
     sun_rgb = disc[..., None] * np.asarray(sky.sun_color)[None, None, :] * (up > 0)[..., None]
     rest_irr, sun_irr = up_irradiance(radiance), up_irradiance(sun_rgb)
-    target = math.pi * sky.brightness
+    target = math.pi
     rest_gain = target * (1 - sky.sun_share) / max(rest_irr, 1e-9)
     sun_gain = target * sky.sun_share / max(sun_irr, 1e-9) if sun_irr > 0 else 0.0
     radiance = radiance * rest_gain
-    radiance[below] = ground[below] * sky.brightness            # the ground keeps its own albedo-lit level
+    radiance[below] = ground[below]            # the ground keeps its own albedo-lit level
     out = np.where(disc[..., None] > 0, sun_rgb * sun_gain, radiance)
     # the disc replaced sky pixels: renormalise so the total is exact
     out *= target / max(up_irradiance(out), 1e-9)
@@ -99,16 +99,16 @@ OUTDOOR_SKIES: dict[str, OutdoorSky] = {
     "Clear/qwantani_4k": OutdoorSky((0.25, 0.45, 0.80), (0.72, 0.78, 0.86), (0.35, 0.40, 0.22), -60.0, 35.0,
                                     (1.0, 0.94, 0.85), 0.6, 0.2, (0.93, 0.93, 0.95), 13),
     "Clear/evening_road_01_4k": OutdoorSky((0.18, 0.28, 0.55), (0.95, 0.62, 0.38), (0.30, 0.26, 0.22), 80.0, 6.0,
-                                           (1.0, 0.70, 0.42), 0.55, 0.15, (0.90, 0.62, 0.50), 14, 0.45),
+                                           (1.0, 0.70, 0.42), 0.55, 0.15, (0.90, 0.62, 0.50), 14),
     "Evening/evening_road_01_4k": OutdoorSky((0.18, 0.28, 0.55), (0.95, 0.62, 0.38), (0.30, 0.26, 0.22), 80.0, 6.0,
-                                             (1.0, 0.70, 0.42), 0.55, 0.15, (0.90, 0.62, 0.50), 14, 0.45),
+                                             (1.0, 0.70, 0.42), 0.55, 0.15, (0.90, 0.62, 0.50), 14),
     "Cloudy/champagne_castle_1_4k": OutdoorSky((0.45, 0.52, 0.62), (0.75, 0.78, 0.80), (0.28, 0.32, 0.20), 150.0,
-                                               40.0, (1.0, 0.97, 0.93), 0.3, 0.7, (0.80, 0.81, 0.83), 15, 0.8),
+                                               40.0, (1.0, 0.97, 0.93), 0.3, 0.7, (0.80, 0.81, 0.83), 15),
     "Cloudy/kloofendal_48d_partly_cloudy_4k": OutdoorSky((0.28, 0.45, 0.75), (0.72, 0.77, 0.83), (0.30, 0.34, 0.18),
                                                          -20.0, 48.0, (1.0, 0.97, 0.92), 0.5, 0.45,
                                                          (0.92, 0.92, 0.94), 16),
     "Night/kloppenheim_02_4k": OutdoorSky((0.01, 0.015, 0.04), (0.05, 0.06, 0.10), (0.03, 0.03, 0.03), 40.0, 30.0,
-                                          (0.75, 0.80, 0.95), 0.2, 0.3, (0.06, 0.06, 0.08), 17, 0.02, 1.5),
+                                          (0.75, 0.80, 0.95), 0.2, 0.3, (0.06, 0.06, 0.08), 17, 1.5),
     "Night/moonlit_golf_4k": OutdoorSky((0.015, 0.02, 0.05), (0.06, 0.08, 0.12), (0.02, 0.05, 0.02), -100.0, 35.0,
-                                        (0.80, 0.85, 1.0), 0.4, 0.1, (0.08, 0.08, 0.10), 18, 0.03, 1.5),
+                                        (0.80, 0.85, 1.0), 0.4, 0.1, (0.08, 0.08, 0.10), 18, 1.5),
 }
