@@ -340,16 +340,23 @@ def execute_action(extension_id: str, action_id: str, *args: Any, **kwargs: Any)
 
 
 # ---- legacy semantics -----------------------------------------------------------------------------------------
+def _schema_tokens(prim: Usd.Prim) -> list[str]:
+    """The prim's composed ``apiSchemas`` tokens, those of schemas usd-core does not know included
+    (``GetAppliedSchemas`` drops unregistered ones such as Isaac's ``SemanticsAPI``)."""
+    items: list[str] = []
+    for spec in reversed(prim.GetPrimStack()):           # weakest opinion first
+        if spec.HasInfo("apiSchemas"):
+            items = list(spec.GetInfo("apiSchemas").ApplyOperations(items))
+    return items
+
+
 def _legacy_instances(prim: Usd.Prim) -> list[str]:
-    """Instance names of the older ``SemanticsAPI`` on ``prim`` (from its attributes and applied schemas)."""
-    names = []
+    """Instance names of the older ``SemanticsAPI`` still on ``prim``: applied, or with a type value."""
+    names = [t.split(":", 1)[1] for t in _schema_tokens(prim) if t.startswith("SemanticsAPI:")]
     for attr in prim.GetAttributes():
         parts = attr.GetName().split(":")
-        if len(parts) == 4 and parts[0] == "semantic" and parts[2:] == ["params", "semanticType"]:
+        if len(parts) == 4 and parts[0] == "semantic" and parts[2:] == ["params", "semanticType"] and attr.Get():
             names.append(parts[1])
-    for schema in prim.GetAppliedSchemas():
-        if schema.startswith("SemanticsAPI:"):
-            names.append(schema.split(":", 1)[1])
     return list(dict.fromkeys(names))
 
 
@@ -383,7 +390,7 @@ def upgrade_prim_semantics_to_labels(prim: Usd.Prim | str, include_descendants: 
                     if left and left.HasAuthoredValue():   # authored in a referenced layer: block it
                         left.Block()
             token = f"SemanticsAPI:{instance}"
-            if token in p.GetAppliedSchemas():
+            if token in _schema_tokens(p):
                 p.RemoveAppliedSchema(token)
             count += 1
     return count
