@@ -334,10 +334,10 @@ class StageEventType(enum.IntEnum):
 class StageState(enum.IntEnum):
     """omni.usd.StageState."""
 
-    CLOSED = 0
-    CLOSING = 1
-    OPENING = 2
-    OPENED = 3
+    CLOSED = 0     # Kit's order: eClosed, eOpening, eOpened, eClosing
+    OPENING = 1
+    OPENED = 2
+    CLOSING = 3
 
 
 class UsdContext(CompatObject):
