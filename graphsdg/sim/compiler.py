@@ -52,10 +52,13 @@ from graphsdg.sim import colliders, deformables, environment_map
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import texture_images
+from graphsdg.sim.mujoco_warnings import route_warnings
 from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import shapes
 from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, up_axis_vector, world_matrix
+
+route_warnings()   # before the first compile: MuJoCo's warnings are logged, not written to MUJOCO_LOG.TXT
 
 HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)
 COLLISION_ONLY_GROUP = 4    # proxy collision shapes (not drawn)
