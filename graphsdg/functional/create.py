@@ -374,3 +374,31 @@ def add_reference(prim: Usd.Prim, usd_path: str, layer: Sdf.Layer | None = None,
                                 + "; ".join(missing))
     _resolve_units(prim, layer)
     return prim
+
+
+def clone(input_prim: PrimLike, name: str | None = None, parent: PrimLike | None = None,
+          position: Vec3 | None = None, rotation: Vec3 | None = None, scale: Vec3 | float | None = None,
+          semantics: Any = None, visible: bool = True) -> Usd.Prim:
+    """Copy ``input_prim`` and its subtree to a new prim (``parent``/``name``, default: beside it, named
+    after it) and return the copy.
+
+    Every layer's opinions of the source are copied into that layer (applied schemas,
+    references, material bindings, physics), and relationships that point inside the
+    copied subtree are retargeted to the copy. ``position``, ``rotation``, ``scale``
+    and ``semantics`` then apply to the copy, as for the other create functions.
+    """
+    sources = resolve_prims(input_prim)
+    if len(sources) != 1:
+        raise ValueError(f"clone takes one prim, got {len(sources)} ({input_prim!r})")
+    source = sources[0]
+    stage = source.GetStage()
+    src = source.GetPath()
+    dst = _new_path(name or src.name, src.name, parent if parent is not None else str(src.GetParentPath()))
+    for layer in stage.GetLayerStack(includeSessionLayers=True):
+        if layer.GetPrimAtPath(src) is None:
+            continue
+        if layer.GetPrimAtPath(dst.GetParentPath()) is None:
+            Sdf.CreatePrimInLayer(layer, dst.GetParentPath())   # an "over", so the copy has a parent there
+        if not Sdf.CopySpec(layer, src, layer, dst):
+            raise ValueError(f"clone could not copy {src} to {dst} in layer {layer.identifier}")
+    return _finish(stage.GetPrimAtPath(dst), position, rotation, scale, None, None, semantics, visible)
