@@ -56,7 +56,8 @@ from graphsdg.sim.mujoco_warnings import route_warnings
 from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import shapes
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, up_axis_vector, world_matrix
+from graphsdg.stage.changes import STATE_PROPERTIES
+from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, up_axis_vector, world_matrix
 
 route_warnings()   # before the first compile: MuJoCo's warnings are logged, not written to MUJOCO_LOG.TXT
 
@@ -97,6 +98,21 @@ class GeomBinding:
     material: str | None             # bound material path
     visible: bool = True
     relative: np.ndarray | None = None   # pose in its rigid body's frame (row-vector 4x4)
+
+
+VELOCITY_ATTRIBUTES = STATE_PROPERTIES   # a rigid body's velocities: live state, not model structure
+
+
+def authored_velocity(prim: Usd.Prim) -> tuple[np.ndarray, np.ndarray]:
+    """A rigid body's authored world-frame (linear, angular rad/s) velocity; zeros where not authored.
+
+    UsdPhysics gives ``physics:angularVelocity`` in degrees per second; PhysX reads
+    both in world space unless ``physxRigidBody:localSpaceVelocities`` is set.
+    """
+    body = UsdPhysics.RigidBodyAPI(prim)
+    linear, angular = body.GetVelocityAttr().Get(), body.GetAngularVelocityAttr().Get()
+    return (np.array(linear if linear is not None else (0, 0, 0), dtype=np.float64),
+            np.radians(np.array(angular if angular is not None else (0, 0, 0), dtype=np.float64)))
 
 
 @dataclass
@@ -389,6 +405,7 @@ class _Builder:
         self.sky_flat = np.zeros(3)                      # untextured domes' share of the background
         self.joint_plan = jointmap.JointPlan()
         self.free_poses: dict[str, np.ndarray] = {}     # free body -> its current (position, quaternion)
+        self.free_velocities: dict[str, tuple[np.ndarray, np.ndarray]] = {}   # world (linear, angular rad/s)
 
     # ---- options -------------------------------------------------------
     def configure(self) -> None:
@@ -510,6 +527,7 @@ class _Builder:
             if not kinematic:
                 body.add_freejoint(name=f"{path}#free")
                 self.free_poses[path] = np.concatenate([t, q])
+                self.free_velocities[path] = authored_velocity(root)
         if not kinematic:
             disable = root.GetAttribute("physxRigidBody:disableGravity")
             if disable and disable.Get():
@@ -931,6 +949,10 @@ class _Builder:
         for path, b in scene.bodies.items():
             if b.qpos_adr >= 0:
                 data.qpos[b.qpos_adr:b.qpos_adr + 7] = self.free_poses[path]
+                linear, angular = self.free_velocities[path]
+                data.qvel[b.qvel_adr:b.qvel_adr + 3] = linear
+                # MuJoCo's free-joint angular velocity is in the body's frame
+                data.qvel[b.qvel_adr + 3:b.qvel_adr + 6] = quat_wxyz_to_matrix(self.free_poses[path][3:]).T @ angular
         self._bind_joints(scene)
         mujoco.mj_forward(model, data)
         scene.deformables = deformables.bind(self.flex_plans, model, data, scene.geoms, self.stage)

@@ -26,13 +26,14 @@ from typing import Callable
 
 import mujoco
 import numpy as np
-from pxr import Gf, Sdf, Usd, UsdGeom
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.sim import deformables
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
-from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, BodyBinding, CompiledScene, compile_stage,
+from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, VELOCITY_ATTRIBUTES, BodyBinding,
+                                   CompiledScene, authored_velocity, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size,
                                    rigid_root)
 from graphsdg.sim.mesh_scaling import rescale_mesh_geoms
@@ -71,6 +72,8 @@ def edit_aspects(names: set[str]) -> set[str]:
             aspects.add("shape")
         elif name.startswith("semantic"):
             continue   # labels are read by annotators, not compiled
+        elif name in VELOCITY_ATTRIBUTES:
+            continue   # simulation state, set on the body (SimScene._refresh_body_velocity)
         else:
             return set(ALL_ASPECTS)
     return aspects
@@ -241,6 +244,9 @@ class SimScene:
         if deformables.edits_touch(c.deformables, changes.edited):
             raise NeedsRecompile   # a deformable's nodes are placed from its pose at compile time
         geoms, lights, bodies, mats = self._affected(changes.edited)
+        for path, names in changes.edited.items():
+            if names & VELOCITY_ATTRIBUTES and str(path) in c.bodies:
+                self._refresh_body_velocity(str(path))
         cache = UsdGeom.XformCache(Usd.TimeCode.Default())
         for path in bodies:
             self._refresh_body(path, cache)
@@ -253,6 +259,14 @@ class SimScene:
         self.stats["edited_prims"] += len(geoms) + len(lights) + len(bodies) + len(mats)
         mujoco.mj_kinematics(c.model, c.data)
         mujoco.mj_camlight(c.model, c.data)
+
+    def _refresh_body_velocity(self, path: str) -> None:
+        """A script authored a dynamic body's ``physics:velocity`` / ``physics:angularVelocity``."""
+        b = self.compiled.bodies[path]
+        if b.qvel_adr < 0:
+            return
+        linear, angular = authored_velocity(self.stage.GetPrimAtPath(path))
+        self.set_body_velocity(path, linear, angular)
 
     def _refresh_body(self, path: str, cache: UsdGeom.XformCache) -> None:
         c = self.compiled
@@ -504,6 +518,9 @@ class SimScene:
                         continue
                     writer = writers[path] = PoseWriter(prim)
                 writer.write(pose, cache)
+                if b.qvel_adr >= 0:   # PhysX writes world-frame velocities back too; scripts read them
+                    v = c.data.qvel[b.qvel_adr:b.qvel_adr + 6]
+                    writer.write_velocity(v[:3], quat_wxyz_to_matrix(pose[3:]) @ v[3:])
 
     # ---- rigid-body state ----------------------------------------------
     def body(self, path: str) -> BodyBinding:
@@ -586,17 +603,18 @@ class SimScene:
 
     # ---- play / stop ---------------------------------------------------
     def snapshot(self) -> dict[str, dict[str, object]]:
-        """The authored xform values of every rigid body, to restore on stop."""
+        """The authored xform values and velocities of every rigid body, to restore on stop
+        (a velocity not authored at play is saved as None: cleared again on stop)."""
         self.sync_dirty_prims()
         saved: dict[str, dict[str, object]] = {}
         for path in self.ensure_compiled().bodies:
             prim = self.stage.GetPrimAtPath(path)
             if not prim:
                 continue
-            values = {}
+            values: dict[str, object] = {name: None for name in VELOCITY_ATTRIBUTES}
             for attr in prim.GetAttributes():
                 name = attr.GetName()
-                if name.startswith("xformOp") and attr.HasAuthoredValue():
+                if (name.startswith("xformOp") or name in VELOCITY_ATTRIBUTES) and attr.HasAuthoredValue():
                     values[name] = attr.Get()
             saved[path] = values
         return saved
@@ -610,9 +628,12 @@ class SimScene:
                     continue
                 for name, value in values.items():
                     attr = prim.GetAttribute(name)
-                    if attr:
+                    if attr and value is None:
+                        attr.Clear()
+                    elif attr:
                         attr.Set(value)
         self.tracker.drain()
+        self._pose_writers.clear()   # their last-written values are no longer what the stage holds
         self.recompile(keep_state=False)
 
 
@@ -690,6 +711,9 @@ class PoseWriter:
         self._order_attr = prim.GetAttribute("xformOpOrder")
         self._order: tuple[str, ...] | None = None
         self._last: np.ndarray | None = None
+        self._last_velocity: np.ndarray | None = None
+        self._velocity: Usd.Attribute | None = None
+        self._angular: Usd.Attribute | None = None
         self._read_ops()
 
     def _read_ops(self) -> None:
@@ -709,6 +733,19 @@ class PoseWriter:
                                  "float3": "eulerf"}.get(type_name, "")
             if str(self._translate.GetTypeName()) != "double3":
                 self._rotate_kind = ""
+
+    def write_velocity(self, linear: np.ndarray, angular: np.ndarray) -> None:
+        """Author world-frame ``physics:velocity`` and ``physics:angularVelocity`` (given in rad/s,
+        authored in degrees/s as UsdPhysics specifies)."""
+        values = np.concatenate([linear, np.degrees(angular)]).astype(np.float32)
+        if self._last_velocity is not None and np.array_equal(values, self._last_velocity):
+            return
+        self._last_velocity = values
+        if self._velocity is None:
+            body = UsdPhysics.RigidBodyAPI(self.prim)
+            self._velocity, self._angular = body.CreateVelocityAttr(), body.CreateAngularVelocityAttr()
+        self._velocity.Set(Gf.Vec3f(*(float(x) for x in values[:3])))
+        self._angular.Set(Gf.Vec3f(*(float(x) for x in values[3:])))
 
     def write(self, qpos7: np.ndarray, cache: UsdGeom.XformCache) -> None:
         """Author ``qpos7`` (position, quaternion w, x, y, z) as the prim's world pose."""

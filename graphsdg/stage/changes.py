@@ -16,6 +16,8 @@ from pxr import Sdf, Tf, Usd
 # Properties of these namespaces shape the physics model (masses, colliders, scene
 # settings): an edit recompiles, like a structural change.
 PHYSICS_PROPERTY_PREFIXES = ("physics:", "physx", "material:binding:physics")
+# ... except a rigid body's velocities: simulation state, set on the live simulation as a value edit
+STATE_PROPERTIES = frozenset({"physics:velocity", "physics:angularVelocity"})
 
 
 @dataclass
@@ -61,7 +63,7 @@ class ChangeTracker:
             name = path.name
             if name.startswith("semantic"):
                 self._pending.semantics_changed = True
-            if name.startswith(PHYSICS_PROPERTY_PREFIXES):
+            if name.startswith(PHYSICS_PROPERTY_PREFIXES) and name not in STATE_PROPERTIES:
                 self._pending.structural.add(path.GetPrimPath())
                 return
             self._pending.edited.setdefault(path.GetPrimPath(), set()).add(name)
