@@ -60,6 +60,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/app/player/timelineSubsampleRate": (1, "timeline ticks per frame: each app update's frame is split into this "
                                               "many ticks, each with its physics and tick events "
                                               "(omni.timeline set_ticks_per_frame)"),
+    "/syntheticdata/sensors/perSubsetSegmentation": (True, "labels on a mesh's GeomSubsets make their faces separate "
+                                                           "semantic instances (off: the faces carry the mesh's labels)"),
     "/graphsdg/render/maxSubframes": (0, "upper bound on accumulated subframes per capture (rt_subframes and "
                                          "path-tracing samples); 0 means no bound (CI-sized runs of full scripts)"),
 }
@@ -112,6 +114,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/exposure": _positive_number,
     "/graphsdg/render/maxResolution": _integer(1),
     "/app/player/timelineSubsampleRate": _integer(1),
+    "/syntheticdata/sensors/perSubsetSegmentation": _boolean,
 }
 
 _values: dict[str, Any] = {}

@@ -28,6 +28,7 @@ from graphsdg.render.lookup import lookup
 from graphsdg.render.rasterizer import RenderOutputs
 from graphsdg.render.raycast import surface_normals
 from graphsdg.render.render_product import RenderProduct
+from graphsdg.sim import geom_subsets
 from graphsdg.sim.compiler import drawn_geom_mask
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage import semantics as semlib
@@ -70,11 +71,11 @@ class SceneLabels:
 
     def __init__(self, ids: IdTables) -> None:
         self.ids = ids
-        self._key: tuple[int, int] | None = None
+        self._key: tuple[int, int, bool] | None = None
         self._maps: dict[str, InstanceMap] = {}
 
     def instance_map(self, sim: SimScene, stage: Usd.Stage, semantic_filter: SemanticFilter) -> InstanceMap:
-        key = (sim.model_version, sim.labels_version)
+        key = (sim.model_version, sim.labels_version, geom_subsets.per_subset_segmentation())
         if key != self._key:
             self._maps.clear()
             self._key = key
@@ -89,7 +90,7 @@ class SceneLabels:
         owner_of_prim: dict[str, str | None] = {}
         owner_of_geom: list[str | None] = []
         for path in compiled.geom_paths:
-            prim = stage.GetPrimAtPath(path) if path else None
+            prim = geom_subsets.segmentation_prim(stage.GetPrimAtPath(path)) if path else None
             owner = _owner(prim, semantic_filter, owner_of_prim, owners) if prim else None
             owner_of_geom.append(owner)
         paths = sorted(owners)

@@ -23,7 +23,7 @@ from pxr import Gf, Pcp, Sdf, Usd, UsdGeom, UsdLux
 from graphsdg.errors import closest, usd_error_text
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
-from graphsdg.stage import shapes
+from graphsdg.stage import shape_meshes, shapes
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import PrimLike, parent_path, resolve_prims, unique_child_path
 from graphsdg.stage.xform import set_local_pose
@@ -61,9 +61,14 @@ def scope(name: str | None = None, parent: PrimLike | None = None) -> Usd.Prim:
 
 
 def _shape(shape: str, position, rotation, scale, look_at, look_at_up_axis, semantics, visible, name,
-           parent) -> Usd.Prim:
+           parent, as_mesh: bool = False) -> Usd.Prim:
+    if not isinstance(as_mesh, (bool, np.bool_)):
+        raise TypeError(f"as_mesh must be True or False, got {as_mesh!r}")
     path = _new_path(name, shape.capitalize(), parent)
-    prim = shapes.define_shape(get_stage(), path, shape)
+    if as_mesh:
+        prim = shape_meshes.define_shape_mesh(get_stage(), path, shape)
+    else:
+        prim = shapes.define_shape(get_stage(), path, shape)
     return _finish(prim, position, rotation, scale, look_at, look_at_up_axis, semantics, visible)
 
 
@@ -71,11 +76,13 @@ def _shape_fn(shape: str):
     def create_shape(position: Vec3 | None = None, rotation: Vec3 | None = None,
                      scale: Vec3 | float | None = None, look_at: Vec3 | None = None,
                      look_at_up_axis: Vec3 | None = None, semantics: Any = None, visible: bool = True,
-                     name: str | None = None, parent: PrimLike | None = None) -> Usd.Prim:
-        return _shape(shape, position, rotation, scale, look_at, look_at_up_axis, semantics, visible, name, parent)
+                     name: str | None = None, parent: PrimLike | None = None, as_mesh: bool = False) -> Usd.Prim:
+        return _shape(shape, position, rotation, scale, look_at, look_at_up_axis, semantics, visible, name, parent,
+                      as_mesh)
 
     create_shape.__name__ = shape
-    create_shape.__doc__ = f"Define a unit {shape} prim and return it."
+    create_shape.__doc__ = (f"Define a unit {shape} prim and return it; ``as_mesh=True`` authors it as a "
+                            f"``UsdGeom.Mesh`` (see :mod:`graphsdg.stage.shape_meshes`).")
     return create_shape
 
 

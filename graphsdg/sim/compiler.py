@@ -48,7 +48,7 @@ import numpy as np
 from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
-from graphsdg.sim import colliders, deformables, environment_map
+from graphsdg.sim import colliders, deformables, environment_map, geom_subsets
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import texture_images
@@ -98,6 +98,7 @@ class GeomBinding:
     material: str | None             # bound material path
     visible: bool = True
     relative: np.ndarray | None = None   # pose in its rigid body's frame (row-vector 4x4)
+    parts: tuple[int, ...] = ()          # drawn per-subset part geoms (the geom itself is then not drawn)
 
 
 VELOCITY_ATTRIBUTES = STATE_PROPERTIES   # a rigid body's velocities: live state, not model structure
@@ -397,6 +398,7 @@ class _Builder:
         self.collider_records: list[tuple] = []
         self.material_descs: dict[str, matlib.MaterialDesc] = {}
         self.texture_names: dict[str, str] = {}       # texture file -> MuJoCo texture name
+        self.part_records: dict[str, list[geom_subsets.PartGeom]] = {}   # mesh -> its GeomSubset part geoms
         self.mesh_count = 0
         self.has_lights = False
         self.ambient = np.zeros(3)
@@ -651,6 +653,11 @@ class _Builder:
             geom.rgba = list(MUJOCO_DEFAULT_RGBA)
         else:
             geom.rgba = list(display_rgba(prim))
+        if type_name == "Mesh":
+            parts = geom_subsets.add_part_geoms(self, prim, body, geom, *mesh_data, r, t, MUJOCO_DEFAULT_RGBA)
+            if parts:
+                geom.group = HIDDEN_GROUP      # it still collides and carries mass; its parts draw it
+                self.part_records[path] = parts
         physical = [geom]
         if collides:
             physical = self.collision_shapes(prim, body, geom, mesh_data, t, r, dynamic, root is None)
@@ -912,6 +919,11 @@ class _Builder:
                                             scale=scale, material=material, visible=visible,
                                             relative=relative)
             scene.geom_paths[gid] = path
+        for path, parts in self.part_records.items():
+            ids = tuple(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, part.name) for part in parts)
+            for gid, part in zip(ids, parts):
+                scene.geom_paths[gid] = part.label_path     # a labelled GeomSubset, or the mesh
+            scene.geoms[path].parts = ids
         rescaled = False
         for path in self.body_records:
             bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, path)

@@ -28,7 +28,7 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
-from graphsdg.sim import deformables
+from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
@@ -243,6 +243,8 @@ class SimScene:
         assert c is not None
         if deformables.edits_touch(c.deformables, changes.edited):
             raise NeedsRecompile   # a deformable's nodes are placed from its pose at compile time
+        if geom_subsets.edits_touch(self.stage, changes.edited):
+            raise NeedsRecompile   # face subsets decide a mesh's part geoms
         geoms, lights, bodies, mats = self._affected(changes.edited)
         for path, names in changes.edited.items():
             if names & VELOCITY_ATTRIBUTES and str(path) in c.bodies:
@@ -299,6 +301,9 @@ class SimScene:
             raise NeedsRecompile
         g = c.geoms[path]
         m, d = c.model, c.data
+        if g.parts and (aspects - {"pose"} or (g.rigid_root is None and not np.allclose(
+                decompose(world_matrix(prim, cache))[2], g.scale, rtol=1e-9, atol=1e-12))):
+            raise NeedsRecompile   # a mesh drawn as GeomSubset parts: rebuild them (group, material, vertices)
         if aspects & {"pose", "shape"}:
             m_world = world_matrix(prim, cache)
             if g.rigid_root is None:
