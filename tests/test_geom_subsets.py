@@ -221,3 +221,16 @@ def test_editing_a_subset_recompiles_its_parts():
     classes = _class_image(out["semantic_segmentation"])
     assert (classes[keep & (faces == PLUS_X)] == "cube").all()
     assert settings.get(geom_subsets.PER_SUBSET_SETTING) is True
+
+
+def test_a_labelled_subset_is_bounded_by_its_faces_in_3d():
+    cube = _scene(bind_materials=False)
+    rep.functional.modify.pose(cube, position_value=(0.0, 0.0, 0.25))
+    rows = _capture("bounding_box_3d")["bounding_box_3d"]
+    names = {int(k): v["class"] for k, v in rows["info"]["idToLabels"].items()}
+    boxes = {names[int(r["semanticId"])]: r for r in rows["data"]}
+    top, side = boxes["cube,top"], boxes["cube,side"]
+    assert [float(top[k]) for k in ("x_min", "y_min", "z_min", "x_max", "y_max", "z_max")] == \
+        [-0.5, -0.5, 0.5, 0.5, 0.5, 0.5]                       # the +Z face, in the mesh's frame
+    assert [float(side[k]) for k in ("x_min", "x_max")] == [0.5, 0.5]
+    assert np.allclose(top["transform"][3, :3], (0.0, 0.0, 0.25))   # the mesh's local-to-world

@@ -4,7 +4,8 @@ A prim's box is the axis-aligned range of its geometry (its own extent and its
 renderable descendants') in the prim's *local* frame, plus its local-to-world
 transform in USD's row-vector layout (``p_world = p_local @ M``, translation in
 the last row): Replicator's ``bounding_box_3d`` contract. Only ``default`` and
-``render`` purposes count, as those are the ones drawn.
+``render`` purposes count, as those are the ones drawn. A face ``GeomSubset``
+(a labelled part of a mesh) is bounded by its faces' points in its mesh's frame.
 """
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ from typing import Sequence
 
 import numpy as np
 from pxr import Usd, UsdGeom
+
+from graphsdg.sim.geom_subsets import face_points
 
 
 def local_boxes(stage: Usd.Stage, paths: Sequence[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -36,6 +39,12 @@ def local_boxes(stage: Usd.Stage, paths: Sequence[str]) -> tuple[np.ndarray, np.
         prim = stage.GetPrimAtPath(path)
         if not prim:
             raise ValueError(f"no prim at {path!r} to bound")
+        if prim.GetTypeName() == "GeomSubset":
+            points = face_points(prim)
+            if len(points):
+                mins[i], maxs[i] = points.min(0), points.max(0)
+            transforms[i] = np.array(xforms.GetLocalToWorldTransform(prim.GetParent()))
+            continue
         rng = cache.ComputeUntransformedBound(prim).ComputeAlignedRange()
         if not rng.IsEmpty():
             mins[i], maxs[i] = np.array(rng.GetMin()), np.array(rng.GetMax())

@@ -183,3 +183,15 @@ def add_part_geoms(builder, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris:
             drawn.rgba = list(geom.rgba)
         made.append(PartGeom(name=name, label_path=str(part.label_prim.GetPath())))
     return made
+
+
+def face_points(subset: Usd.Prim) -> np.ndarray:
+    """(K, 3) points of a face subset's faces, in its mesh's local frame (its 3D bounds)."""
+    mesh = UsdGeom.Mesh(subset.GetParent())
+    counts = np.asarray(mesh.GetFaceVertexCountsAttr().Get() or [], dtype=np.int64)
+    indices = np.asarray(mesh.GetFaceVertexIndicesAttr().Get() or [], dtype=np.int64)
+    points = np.asarray(mesh.GetPointsAttr().Get() or [], dtype=np.float64).reshape(-1, 3)
+    faces = _face_indices(UsdGeom.Subset(subset), len(counts))
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]) if counts.size else counts
+    corners = [indices[starts[f]:starts[f] + counts[f]] for f in faces]
+    return points[np.concatenate(corners)] if corners else np.zeros((0, 3))
