@@ -10,21 +10,13 @@ from typing import Any, Callable, Iterable, Sequence
 import numpy as np
 from pxr import Usd, UsdGeom
 
+from graphsdg.compat.experimental_prims import RigidPrim, XformPrim  # noqa: F401 - re-exported
 from graphsdg.compat.modules import CompatObject
+from graphsdg.compat.warp_arrays import WarpLikeArray  # noqa: F401 - re-exported
+from graphsdg.compat.warp_arrays import as_warp_like as _warp  # noqa: F401 - re-exported
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prim
-
-
-class WarpLikeArray(np.ndarray):
-    """A numpy array with warp's ``.numpy()`` (returns itself as a plain array)."""
-
-    def numpy(self) -> np.ndarray:
-        return np.asarray(self)
-
-
-def _warp(a: Any) -> WarpLikeArray:
-    return np.asarray(a).view(WarpLikeArray)
 
 
 # ---- bounds -----------------------------------------------------------------------
@@ -59,66 +51,6 @@ def compute_combined_aabb(bbox_cache: UsdGeom.BBoxCache, prim_paths: Iterable[st
 def compute_obb(bbox_cache: UsdGeom.BBoxCache, prim_path: str):
     from graphsdg.sim.bounds import compute_obb as obb
     return obb(prim_path, bbox_cache)
-
-
-# ---- prims --------------------------------------------------------------------------
-class XformPrim(CompatObject):
-    """isaacsim.core.experimental.prims.XformPrim: world poses of prims matched by path(s)."""
-
-    _compat_name = "isaacsim.core.experimental.prims.XformPrim"
-
-    def __init__(self, paths: str | Sequence[str], **_: Any) -> None:
-        self.paths = [paths] if isinstance(paths, str) else list(paths)
-        for p in self.paths:
-            resolve_prim(p)
-
-    def _selected(self, indices: Sequence[int] | None) -> list[str]:
-        return self.paths if indices is None else [self.paths[int(i)] for i in np.atleast_1d(indices)]
-
-    def get_world_poses(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
-        """(positions (k, 3), orientations (k, 4) w, x, y, z)."""
-        from graphsdg.sim.transforms import get_world_pose
-        poses = [get_world_pose(p) for p in self._selected(indices)]
-        return _warp([p[0] for p in poses]), _warp([p[1] for p in poses])
-
-    def set_world_poses(self, positions: Any = None, orientations: Any = None,
-                        indices: Sequence[int] | None = None) -> None:
-        from graphsdg.sim.transforms import set_world_pose
-        paths = self._selected(indices)
-        pos = None if positions is None else np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-        quat = None if orientations is None else np.asarray(orientations, dtype=np.float64).reshape(-1, 4)
-        for i, path in enumerate(paths):
-            set_world_pose(path, None if pos is None else pos[i], None if quat is None else quat[i])
-
-
-class RigidPrim(XformPrim):
-    """isaacsim.core.experimental.prims.RigidPrim over graphsdg's rigid-body view."""
-
-    _compat_name = "isaacsim.core.experimental.prims.RigidPrim"
-
-    def __init__(self, paths: str | Sequence[str], **kwargs: Any) -> None:
-        super().__init__(paths, **kwargs)
-        from graphsdg.sim.bodies import RigidBodyView
-        self._view = RigidBodyView(self.paths)
-
-    def get_world_poses(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
-        pos, quat = self._view.get_world_poses(indices)
-        return _warp(pos), _warp(quat)
-
-    def set_world_poses(self, positions: Any = None, orientations: Any = None,
-                        indices: Sequence[int] | None = None) -> None:
-        self._view.set_world_poses(positions, orientations, indices)
-
-    def get_velocities(self, indices: Sequence[int] | None = None) -> tuple[WarpLikeArray, WarpLikeArray]:
-        lin, ang = self._view.get_velocities(indices)
-        return _warp(lin), _warp(ang)
-
-    def set_velocities(self, linear_velocities: Any = None, angular_velocities: Any = None,
-                       indices: Sequence[int] | None = None) -> None:
-        self._view.set_velocities(linear_velocities, angular_velocities, indices)
-
-    def get_masses(self, indices: Sequence[int] | None = None) -> WarpLikeArray:
-        return _warp(self._view.get_masses(indices))
 
 
 # ---- stage and semantics utils ---------------------------------------------------------
