@@ -139,6 +139,9 @@ def test_as_mesh_cube_compiles_to_the_implicit_cubes_box():
     assert np.allclose(world.min(0), d.geom_xpos[box] - m.geom_size[box], atol=1e-6)
     assert np.allclose(world.max(0), d.geom_xpos[box] + m.geom_size[box], atol=1e-6)
     assert np.allclose(m.geom_size[box], np.array(scale) / 2)
+    # Kit's face-varying normals are kept: every corner normal is a face's axis (flat faces, sharp edges)
+    normals = m.mesh_normal[m.mesh_normaladr[mesh_id]:m.mesh_normaladr[mesh_id] + m.mesh_normalnum[mesh_id]]
+    assert len(normals) == 24 and np.allclose(np.abs(normals).max(1), 1.0, atol=1e-6)
 
 
 def test_as_mesh_rejects_a_non_boolean():

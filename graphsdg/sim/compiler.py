@@ -52,6 +52,7 @@ from graphsdg.sim import colliders, deformables, environment_map, geom_subsets
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import texture_images
+from graphsdg.sim.mesh_normals import mesh_normals
 from graphsdg.sim.mujoco_warnings import route_warnings
 from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
@@ -630,7 +631,6 @@ class _Builder:
         mesh_data = None
         if type_name in ("Mesh", "Cone"):
             verts, tris = mesh_arrays(prim, scale)
-            mesh_data = (verts, tris)
             mesh_name = f"mesh:{path}"
             mesh = self.spec.add_mesh(name=mesh_name, uservert=(verts @ r.T + t).ravel().tolist(),
                                       userface=tris.ravel().tolist())
@@ -638,6 +638,11 @@ class _Builder:
             if uvs is not None and len(uvs.face_texcoord) == len(tris):
                 mesh.usertexcoord = uvs.texcoord.ravel().tolist()
                 mesh.userfacetexcoord = uvs.face_texcoord.ravel().tolist()
+            normals = mesh_normals(prim, scale, r) if type_name == "Mesh" else None
+            if normals is not None and len(normals.face_normal) == len(tris):
+                mesh.usernormal = normals.normal.ravel().tolist()
+                mesh.userfacenormal = normals.face_normal.ravel().tolist()
+            mesh_data = (verts, tris, normals)
             solid = dynamic and collides and not colliders.is_flat(verts)
             mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX if solid else \
                 mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
@@ -690,7 +695,7 @@ class _Builder:
             return [plane]
         if type_name != "Mesh":
             return [geom]
-        verts, tris = mesh_data
+        verts, tris = mesh_data[:2]
         approximation = _approximation(prim)
         pieces = colliders.collision_pieces(verts, tris, approximation, dynamic)
         if len(pieces) == 1 and pieces[0].kind == "hull" and len(pieces[0].vertices) == len(np.unique(tris)):

@@ -27,6 +27,7 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from graphsdg import settings
+from graphsdg.sim.mesh_normals import MeshNormals
 from graphsdg.sim.texcoords import fan_triangles
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -144,14 +145,16 @@ class PartGeom:
     label_path: str
 
 
-def add_part_geoms(builder, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris: np.ndarray, r: np.ndarray,
-                   t: np.ndarray, material_rgba: tuple[float, ...]) -> list[PartGeom]:
+def add_part_geoms(builder, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris: np.ndarray,
+                   normals: MeshNormals | None, r: np.ndarray, t: np.ndarray,
+                   material_rgba: tuple[float, ...]) -> list[PartGeom]:
     """Add a drawn geom per :func:`face_parts` of ``mesh`` (if it has any) beside its own ``geom``.
 
     ``builder`` is the compiler's builder: its ``spec``, ``material(prim)``
     (registers the prim's bound material, returns its name) and
     ``mesh_uvs(prim, material)`` are used. ``verts`` / ``tris`` are the mesh's
-    scaled vertices and triangles, ``r`` / ``t`` its pose in ``body``'s frame;
+    scaled vertices and triangles (``normals`` its authored normals, if any),
+    ``r`` / ``t`` its pose in ``body``'s frame;
     a part showing a material gets ``material_rgba`` (the geom colour that lets
     a MuJoCo material show through). Returns the parts made (none when the mesh
     is drawn as one geom); the caller stops drawing ``geom`` when there are any.
@@ -174,6 +177,9 @@ def add_part_geoms(builder, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris:
         if uvs is not None and len(uvs.face_texcoord) == len(tris):
             mj_mesh.usertexcoord = uvs.texcoord.ravel().tolist()
             mj_mesh.userfacetexcoord = uvs.face_texcoord[part.triangles].ravel().tolist()
+        if normals is not None and len(normals.face_normal) == len(tris):
+            mj_mesh.usernormal = normals.normal.ravel().tolist()
+            mj_mesh.userfacenormal = normals.face_normal[part.triangles].ravel().tolist()
         drawn = body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"mesh:{name}",
                               group=geom.group, contype=0, conaffinity=0, density=0.0)
         if material is not None:
