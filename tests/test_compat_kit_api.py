@@ -211,3 +211,15 @@ def test_rotation_utils_match_scipy_extrinsic_and_intrinsic(compat):
         assert np.allclose(quat_to_rot_matrix(q), Rotation.from_euler(seq, angles).as_matrix())
     assert np.allclose(euler_angles_to_quat([0, 0, 90], degrees=True), [np.sqrt(0.5), 0, 0, np.sqrt(0.5)])
     assert np.allclose(gf_quat_to_np_array(Gf.Quatd(0.5, 0.5, -0.5, 0.5)), [0.5, 0.5, -0.5, 0.5])
+
+
+def test_kit_command_line_settings_reach_carb_settings(compat, monkeypatch):
+    from graphsdg.compat.kit import command_line_settings
+    assert command_line_settings(["--test", "--/a/b=false", "--/n=3", "--/x=0.5", "--/s=Quality", "--/bad"]) == \
+        {"/a/b": False, "/n": 3, "/x": 0.5, "/s": "Quality"}
+    import carb.settings
+    from isaacsim import SimulationApp
+    monkeypatch.setattr(sys, "argv", ["script.py", "--/syntheticdata/sensors/perSubsetSegmentation=false"])
+    SimulationApp({"headless": True})
+    assert carb.settings.get_settings().get("/syntheticdata/sensors/perSubsetSegmentation") is False
+    carb.settings.get_settings().set("/syntheticdata/sensors/perSubsetSegmentation", True)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import asyncio
 import enum
 import logging
+import sys
 import unittest
 import warnings
 from typing import Any, Callable
@@ -287,6 +288,8 @@ class SimulationApp(CompatObject):
     def __init__(self, launch_config: dict | None = None, experience: str = "") -> None:
         self.config = dict(launch_config or {})
         self._closed = False
+        for key, value in command_line_settings(sys.argv[1:]).items():   # Kit reads them from the command line
+            _carb_settings.set(key, value)
 
     def update(self) -> None:
         _app.update()
@@ -316,6 +319,28 @@ class SimulationApp(CompatObject):
 
     def reset_render_settings(self) -> None:
         """Render settings have nothing to reset here."""
+
+
+def command_line_settings(argv: list[str]) -> dict[str, Any]:
+    """Kit's ``--/path/to/setting=value`` arguments as ``{"/path/to/setting": value}``; values read as Kit
+    does: ``true``/``false`` as bools, then ints, then floats, else strings."""
+    settings_found: dict[str, Any] = {}
+    for arg in argv:
+        if not arg.startswith("--/") or "=" not in arg:
+            continue
+        key, text = arg[2:].split("=", 1)
+        value: Any = text
+        if text.lower() in ("true", "false"):
+            value = text.lower() == "true"
+        else:
+            for kind in (int, float):
+                try:
+                    value = kind(text)
+                    break
+                except ValueError:
+                    pass
+        settings_found[key] = value
+    return settings_found
 
 
 # ---- USD context ----------------------------------------------------------------
