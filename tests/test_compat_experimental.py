@@ -6,7 +6,7 @@ import warnings
 import mujoco
 import numpy as np
 import pytest
-from pxr import UsdGeom, UsdPhysics, UsdShade
+from pxr import UsdGeom, UsdPhysics
 
 import graphsdg as rep
 from graphsdg.compat import isaac

@@ -16,7 +16,6 @@ from graphsdg.compat.warp_arrays import WarpLikeArray  # noqa: F401 - re-exporte
 from graphsdg.compat.warp_arrays import as_warp_like as _warp  # noqa: F401 - re-exported
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.context import get_stage
-from graphsdg.stage.prims import resolve_prim
 
 
 # ---- bounds -----------------------------------------------------------------------
