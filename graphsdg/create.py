@@ -25,7 +25,7 @@ from graphsdg.render.render_product import create_render_product as render_produ
 def _shape(shape: str) -> Callable[..., ReplicatorItem]:
     def create_shape(position: Any = None, scale: Any = None, pivot: Any = None, rotation: Any = None,
                      look_at: Any = None, look_at_up_axis: Any = None, semantics: Any = None, material: Any = None,
-                     visible: bool = True, as_mesh: bool = True, count: int = 1, name: str | None = None,
+                     visible: bool = True, as_mesh: bool = False, count: int = 1, name: str | None = None,
                      parent: Any = None) -> ReplicatorItem:
         return add_node(NodeRegistry.create(
             f"create.{shape}", name=name, position=position, scale=scale, pivot=pivot, rotation=rotation,
@@ -34,7 +34,8 @@ def _shape(shape: str) -> Callable[..., ReplicatorItem]:
 
     create_shape.__name__ = create_shape.__qualname__ = shape
     create_shape.__doc__ = (f"``count`` unit {shape}s at ``/Replicator/{shape.capitalize()}_Xform/"
-                            f"{shape.capitalize()}``; pose arguments may be distributions.")
+                            f"{shape.capitalize()}``; pose arguments may be distributions; ``as_mesh=True`` "
+                            f"makes each a ``UsdGeom.Mesh`` (Replicator's default; graphsdg's is an implicit prim).")
     return create_shape
 
 

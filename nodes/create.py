@@ -102,11 +102,11 @@ def _shape_node(shape: str) -> type[CreateNode]:
         type_name = f"create.{shape}"
         default_name = shape.capitalize()
         inputs = {**POSE, **COMMON, "pivot": Port("vec3"), "semantics": Port(list), "material": Port("material"),
-                  "visible": Port(bool, True), "as_mesh": Port(bool, True)}
+                  "visible": Port(bool, True), "as_mesh": Port(bool, False)}
 
         def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
             prim = make_fn(name=name, parent=parent, semantics=self.value_of("semantics"),
-                           visible=bool(self.value_of("visible")))
+                           visible=bool(self.value_of("visible")), as_mesh=bool(self.value_of("as_mesh")))
             material = self.value_of("material")
             if material is not None:
                 mats = flatten_prims(ctx.value("material"), f"{self.type_name}.material")

@@ -237,3 +237,12 @@ def test_a_labelled_subset_is_bounded_by_its_faces_in_3d():
         [-0.5, -0.5, 0.5, 0.5, 0.5, 0.5]                       # the +Z face, in the mesh's frame
     assert [float(side[k]) for k in ("x_min", "x_max")] == [0.5, 0.5]
     assert np.allclose(top["transform"][3, :3], (0.0, 0.0, 0.25))   # the mesh's local-to-world
+
+
+def test_graph_shapes_are_meshes_only_when_asked():
+    import graphsdg as rep
+    rep.stage.new_stage()
+    mesh = rep.create.cube(as_mesh=True, count=2).get_output_prims()["prims"]
+    implicit = rep.create.cube().get_output_prims()["prims"]
+    assert [p.GetTypeName() for p in mesh] == ["Mesh", "Mesh"]
+    assert [p.GetTypeName() for p in implicit] == ["Cube"]
