@@ -49,6 +49,7 @@ from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
 from graphsdg.sim import colliders, deformables, environment_map, geom_subsets
+from graphsdg.sim import physx_attributes
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import texture_images
@@ -878,6 +879,11 @@ class _Builder:
         self.flex_plans = deformables.add_to_spec(self.spec, prims, self.cache)
         self.finish_lighting()
         self.assign_masses()
+        try:   # physxCollision offsets -> margins; authored PhysX attributes with no effect warn once
+            physx_attributes.tune_colliders(self.stage, self.collider_records)
+            physx_attributes.warn_unmapped(prims)
+        except physx_attributes.PhysxAttributeError as exc:
+            raise CompileError(str(exc)) from None
         self.add_probes()
         self.size_memory()
         try:
@@ -955,6 +961,11 @@ class _Builder:
         scene.probe_sphere = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, PROBE_SPHERE)
         if rescaled:
             mujoco.mj_setConst(model, data)
+        try:   # after the mass rescale: PhysX damping is per unit mass / inertia
+            physx_attributes.apply_body_damping(model, self.stage, [(p, b.body_id, b.qvel_adr) for p, b
+                                                                    in scene.bodies.items() if b.qvel_adr >= 0])
+        except physx_attributes.PhysxAttributeError as exc:
+            raise CompileError(str(exc)) from None
         for path, kind, made in self.light_records:
             ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_LIGHT, lt.name) for lt in made]
             scene.lights[path] = LightBinding(path=path, kind=kind, light_ids=ids)
