@@ -22,7 +22,8 @@ from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import run_state
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
 from graphsdg.progress import Progress
-from graphsdg.render.camera import camera_view
+from graphsdg.render import motion_blur
+from graphsdg.render.camera import CameraView, camera_view
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import stage_context
 
@@ -145,7 +146,8 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None, def
     sim = rt.sim
     sim.sync_dirty_prims()
     t = _timed("sync", t)
-    advance_time(delta_time)
+    with motion_blur.motion_blur().recording(sim, _shutter_views(rt)):   # records the step's motion if blurring
+        advance_time(delta_time)
     if pause_timeline and rt.timeline.is_playing():
         rt.timeline.pause()
     t = _timed("physics", t)
@@ -182,6 +184,15 @@ def advance_time(delta_time: float | None) -> None:
         return
     timeline.play()
     timeline.advance(dt)
+
+
+def _shutter_views(rt) -> dict[str, CameraView]:
+    """Each active render product's camera as the step starts (where a motion-blur shutter opens); none when
+    motion blur is off."""
+    if motion_blur.shutter() is None:
+        return {}
+    return {path: camera_view(rp.camera_prim(rt.stage), rp.width, rp.height)
+            for path, (rp, _) in _active_products(rt).items()}
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
@@ -222,7 +233,8 @@ def _render(rt, rp, annotators: list[Annotator], subframes: int, defer: bool) ->
     passes: set[str] = set()
     for a in annotators:
         passes |= a.spec.passes
-    render = rt.rasterizer.render(sim, view, passes, subframes, defer=defer) if passes else None
+    motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
+    render = rt.rasterizer.render(sim, view, passes, subframes, defer=defer, motion=motion) if passes else None
     t = _timed("render", t)
     frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim.data.time,
                       attached=frozenset(a.spec.name for a in annotators))

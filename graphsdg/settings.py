@@ -64,6 +64,15 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                            "semantic instances (off: the faces carry the mesh's labels)"),
     "/graphsdg/render/maxSubframes": (0, "upper bound on accumulated subframes per capture (rt_subframes and "
                                          "path-tracing samples); 0 means no bound (CI-sized runs of full scripts)"),
+    # motion blur (graphsdg.render.motion_blur)
+    "/omni/replicator/captureMotionBlur": (False, "motion blur: colour accumulated over each step's motion"),
+    "/omni/replicator/pathTracedMotionBlurSubSamples": (8, "motion-blur sub-frames over the whole step in "
+                                                           "PathTracing mode"),
+    "/rtx/post/motionblur/numSamples": (8, "motion-blur sub-frames outside PathTracing mode"),
+    "/rtx/post/motionblur/exposureFraction": (1.0, "fraction of the step the shutter is open, outside PathTracing "
+                                                   "mode (above 1: the whole step)"),
+    "/rtx/post/motionblur/maxBlurDiameterFraction": (0.02, "longest motion-blur smear, as a fraction of the image's "
+                                                           "larger side, outside PathTracing mode"),
 }
 
 def _integer(minimum: int, none_ok: bool = False) -> Callable[[str, Any], None]:
@@ -85,6 +94,16 @@ def _boolean(key: str, value: Any) -> None:
 def _positive_number(key: str, value: Any) -> None:
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value > 0:
         raise ValueError(f"setting {key} must be a number > 0, got {value!r}")
+
+
+def _non_negative_number(key: str, value: Any) -> None:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value >= 0:
+        raise ValueError(f"setting {key} must be a number >= 0, got {value!r}")
+
+
+def _fraction(key: str, value: Any) -> None:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 <= value <= 1:
+        raise ValueError(f"setting {key} must be a number in [0, 1], got {value!r}")
 
 
 def _path_or_none(key: str, value: Any) -> None:
@@ -113,6 +132,11 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/msaaSamples": _integer(0),
     "/graphsdg/render/exposure": _positive_number,
     "/graphsdg/render/maxResolution": _integer(1),
+    "/omni/replicator/captureMotionBlur": _boolean,
+    "/omni/replicator/pathTracedMotionBlurSubSamples": _integer(1),
+    "/rtx/post/motionblur/numSamples": _integer(1),
+    "/rtx/post/motionblur/exposureFraction": _non_negative_number,
+    "/rtx/post/motionblur/maxBlurDiameterFraction": _fraction,
     "/app/player/timelineSubsampleRate": _integer(1),
     "/syntheticdata/sensors/perSubsetSegmentation": _boolean,
 }

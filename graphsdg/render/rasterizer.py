@@ -44,6 +44,7 @@ from graphsdg.render import sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
+from graphsdg.render.motion_blur import MotionSamples
 from graphsdg.render.readback import PixelReads, code_bits
 from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 from graphsdg.sim.scene import SimScene
@@ -244,14 +245,16 @@ class Rasterizer:
 
     # ---- one render ----------------------------------------------------
     def _update_scene(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float],
-                      jitter: tuple[float, float], crop: Crop | None = None) -> float:
+                      jitter: tuple[float, float], crop: Crop | None = None,
+                      data: mujoco.MjData | None = None) -> float:
         """Fill the scene for one render of ``view`` with the geometry inside ``bounds`` (from
-        :func:`geometry_bounds`); returns the far plane used (see :func:`effective_far`)."""
+        :func:`geometry_bounds`), posed as in ``data`` (default: the simulation's); returns the far plane
+        used (see :func:`effective_far`)."""
         scene = self._scene
         assert scene is not None and self._mjr is not None
         center, radius = bounds
         far = effective_far(center, radius, view)
-        mujoco.mjv_updateScene(sim.model, sim.data, self._option, None, self._camera,
+        mujoco.mjv_updateScene(sim.model, sim.data if data is None else data, self._option, None, self._camera,
                                mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
         if sim.mesh_maps:
             self._draw_rescaled_meshes(sim, scene)
@@ -317,13 +320,15 @@ class Rasterizer:
                 g.mat[:] = g.mat @ (current if undo is None else current @ undo)
 
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
-               defer: bool = False) -> RenderOutputs:
+               defer: bool = False, motion: MotionSamples | None = None) -> RenderOutputs:
         """Render the requested ``passes`` of ``view`` (only those: each pass costs a render).
 
         With ``defer`` the pixels are left copying off the GPU: each pass is
         finished (mapped, decoded) when first read from the outputs, so the
         caller can do other work meanwhile. Jittered subframes are always read
-        at once (they are summed on the CPU).
+        at once (they are summed on the CPU). ``motion``: the colour is the mean of
+        renders at these motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`);
+        depth and ids stay those of the simulation's current state.
         """
         unknown = set(passes) - set(PASSES)
         if unknown:
@@ -342,11 +347,12 @@ class Rasterizer:
         # depth come from one render; with MSAA it holds an off-centre sample, so depth is read
         # from the (single-sample) id render instead.
         depth_with_colour = colour and "depth" in passes and "segmentation" not in passes and \
-            int(model.vis.quality.offsamples) == 0
+            int(model.vis.quality.offsamples) == 0 and motion is None
         scene_far = None   # set while the scene holds this frame's unjittered geometry (reused by the id pass)
         if colour:
             scene_far = self._render_color(sim, view, bounds, subframes, out, want_color="color" in passes,
-                                           want_linear="hdr" in passes, want_depth=depth_with_colour)
+                                           want_linear="hdr" in passes, want_depth=depth_with_colour,
+                                           motion=motion)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
             codes, lut, depth = self._render_ids(sim, view, bounds, None, with_depth="depth" in passes,
                                                  scene_far=scene_far)
@@ -361,7 +367,8 @@ class Rasterizer:
         return out
 
     def _render_color(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], subframes: int,
-                      out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool) -> float | None:
+                      out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool,
+                      motion: MotionSamples | None = None) -> float | None:
         """Draw and queue the colour pass; returns the far plane when the scene is left as updated for
         the unjittered view (one subframe), else None."""
         assert self._scene is not None and self._mjr is not None and self._reads is not None
@@ -379,6 +386,25 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
         if background is not None:
             self.skies_filled += 1
+        if motion is not None:   # motion blur: each render at its sub-frame's poses, with the next jitter
+            n = max(subframes, motion.count)
+            jitters = jitter_offsets(n)
+            acc = np.zeros((h, w, 3), dtype=np.float32)
+            for i in range(n):
+                posed, seen = motion.pose(i * motion.count // n)
+                self._update_scene(sim, seen, bounds, jitters[i], data=posed)
+                with profiling.timed("render:color"):
+                    self._draw_color(rect, background)
+                acc += self._reads.read_color(ctx, w, h).result()[..., :3]
+                self.stats["color"] += 1
+            mean = acc / n
+            if want_color:
+                rgba = np.full((h, w, 4), 255, dtype=np.uint8)
+                rgba[..., :3] = np.rint(mean)
+                out.put("color", rgba)
+            if want_linear:
+                out.put("hdr", mean / np.float32(255))
+            return None
         far = self._update_scene(sim, view, bounds, (0.0, 0.0))
         with profiling.timed("render:color"):
             self._draw_color(rect, background)
