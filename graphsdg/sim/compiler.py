@@ -627,7 +627,8 @@ class _Builder:
             t, r = np.zeros(3), np.eye(3)
         collides = _collides(prim)
         dynamic = root is not None and not _is_kinematic(root)
-        visible = UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible
+        visible = UsdGeom.Imageable(prim).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible \
+            and _is_renderable(prim)
         material = self.material(prim)
         type_name = prim.GetTypeName()
         mesh_data = None
@@ -869,7 +870,8 @@ class _Builder:
             type_name = prim.GetTypeName()
             if type_name in lightmap.LIGHT_KINDS:
                 self.add_light(prim)
-            elif _is_renderable(prim):
+            elif _is_renderable(prim) or (prim.GetTypeName() in GPRIM_TYPES and _collides(prim)):
+                # a guide / proxy purpose collider is not drawn but collides (as in PhysX: addGroundPlane's plane)
                 try:
                     self.add_gprim(prim)
                 except CompileError:

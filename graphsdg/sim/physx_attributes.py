@@ -15,8 +15,9 @@ Mapped (the compiler calls :func:`tune_colliders` before compiling and
                                            in the body frame)
 ``physxRigidBody:disableGravity``          ``body_gravcomp = 1`` (compiler)
 ``physxScene:timeStepsPerSecond``          ``opt.timestep`` (compiler; authored values only)
-``physxCollision:contactOffset`` c         geom ``margin = c`` (contacts are found within c)
-``physxCollision:restOffset`` r            geom ``gap = margin - r`` (shapes come to rest r apart)
+``physxCollision:restOffset`` r >= 0      geom ``margin = r``: MuJoCo's contacts act from ``r`` apart
+                                           and shapes rest there, as PhysX's rest offset (checked to be
+                                           below ``contactOffset``, PhysX's rule)
 ``physxMaterial:frictionCombineMode``      contact priority (compiler)
 ``physxArticulation:enabledSelfCollisions``, ``physxJoint:armature``   (:mod:`graphsdg.sim.joints`)
 =========================================  ==============================================================
@@ -39,7 +40,7 @@ from graphsdg.stage import physx_schemas as defs
 
 MAPPED = frozenset({
     "physxRigidBody:linearDamping", "physxRigidBody:angularDamping", "physxRigidBody:disableGravity",
-    "physxScene:timeStepsPerSecond", "physxCollision:contactOffset", "physxCollision:restOffset",
+    "physxScene:timeStepsPerSecond", "physxCollision:restOffset",
     "physxMaterial:frictionCombineMode", "physxArticulation:enabledSelfCollisions", "physxJoint:armature",
 })
 # every attribute name the schema definitions declare, for the no-effect check
@@ -87,8 +88,13 @@ def apply_body_damping(model: mujoco.MjModel, stage: Usd.Stage, free_bodies: Ite
 
 
 def contact_offsets(prim: Usd.Prim) -> tuple[float, float] | None:
-    """(margin, gap) for collider ``prim`` from ``physxCollision:contactOffset`` / ``restOffset``, or None
-    when neither resolves to a finite value (PhysX's -inf fallbacks mean "picked by the simulation")."""
+    """(margin, gap) for collider ``prim`` from ``physxCollision:restOffset``, or None when it does not
+    resolve to a finite value (PhysX's -inf fallback means "picked by the simulation": 0 for rigid bodies).
+
+    MuJoCo rests shapes ``margin`` apart, PhysX ``restOffset`` apart; PhysX's
+    ``contactOffset`` (how far ahead contacts are generated) has no MuJoCo
+    counterpart apart from that and is only checked against the rest offset.
+    """
     contact = defs.resolved_value(prim, "PhysxCollisionAPI", "contactOffset")
     rest = defs.resolved_value(prim, "PhysxCollisionAPI", "restOffset")
     contact = float(contact) if contact is not None and math.isfinite(float(contact)) else None
@@ -100,12 +106,10 @@ def contact_offsets(prim: Usd.Prim) -> tuple[float, float] | None:
     if rest is not None and rest < 0:
         raise PhysxAttributeError(f"{prim.GetPath()}: physxCollision:restOffset is {rest}; graphsdg cannot rest "
                                   f"shapes inside each other (MuJoCo's margin is >= 0); expected >= 0")
-    margin = contact if contact is not None else rest
-    rest = 0.0 if rest is None else rest
-    if rest > margin:
-        raise PhysxAttributeError(f"{prim.GetPath()}: physxCollision:restOffset {rest} exceeds contactOffset "
-                                  f"{margin}; PhysX requires restOffset < contactOffset")
-    return margin, margin - rest
+    if rest is not None and contact is not None and rest > contact:
+        raise PhysxAttributeError(f"{prim.GetPath()}: physxCollision:restOffset {rest:.6g} exceeds contactOffset "
+                                  f"{contact:.6g}; PhysX requires restOffset < contactOffset")
+    return None if rest is None else (rest, 0.0)
 
 
 def tune_colliders(stage: Usd.Stage, records: Iterable[tuple[object, str, str]]) -> None:
