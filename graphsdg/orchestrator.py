@@ -234,7 +234,7 @@ def _render(rt, rp, annotators: list[Annotator], subframes: int, defer: bool) ->
     for a in annotators:
         passes |= a.spec.passes
     motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
-    render = rt.rasterizer.render(sim, view, passes, subframes, defer=defer, motion=motion) if passes else None
+    render = rt.renderer.render(sim, view, passes, subframes, defer=defer, motion=motion) if passes else None
     t = _timed("render", t)
     frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim.data.time,
                       attached=frozenset(a.spec.name for a in annotators))

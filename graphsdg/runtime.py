@@ -13,6 +13,7 @@ from pxr import Usd
 
 from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
+from graphsdg.render.backend import RenderBackend, resolve_backend
 from graphsdg.render.rasterizer import Rasterizer
 from graphsdg.errors import RenderProductDestroyedError
 from graphsdg.render.render_product import registry as rp_registry
@@ -54,7 +55,8 @@ class Runtime:
     def __init__(self) -> None:
         self._sim: SimScene | None = None
         self._sim_stage: Usd.Stage | None = None
-        self.rasterizer = Rasterizer()
+        self.rasterizer = Rasterizer()    # the classic backend (always there: tests and tools read its stats)
+        self._pbr = None                   # graphsdg.render.pbr.PbrRenderer, made on first use
         self.timeline = Timeline(simulation=lambda: self.sim)
         self.annotators: OrderedSet = OrderedSet()
         self.writers: OrderedSet = OrderedSet()
@@ -72,6 +74,17 @@ class Runtime:
         finish, self.pending_capture = self.pending_capture, None
         if finish is not None:
             finish()
+
+    @property
+    def renderer(self) -> RenderBackend:
+        """The render backend the settings choose now (:mod:`graphsdg.render.backend`): the classic
+        rasteriser or the PBR renderer (made on first use)."""
+        if resolve_backend() == "classic":
+            return self.rasterizer
+        if self._pbr is None:
+            from graphsdg.render.pbr import PbrRenderer   # imports Warp: only where pbr was chosen
+            self._pbr = PbrRenderer()
+        return self._pbr
 
     @property
     def stage(self) -> Usd.Stage:

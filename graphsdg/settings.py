@@ -51,10 +51,16 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                     "num_bins); fewer make CI-sized runs"),
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
-    "/rtx/rendermode": ("RayTracedLighting", "render mode; PathTracing enables the highest-quality "
-                        "rasteriser settings (8x MSAA, shadow maps of 8 texels per image pixel up to 4096 px, "
-                        "/rtx/pathtracing/totalSpp jittered subframes per capture)"),
-    "/rtx/pathtracing/spp": (1, "samples per pixel per frame in PathTracing mode (see totalSpp)"),
+    "/rtx/rendermode": ("RayTracedLighting", "render mode; with the pbr backend RaytracedLighting is its "
+                        "real-time tier and PathTracing its path tier; on the classic rasteriser PathTracing "
+                        "enables the highest-quality settings (8x MSAA, shadow maps of 8 texels per image pixel "
+                        "up to 4096 px, /rtx/pathtracing/totalSpp jittered subframes per capture)"),
+    "/rtx/pathtracing/spp": (1, "samples per pixel per frame in PathTracing mode (pbr backend: path samples per "
+                                "launch are the larger of spp and totalSpp)"),
+    "/rtx/pathtracing/optixDenoiser/enabled": (True, "denoise path-traced images (pbr backend's path tier)"),
+    "/graphsdg/render/backend": ("auto", "renderer: classic (MuJoCo's OpenGL rasteriser), pbr (mujoco-warp-pbr on "
+                                         "a CUDA GPU; pip install 'graphsdg[gpu]', Python >= 3.12) or auto (pbr "
+                                         "where it can run, else classic; said once in the log)"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
     "/app/player/timelineSubsampleRate": (1, "timeline ticks per frame: each app update's frame is split into this "
@@ -106,6 +112,13 @@ def _fraction(key: str, value: Any) -> None:
         raise ValueError(f"setting {key} must be a number in [0, 1], got {value!r}")
 
 
+def _choice(*options: str) -> Callable[[str, Any], None]:
+    def check(key: str, value: Any) -> None:
+        if not isinstance(value, str) or value.strip().lower() not in options:
+            raise ValueError(f"setting {key} must be one of {list(options)}, got {value!r}")
+    return check
+
+
 def _path_or_none(key: str, value: Any) -> None:
     if value is not None and not isinstance(value, (str, os.PathLike)):
         raise ValueError(f"setting {key} must be a folder path or None, got {value!r}")
@@ -132,6 +145,9 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/msaaSamples": _integer(0),
     "/graphsdg/render/exposure": _positive_number,
     "/graphsdg/render/maxResolution": _integer(1),
+    "/graphsdg/render/backend": _choice("classic", "pbr", "auto"),
+    "/rtx/pathtracing/spp": _integer(1),
+    "/rtx/pathtracing/optixDenoiser/enabled": _boolean,
     "/omni/replicator/captureMotionBlur": _boolean,
     "/omni/replicator/pathTracedMotionBlurSubSamples": _integer(1),
     "/rtx/post/motionblur/numSamples": _integer(1),

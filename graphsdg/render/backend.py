@@ -1,0 +1,167 @@
+"""The render backend seam: which renderer draws a render product's passes.
+
+Render products, annotators and writers only see :class:`RenderBackend`: a
+``render(sim, view, passes, subframes, defer, motion)`` that returns
+:class:`~graphsdg.render.rasterizer.RenderOutputs` in one layout (uint8 RGBA
+colour, linear float ``hdr``, planar-z depth with ``inf`` background, int32 geom
+ids with -1 background). Two backends implement it:
+
+* ``classic``: MuJoCo's OpenGL rasteriser (:class:`~graphsdg.render.rasterizer.Rasterizer`),
+  headless through EGL, on any machine. It is the backend unchanged, not a wrapper,
+  so its images are byte for byte those of before the seam.
+* ``pbr``: mujoco-warp-pbr's batched physically based ray tracer on an NVIDIA GPU
+  (:mod:`graphsdg.render.pbr`, the optional ``graphsdg[gpu]`` extra, Python >= 3.12).
+
+The choice comes from settings (:func:`requested_backend`):
+
+* ``/graphsdg/render/backend``: ``classic`` | ``pbr`` | ``auto`` (default). ``auto`` is
+  ``pbr`` where the extra is installed and a CUDA GPU is present, else ``classic``;
+  the outcome is logged once per process. ``pbr`` without what it needs raises
+  :class:`PbrUnavailableError` naming what is missing.
+* ``/rtx/rendermode``: ``RaytracedLighting`` (Isaac's default) -> the real-time tier;
+  ``PathTracing`` -> the path tier with ``max(/rtx/pathtracing/spp, /rtx/pathtracing/totalSpp)``
+  samples per pixel per launch and ``/rtx/pathtracing/optixDenoiser/enabled`` as the denoiser.
+"""
+from __future__ import annotations
+
+import importlib.util
+import logging
+import sys
+from dataclasses import dataclass
+from typing import Callable, Protocol, runtime_checkable
+
+from graphsdg import settings
+
+log = logging.getLogger("graphsdg.render")
+
+BACKEND_KEY = "/graphsdg/render/backend"
+BACKENDS = ("classic", "pbr", "auto")
+DENOISER_KEY = "/rtx/pathtracing/optixDenoiser/enabled"
+#: the ``graphsdg[gpu]`` extra: import name -> distribution pinned in pyproject.toml
+PBR_MODULES = {"warp": "warp-lang==1.19.0", "mujoco_warp": "mujoco-warp==3.17.0",
+               "mujoco_warp_pbr": "mujoco-warp-pbr==0.2.0"}
+PBR_MIN_PYTHON = (3, 12)
+INSTALL_HINT = "pip install 'graphsdg[gpu]'"
+
+
+class PbrUnavailableError(RuntimeError):
+    """The PBR backend was asked for on a machine that cannot run it (the message says what is missing)."""
+
+
+@runtime_checkable
+class RenderBackend(Protocol):
+    """What render products' captures call; both backends return the same :class:`RenderOutputs` layout."""
+
+    def render(self, sim, view, passes: set[str], subframes: int = 1, defer: bool = False,
+               motion=None):   # -> graphsdg.render.rasterizer.RenderOutputs
+        """Render ``passes`` (``color``, ``hdr``, ``depth``, ``segmentation``) of ``view`` of ``sim`` now."""
+        ...
+
+    def close(self) -> None:
+        """Free the backend's device resources."""
+        ...
+
+
+@dataclass(frozen=True)
+class BackendRequest:
+    """What the settings ask the renderer for (before checking the machine can do it).
+
+    ``backend``: ``classic``, ``pbr`` or ``auto``; ``tier``: ``realtime`` or ``path``;
+    ``path_samples``: path-traced samples per pixel of one launch; ``denoise``: filter
+    the path-traced image.
+    """
+
+    backend: str
+    tier: str
+    path_samples: int
+    denoise: bool
+
+
+def requested_backend() -> BackendRequest:
+    """The render backend and tier the current settings ask for (see the module docstring)."""
+    backend = str(settings.get(BACKEND_KEY, "auto")).strip().lower()
+    if backend not in BACKENDS:   # the validator refuses these on set(); a default edited by hand lands here
+        raise ValueError(f"setting {BACKEND_KEY} must be one of {BACKENDS}, got {backend!r}")
+    path = str(settings.get("/rtx/rendermode", "RaytracedLighting")).strip().lower() == "pathtracing"
+    spp = int(settings.get("/rtx/pathtracing/spp", 1) or 1)
+    total = int(settings.get("/rtx/pathtracing/totalSpp", 1) or 1)
+    samples = max(spp, total, 1)
+    cap = int(settings.get("/graphsdg/render/maxSubframes", 0) or 0)
+    if cap > 0:   # CI-sized runs of full scripts bound path samples as they bound subframes
+        samples = min(samples, cap)
+    return BackendRequest(backend=backend, tier="path" if path else "realtime", path_samples=samples,
+                          denoise=bool(settings.get(DENOISER_KEY, True)))
+
+
+def pbr_missing(has_module: Callable[[str], bool] | None = None,
+                cuda_devices: Callable[[], int] | None = None,
+                python: tuple[int, int] | None = None) -> list[str]:
+    """What this machine lacks to run the PBR backend, each with how to get it; empty when it can.
+
+    The checks run cheapest first and stop at the first failing group, so a machine
+    without the extra never imports Warp (which initialises CUDA). The arguments
+    replace the real probes in tests.
+    """
+    has_module = has_module or (lambda name: importlib.util.find_spec(name) is not None)
+    python = python or (sys.version_info.major, sys.version_info.minor)
+    if tuple(python) < PBR_MIN_PYTHON:
+        return [f"Python >= {PBR_MIN_PYTHON[0]}.{PBR_MIN_PYTHON[1]} (this is {python[0]}.{python[1]}; "
+                f"mujoco-warp-pbr 0.2.0 needs it), then {INSTALL_HINT}"]
+    absent = [pin for name, pin in PBR_MODULES.items() if not has_module(name)]
+    if absent:
+        return [f"the gpu extra ({', '.join(absent)} not installed): {INSTALL_HINT}"]
+    count = (cuda_devices or _cuda_device_count)()
+    if count < 1:
+        return ["a CUDA GPU (Warp finds no CUDA device: an NVIDIA GPU and driver are needed)"]
+    return []
+
+
+def _cuda_device_count() -> int:
+    try:
+        import warp as wp
+        wp.init()
+        return int(wp.get_cuda_device_count())
+    except Exception:   # a broken driver or toolkit is "no usable GPU", said by pbr_missing
+        return 0
+
+
+_auto_logged = False
+_machine_lacks: list[str] | None = None
+
+
+def _cached_missing() -> list[str]:
+    """:func:`pbr_missing` once per process (the machine does not change; the CUDA probe costs a Warp init)."""
+    global _machine_lacks
+    if _machine_lacks is None:
+        _machine_lacks = pbr_missing()
+    return _machine_lacks
+
+
+def resolve_backend(request: BackendRequest | None = None,
+                    missing: Callable[[], list[str]] = _cached_missing) -> str:
+    """``classic`` or ``pbr`` for ``request`` (default: the settings' request) on this machine.
+
+    Raises:
+        PbrUnavailableError: ``pbr`` was asked for explicitly and the machine cannot run it.
+    """
+    global _auto_logged
+    request = request or requested_backend()
+    if request.backend == "classic":
+        return "classic"
+    lacks = missing()
+    if request.backend == "pbr":
+        if lacks:
+            raise PbrUnavailableError(
+                f"setting {BACKEND_KEY} = 'pbr' needs " + "; and ".join(lacks)
+                + f". Set {BACKEND_KEY} to 'classic' (or 'auto') to render with the OpenGL rasteriser.")
+        return "pbr"
+    chosen = "classic" if lacks else "pbr"
+    if not _auto_logged:   # said once: which renderer draws this process's images, and why
+        _auto_logged = True
+        why = f" (pbr needs {'; '.join(lacks)})" if lacks else " (graphsdg[gpu] and a CUDA GPU found)"
+        log.info("render backend auto -> %s%s", chosen, why)
+    return chosen
+
+
+__all__ = ["BACKENDS", "BackendRequest", "PbrUnavailableError", "RenderBackend", "pbr_missing",
+           "requested_backend", "resolve_backend"]

@@ -1,0 +1,135 @@
+"""The render backend seam: settings choose classic or pbr, pbr says what it lacks, tiers map from Isaac's modes."""
+from __future__ import annotations
+
+import logging
+import warnings
+
+import numpy as np
+import pytest
+
+import graphsdg as rep
+from graphsdg import settings
+from graphsdg.render import backend
+from graphsdg.render.backend import BackendRequest, PbrUnavailableError, pbr_missing, requested_backend, \
+    resolve_backend
+from graphsdg.runtime import runtime
+
+HAVE_ALL = dict(has_module=lambda name: True, cuda_devices=lambda: 1, python=(3, 12))
+
+
+def test_pbr_missing_names_each_gap_and_how_to_close_it():
+    assert pbr_missing(**HAVE_ALL) == []
+    old_python = pbr_missing(**{**HAVE_ALL, "python": (3, 11)})
+    assert len(old_python) == 1 and "Python >= 3.12" in old_python[0] and "3.11" in old_python[0]
+    assert "pip install 'graphsdg[gpu]'" in old_python[0]
+    no_pbr = pbr_missing(**{**HAVE_ALL, "has_module": lambda name: name != "mujoco_warp_pbr"})
+    assert no_pbr == ["the gpu extra (mujoco-warp-pbr==0.2.0 not installed): pip install 'graphsdg[gpu]'"]
+    no_gpu = pbr_missing(**{**HAVE_ALL, "cuda_devices": lambda: 0})
+    assert len(no_gpu) == 1 and "CUDA GPU" in no_gpu[0]
+
+
+def test_cuda_is_not_probed_without_the_extra():
+    def probe():
+        raise AssertionError("Warp was imported on a machine without the extra")
+    assert pbr_missing(has_module=lambda name: False, cuda_devices=probe, python=(3, 12))
+
+
+def test_classic_is_the_rasterizer_itself():
+    settings.set("/graphsdg/render/backend", "classic")
+    assert runtime().renderer is runtime().rasterizer
+    assert isinstance(runtime().renderer, backend.RenderBackend)
+
+
+@pytest.mark.skipif(not pbr_missing(), reason="this machine can run the pbr backend")
+def test_auto_falls_back_to_classic_and_explicit_pbr_raises_naming_what_is_missing():
+    assert settings.get("/graphsdg/render/backend") == "auto"      # the default
+    assert runtime().renderer is runtime().rasterizer
+    settings.set("/graphsdg/render/backend", "pbr")
+    with pytest.raises(PbrUnavailableError, match=r"graphsdg\[gpu\]|CUDA GPU") as err:
+        runtime().renderer
+    assert "/graphsdg/render/backend" in str(err.value) and "classic" in str(err.value)
+
+
+def test_explicit_pbr_error_lists_the_missing_parts():
+    request = BackendRequest("pbr", "realtime", 1, False)
+    with pytest.raises(PbrUnavailableError, match=r"needs a CUDA GPU"):
+        resolve_backend(request, missing=lambda: ["a CUDA GPU (none)"])
+    assert resolve_backend(request, missing=lambda: []) == "pbr"
+    assert resolve_backend(BackendRequest("classic", "realtime", 1, False),
+                           missing=lambda: pytest.fail("classic needs no probe")) == "classic"
+
+
+def test_auto_logs_its_choice_once(monkeypatch, caplog):
+    monkeypatch.setattr(backend, "_auto_logged", False)
+    auto = BackendRequest("auto", "realtime", 1, False)
+    with caplog.at_level(logging.INFO, logger="graphsdg.render"):
+        assert resolve_backend(auto, missing=lambda: ["a CUDA GPU"]) == "classic"
+        assert resolve_backend(auto, missing=lambda: ["a CUDA GPU"]) == "classic"
+    said = [r.getMessage() for r in caplog.records if "render backend auto" in r.getMessage()]
+    assert said == ["render backend auto -> classic (pbr needs a CUDA GPU)"]
+    monkeypatch.setattr(backend, "_auto_logged", False)
+    assert resolve_backend(auto, missing=lambda: []) == "pbr"
+
+
+def test_isaac_render_modes_map_to_tiers():
+    assert requested_backend() == BackendRequest("auto", "realtime", 1, True)
+    rep.settings.set_render_pathtraced(samples_per_pixel=64)
+    settings.set("/rtx/pathtracing/spp", 16)
+    assert requested_backend() == BackendRequest("auto", "path", 64, True)
+    settings.set("/rtx/pathtracing/spp", 128)                 # per-frame samples above the total: the larger
+    settings.set("/rtx/pathtracing/optixDenoiser/enabled", False)
+    assert requested_backend() == BackendRequest("auto", "path", 128, False)
+    settings.set("/graphsdg/render/maxSubframes", 8)          # CI-sized runs bound path samples too
+    assert requested_backend().path_samples == 8
+    rep.settings.set_render_rtx_realtime()
+    assert requested_backend().tier == "realtime"
+
+
+def test_backend_settings_have_effect_and_refuse_nonsense():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")        # honoured keys do not warn "no effect"
+        settings.set("/graphsdg/render/backend", "PBR")
+        settings.set("/rtx/pathtracing/optixDenoiser/enabled", True)
+    assert requested_backend().backend == "pbr"
+    with pytest.raises(ValueError, match="/graphsdg/render/backend"):
+        settings.set("/graphsdg/render/backend", "vulkan")
+    with pytest.raises(ValueError, match="/rtx/pathtracing/spp"):
+        settings.set("/rtx/pathtracing/spp", 0)
+
+
+def test_captures_render_through_the_chosen_backend(monkeypatch):
+    """The orchestrator asks the runtime's backend, not the rasteriser, for pixels."""
+    rep.functional.create.dome_light(intensity=600)
+    rep.functional.create.cube()
+    cam = rep.functional.create.camera(position=(0, -4, 0), look_at=(0, 0, 0))
+    rgb = rep.annotators.get("rgb")
+    rgb.attach(rep.create.render_product(cam, (32, 24)))
+    calls = []
+
+    class Recording:
+        def render(self, sim, view, passes, subframes=1, defer=False, motion=None):
+            calls.append((view.width, view.height, set(passes), subframes))
+            return runtime().rasterizer.render(sim, view, passes, subframes, defer=defer, motion=motion)
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(type(runtime()), "renderer", property(lambda self: Recording()))
+    rep.orchestrator.step(delta_time=0)
+    assert calls == [(32, 24, {"color"}, 1)]
+    assert rgb.get_data().shape == (24, 32, 4) and np.asarray(rgb.get_data())[..., 3].min() == 255
+
+
+
+def test_gpu_extra_pins_the_measured_versions_for_python_312_only():
+    import os
+    import tomllib
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, "pyproject.toml"), "rb") as f:
+        project = tomllib.load(f)["project"]
+    gpu = project["optional-dependencies"]["gpu"]
+    pins = {req.split(";")[0].strip() for req in gpu}
+    assert pins == set(backend.PBR_MODULES.values())
+    assert all('python_version >= "3.12"' in req for req in gpu)
+    assert not any("warp" in dep for dep in project["dependencies"])          # the core install is unchanged
+    assert not any("warp" in dep for dep in project["optional-dependencies"]["dev"])   # and so is CI's
