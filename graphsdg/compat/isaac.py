@@ -26,7 +26,8 @@ AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.c
          "graphsdg.compat.physics_core",
          "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
          "graphsdg.compat.simulation_manager", "graphsdg.compat.deformables",
-         "graphsdg.compat.viewport", "graphsdg.compat.core_utils")
+         "graphsdg.compat.viewport", "graphsdg.compat.core_utils", "graphsdg.compat.experimental_semantics",
+         "graphsdg.compat.omni_usd_functions")
 
 _installed: dict[str, types.ModuleType] = {}
 _finder: CompatFinder | None = None
@@ -88,8 +89,8 @@ def _modules() -> dict[str, types.ModuleType]:
                               compute_combined_aabb=isaac_core.compute_combined_aabb,
                               compute_obb=isaac_core.compute_obb)
     exp_stage = CompatModule("isaacsim.core.experimental.utils.stage", get_current_stage=isaac_core.get_current_stage)
-    exp_semantics = CompatModule("isaacsim.core.experimental.utils.semantics", add_labels=isaac_core.add_labels,
-                                 get_labels=isaac_core.get_labels, remove_labels=isaac_core.remove_labels)
+    # its names (Isaac Sim 6's keyword-only label helpers) come from graphsdg.compat.experimental_semantics
+    exp_semantics = CompatModule("isaacsim.core.experimental.utils.semantics")
     exp_utils = CompatModule("isaacsim.core.experimental.utils", bounds=exp_bounds, stage=exp_stage,
                              semantics=exp_semantics)
     exp_prims = CompatModule("isaacsim.core.experimental.prims", RigidPrim=isaac_core.RigidPrim,

@@ -508,10 +508,13 @@ _COMMANDS: dict[str, Callable[..., Any]] = {"DeletePrimsCommand": delete_prims}
 
 def execute(command: str, **kwargs: Any) -> tuple[bool, Any]:
     """omni.kit.commands.execute for the commands graphsdg maps; returns Kit's ``(success, result)``."""
-    fn = _COMMANDS.get(command)
+    from graphsdg.compat.kit_commands import COMMANDS   # Kit's prim-authoring commands
+    commands = {**_COMMANDS, **COMMANDS}
+    # Kit registers a command by its class name less "Command"; either spelling runs it
+    fn = commands.get(command) or commands.get(command.removesuffix("Command")) or commands.get(command + "Command")
     if fn is None:
         raise CompatError(f"omni.kit.commands {command!r} is not available in graphsdg's compat mode; "
-                          f"available: {', '.join(sorted(_COMMANDS))}. See docs/porting.md.")
+                          f"available: {', '.join(sorted(commands))}. See docs/porting.md.")
     return True, fn(**kwargs)
 
 

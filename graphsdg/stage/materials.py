@@ -272,6 +272,21 @@ def _uv_source(texture: UsdShade.Shader) -> dict:
     return out
 
 
+def define_mdl_material(stage: Usd.Stage, path: str | Sdf.Path, mdl_url: str, mdl_name: str) -> UsdShade.Material:
+    """Define Kit's MDL material at ``path``: a ``Shader`` child running ``mdl_name`` of ``mdl_url``
+    (``info:mdl:sourceAsset`` / ``sourceAsset:subIdentifier``) whose ``out`` drives the material's mdl
+    surface, displacement and volume outputs. :func:`describe` reads its OmniPBR inputs."""
+    material = UsdShade.Material.Define(stage, path)
+    shader = UsdShade.Shader.Define(stage, Sdf.Path(path).AppendChild("Shader"))
+    shader.SetSourceAsset(Sdf.AssetPath(mdl_url), "mdl")
+    shader.SetSourceAssetSubIdentifier(mdl_name, "mdl")
+    out = shader.CreateOutput("out", Sdf.ValueTypeNames.Token)
+    for output in (material.CreateSurfaceOutput("mdl"), material.CreateDisplacementOutput("mdl"),
+                   material.CreateVolumeOutput("mdl")):
+        output.ConnectToSource(out)
+    return material
+
+
 def bind(prim: Usd.Prim, material: UsdShade.Material) -> None:
     """Bind ``material`` to ``prim`` (stronger than descendants, as Replicator does)."""
     UsdShade.MaterialBindingAPI.Apply(prim).Bind(material, UsdShade.Tokens.strongerThanDescendants)
