@@ -126,6 +126,8 @@ def _cuda_device_count() -> int:
 
 
 _auto_logged = False
+#: set when a PBR renderer exists in this process (also one on Warp's CPU device): compiles add its camera
+pbr_in_use = False
 _machine_lacks: list[str] | None = None
 
 
@@ -135,6 +137,11 @@ def _cached_missing() -> list[str]:
     if _machine_lacks is None:
         _machine_lacks = pbr_missing()
     return _machine_lacks
+
+
+def pbr_draws() -> bool:
+    """Whether the PBR backend draws in this process (compiled models then carry its camera)."""
+    return pbr_in_use or resolve_backend() == "pbr"
 
 
 def resolve_backend(request: BackendRequest | None = None,

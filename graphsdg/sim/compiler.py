@@ -67,6 +67,7 @@ route_warnings()   # before the first compile: MuJoCo's warnings are logged, not
 HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)
 COLLISION_ONLY_GROUP = 4    # proxy collision shapes (not drawn)
 UNDRAWN_GROUPS = (COLLISION_ONLY_GROUP, HIDDEN_GROUP)
+PBR_CAMERA = "graphsdg:pbr_camera"   # the camera the PBR backend renders from (render products' poses)
 DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
 MUJOCO_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)   # geom rgba that lets a bound material show through
 GPRIM_TYPES = ("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh")
@@ -842,6 +843,14 @@ class _Builder:
                                   builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb.tolist(), rgb2=rgb.tolist(),
                                   width=8, height=8)
 
+    def add_pbr_camera(self) -> None:
+        """One MuJoCo camera for the PBR backend to pose at each render product's USD camera (its rays are
+        per pixel, so no field of view is needed); only where that backend draws, so the classic model is
+        unchanged."""
+        from graphsdg.render.backend import pbr_draws
+        if pbr_draws():
+            self.spec.worldbody.add_camera(name=PBR_CAMERA)
+
     def size_memory(self) -> None:
         """Skip contact detection when nothing collides; give big scenes a big enough arena.
 
@@ -881,6 +890,7 @@ class _Builder:
         self.add_joint_elements()
         self.flex_plans = deformables.add_to_spec(self.spec, prims, self.cache)
         self.finish_lighting()
+        self.add_pbr_camera()
         self.assign_masses()
         try:   # physxCollision offsets -> margins; authored PhysX attributes with no effect warn once
             physx_attributes.tune_colliders(self.stage, self.collider_records)

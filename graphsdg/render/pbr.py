@@ -1,0 +1,282 @@
+"""The PBR backend: mujoco-warp-pbr draws render products on an NVIDIA GPU.
+
+:class:`PbrRenderer` is a :class:`~graphsdg.render.backend.RenderBackend`: it
+renders graphsdg's compiled model (the classic path's model and state) with
+mujoco-warp-pbr and returns :class:`~graphsdg.render.rasterizer.RenderOutputs` in
+the classic layout, so annotators and writers do not know which backend drew.
+
+* **Same state.** Each render writes the simulation's geom, light and camera poses
+  (``geom_xpos``/``geom_xmat`` as MuJoCo computed them on the CPU: mocap poses,
+  physics, randomizers) straight into the renderer's data and refits the scene
+  BVH; no kinematics run on the GPU. Colours, material bindings and light colours
+  are copied into the renderer's model every render (per-world arrays: nothing
+  recompiles). A change that alters geometry (a new model, mesh rescaling, a geom
+  shown or hidden) builds a new render context: mesh BVHs are built from the
+  model's rescaled vertices.
+* **Same camera.** The model carries one camera (``graphsdg:pbr_camera``, added by
+  the compiler where this backend draws); each render poses it at the USD camera
+  and renders per-pixel rays (:func:`graphsdg.render.pbr_scene.camera_rays`), so
+  aperture fit, offsets and clipping are the classic path's exactly.
+* **Labels from the same rays.** Depth (planar z, ``inf`` background) and geom ids
+  (-1 background) come from the colour render's primary rays.
+  ``render_isolated`` (unoccluded footprints for occlusion and loose boxes) is
+  drawn by the classic rasteriser, which samples the same pixel centres.
+* **Tiers.** ``RaytracedLighting``: the real-time tier; ``rt_subframes`` N gives
+  ceil(sqrt(N))^2 stratified samples per pixel (anti-aliasing, as on the
+  rasteriser). ``PathTracing``: the path tier with the settings' samples and
+  denoiser; subframes beyond one launch's samples are further launches, averaged.
+
+Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``).
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import mujoco
+import numpy as np
+from pxr import UsdShade
+
+from graphsdg import profiling, settings
+from graphsdg.render import pbr_scene
+from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend
+from graphsdg.render.camera import CameraView
+from graphsdg.render.rasterizer import PASSES, RenderOutputs
+from graphsdg.sim.compiler import PBR_CAMERA, UNDRAWN_GROUPS, drawn_geom_mask
+from graphsdg.sim.scene import SimScene
+
+ENABLED_GROUPS = tuple(g for g in range(mujoco.mjNGROUP) if g not in UNDRAWN_GROUPS)
+
+
+@dataclass
+class _Context:
+    """One render context: a model's geometry at one resolution and tier."""
+
+    key: tuple
+    model: Any          # mujoco_warp Model
+    data: Any           # mujoco_warp Data (nworld 1)
+    rc: Any             # mujoco_warp_pbr PbrRenderContext
+    camera: int         # the PBR camera's id
+    rgb: Any            # wp.array (1, H, W) vec3
+    env_yaw: float
+
+
+class PbrRenderer:
+    """Renders :class:`SimScene` views with mujoco-warp-pbr (see the module docstring)."""
+
+    def __init__(self, device: str | None = None) -> None:
+        lacks = pbr_missing()
+        if lacks and device != "cpu":
+            raise PbrUnavailableError("the pbr backend needs " + "; and ".join(lacks))
+        import mujoco_warp as mjw
+        import mujoco_warp_pbr as mjpbr
+        import warp as wp
+
+        from graphsdg.render import backend
+        backend.pbr_in_use = True
+        self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
+        self._device = device or "cuda:0"
+        self._contexts: dict[tuple, _Context] = {}
+        self._renders: dict[str, int] = {}       # per camera path: the seed of its next path-traced launch
+        self._isolated = None                    # classic rasteriser for render_isolated footprints
+        self.stats: dict[str, int] = {"color": 0, "contexts": 0}
+        self._warned_motion = False
+
+    # ---- contexts ------------------------------------------------------
+    def _key(self, sim: SimScene, view: CameraView, subframes: int) -> tuple:
+        request = requested_backend()
+        model = sim.model
+        drawn = drawn_geom_mask(model)
+        meshes = hashlib.sha1(b"".join(m.tobytes() for _, m in sorted(sim.mesh_maps.items()))).hexdigest()
+        per_axis = math.ceil(math.sqrt(subframes)) if request.tier == "realtime" else 1
+        return (id(model), sim.model_version, view.width, view.height, request.tier, request.path_samples,
+                request.denoise, per_axis, drawn.tobytes(), meshes, float(settings.get("/graphsdg/render/exposure", 1.0)))
+
+    def _context(self, sim: SimScene, view: CameraView, subframes: int) -> _Context:
+        if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, PBR_CAMERA) < 0:
+            sim.recompile(keep_state=True)   # compiled while the classic backend drew: add the PBR camera
+        key = self._key(sim, view, subframes)
+        ctx = self._contexts.get(key)
+        if ctx is not None:
+            return ctx
+        self._contexts.clear()      # one live context (device memory); products at several sizes rebuild
+        with profiling.timed("render:pbr_context"):
+            ctx = self._build(sim, view, key)
+        self._contexts[key] = ctx
+        self.stats["contexts"] += 1
+        return ctx
+
+    def _build(self, sim: SimScene, view: CameraView, key: tuple) -> _Context:
+        wp, mjw, mjpbr = self._wp, self._mjw, self._mjpbr
+        model = sim.model
+        camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, PBR_CAMERA)
+        request = requested_backend()
+        exposure_setting = float(settings.get("/graphsdg/render/exposure", 1.0))
+        env, yaw = self._environment(sim)
+        path = request.tier == "path"
+        cam_active = [i == camera for i in range(model.ncam)]
+        with wp.ScopedDevice(self._device):
+            m = mjw.put_model(model)
+            d = mjw.put_data(model, sim.data, nworld=1)
+            rc = mjpbr.create_render_context(
+                model, nworld=1, cam_res=[(view.width, view.height)], render_rgb=True, render_depth=True,
+                render_seg=True, enabled_geom_groups=ENABLED_GROUPS, cam_active=cam_active,
+                light_model=mjpbr.LightModel.PHYSICAL, tone_mapper=mjpbr.ToneMapper.CLAMP,
+                ev100=pbr_scene.ev100(exposure_setting), samples_per_pixel=key[7],
+                envmap=env, envmap_intensity=1.0 if env is not None else None, envmap_rotation=math.degrees(yaw),
+                use_skybox=env is None, mesh_bvh_frame="mujoco",
+                tier=mjpbr.Tier.PATH if path else mjpbr.Tier.REALTIME, path_samples=request.path_samples,
+                denoise=path and request.denoise, camera_rays=pbr_scene.camera_rays(view)[None])
+            rgb = wp.zeros((1, view.height, view.width), dtype=wp.vec3)
+        return _Context(key=key, model=m, data=d, rc=rc, camera=camera, rgb=rgb, env_yaw=yaw)
+
+    def _environment(self, sim: SimScene) -> tuple[np.ndarray | None, float]:
+        """The stage's dome lights as one environment map in nits, and its yaw (0 when resampled)."""
+        from pxr import Usd, UsdGeom
+
+        from graphsdg.sim import environment_map
+        from graphsdg.sim import lights as lightmap
+        from graphsdg.stage.xform import decompose, world_matrix
+        stage = sim.stage
+        domes = [p for p in stage.Traverse() if p.GetTypeName() == "DomeLight"
+                 and UsdGeom.Imageable(p).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible]
+        if not domes:
+            return None, 0.0
+        total, yaw = None, 0.0
+        for prim in domes:
+            _, rotation, scale = decompose(world_matrix(prim))
+            params = lightmap.light_params(prim, scale)
+            # light_params scaled to display units; undo it for nits
+            nits = params.color * lightmap.REFERENCE_IRRADIANCE / float(settings.get("/graphsdg/render/exposure", 1.0))
+            nits = nits / math.pi      # dome "power" was radiance x pi (horizontal irradiance)
+            radiance = environment_map.load(params.texture).radiance if params.texture else None
+            turn = pbr_scene.dome_yaw(rotation) if len(domes) == 1 else None
+            env = pbr_scene.dome_environment(radiance, rotation, nits, resample=turn is None)
+            if turn is not None:
+                yaw = turn
+            total = env if total is None else total + env
+        return total, yaw
+
+    # ---- one render ----------------------------------------------------
+    def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
+               defer: bool = False, motion=None) -> RenderOutputs:
+        """Render ``passes`` of ``view``: colour, depth and ids from the same rays (see the module docstring)."""
+        unknown = set(passes) - set(PASSES)
+        if unknown:
+            raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
+        if subframes < 1:
+            raise ValueError(f"subframes must be >= 1, got {subframes}")
+        if motion is not None and not self._warned_motion:
+            self._warned_motion = True
+            warnings.warn("motion blur is not rendered by the pbr backend yet: frames show the step's end state",
+                          stacklevel=2)
+        wp = self._wp
+        ctx = self._context(sim, view, subframes)
+        with wp.ScopedDevice(self._device):
+            self._upload_state(sim, view, ctx)
+            launches = 1
+            if requested_backend().tier == "path":
+                launches = max(1, math.ceil(subframes / max(1, ctx.rc.path_samples)))
+            acc = None
+            with profiling.timed("render:pbr"):
+                for _ in range(launches):
+                    seed = self._renders.get(view.path, 0)
+                    self._renders[view.path] = seed + 1
+                    self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
+                    self._mjpbr.get_rgb(ctx.rc, 0, ctx.rgb)
+                    rgb = ctx.rgb.numpy()[0]
+                    acc = rgb if acc is None else acc + rgb
+                    self.stats["color"] += 1
+            with profiling.timed("readback:pbr"):
+                colour = np.clip(acc / launches, 0.0, 1.0).astype(np.float32)
+                n = view.width * view.height
+                distance = ctx.rc.base.depth_data.numpy()[0, :n].reshape(view.height, view.width)
+                seg = ctx.rc.base.seg_data.numpy()[0, :n].reshape(view.height, view.width, 2)
+        out = RenderOutputs()
+        geom_ids = np.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1).astype(np.int32)
+        if "color" in passes:
+            rgba = np.full((view.height, view.width, 4), 255, dtype=np.uint8)
+            rgba[..., :3] = np.rint(colour * 255.0)
+            out.put("color", rgba)
+        if "hdr" in passes:
+            out.put("hdr", colour)
+        if "depth" in passes:
+            out.put("depth", pbr_scene.planar_depth(distance, view, hit=seg[..., 0] >= 0))
+        if "segmentation" in passes:
+            codes, lut = id_codes(geom_ids, sim.model.ngeom)
+            out.put("id_codes", codes)
+            out.id_lut = lut
+            out.put("geom_ids", geom_ids)
+        out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
+        return out
+
+    def _upload_state(self, sim: SimScene, view: CameraView, ctx: _Context) -> None:
+        """The simulation's poses and randomized model fields into the renderer (no recompile)."""
+        model, data, m, d = sim.model, sim.data, ctx.model, ctx.data
+        d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
+        d.geom_xmat.assign(np.asarray(data.geom_xmat, dtype=np.float32).reshape(1, -1, 3, 3))
+        if model.nlight:
+            d.light_xpos.assign(np.asarray(data.light_xpos, dtype=np.float32)[None])
+            d.light_xdir.assign(np.asarray(data.light_xdir, dtype=np.float32)[None])
+        position, xmat = pbr_scene.camera_pose(view)
+        cam_xpos = np.zeros((1, model.ncam, 3), dtype=np.float32)
+        cam_xmat = np.tile(np.eye(3, dtype=np.float32), (1, model.ncam, 1, 1))
+        cam_xpos[0, ctx.camera], cam_xmat[0, ctx.camera] = position, xmat
+        d.cam_xpos.assign(cam_xpos)
+        d.cam_xmat.assign(cam_xmat)
+        # colour / material / light randomizers write these on the CPU model
+        m.geom_rgba.assign(np.asarray(model.geom_rgba, dtype=np.float32)[None])
+        m.geom_matid.assign(np.asarray(model.geom_matid, dtype=np.int32)[None])
+        if model.nmat:
+            m.mat_rgba.assign(np.asarray(model.mat_rgba, dtype=np.float32)[None])
+        if model.nlight:
+            m.light_diffuse.assign(np.asarray(model.light_diffuse, dtype=np.float32)[None])
+        world = pbr_scene.world_arrays(model, self._surfaces(sim), float(settings.get("/graphsdg/render/exposure",
+                                                                                       1.0)))
+        rc = ctx.rc
+        rc.geom_metallic.assign(world.geom_metallic[None])
+        rc.geom_roughness.assign(world.geom_roughness[None])
+        rc.geom_reflectance.assign(world.geom_reflectance[None])
+        if model.nlight:
+            rc.light_intensity.assign(world.light_intensity[None])
+        self._mjw.refit_bvh(m, d, rc.base)
+
+    def _surfaces(self, sim: SimScene) -> dict[int, pbr_scene.SurfaceFields]:
+        compiled = sim.ensure_compiled()
+        cache = getattr(self, "_surface_cache", None)
+        if cache is None or cache[0] != (id(compiled), sim.model_version):
+            stage = sim.stage
+            fields = {}
+            for path, mid in compiled.materials.items():
+                prim = stage.GetPrimAtPath(path)
+                if prim and mid >= 0:
+                    fields[mid] = pbr_scene.surface_fields(UsdShade.Material(prim))
+            cache = ((id(compiled), sim.model_version), fields)
+            self._surface_cache = cache
+        return cache[1]
+
+    def _classic(self):
+        if self._isolated is None:
+            from graphsdg.render.rasterizer import Rasterizer
+            self._isolated = Rasterizer()
+        return self._isolated
+
+    def close(self) -> None:
+        self._contexts.clear()
+        if self._isolated is not None:
+            self._isolated.close()
+            self._isolated = None
+
+
+def id_codes(geom_ids: np.ndarray, ngeom: int) -> tuple[np.ndarray, np.ndarray]:
+    """Codes (geom id + 1, 0 background) and their ``code -> geom id`` table, as the classic path reports them:
+    uint8-sized tables are 256 long, uint16 ones 65536 (every code indexes the table)."""
+    bits = 8 if ngeom + 1 < (1 << 8) else 16 if ngeom + 1 < (1 << 16) else 32
+    size = 1 << bits if bits < 32 else ngeom + 2
+    lut = np.full(size, -1, dtype=np.int32)
+    lut[1:ngeom + 1] = np.arange(ngeom, dtype=np.int32)
+    dtype = np.uint8 if bits == 8 else np.uint16 if bits == 16 else np.uint32
+    return (geom_ids + 1).astype(dtype), lut
