@@ -18,6 +18,7 @@ import os
 from dataclasses import dataclass
 from typing import Callable
 
+import numpy as np
 from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
 
 from graphsdg.assets import authoring, geometry, outdoor_skies, packing_table, simready, skies, textures, ycb
@@ -27,6 +28,7 @@ PROPS = "/Isaac/Environments/Simple_Warehouse/Props"
 WAREHOUSE_DIR = "/Isaac/Environments/Simple_Warehouse"
 WOOD_DIR = "/NVIDIA/Materials/Base/Wood"
 SKIES_DIR = "/NVIDIA/Assets/Skies/Indoor"
+GROUND_DIR = "/NVIDIA/Materials/vMaterials_2/Ground/textures"
 
 
 def _abs(root: str, rel: str) -> str:
@@ -371,6 +373,43 @@ IMAGE_ASSETS.update({
         f"outdoor HDR lat-long sky ({n.split('/')[0].lower()}: {n.split('/')[1].replace('_4k', '').replace('_', ' ')})",
         _outdoor_sky_builder(n))
     for n in outdoor_skies.OUTDOOR_SKIES})
+
+# Ground textures at the paths of Isaac's vMaterials_2 (the "Randomizing Textures" snippet reads them)
+GROUND_SIZE = (256, 256)
+
+
+def _ground_packed(seed: int) -> np.ndarray:
+    """R roughness, G ambient occlusion (dark in the gaps between stones), B height."""
+    stones = textures.gravel(GROUND_SIZE, seed, base=(1.0, 1.0, 1.0))
+    lum = stones.mean(-1)
+    rough = textures.roughness_map(GROUND_SIZE, seed + 1, mean=0.85, spread=0.2)[..., 0]
+    return np.stack([rough, 0.35 + 0.65 * np.clip(lum * 1.6, 0, 1), lum], -1)
+
+
+GROUND_TEXTURES: dict[str, tuple[str, Callable[[], np.ndarray]]] = {
+    "aggregate_exposed_diff": ("exposed-aggregate concrete base colour, tileable",
+                               lambda: textures.exposed_aggregate(GROUND_SIZE, 701)),
+    "gravel_track_ballast_diff": ("track-ballast gravel base colour, tileable",
+                                  lambda: textures.gravel(GROUND_SIZE, 702, base=(0.42, 0.41, 0.40))),
+    "gravel_track_ballast_multi_R_rough_G_ao": ("track-ballast packed map: R roughness, G ambient occlusion, "
+                                                "B height; tileable", lambda: _ground_packed(703)),
+    "rough_gravel_rough": ("rough gravel roughness (grey), tileable",
+                           lambda: textures.roughness_map(GROUND_SIZE, 704, mean=0.8, spread=0.35)),
+}
+
+
+def _ground_builder(name: str) -> Callable[[str], list[str]]:
+    def build(root: str) -> list[str]:
+        rel = f"{GROUND_DIR}/{name}.jpg"
+        textures.write_jpg(_abs(root, rel), GROUND_TEXTURES[name][1]())
+        return [rel]
+    return build
+
+
+IMAGE_ASSETS.update({
+    f"ground_{n.lower()}": ImageAsset(f"ground_{n.lower()}", f"{GROUND_DIR}/{n}.jpg", GROUND_SIZE, d,
+                                      _ground_builder(n))
+    for n, (d, _) in GROUND_TEXTURES.items()})
 
 # Images first: the warehouse's rack decks use the plywood texture.
 BUILD_ORDER: list[Callable[[str], list[str]]] = [a.build for a in IMAGE_ASSETS.values()] + \

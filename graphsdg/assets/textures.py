@@ -341,3 +341,38 @@ def grid(size: int, cells: int = 4, base: RGB = (0.62, 0.62, 0.64), line: RGB = 
         img[sl, :] = line
         img[:, sl] = line
     return img
+
+
+def gravel(size: tuple[int, int], seed: int, base: RGB = (0.47, 0.45, 0.42), stones: int = 24) -> np.ndarray:
+    """Tileable loose gravel: about ``stones`` pebbles across, each its own shade of ``base``, dark gaps between."""
+    rows, cols = size
+    cells = value_noise(size, period=(stones, stones * cols // rows), seed=seed)
+    ridges = np.abs(fbm(size, period=(stones // 2, stones * cols // rows // 2), octaves=2, seed=seed + 1) - 0.5)
+    gaps = _smoothstep(0.0, 0.06, ridges)                  # 0 in the cracks between pebbles
+    grain = speckle(size, seed + 2)
+    shade = 0.55 + 0.6 * cells + 0.08 * (grain - 0.5)
+    hue = value_noise(size, period=(stones // 3 or 1, stones * cols // rows // 3 or 1), seed=seed + 3)
+    img = np.asarray(base)[None, None, :] * shade[..., None] * (0.45 + 0.55 * gaps[..., None])
+    img = img * (0.94 + 0.12 * np.stack([hue, 1 - hue, 0.5 + 0 * hue], -1))
+    return np.clip(img, 0.0, 1.0)
+
+
+def exposed_aggregate(size: tuple[int, int], seed: int) -> np.ndarray:
+    """Tileable exposed-aggregate concrete: cement matrix with small pebbles showing through."""
+    cement = concrete(size, seed, base=(0.62, 0.60, 0.56), joints=False)
+    pebbles = gravel(size, seed + 10, base=(0.55, 0.50, 0.44), stones=40)
+    mask = _smoothstep(0.45, 0.6, fbm(size, period=(24, 24), octaves=2, seed=seed + 20))[..., None]
+    return np.clip(cement * (1 - mask) + pebbles * mask, 0.0, 1.0)
+
+
+def roughness_map(size: tuple[int, int], seed: int, mean: float = 0.8, spread: float = 0.3) -> np.ndarray:
+    """Tileable grey roughness in [0, 1] (the same value in R, G and B) around ``mean``."""
+    r = np.clip(mean + spread * (fbm(size, period=(16, 16), octaves=4, seed=seed) - 0.5), 0.0, 1.0)
+    return np.repeat(r[..., None], 3, axis=-1)
+
+
+def write_jpg(path: str, rgb: np.ndarray, quality: int = 92) -> None:
+    """Write a float RGB image in [0, 1] as a JPEG (parent folders are created)."""
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    if not cv2.imwrite(path, cv2.cvtColor(to_uint8(rgb), cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, quality]):
+        raise OSError(f"could not write texture {path!r}")
