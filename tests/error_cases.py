@@ -286,7 +286,7 @@ CASES: list[Case] = [
     # ---- writers -------------------------------------------------------------------------------------------------
     C("writers", "a misspelt writer name", 'rep.writers.get("BasicWritter")',
       "UnknownNameError", "unknown writer 'BasicWritter' (did you mean 'BasicWriter'?); known writers: BasicWriter, "
-                          "BopWriter, CocoWriter, KittiWriter, PoseWriter, WebDatasetWriter, YoloWriter"),
+                          "BopWriter, CocoWriter, CosmosWriter, KittiWriter, PoseWriter, WebDatasetWriter, YoloWriter"),
     C("writers", "a misspelt writer flag", 'rep.writers.get("BasicWriter").initialize(output_dir=tmp, rgb=True, '
                                            'bounding_box_2d_thight=True)',
       "TypeError", "BasicWriter.initialize() got unknown parameter(s) ['bounding_box_2d_thight'] (did you mean "

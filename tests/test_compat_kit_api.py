@@ -223,3 +223,16 @@ def test_kit_command_line_settings_reach_carb_settings(compat, monkeypatch):
     SimulationApp({"headless": True})
     assert carb.settings.get_settings().get("/syntheticdata/sensors/perSubsetSegmentation") is False
     carb.settings.get_settings().set("/syntheticdata/sensors/perSubsetSegmentation", True)
+
+
+def test_uninstall_unhooks_the_simulation_manager_from_plain_graphsdg():
+    import graphsdg as rep
+    isaac.install()
+    from isaacsim.core.simulation_manager import SimulationManager
+    SimulationManager.initialize_physics()      # hooks the timeline (as Isaac's extension does)
+    isaac.uninstall()
+    rep.stage.new_stage()
+    timeline = rep.timeline.get_timeline_interface()
+    timeline.play()
+    timeline.stop()
+    assert not [p for p in rep.stage.get_stage().Traverse() if p.GetTypeName() == "PhysicsScene"]

@@ -21,7 +21,8 @@ from graphsdg.compat import extensions, isaac_core, kit
 from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, ForwardingModule
 
 # Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
-# CompatModules named by their full Isaac name. :func:`_mount` links them under their parents.
+# CompatModules named by their full Isaac name (:func:`_mount` links them under their parents), and may
+# have ``uninstall()``, called by :func:`uninstall` to unhook what it hooked into graphsdg's runtime.
 AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
          "graphsdg.compat.physics_core",
          "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
@@ -201,6 +202,10 @@ def uninstall() -> None:
             delattr(sys.modules[parent], leaf)
     _installed.clear()
     kit.get_context()._stop_listening()
+    for area in AREAS:   # areas that hooked graphsdg's runtime let go of it
+        release = getattr(importlib.import_module(area), "uninstall", None)
+        if release is not None:
+            release()
     if _finder is not None and _finder in sys.meta_path:
         sys.meta_path.remove(_finder)
     _finder = None

@@ -204,6 +204,22 @@ class SimulationManager:
             cls.initialize_physics()
 
     @classmethod
+    def _stop(cls) -> None:
+        """Unhook what :meth:`_start` hooked (compat mode uninstalled: plain graphsdg runs untouched)."""
+        if not cls._started:
+            return
+        from graphsdg.stage.context import stage_context
+        cls._reset()
+        for subscription in cls._timeline_subscriptions:
+            subscription.unsubscribe()
+        cls._timeline_subscriptions = []
+        stage_context.unsubscribe(cls._on_stage_replaced)
+        if cls._step_observer is not None:
+            physics_steps.unsubscribe(cls._step_observer)
+            cls._step_observer = None
+        cls._started = False
+
+    @classmethod
     def _count_step(cls, step_size: float) -> None:
         # runs before every other post-step observer, so callbacks see the time after the step
         if cls._initialized:
@@ -531,6 +547,11 @@ def _scene_prim(path: str) -> Usd.Prim:
         raise ValueError(f"physics scene {path!r} is not a UsdPhysics.Scene prim on the stage; scenes: "
                          f"{_physics_scenes() or 'none'}")
     return prim
+
+
+def uninstall() -> None:
+    """Called by :func:`graphsdg.compat.isaac.uninstall`: the simulation manager lets go of the timeline."""
+    SimulationManager._stop()
 
 
 def modules() -> list[types.ModuleType]:
