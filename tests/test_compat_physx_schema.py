@@ -188,3 +188,21 @@ def test_path_integers_round_trip(compat):
     assert PhysicsSchemaTools.decodeSdfPath(*PhysicsSchemaTools.encodeSdfPath("/A/b")) == Sdf.Path("/A/b")
     with pytest.raises(ValueError, match="not an integer"):
         PhysicsSchemaTools.intToSdfPath(-5)
+
+
+def test_prim_has_api_knows_physx_schemas_while_installed():
+    from pxr import Usd, UsdPhysics
+    isaac.install()
+    try:
+        from pxr import PhysxSchema
+        stage = Usd.Stage.CreateInMemory()
+        prim = stage.DefinePrim("/Box", "Cube")
+        assert not prim.HasAPI(PhysxSchema.PhysxRigidBodyAPI)
+        PhysxSchema.PhysxRigidBodyAPI.Apply(prim)
+        UsdPhysics.RigidBodyAPI.Apply(prim)
+        assert prim.HasAPI(PhysxSchema.PhysxRigidBodyAPI) and not prim.HasAPI(PhysxSchema.PhysxCollisionAPI)
+        assert prim.HasAPI(UsdPhysics.RigidBodyAPI)           # pxr's own schemas as before
+    finally:
+        isaac.uninstall()
+    with pytest.raises(Exception):
+        prim.HasAPI(PhysxSchema.PhysxRigidBodyAPI)            # pxr's HasAPI is back: it knows no such type

@@ -22,7 +22,8 @@ from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, Forwardin
 
 # Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
 # CompatModules named by their full Isaac name (:func:`_mount` links them under their parents), and may
-# have ``uninstall()``, called by :func:`uninstall` to unhook what it hooked into graphsdg's runtime.
+# have ``install()`` / ``uninstall()``, called by :func:`install` / :func:`uninstall` to hook into pxr or
+# graphsdg's runtime and to let go again.
 AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
          "graphsdg.compat.physics_core",
          "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
@@ -188,6 +189,10 @@ def install() -> None:
     _finder = CompatFinder(_installed, manager.providing)
     sys.meta_path.insert(0, _finder)
     kit.get_context()._listen()   # stage events from here on
+    for area in AREAS:   # areas that extend pxr or graphsdg's runtime while installed
+        extend = getattr(importlib.import_module(area), "install", None)
+        if extend is not None:
+            extend()
 
 
 def uninstall() -> None:

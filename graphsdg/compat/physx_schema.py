@@ -25,7 +25,7 @@ import itertools
 import math
 import threading
 import types
-from typing import Any
+from typing import Any, Callable
 
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
@@ -345,6 +345,33 @@ def addRigidSphere(stage: Usd.Stage, path: str | Sdf.Path, radius: float, positi
     sphere.CreateRadiusAttr(float(radius))
     sphere.CreateExtentAttr([Gf.Vec3f(-float(radius)), Gf.Vec3f(float(radius))])
     _rigid(stage, sphere, position, orientation, color, density, lin_velocity, ang_velocity)
+
+
+_usd_has_api: Callable[..., bool] | None = None   # pxr's own Usd.Prim.HasAPI while compat mode is installed
+
+
+def _has_api(prim: Usd.Prim, schema: Any, *args: Any, **kwargs: Any) -> bool:
+    """``prim.HasAPI(PhysxSchema.X)`` answers from the prim's ``apiSchemas``; other schemas go to pxr."""
+    if isinstance(schema, type) and issubclass(schema, PhysxAPISchema):
+        return defs.has_api(prim, schema._schema.token)
+    return _usd_has_api(prim, schema, *args, **kwargs)
+
+
+def install() -> None:
+    """Called by :func:`graphsdg.compat.isaac.install`: ``Usd.Prim.HasAPI`` learns the PhysX schema classes
+    (usd-core cannot register them as schema types, and Isaac scripts ask ``prim.HasAPI(PhysxSchema...)``)."""
+    global _usd_has_api
+    if _usd_has_api is None:
+        _usd_has_api = Usd.Prim.HasAPI
+        Usd.Prim.HasAPI = _has_api
+
+
+def uninstall() -> None:
+    """Called by :func:`graphsdg.compat.isaac.uninstall`: pxr's ``HasAPI`` back."""
+    global _usd_has_api
+    if _usd_has_api is not None:
+        Usd.Prim.HasAPI = _usd_has_api
+        _usd_has_api = None
 
 
 def modules() -> list[types.ModuleType]:
