@@ -251,14 +251,7 @@ class OmniPbrMaterial(VisualMaterial):
                 if not self._is_kind(stage.GetPrimAtPath(path)):
                     raise ValueError(f"the prim at {path} is not a material with an OmniPBR.mdl shader")
             else:
-                material = UsdShade.Material.Define(stage, path)
-                shader = UsdShade.Shader.Define(stage, Sdf.Path(path).AppendChild("Shader"))
-                shader.SetSourceAsset(Sdf.AssetPath("OmniPBR.mdl"), "mdl")
-                shader.SetSourceAssetSubIdentifier("OmniPBR", "mdl")
-                out = shader.CreateOutput("out", Sdf.ValueTypeNames.Token)
-                for output in (material.CreateSurfaceOutput("mdl"), material.CreateDisplacementOutput("mdl"),
-                               material.CreateVolumeOutput("mdl")):
-                    output.ConnectToSource(out)
+                matlib.define_mdl_material(stage, path, "OmniPBR.mdl", "OmniPBR")
         super().__init__(found, resolve_paths=False)
 
     @classmethod

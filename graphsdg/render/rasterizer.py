@@ -397,13 +397,7 @@ class Rasterizer:
                     self._draw_color(rect, background)
                 acc += self._reads.read_color(ctx, w, h).result()[..., :3]
                 self.stats["color"] += 1
-            mean = acc / n
-            if want_color:
-                rgba = np.full((h, w, 4), 255, dtype=np.uint8)
-                rgba[..., :3] = np.rint(mean)
-                out.put("color", rgba)
-            if want_linear:
-                out.put("hdr", mean / np.float32(255))
+            _put_average(out, acc / n, want_color, want_linear)
             return None
         far = self._update_scene(sim, view, bounds, (0.0, 0.0))
         with profiling.timed("render:color"):
@@ -426,13 +420,7 @@ class Rasterizer:
             self._draw_color(rect, background)
             acc += self._reads.read_color(ctx, w, h).result()[..., :3]
             self.stats["color"] += 1
-        mean = acc / subframes
-        if want_color:
-            rgba = np.full((h, w, 4), 255, dtype=np.uint8)
-            rgba[..., :3] = np.rint(mean)
-            out.put("color", rgba)
-        if want_linear:
-            out.put("hdr", mean / np.float32(255))
+        _put_average(out, acc / subframes, want_color, want_linear)
         return None
 
     def _draw_color(self, rect: mujoco.MjrRect, background: tuple[float, float, float] | None) -> None:
@@ -505,6 +493,16 @@ class Rasterizer:
             return lookup(lut, codes())
         finally:
             group[:] = saved
+
+
+def _put_average(out: RenderOutputs, mean: np.ndarray, want_color: bool, want_linear: bool) -> None:
+    """The mean of several colour renders (jittered sub-frames, motion-blur samples) as the outputs."""
+    if want_color:
+        rgba = np.full((*mean.shape[:2], 4), 255, dtype=np.uint8)
+        rgba[..., :3] = np.rint(mean)
+        out.put("color", rgba)
+    if want_linear:
+        out.put("hdr", mean / np.float32(255))
 
 
 def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, float]:
