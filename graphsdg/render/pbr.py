@@ -30,10 +30,9 @@ Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``
 """
 from __future__ import annotations
 
-import hashlib
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import mujoco
@@ -60,8 +59,12 @@ class _Context:
     data: Any           # mujoco_warp Data (nworld 1)
     rc: Any             # mujoco_warp_pbr PbrRenderContext
     camera: int         # the PBR camera's id
-    rgb: Any            # wp.array (1, H, W) vec3
+    rgb: Any            # wp.array (1, H, W) vec3 (path-tier accumulation)
     env_yaw: float
+    layout: Any         # pbr_outputs.ClassicLayout: device-side conversion and host buffers
+    rays_key: tuple     # the camera intrinsics the rays were made from
+    mesh_stamps: np.ndarray   # SimScene.mesh_stamps when the BVHs were last brought up to date
+    uploaded: dict = field(default_factory=dict)   # field name -> host copy last uploaded
 
 
 class PbrRenderer:
@@ -75,9 +78,10 @@ class PbrRenderer:
         import mujoco_warp_pbr as mjpbr
         import warp as wp
 
-        from graphsdg.render import backend
+        from graphsdg.render import backend, pbr_meshes, pbr_outputs
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
+        self._outputs, self._meshes = pbr_outputs, pbr_meshes
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
         self._renders: dict[str, int] = {}       # per camera path: the seed of its next path-traced launch
@@ -90,10 +94,9 @@ class PbrRenderer:
         request = requested_backend()
         model = sim.model
         drawn = drawn_geom_mask(model)
-        meshes = hashlib.sha1(b"".join(m.tobytes() for _, m in sorted(sim.mesh_maps.items()))).hexdigest()
         per_axis = math.ceil(math.sqrt(subframes)) if request.tier == "realtime" else 1
         return (id(model), sim.model_version, view.width, view.height, request.tier, request.path_samples,
-                request.denoise, per_axis, drawn.tobytes(), meshes, float(settings.get("/graphsdg/render/exposure", 1.0)))
+                request.denoise, per_axis, drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)))
 
     def _context(self, sim: SimScene, view: CameraView, subframes: int) -> _Context:
         if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, PBR_CAMERA) < 0:
@@ -131,7 +134,12 @@ class PbrRenderer:
                 tier=mjpbr.Tier.PATH if path else mjpbr.Tier.REALTIME, path_samples=request.path_samples,
                 denoise=path and request.denoise, camera_rays=pbr_scene.camera_rays(view)[None])
             rgb = wp.zeros((1, view.height, view.width), dtype=wp.vec3)
-        return _Context(key=key, model=m, data=d, rc=rc, camera=camera, rgb=rgb, env_yaw=yaw)
+        layout = self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
+                                             view.far, self._device)
+        # the context was built from the model's current vertices: every mesh is up to date
+        stamps = sim.mesh_stamps.copy() if sim.mesh_stamps.shape[0] == model.nmesh else np.zeros(model.nmesh, np.int64)
+        return _Context(key=key, model=m, data=d, rc=rc, camera=camera, rgb=rgb, env_yaw=yaw, layout=layout,
+                        rays_key=_rays_key(view), mesh_stamps=stamps)
 
     def _environment(self, sim: SimScene) -> tuple[np.ndarray | None, float]:
         """The stage's dome lights as one environment map in nits, and its yaw (0 when resampled)."""
@@ -176,73 +184,113 @@ class PbrRenderer:
         wp = self._wp
         ctx = self._context(sim, view, subframes)
         with wp.ScopedDevice(self._device):
-            self._upload_state(sim, view, ctx)
-            launches = 1
-            if requested_backend().tier == "path":
-                launches = max(1, math.ceil(subframes / max(1, ctx.rc.path_samples)))
+            with profiling.timed("render:pbr_upload"):
+                self._upload_state(sim, view, ctx)
+            path = requested_backend().tier == "path"
+            launches = max(1, math.ceil(subframes / max(1, ctx.rc.path_samples))) if path else 1
             acc = None
             with profiling.timed("render:pbr"):
                 for _ in range(launches):
                     seed = self._renders.get(view.path, 0)
                     self._renders[view.path] = seed + 1
                     self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
-                    self._mjpbr.get_rgb(ctx.rc, 0, ctx.rgb)
-                    rgb = ctx.rgb.numpy()[0]
-                    acc = rgb if acc is None else acc + rgb
                     self.stats["color"] += 1
+                    if launches > 1:      # several path launches: average their display colours
+                        self._mjpbr.get_rgb(ctx.rc, 0, ctx.rgb)
+                        rgb = ctx.rgb.numpy()[0]
+                        acc = rgb if acc is None else acc + rgb
+                ctx.layout.convert(ctx.rc.base, 0)
             with profiling.timed("readback:pbr"):
-                colour = np.clip(acc / launches, 0.0, 1.0).astype(np.float32)
-                n = view.width * view.height
-                distance = ctx.rc.base.depth_data.numpy()[0, :n].reshape(view.height, view.width)
-                seg = ctx.rc.base.seg_data.numpy()[0, :n].reshape(view.height, view.width, 2)
+                want_ids = "segmentation" in passes or "depth" in passes
+                host = ctx.layout.read(colour=acc is None and bool({"color", "hdr"} & passes),
+                                       depth="depth" in passes, ids=want_ids)
         out = RenderOutputs()
-        geom_ids = np.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1).astype(np.int32)
-        if "color" in passes:
+        if acc is not None:
+            colour = np.clip(acc / launches, 0.0, 1.0).astype(np.float32)
             rgba = np.full((view.height, view.width, 4), 255, dtype=np.uint8)
             rgba[..., :3] = np.rint(colour * 255.0)
+        else:
+            rgba = host.rgba
+        if "color" in passes:
             out.put("color", rgba)
         if "hdr" in passes:
-            out.put("hdr", colour)
+            out.put("hdr", colour if acc is not None else rgba[..., :3].astype(np.float32) / 255.0)
         if "depth" in passes:
-            out.put("depth", pbr_scene.planar_depth(distance, view, hit=seg[..., 0] >= 0))
+            out.put("depth", host.depth)
         if "segmentation" in passes:
-            codes, lut = id_codes(geom_ids, sim.model.ngeom)
+            codes, lut = id_codes(host.geom_ids, sim.model.ngeom)
             out.put("id_codes", codes)
             out.id_lut = lut
-            out.put("geom_ids", geom_ids)
+            out.put("geom_ids", host.geom_ids)
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
         return out
 
     def _upload_state(self, sim: SimScene, view: CameraView, ctx: _Context) -> None:
-        """The simulation's poses and randomized model fields into the renderer (no recompile)."""
-        model, data, m, d = sim.model, sim.data, ctx.model, ctx.data
+        """The simulation's poses and randomized model fields into the renderer (no recompile).
+
+        Poses change every frame and always go up; model fields that randomizers may write (colours,
+        material bindings, sizes, light colours) go up only when they differ from the last upload."""
+        model, data, m, d, rc = sim.model, sim.data, ctx.model, ctx.data, ctx.rc
         d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
         d.geom_xmat.assign(np.asarray(data.geom_xmat, dtype=np.float32).reshape(1, -1, 3, 3))
         if model.nlight:
             d.light_xpos.assign(np.asarray(data.light_xpos, dtype=np.float32)[None])
             d.light_xdir.assign(np.asarray(data.light_xdir, dtype=np.float32)[None])
-        position, xmat = pbr_scene.camera_pose(view)
-        cam_xpos = np.zeros((1, model.ncam, 3), dtype=np.float32)
-        cam_xmat = np.tile(np.eye(3, dtype=np.float32), (1, model.ncam, 1, 1))
-        cam_xpos[0, ctx.camera], cam_xmat[0, ctx.camera] = position, xmat
-        d.cam_xpos.assign(cam_xpos)
-        d.cam_xmat.assign(cam_xmat)
-        # colour / material / light randomizers write these on the CPU model
-        m.geom_rgba.assign(np.asarray(model.geom_rgba, dtype=np.float32)[None])
-        m.geom_matid.assign(np.asarray(model.geom_matid, dtype=np.int32)[None])
-        if model.nmat:
-            m.mat_rgba.assign(np.asarray(model.mat_rgba, dtype=np.float32)[None])
-        if model.nlight:
-            m.light_diffuse.assign(np.asarray(model.light_diffuse, dtype=np.float32)[None])
-        world = pbr_scene.world_arrays(model, self._surfaces(sim), float(settings.get("/graphsdg/render/exposure",
-                                                                                       1.0)))
-        rc = ctx.rc
-        rc.geom_metallic.assign(world.geom_metallic[None])
-        rc.geom_roughness.assign(world.geom_roughness[None])
-        rc.geom_reflectance.assign(world.geom_reflectance[None])
-        if model.nlight:
-            rc.light_intensity.assign(world.light_intensity[None])
+        self._pose_camera(view, ctx)
+        changed = self._upload_changed(ctx, [
+            (m.geom_rgba, "geom_rgba", model.geom_rgba, np.float32),
+            (m.geom_matid, "geom_matid", model.geom_matid, np.int32),
+            (m.geom_size, "geom_size", model.geom_size, np.float32),
+            (m.mat_rgba, "mat_rgba", model.mat_rgba if model.nmat else None, np.float32),
+            (m.light_diffuse, "light_diffuse", model.light_diffuse if model.nlight else None, np.float32)])
+        if changed & {"geom_matid", "light_diffuse"} or "surfaces" not in ctx.uploaded:
+            exposure = float(settings.get("/graphsdg/render/exposure", 1.0))
+            world = pbr_scene.world_arrays(model, self._surfaces(sim), exposure)
+            rc.geom_metallic.assign(world.geom_metallic[None])
+            rc.geom_roughness.assign(world.geom_roughness[None])
+            rc.geom_reflectance.assign(world.geom_reflectance[None])
+            if model.nlight:
+                rc.light_intensity.assign(world.light_intensity[None])
+            ctx.uploaded["surfaces"] = True
+        if model.nmesh and not np.array_equal(sim.mesh_stamps, ctx.mesh_stamps):
+            with profiling.timed("render:pbr_mesh_refit"):
+                moved = self._meshes.changed(ctx.mesh_stamps, sim.mesh_stamps)
+                self._meshes.refit(model, m, rc, moved)
+            ctx.mesh_stamps = sim.mesh_stamps.copy()
         self._mjw.refit_bvh(m, d, rc.base)
+
+    @staticmethod
+    def _upload_changed(ctx: _Context, fields: list) -> set[str]:
+        """Assign each ``(device array, name, host array, dtype)`` whose host array differs from its last upload;
+        returns the names assigned."""
+        changed = set()
+        for device_array, name, host, dtype in fields:
+            if host is None:
+                continue
+            last = ctx.uploaded.get(name)
+            if last is not None and np.array_equal(last, host):
+                continue
+            copy = np.array(host, dtype=dtype)
+            device_array.assign(copy[None])
+            ctx.uploaded[name] = copy
+            changed.add(name)
+        return changed
+
+    def _pose_camera(self, view: CameraView, ctx: _Context) -> None:
+        """Place the PBR camera at the USD camera; new intrinsics (focal length, apertures, clipping) give new
+        rays, copied to the renderer without recompiling."""
+        position, xmat = pbr_scene.camera_pose(view)
+        cam_xpos = np.zeros((1, ctx.model.ncam, 3), dtype=np.float32)
+        cam_xmat = np.tile(np.eye(3, dtype=np.float32), (1, ctx.model.ncam, 1, 1))
+        cam_xpos[0, ctx.camera], cam_xmat[0, ctx.camera] = position, xmat
+        ctx.data.cam_xpos.assign(cam_xpos)
+        ctx.data.cam_xmat.assign(cam_xmat)
+        key = _rays_key(view)
+        if key != ctx.rays_key:
+            self._mjpbr.set_camera_rays(ctx.rc, pbr_scene.camera_rays(view)[None])
+            ctx.layout = self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
+                                                     view.far, self._device)
+            ctx.rays_key = key
 
     def _surfaces(self, sim: SimScene) -> dict[int, pbr_scene.SurfaceFields]:
         compiled = sim.ensure_compiled()
@@ -269,6 +317,11 @@ class PbrRenderer:
         if self._isolated is not None:
             self._isolated.close()
             self._isolated = None
+
+
+def _rays_key(view: CameraView) -> tuple:
+    """What a view's camera rays and depth conversion depend on besides its pose."""
+    return (view.projection, view.width, view.height, view.fx, view.fy, view.cx, view.cy, view.near, view.far)
 
 
 def id_codes(geom_ids: np.ndarray, ngeom: int) -> tuple[np.ndarray, np.ndarray]:

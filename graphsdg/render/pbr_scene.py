@@ -123,11 +123,8 @@ def light_intensities(model: mujoco.MjModel, exposure_setting: float = 1.0) -> n
     other bookkeeping. Dome stand-ins (``#sky``) are 0: the environment map lights instead.
     """
     k = lightmap.REFERENCE_IRRADIANCE / float(exposure_setting)
-    out = np.full(model.nlight, k, dtype=np.float32)
-    for i in range(model.nlight):
-        if model.light(i).name.endswith(SKY_LIGHT_SUFFIX):
-            out[i] = 0.0
-    return out
+    sky = np.array([model.light(i).name.endswith(SKY_LIGHT_SUFFIX) for i in range(model.nlight)], dtype=bool)
+    return np.where(sky, 0.0, k).astype(np.float32)
 
 
 # ---- materials ------------------------------------------------------------------------------------
@@ -271,14 +268,14 @@ def geom_surfaces(model: mujoco.MjModel, by_material: dict[int, SurfaceFields]) 
     colour only) take USD's defaults (dielectric, roughness 0.5, F0 4%). Material randomizers rebind
     ``geom_matid``, so calling this per frame follows them.
     """
-    n = model.ngeom
-    metallic = np.zeros(n, dtype=np.float32)
-    roughness = np.full(n, 0.5, dtype=np.float32)
-    reflectance = np.full(n, 0.5, dtype=np.float32)
-    for g, mat in enumerate(np.asarray(model.geom_matid)):
-        surface = by_material.get(int(mat))
-        if surface is not None:
-            metallic[g], roughness[g], reflectance[g] = surface.metallic, surface.roughness, surface.reflectance
+    # one row per MuJoCo material and a last row of defaults, indexed by geom_matid (-1: the defaults)
+    table = np.tile(np.array([0.0, 0.5, 0.5], dtype=np.float32), (model.nmat + 1, 1))
+    for mat, surface in by_material.items():
+        if 0 <= mat < model.nmat:
+            table[mat] = surface.metallic, surface.roughness, surface.reflectance
+    matid = np.asarray(model.geom_matid)
+    rows = table[np.where((matid >= 0) & (matid < model.nmat), matid, model.nmat)]
+    metallic, roughness, reflectance = (np.ascontiguousarray(rows[:, i]) for i in range(3))
     return GeomSurfaces(metallic, roughness, reflectance)
 
 

@@ -96,6 +96,9 @@ class SimScene:
         # mesh id -> 3x3 map from the compiled vertices to the current ones, for meshes rescaled in
         # place since the compile; renderers draw the copy they uploaded through it (no re-upload)
         self.mesh_maps: dict[int, np.ndarray] = {}
+        # per mesh: the count of vertex changes since the compile (rescales, deformables), so renderers that
+        # keep their own copy (the pbr backend's BVHs) find the meshes to refit with one comparison
+        self.mesh_stamps = np.zeros(0, dtype=np.int64)
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
@@ -138,6 +141,15 @@ class SimScene:
         for mesh_id, linear in zip(mesh_ids.tolist(), linears):
             previous = maps.get(mesh_id)
             maps[mesh_id] = linear if previous is None else linear @ previous
+        self.stamp_meshes(mesh_ids)
+
+    def stamp_meshes(self, mesh_ids) -> None:
+        """Record that meshes ``mesh_ids``' vertices changed (see :attr:`mesh_stamps`)."""
+        nmesh = self.model.nmesh
+        if self.mesh_stamps.shape[0] != nmesh:
+            self.mesh_stamps = np.zeros(nmesh, dtype=np.int64)
+        np.add.at(self.mesh_stamps, np.asarray(list(mesh_ids) if isinstance(mesh_ids, set) else mesh_ids,
+                                               dtype=np.int64), 1)
 
     def recompile(self, keep_state: bool = True) -> CompiledScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
@@ -152,6 +164,7 @@ class SimScene:
         self.labels_version += 1
         self.textures_to_upload.clear()
         self.mesh_maps.clear()
+        self.mesh_stamps = np.zeros(new.model.nmesh, dtype=np.int64)
         self.meshes_to_upload.clear()
         self.follow_deformables()
         self.stats["compiles"] += 1
@@ -500,6 +513,8 @@ class SimScene:
             return
         with self.tracker.muted():
             deformables.follow(c.deformables, c.model, c.data, self.stage, self.meshes_to_upload)
+        if self.meshes_to_upload:
+            self.stamp_meshes(self.meshes_to_upload)
 
     def write_back_rigid_bodies(self) -> None:
         """Author simulated rigid-body poses on the stage (as PhysX does for USD readers)."""

@@ -1,0 +1,102 @@
+"""mujoco-warp-pbr's raw output buffers -> host arrays in the classic layout, converted on the GPU.
+
+The renderer leaves one camera's pixels in three device buffers: colour packed as
+``0xAARRGGBB`` words (8-bit sRGB), the hit distance along each ray, and
+``(object id, object type)`` pairs. Annotators want RGBA bytes, planar depth with
+``inf`` on misses and past the far plane, and int32 geom ids with -1 for background
+(:class:`~graphsdg.render.rasterizer.RenderOutputs`). One kernel converts all three
+where the pixels already are, then each asked-for array comes back in one copy into
+page-locked host memory: about a third of the bytes the renderer's own float
+``get_rgb`` readback moves, and no per-pixel numpy work on the CPU.
+
+Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+GEOM_TYPE = 5          # mujoco.mjtObj.mjOBJ_GEOM, as the renderer writes it into segmentation pairs
+
+
+@wp.kernel(enable_backward=False)
+def _classic_layout(packed: wp.array2d[wp.uint32], distance: wp.array2d[wp.float32], seg: wp.array2d[wp.vec2i],
+                    rgb_adr: int, depth_adr: int, seg_adr: int, cosines: wp.array[wp.float32], near: float,
+                    far: float, rgba: wp.array[wp.uint32], depth: wp.array[wp.float32], ids: wp.array[wp.int32]):
+    p = wp.tid()
+    word = packed[0, rgb_adr + p]
+    # 0xAARRGGBB -> bytes R, G, B, A in memory (little endian 0xAABBGGRR)
+    rgba[p] = (word & wp.uint32(0xFF00FF00)) | ((word >> wp.uint32(16)) & wp.uint32(0xFF)) \
+        | ((word & wp.uint32(0xFF)) << wp.uint32(16))
+    pair = seg[0, seg_adr + p]
+    geom = wp.where(pair[1] == GEOM_TYPE, pair[0], -1)
+    ids[p] = geom
+    z = near + distance[0, depth_adr + p] * cosines[p]
+    if geom < 0 or z > far:
+        z = wp.inf
+    depth[p] = z
+
+
+@dataclass
+class HostFrame:
+    """One render's host arrays (None: not asked for)."""
+
+    rgba: np.ndarray | None       # (H, W, 4) uint8
+    depth: np.ndarray | None      # (H, W) float32 planar z, inf on misses and beyond the far plane
+    geom_ids: np.ndarray | None   # (H, W) int32, -1 background
+
+
+class ClassicLayout:
+    """Device buffers and page-locked host buffers of one camera's outputs at one resolution.
+
+    ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos).
+    """
+
+    def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str) -> None:
+        n = width * height
+        self.shape, self.near, self.far, self.device = (height, width), float(near), float(far), device
+        self.cosines = wp.array(np.ascontiguousarray(cosines, dtype=np.float32).ravel(), dtype=wp.float32,
+                                device=device)
+        self.rgba = wp.empty(n, dtype=wp.uint32, device=device)
+        self.depth = wp.empty(n, dtype=wp.float32, device=device)
+        self.ids = wp.empty(n, dtype=wp.int32, device=device)
+        pinned = wp.get_device(device).is_cuda
+        self.host_rgba = wp.empty(n, dtype=wp.uint32, device="cpu", pinned=pinned)
+        self.host_depth = wp.empty(n, dtype=wp.float32, device="cpu", pinned=pinned)
+        self.host_ids = wp.empty(n, dtype=wp.int32, device="cpu", pinned=pinned)
+        self._adrs: dict[tuple, int] = {}
+
+    def convert(self, base, camera: int) -> None:
+        """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0)."""
+        wp.launch(_classic_layout, dim=self.shape[0] * self.shape[1],
+                  inputs=[base.rgb_data, base.depth_data, base.seg_data, self._adr(base, "rgb", camera),
+                          self._adr(base, "depth", camera), self._adr(base, "seg", camera), self.cosines, self.near,
+                          self.far],
+                  outputs=[self.rgba, self.depth, self.ids], device=self.device)
+
+    def _adr(self, base, kind: str, camera: int) -> int:
+        """The camera's first pixel in one of ``base``'s buffers (read from the device once)."""
+        key = (id(base), kind, camera)
+        if key not in self._adrs:
+            self._adrs[key] = int(getattr(base, f"{kind}_adr").numpy()[camera])
+        return self._adrs[key]
+
+    def read(self, colour: bool, depth: bool, ids: bool) -> HostFrame:
+        """Copy the asked-for arrays to the host (one device copy each, into page-locked memory, then into
+        arrays of their own: annotators and writer threads keep them past the next render)."""
+        h, w = self.shape
+        wanted = [(colour, self.rgba, self.host_rgba), (depth, self.depth, self.host_depth),
+                  (ids, self.ids, self.host_ids)]
+        for want, src, dst in wanted:
+            if want:
+                wp.copy(dst, src)
+        wp.synchronize_device(self.device)
+        own = [np.array(dst.numpy()) if want else None for want, _, dst in wanted]
+        return HostFrame(rgba=None if own[0] is None else own[0].view(np.uint8).reshape(h, w, 4),
+                         depth=None if own[1] is None else own[1].reshape(h, w),
+                         geom_ids=None if own[2] is None else own[2].reshape(h, w))
+
+
+__all__ = ["ClassicLayout", "HostFrame"]
