@@ -183,9 +183,16 @@ def run_folder_command(args: argparse.Namespace, script_args: list[str]) -> int:
 def _hint(exc: BaseException) -> str:
     """The hint line printed under a one-line error."""
     from graphsdg.job import JobMismatchError
-    from graphsdg.scaleout import RayMissingError
+    from graphsdg.io.object_store import ObjectStoreError, S3MissingError
+    from graphsdg.scaleout import RayMissingError, ShardFailedError
     if isinstance(exc, RayMissingError):
         return "install Ray with: pip install 'graphsdg[ray]'"
+    if isinstance(exc, S3MissingError):
+        return "install boto3 with: pip install 'graphsdg[s3]'"
+    if isinstance(exc, ShardFailedError):
+        return "rerun the same command with --resume to capture the missing frames"
+    if isinstance(exc, ObjectStoreError):
+        return "check the bucket, the endpoint (AWS_ENDPOINT_URL_S3) and the credentials; see docs/cli.md"
     if isinstance(exc, JobMismatchError):
         return "resume with the arguments of the first run, or write to a fresh --out"
     if isinstance(exc, (FileNotFoundError, NotADirectoryError)):

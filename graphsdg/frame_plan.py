@@ -112,7 +112,8 @@ def record_writer(writer) -> None:
     if output_dir is None:
         return
     info = writer.shard_info() if hasattr(writer, "shard_info") else {}
-    _records[id(writer)] = WriterRecord(type(writer).__name__, os.path.abspath(output_dir),
+    folder = output_dir if output_dir.startswith("s3://") else os.path.abspath(output_dir)   # or an S3 prefix
+    _records[id(writer)] = WriterRecord(type(writer).__name__, folder,
                                         dict(info.pop("aggregates", {})), info)
 
 

@@ -2,9 +2,9 @@
 
 ``graphsdg run`` builds a :class:`JobSpec`; :func:`run_job` runs it in this
 process (the whole job, or one shard of a sharded job) and returns a summary.
-A job with an output root leaves ``.graphsdg-job.json`` there, so ``--resume``
-can refuse to continue a dataset that another job (other script, seed or frame
-count) wrote.
+A job with an output root (a folder or an ``s3://bucket/prefix``) leaves
+``.graphsdg-job.json`` there, so ``--resume`` can refuse to continue a dataset
+that another job (other script, seed or frame count) wrote.
 """
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, field
 from graphsdg import frame_plan, orchestrator
 from graphsdg.frame_plan import FramePlan
 from graphsdg.io import backends
+from graphsdg.io.location import open_location
 
 JOB_FILE = ".graphsdg-job.json"
 
@@ -38,6 +39,12 @@ class JobSpec:
     resume: bool = False
     resolution_scale: float | None = None
     env: dict = field(default_factory=dict)
+    #: the script's bytes, sent along to shards on nodes that may not see ``script`` (no shared filesystem)
+    script_source: bytes | None = None
+
+    def describe(self) -> dict:
+        """The job for summaries and ``graphsdg_index.json`` (no environment, no script bytes)."""
+        return {k: v for k, v in asdict(self).items() if k not in ("env", "script_source")}
 
     def fingerprint(self) -> dict:
         """What must match for a resume: the script's bytes, its arguments, seed and frame count."""
@@ -52,18 +59,16 @@ def check_job_file(job: JobSpec) -> None:
     """Write ``.graphsdg-job.json`` under ``job.out``; on resume first check it describes the same job."""
     if job.out is None:
         return
-    path = os.path.join(job.out, JOB_FILE)
+    root = open_location(job.out)       # an s3:// root: the bucket and credentials are checked here
     mine = job.fingerprint()
-    if job.resume and os.path.exists(path):
-        with open(path, encoding="utf-8") as f:
-            theirs = json.load(f)
+    if job.resume and root.exists(JOB_FILE):
+        theirs = json.loads(root.read(JOB_FILE))
         diff = {k: (theirs.get(k), v) for k, v in mine.items() if k != "script" and theirs.get(k) != v}
         if diff:
             detail = ", ".join(f"{k}: {a!r} on disk, {b!r} now" for k, (a, b) in diff.items())
             raise JobMismatchError(f"--resume: {job.out} was written by a different job ({detail}); "
                                    f"rerun with the same script, arguments, --seed and --frames, or drop --resume")
-    os.makedirs(job.out, exist_ok=True)
-    backends.write_file_atomic(path, json.dumps(mine, indent=2).encode())
+    root.write(JOB_FILE, json.dumps(mine, indent=2).encode(), count=False)
 
 
 def run_job(job: JobSpec, plan: FramePlan | None = None) -> dict:
@@ -87,7 +92,7 @@ def run_job(job: JobSpec, plan: FramePlan | None = None) -> dict:
     return {"shard": plan.shard_index, "frames": frames, "files": backends.files_written() - files0,
             "bytes": backends.bytes_written() - bytes0, "seconds": round(seconds, 3),
             "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0,
-            "writers": frame_plan.records(), "job": asdict(job)}
+            "writers": frame_plan.records(), "job": job.describe()}
 
 
 def format_summary(summary: dict) -> str:

@@ -523,11 +523,11 @@ def _planned_frames(sched, progress: Progress) -> None:
     frames = [f for f in range(total) if plan.owns(f)]
     if plan.resume:
         if not plan.sharded:   # shards share folders: the merge step removes their leftovers
-            from graphsdg.io.backends import remove_temporaries
+            from graphsdg.io.location import open_location
             get_write_queue().wait_until_done()   # writes already scheduled (a writer's first json) land first
             for writer in writers:
-                if getattr(writer.backend, "output_dir", None):
-                    remove_temporaries(writer.backend.output_dir)
+                if getattr(writer.backend, "output_dir", None):    # temporary files, unfinished uploads
+                    open_location(writer.backend.output_dir).remove_leftovers()
         frames = [f for f in frames
                   if not all(w.frame_complete(_state.frame_bases[id(w)] + f) for w in writers)]
         log.info("resume: %d of %d frames to capture", len(frames), total)

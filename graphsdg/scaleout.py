@@ -9,9 +9,13 @@ union of the shards is that run's dataset). Actors ask for one CPU and
 GPU Ray assigned. The driver then merges the shards (:mod:`graphsdg.dataset.merge`)
 and writes ``graphsdg_index.json``.
 
-With ``address`` the driver joins that Ray cluster (every node needs graphsdg and
-the output folder on a shared filesystem at the same path); otherwise it starts
-a local one for the job and shuts it down afterwards.
+With ``address`` the driver joins that Ray cluster; otherwise it starts a local
+one for the job and shuts it down afterwards. Every node needs graphsdg, and
+either the output folder on a shared filesystem at the same path or an
+``s3://bucket/prefix`` output root: then shards write objects, and the merge
+step and ``graphsdg_index.json`` work in the bucket, so the nodes share no disk.
+Shards are spread over the nodes (Ray's ``SPREAD`` strategy); each reports the
+node it ran on.
 
 Ray is optional: ``pip install 'graphsdg[ray]'``.
 """
@@ -19,20 +23,31 @@ from __future__ import annotations
 
 import logging
 import os
+import tempfile
 import time
 from dataclasses import replace
 
 from graphsdg.cpu_share import cores_per_process
+from graphsdg.io import object_store
+from graphsdg.io.location import normalize
 from graphsdg.io.write_queue import threads_per_process
 from graphsdg.job import JobSpec, run_job
 
 log = logging.getLogger("graphsdg.scaleout")
 RAY_HINT = "pip install 'graphsdg[ray]'"
-SHARD_COLUMNS = ("shard", "frames", "seconds", "pid", "gpu_ids", "egl_device", "write_threads", "image_threads")   # per-shard summary
+SHARD_COLUMNS = ("shard", "frames", "seconds", "node", "pid", "gpu_ids", "egl_device", "write_threads",
+                 "image_threads")   # per-shard summary
+# what the shards need from the driver's environment: rendering, reproducible dates, and where S3 is (the
+# endpoint and region; credentials come from each node's own AWS chain, never through Ray)
+FORWARDED_ENV = ("MUJOCO_GL", "PYOPENGL_PLATFORM", "SOURCE_DATE_EPOCH") + object_store.ENVIRONMENT
 
 
 class RayMissingError(ImportError):
     """``--workers`` without Ray installed."""
+
+
+class ShardFailedError(RuntimeError):
+    """A shard of a sharded run failed or its node died; what it wrote is kept for ``--resume``."""
 
 
 def import_ray():
@@ -67,10 +82,29 @@ class ShardWorker:
             settings.set(THREADS_KEY, write_threads)
         if image_threads is not None:
             limit_image_threads(image_threads)
-        summary = run_job(job, FramePlan(index, count, job.resume))
-        summary.update(pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
+        summary = run_job(script_here(job), FramePlan(index, count, job.resume))
+        import ray
+        summary.update(node=ray.get_runtime_context().get_node_id(), pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
                        write_threads=get_write_queue().num_threads, image_threads=image_threads)
         return summary
+
+
+def script_here(job: JobSpec) -> JobSpec:
+    """``job`` with a script path readable on this node: the driver's path where it holds the same bytes (a
+    shared filesystem), else a copy written from the bytes the driver sent (nodes that share no disk)."""
+    if job.script_source is None:
+        return job
+    try:
+        with open(job.script, "rb") as f:
+            if f.read() == job.script_source:
+                return job
+    except OSError:
+        pass
+    folder = tempfile.mkdtemp(prefix="graphsdg-job-")
+    path = os.path.join(folder, os.path.basename(job.script))
+    with open(path, "wb") as f:
+        f.write(job.script_source)
+    return replace(job, script=path)
 
 
 def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per_worker: float | None = None,
@@ -82,7 +116,7 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         raise ValueError(f"--workers must be a positive integer, got {workers!r}")
     if job.out is None:
         raise ValueError("--workers needs --out DIR: the shards write into one output root (on a shared "
-                         "filesystem when the cluster has several machines)")
+                         "filesystem, or an s3://bucket/prefix, when the cluster has several machines)")
     ray = import_ray()
     start = time.perf_counter()
     started_here = not ray.is_initialized()
@@ -97,9 +131,12 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         per_worker = gpus_per_worker if gpus_per_worker is not None else (min(1.0, gpus / workers) if gpus else 0)
         if per_worker > gpus:
             raise ValueError(f"--gpus-per-worker {per_worker} but the cluster has {gpus:g} GPU(s)")
-        env = {k: v for k, v in os.environ.items() if k in ("MUJOCO_GL", "PYOPENGL_PLATFORM", "SOURCE_DATE_EPOCH")}
-        job = replace(job, out=os.path.abspath(job.out), script=os.path.abspath(job.script), env=env)
-        actor = ray.remote(num_cpus=1, num_gpus=per_worker)(ShardWorker)
+        env = {k: v for k, v in os.environ.items() if k in FORWARDED_ENV}
+        with open(job.script, "rb") as f:
+            source = f.read()
+        job = replace(job, out=normalize(job.out), script=os.path.abspath(job.script), env=env, script_source=source)
+        # one shard per node first: on a cluster each node's cores and GPUs are used
+        actor = ray.remote(num_cpus=1, num_gpus=per_worker, scheduling_strategy="SPREAD")(ShardWorker)
         actors = [actor.remote() for _ in range(workers)]
         # shards of a local cluster share this machine's cores: a writer pool each of their share of them
         threads = None if address else threads_per_process(workers, num_cpus or os.cpu_count())
@@ -114,8 +151,10 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
                     result = ray.get(done[0])
                 except Exception as exc:   # noqa: BLE001 - one line naming the shard, the cause kept
                     cause = getattr(exc, "cause", None) or exc
-                    raise RuntimeError(f"shard {index} of {workers} failed: {type(cause).__name__}: {cause}") \
-                        from exc
+                    first = (str(cause).strip().splitlines() or [""])[0]
+                    raise ShardFailedError(f"shard {index} of {workers} failed: {type(cause).__name__}: {first}; "
+                                           f"the frames written so far are kept in {job.out}: rerun with --resume "
+                                           f"to capture the rest") from exc
                 log.info("shard %d: %d frames in %.1f s", index, result["frames"], result["seconds"])
                 results.append(result)
         finally:
@@ -133,7 +172,7 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
                "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0, "workers": workers,
                "gpus_per_worker": per_worker,
                "shards": [{k: r[k] for k in SHARD_COLUMNS} for r in results]}
-    job_info = {k: v for k, v in results[0]["job"].items() if k != "env"} if results else {}
+    job_info = job.describe()
     summary["index"] = merge.write_index(job.out, {**job_info, "workers": workers, "shards": summary["shards"]},
                                          datasets)
     return summary

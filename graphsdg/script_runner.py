@@ -17,6 +17,7 @@ import sys
 from typing import Iterator, Sequence
 
 from graphsdg import orchestrator, rng, settings
+from graphsdg.io.location import normalize
 
 # the orchestrator's entry points that capture frames (build_script turns them into a stop)
 CAPTURE_CALLS = ("step", "step_async", "run", "run_async", "run_until_complete", "run_until_complete_async",
@@ -41,8 +42,8 @@ def _configure(path: str, compat: str | None, seed: int | None, out_dir: str | N
     if seed is not None:
         rng.set_global_seed(seed)
     if out_dir is not None:
-        # relative writer output dirs (graphsdg's default) resolve under this root
-        settings.set("/omni/replicator/backends/disk/root_dir", os.path.abspath(out_dir))
+        # relative writer output dirs (graphsdg's default) resolve under this root: a folder or an s3:// prefix
+        settings.set("/omni/replicator/backends/disk/root_dir", normalize(out_dir))
     if frames is not None:
         settings.set("/graphsdg/run/numFrames", int(frames))
     if resolution_scale is not None:

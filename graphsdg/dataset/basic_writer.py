@@ -2,7 +2,7 @@
 
 Replicator's BasicWriter names every file ``<stem>_<frame>.<ext>`` (with ``_labels``,
 ``_prim_paths``, ``_mapping`` ... companions). :class:`BasicWriterDataset`
-finds the frames and loads what each holds.
+finds the frames and loads what each holds, from a folder or an ``s3://bucket/prefix``.
 
 Example:
     >>> ds = BasicWriterDataset("_out_demo")          # doctest: +SKIP
@@ -11,14 +11,17 @@ Example:
 """
 from __future__ import annotations
 
+import io
 import json
-import os
+import posixpath
 import re
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 from PIL import Image
+
+from graphsdg.io.location import Location, open_location
 
 # file stem -> the companion files BasicWriter writes with it
 COMPANIONS = {
@@ -52,41 +55,45 @@ def _color_key(key: str) -> tuple[int, ...] | None:
 
 @dataclass
 class Frame:
-    """The files of one frame in one BasicWriter folder."""
+    """The files of one frame in one BasicWriter folder (``folder``: ``/``-separated, relative to the dataset)."""
 
+    location: Location
     folder: str
     frame_id: str
     files: dict[str, str] = field(default_factory=dict)   # stem -> main file name
 
     def path(self, name: str) -> str:
-        return os.path.join(self.folder, name)
+        """``name`` relative to the dataset."""
+        return posixpath.join(self.folder, name) if self.folder else name
+
+    def read(self, name: str) -> bytes:
+        return self.location.read(self.path(name))
+
+    def _json(self, name: str):
+        return json.loads(self.read(name))
 
     def companion(self, stem: str, suffix: str) -> str:
-        return self.path(f"{stem}{suffix}_{self.frame_id}.json")
+        return f"{stem}{suffix}_{self.frame_id}.json"
 
     def expected_files(self) -> list[str]:
         out = []
         for stem, name in self.files.items():
             out.append(name)
-            out += [os.path.basename(self.companion(stem, s)) for s in COMPANIONS.get(stem, ())]
+            out += [self.companion(stem, s) for s in COMPANIONS.get(stem, ())]
         return out
 
     @cached_property
     def rgb(self) -> np.ndarray | None:
         name = self.files.get("rgb")
-        return np.array(Image.open(self.path(name)).convert("RGB")) if name else None
+        return np.array(Image.open(io.BytesIO(self.read(name))).convert("RGB")) if name else None
 
     def boxes(self, kind: str = "bounding_box_2d_tight") -> tuple[np.ndarray, dict, list[str]] | None:
         """(rows, idToLabels, primPaths) of a box annotator, or None if not written."""
         name = self.files.get(kind)
         if not name:
             return None
-        rows = np.load(self.path(name))
-        with open(self.companion(kind, "_labels")) as f:
-            labels = json.load(f)
-        with open(self.companion(kind, "_prim_paths")) as f:
-            paths = json.load(f)
-        return rows, labels, paths
+        rows = np.load(io.BytesIO(self.read(name)))
+        return rows, self._json(self.companion(kind, "_labels")), self._json(self.companion(kind, "_prim_paths"))
 
     def segmentation(self, kind: str) -> tuple[np.ndarray, dict] | None:
         """(ids (H, W) int64, id -> value mapping) for semantic/instance segmentation, colorized or not."""
@@ -94,9 +101,8 @@ class Frame:
         if not name:
             return None
         suffix = "_labels" if kind == "semantic_segmentation" else "_mapping"
-        with open(self.companion(kind, suffix)) as f:
-            mapping = json.load(f)
-        img = np.array(Image.open(self.path(name)))
+        mapping = self._json(self.companion(kind, suffix))
+        img = np.array(Image.open(io.BytesIO(self.read(name))))
         if img.ndim == 3:   # colorized: pixel colours index the mapping's "(r, g, b, a)" keys
             keys = [k for k in mapping if _color_key(k) is not None]
             ids = np.full(img.shape[:2], -1, dtype=np.int64)
@@ -108,29 +114,38 @@ class Frame:
 
     def depth(self, kind: str = "distance_to_image_plane") -> np.ndarray | None:
         name = self.files.get(kind)
-        return np.load(self.path(name)) if name else None
+        return np.load(io.BytesIO(self.read(name))) if name else None
 
 
 class BasicWriterDataset:
-    """All frames of a BasicWriter output directory (and of its per-render-product folders)."""
+    """All frames of a BasicWriter output directory (and of its per-render-product folders).
 
-    def __init__(self, root: str) -> None:
-        if not os.path.isdir(root):
-            raise NotADirectoryError(f"dataset directory {root!r} does not exist")
-        self.root = os.path.abspath(root)
+    ``root``: a folder or an ``s3://bucket/prefix`` (:mod:`graphsdg.io.location`); it is listed once.
+    """
+
+    def __init__(self, root: str | Location) -> None:
+        self.location = open_location(root)
+        if not self.location.is_folder():
+            raise NotADirectoryError(f"dataset directory {self.location.url!r} does not exist")
+        self.root = self.location.url
         self.frames: dict[tuple[str, str], Frame] = {}
-        self.stray: list[str] = []
-        for folder, _, names in os.walk(self.root):
-            for name in sorted(names):
-                if name.endswith(".tmp") or name.startswith("."):
-                    self.stray.append(os.path.join(folder, name))
-                    continue
-                parsed = _parse(name)
-                if parsed is None:
-                    continue
-                stem, frame_id, _ = parsed
-                key = (folder, frame_id)
-                self.frames.setdefault(key, Frame(folder, frame_id)).files[stem] = name
+        self.stray: list[str] = []                 # relative paths of temporary and hidden files
+        self.listing = self.location.files()       # relative path -> size
+        for rel in self.listing:
+            folder, name = posixpath.split(rel)
+            if name.endswith(".tmp") or name.startswith("."):
+                self.stray.append(rel)
+                continue
+            parsed = _parse(name)
+            if parsed is None:
+                continue
+            stem, frame_id, _ = parsed
+            key = (folder, frame_id)
+            self.frames.setdefault(key, Frame(self.location, folder, frame_id)).files[stem] = name
+
+    def exists(self, rel: str) -> bool:
+        """Whether the dataset holds file ``rel`` (from the listing)."""
+        return rel in self.listing
 
     @property
     def frame_ids(self) -> list[tuple[str, str]]:

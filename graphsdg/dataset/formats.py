@@ -5,7 +5,8 @@
 ``images/`` and ``labels/``; otherwise BasicWriter's ``rgb_<n>.png``);
 :func:`read_dataset` returns every frame as a :class:`ViewFrame`: its image, its
 boxes (inclusive pixel bounds and class name) and, where the format has them,
-per-pixel masks.
+per-pixel masks. A dataset is a folder or an ``s3://bucket/prefix``
+(:mod:`graphsdg.io.location`), listed once.
 
 Example:
     >>> import tempfile
@@ -14,15 +15,19 @@ Example:
 """
 from __future__ import annotations
 
-import glob
+import fnmatch
+import io
 import json
 import os
+import posixpath
 from dataclasses import dataclass, field
 from typing import Callable
 
 import cv2
 import numpy as np
 from PIL import Image
+
+from graphsdg.io.location import Location, open_location
 
 FORMATS = ("basic", "coco", "kitti", "yolo")
 KITTI_LABEL_DIRS = ("label_02", "object_detection")
@@ -47,38 +52,75 @@ class ViewBox:
 
 @dataclass
 class ViewFrame:
-    """One image of a dataset with what is drawn over it."""
+    """One image of a dataset with what is drawn over it (``image``: its path relative to ``location``)."""
 
     name: str
-    image_path: str
+    location: Location
+    image: str
     boxes: list[ViewBox] = field(default_factory=list)
     # () -> (H, W) int array (0 = nothing) and {value: class name}; None if the format has no masks
     masks: Callable[[], tuple[np.ndarray, dict[int, str]] | None] = lambda: None
 
+    @property
+    def image_path(self) -> str:
+        """The image as a path or ``s3://`` URL."""
+        return self.location.path_of(self.image)
+
     def rgb(self) -> np.ndarray:
-        return np.array(Image.open(self.image_path).convert("RGB"))
+        return np.array(Image.open(io.BytesIO(self.location.read(self.image))).convert("RGB"))
 
 
-def detect_format(root: str) -> str:
-    """``"coco"``, ``"kitti"``, ``"yolo"`` or ``"basic"`` for the dataset folder ``root``."""
-    if not os.path.isdir(root):
-        raise NotADirectoryError(f"dataset directory {root!r} does not exist")
-    if glob.glob(os.path.join(root, "coco_annotations*.json")):
+def _names(listing: dict[str, int], folder: str) -> list[str]:
+    """The file names directly in ``folder`` (relative, ``/``-separated; ``""`` for the root), sorted."""
+    return sorted(posixpath.basename(rel) for rel in listing if posixpath.dirname(rel) == folder)
+
+
+def _folders(listing: dict[str, int]) -> list[str]:
+    """Every folder that holds a file (relative; ``""`` for the root), sorted."""
+    return sorted({posixpath.dirname(rel) for rel in listing})
+
+
+def _kitti_label_folders(listing: dict[str, int]) -> list[tuple[str, str]]:
+    """``(parent, label dir)`` of every KITTI label folder holding ``.txt`` files."""
+    out = []
+    for folder in _folders(listing):
+        parent, name = posixpath.split(folder)
+        if name in KITTI_LABEL_DIRS and any(n.endswith(".txt") for n in _names(listing, folder)):
+            out.append((parent, name))
+    return out
+
+
+def detect_format(root: str | Location) -> str:
+    """``"coco"``, ``"kitti"``, ``"yolo"`` or ``"basic"`` for the dataset at ``root`` (a folder or an
+    ``s3://bucket/prefix``)."""
+    location = open_location(root)
+    listing = location.files()
+    if not listing and not location.is_folder():
+        raise NotADirectoryError(f"dataset directory {location.url!r} does not exist")
+    return _detect(listing)
+
+
+def _detect(listing: dict[str, int]) -> str:
+    top = _names(listing, "")
+    if any(fnmatch.fnmatch(n, "coco_annotations*.json") for n in top):
         return "coco"
-    if os.path.exists(os.path.join(root, "data.yaml")) and os.path.isdir(os.path.join(root, "labels")):
+    if "data.yaml" in top and any(rel.startswith("labels/") for rel in listing):
         return "yolo"
-    for folder, dirs, _ in os.walk(root):
-        if any(d in KITTI_LABEL_DIRS and glob.glob(os.path.join(folder, d, "*.txt")) for d in dirs):
-            return "kitti"
+    if _kitti_label_folders(listing):
+        return "kitti"
     return "basic"
 
 
-def read_dataset(root: str, fmt: str | None = None) -> tuple[str, list[ViewFrame]]:
-    """The format and every frame of the dataset at ``root`` (sorted by name)."""
-    fmt = fmt or detect_format(root)
+def read_dataset(root: str | Location, fmt: str | None = None) -> tuple[str, list[ViewFrame]]:
+    """The format and every frame of the dataset at ``root`` (a folder or an ``s3://`` prefix), sorted by name."""
+    location = open_location(root)
+    listing = location.files()
+    if not listing and not location.is_folder():
+        raise NotADirectoryError(f"dataset directory {location.url!r} does not exist")
+    fmt = fmt or _detect(listing)
     if fmt not in FORMATS:
         raise ValueError(f"unknown dataset format {fmt!r}; known: {FORMATS}")
-    frames = {"basic": _basic, "coco": _coco, "kitti": _kitti, "yolo": _yolo}[fmt](os.path.abspath(root))
+    frames = {"basic": _basic, "coco": _coco, "kitti": _kitti, "yolo": _yolo}[fmt](location, listing)
     return fmt, sorted(frames, key=lambda f: f.name)
 
 
@@ -89,9 +131,9 @@ def _label_text(labels) -> str:
     return str(labels)
 
 
-def _basic(root: str) -> list[ViewFrame]:
+def _basic(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
     from graphsdg.dataset.basic_writer import BasicWriterDataset
-    ds = BasicWriterDataset(root)
+    ds = BasicWriterDataset(location)
     out = []
     for key in ds.frame_ids:
         f = ds.frame(key)
@@ -113,9 +155,8 @@ def _basic(root: str) -> list[ViewFrame]:
                      if _label_text(v) not in ("BACKGROUND", "UNLABELLED")}
             shifted = np.where(np.isin(ids, [k - 1 for k in names]), ids + 1, 0)
             return shifted, names
-        rel = os.path.relpath(f.folder, root)
-        out.append(ViewFrame(f.frame_id if rel == "." else f"{rel}/{f.frame_id}", f.path(f.files["rgb"]), boxes,
-                             masks))
+        out.append(ViewFrame(f"{f.folder}/{f.frame_id}" if f.folder else f.frame_id, location,
+                             f.path(f.files["rgb"]), boxes, masks))
     return out
 
 
@@ -137,11 +178,10 @@ def _coco_mask(segmentation, height: int, width: int) -> np.ndarray:
     return mask.astype(bool)
 
 
-def _coco(root: str) -> list[ViewFrame]:
+def _coco(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
     out = []
-    for path in sorted(glob.glob(os.path.join(root, "coco_annotations*.json"))):
-        with open(path, encoding="utf-8") as f:
-            doc = json.load(f)
+    for name in (n for n in _names(listing, "") if fnmatch.fnmatch(n, "coco_annotations*.json")):
+        doc = json.loads(location.read(name))
         names = {int(c["id"]): str(c["name"]) for c in doc.get("categories", [])}
         per_image: dict[int, list[dict]] = {}
         for a in doc.get("annotations", []):
@@ -161,45 +201,45 @@ def _coco(root: str) -> list[ViewFrame]:
                     if a.get("segmentation"):
                         ids[_coco_mask(a["segmentation"], h, w)] = int(a["category_id"])
                 return ids, names
-            out.append(ViewFrame(os.path.splitext(image["file_name"])[0], os.path.join(root, image["file_name"]),
-                                 boxes, masks))
+            rel = image["file_name"].replace(os.sep, "/")
+            out.append(ViewFrame(posixpath.splitext(rel)[0], location, rel, boxes, masks))
     return out
 
 
 # ---- KITTI ------------------------------------------------------------------------
-def _kitti(root: str) -> list[ViewFrame]:
+def _kitti(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
     out = []
-    for folder, dirs, _ in sorted(os.walk(root)):
-        for label_dir in (d for d in dirs if d in KITTI_LABEL_DIRS):
-            for label_path in sorted(glob.glob(os.path.join(folder, label_dir, "*.txt"))):
-                stem = os.path.splitext(os.path.basename(label_path))[0]
-                image = glob.glob(os.path.join(folder, KITTI_IMAGE_DIRS[label_dir], f"{stem}.*"))
-                if not image:
-                    continue
-                boxes = []
-                with open(label_path, encoding="utf-8") as f:
-                    for line in f:
-                        fields = line.split()
-                        if len(fields) >= 8:
-                            x0, y0, x1, y1 = (int(round(float(v))) for v in fields[4:8])
-                            boxes.append(ViewBox(fields[0], x0, y0, x1, y1))
-                instance = os.path.join(folder, KITTI_INSTANCE_DIRS[label_dir], f"{stem}.png")
+    for parent, label_dir in _kitti_label_folders(listing):
+        labels = posixpath.join(parent, label_dir) if parent else label_dir
+        images = posixpath.join(parent, KITTI_IMAGE_DIRS[label_dir]) if parent else KITTI_IMAGE_DIRS[label_dir]
+        image_names = _names(listing, images)
+        for label_name in (n for n in _names(listing, labels) if n.endswith(".txt")):
+            stem = posixpath.splitext(label_name)[0]
+            image = [n for n in image_names if posixpath.splitext(n)[0] == stem]
+            if not image:
+                continue
+            boxes = []
+            for line in location.read(f"{labels}/{label_name}").decode("utf-8").splitlines():
+                fields = line.split()
+                if len(fields) >= 8:
+                    x0, y0, x1, y1 = (int(round(float(v))) for v in fields[4:8])
+                    boxes.append(ViewBox(fields[0], x0, y0, x1, y1))
+            instance_dir = KITTI_INSTANCE_DIRS[label_dir]
+            instance = posixpath.join(parent, instance_dir, f"{stem}.png") if parent else f"{instance_dir}/{stem}.png"
 
-                def masks(instance=instance):
-                    if not os.path.exists(instance):
-                        return None
-                    ids = np.array(Image.open(instance)).astype(np.int64)   # class index * 256 + instance
-                    return ids, {int(v): f"class {int(v) // 256}" for v in np.unique(ids) if v}
-                rel = os.path.relpath(folder, root)
-                out.append(ViewFrame(stem if rel == "." else f"{rel}/{stem}", image[0], boxes, masks))
+            def masks(instance=instance):
+                if instance not in listing:
+                    return None
+                ids = np.array(Image.open(io.BytesIO(location.read(instance)))).astype(np.int64)   # class * 256 + n
+                return ids, {int(v): f"class {int(v) // 256}" for v in np.unique(ids) if v}
+            out.append(ViewFrame(f"{parent}/{stem}" if parent else stem, location, f"{images}/{image[0]}", boxes,
+                                 masks))
     return out
 
 
 # ---- YOLO --------------------------------------------------------------------------
-def yolo_names(path: str) -> dict[int, str]:
-    """Class names of an Ultralytics ``data.yaml`` (``names:`` as a mapping or a list)."""
-    with open(path, encoding="utf-8") as f:
-        text = f.read()
+def yolo_names(text: str) -> dict[int, str]:
+    """Class names of an Ultralytics ``data.yaml``'s text (``names:`` as a mapping or a list)."""
     try:
         import yaml
         names = (yaml.safe_load(text) or {}).get("names", {})
@@ -223,26 +263,25 @@ def yolo_names(path: str) -> dict[int, str]:
     return {int(k): str(v) for k, v in names.items()}
 
 
-def _yolo(root: str) -> list[ViewFrame]:
-    names = yolo_names(os.path.join(root, "data.yaml"))
+def _yolo(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
+    names = yolo_names(location.read("data.yaml").decode("utf-8"))
     out = []
-    for image_path in sorted(glob.glob(os.path.join(root, "images", "*", "*"))):
-        split = os.path.basename(os.path.dirname(image_path))
-        stem = os.path.splitext(os.path.basename(image_path))[0]
-        label_path = os.path.join(root, "labels", split, f"{stem}.txt")
-        with Image.open(image_path) as im:
+    for image in sorted(rel for rel in listing if rel.startswith("images/") and rel.count("/") == 2):
+        _, split, file_name = image.split("/")
+        stem = posixpath.splitext(file_name)[0]
+        label = f"labels/{split}/{stem}.txt"
+        with Image.open(io.BytesIO(location.read(image))) as im:
             width, height = im.size
         boxes = []
-        if os.path.exists(label_path):
-            with open(label_path, encoding="utf-8") as f:
-                for line in f:
-                    fields = line.split()
-                    if len(fields) < 5:
-                        continue
-                    cls = int(fields[0])
-                    cx, cy, w, h = (float(v) for v in fields[1:5])
-                    x0, y0 = round((cx - w / 2) * width), round((cy - h / 2) * height)
-                    boxes.append(ViewBox(names.get(cls, str(cls)), x0, y0, x0 + round(w * width) - 1,
-                                         y0 + round(h * height) - 1))
-        out.append(ViewFrame(f"{split}/{stem}", image_path, boxes))
+        if label in listing:
+            for line in location.read(label).decode("utf-8").splitlines():
+                fields = line.split()
+                if len(fields) < 5:
+                    continue
+                cls = int(fields[0])
+                cx, cy, w, h = (float(v) for v in fields[1:5])
+                x0, y0 = round((cx - w / 2) * width), round((cy - h / 2) * height)
+                boxes.append(ViewBox(names.get(cls, str(cls)), x0, y0, x0 + round(w * width) - 1,
+                                     y0 + round(h * height) - 1))
+        out.append(ViewFrame(f"{split}/{stem}", location, image, boxes))
     return out

@@ -11,7 +11,9 @@ on its own is the writers' dataset-wide files, under
   them), with the panoptic images of a shard recoloured where its numbering differed.
 * every other file a shard kept is moved into place (identical copies collapse).
 
-Finally the shard folders are removed and ``graphsdg_index.json`` is written at the job's root.
+Finally the shard folders are removed and ``graphsdg_index.json`` is written at the job's root. Output
+folders and the root are local folders or ``s3://`` prefixes alike (:mod:`graphsdg.io.location`): a
+sharded run on nodes that share no filesystem merges in the bucket.
 
 Example:
     >>> doc, remaps = merge_coco_documents(
@@ -26,9 +28,10 @@ Example:
 """
 from __future__ import annotations
 
+import io
 import json
 import os
-import shutil
+import posixpath
 from typing import Any
 
 import numpy as np
@@ -37,7 +40,7 @@ from PIL import Image
 from graphsdg.annotate.ids import color_of
 from graphsdg.frame_plan import SHARD_FOLDER
 from graphsdg.io import encode
-from graphsdg.io.backends import remove_temporaries, write_file_atomic
+from graphsdg.io.location import Location, open_location
 from graphsdg.io.writers.coco import renumber_annotations
 
 INDEX_FILE = "graphsdg_index.json"
@@ -92,31 +95,26 @@ def merge_coco_documents(docs: list[dict], auto_categories: bool) -> tuple[dict,
     return merged, remaps
 
 
-def _recolour_panoptic(path: str, remap: dict[int, int]) -> None:
+def _recolour_panoptic(folder: Location, rel: str, remap: dict[int, int]) -> None:
     """Rewrite a panoptic PNG whose category colours follow a shard's numbering."""
-    if not path.endswith(".png"):
-        raise MergeError(f"cannot recolour {path}: shards numbered COCO categories differently and the panoptic "
-                         f"image is not lossless; pass coco_categories to CocoWriter")
-    image = np.array(Image.open(path).convert("RGB"))
+    if not rel.endswith(".png"):
+        raise MergeError(f"cannot recolour {folder.path_of(rel)}: shards numbered COCO categories differently and "
+                         f"the panoptic image is not lossless; pass coco_categories to CocoWriter")
+    image = np.array(Image.open(io.BytesIO(folder.read(rel))).convert("RGB"))
     out = np.zeros_like(image)
     for old, new in remap.items():
         out[np.all(image == color_of(old + 2)[:3], axis=-1)] = color_of(new + 2)[:3]
-    write_file_atomic(path, encode.encode_image(out, ".png"))
+    folder.write(rel, encode.encode_image(out, ".png"))
 
 
-def _merge_coco(output_dir: str, records: list[dict]) -> list[str]:
+def _merge_coco(folder: Location, records: list[dict]) -> list[str]:
     final = next(iter(records[0]["aggregates"]))
-    docs, shard_paths = [], []
+    docs = []
     for rec in records:
-        path = os.path.join(output_dir, rec["aggregates"][final])
-        if os.path.exists(path):
-            with open(path, encoding="utf-8") as f:
-                docs.append(json.load(f))
-            shard_paths.append(path)
-    existing = os.path.join(output_dir, final)
-    if os.path.exists(existing):   # a resumed sharded run: frames merged before stay
-        with open(existing, encoding="utf-8") as f:
-            docs.insert(0, json.load(f))
+        if folder.exists(rec["aggregates"][final]):
+            docs.append(json.loads(folder.read(rec["aggregates"][final])))
+    if folder.exists(final):   # a resumed sharded run: frames merged before stay
+        docs.insert(0, json.loads(folder.read(final)))
     merged, remaps = merge_coco_documents(docs, bool(records[0]["info"].get("auto_categories")))
     if records[0]["info"].get("panoptic"):
         owner = {}
@@ -126,36 +124,35 @@ def _merge_coco(output_dir: str, records: list[dict]) -> list[str]:
         for image in merged["images"]:
             remap = remaps[owner[int(image["id"])]]
             if any(k != v for k, v in remap.items()):
-                folder, name = os.path.split(image["file_name"])
-                _recolour_panoptic(os.path.join(output_dir, folder, "panoptic_" + name[len("rgb_"):]), remap)
-    write_file_atomic(existing, encode.encode_json(merged, indent=2))
+                path, name = posixpath.split(image["file_name"].replace(os.sep, "/"))
+                _recolour_panoptic(folder, posixpath.join(path, "panoptic_" + name[len("rgb_"):]), remap)
+    folder.write(final, encode.encode_json(merged, indent=2))
     return [final]
 
 
 MERGERS = {"CocoWriter": _merge_coco}
 
 
-def _move_rest(output_dir: str) -> None:
+def _move_rest(folder: Location) -> None:
     """Move every file left in the shard folders into place; identical copies collapse."""
-    shards = os.path.join(output_dir, SHARD_FOLDER)
-    for shard in sorted(os.listdir(shards)) if os.path.isdir(shards) else []:
-        root = os.path.join(shards, shard)
-        for folder, _, files in os.walk(root):
-            for name in files:
-                src = os.path.join(folder, name)
-                dst = os.path.join(output_dir, os.path.relpath(src, root))
-                if os.path.exists(dst):
-                    with open(src, "rb") as a, open(dst, "rb") as b:
-                        if a.read() != b.read():
-                            raise MergeError(f"shards wrote different {os.path.relpath(dst, output_dir)}")
-                    continue
-                os.makedirs(os.path.dirname(dst), exist_ok=True)
-                os.replace(src, dst)
-    shutil.rmtree(shards, ignore_errors=True)
+    for rel in folder.files(SHARD_FOLDER):
+        # <SHARD_FOLDER>/shard-<i>/<path> -> <path>
+        dst = rel.split("/", 2)[2] if rel.count("/") >= 2 else None
+        if dst is None:
+            continue
+        if folder.exists(dst):
+            if folder.read(rel) != folder.read(dst):
+                raise MergeError(f"shards wrote different {dst} in {folder.url}")
+            continue
+        folder.move(rel, dst)
+    folder.remove_tree(SHARD_FOLDER)
 
 
 def merge_shards(shard_results: list[dict]) -> list[dict]:
-    """Combine the writers' shard files of a sharded run; return one entry per output folder."""
+    """Combine the writers' shard files of a sharded run; return one entry per output folder.
+
+    Each output folder is a local folder or an ``s3://`` prefix (:mod:`graphsdg.io.location`).
+    """
     by_dir: dict[str, list[dict]] = {}
     for result in shard_results:
         for rec in result.get("writers", []):
@@ -166,35 +163,29 @@ def merge_shards(shard_results: list[dict]) -> list[dict]:
         if len(kinds) > 1:
             raise MergeError(f"several writer types ({sorted(kinds)}) share the output folder {output_dir}")
         kind = kinds.pop()
+        folder = open_location(output_dir)
         merger = MERGERS.get(kind)
         if merger is not None and any(r["aggregates"] for r in recs):
-            merger(output_dir, recs)
+            merger(folder, recs)
             for rec in recs:
                 for shard_path in rec["aggregates"].values():
-                    path = os.path.join(output_dir, shard_path)
-                    if os.path.exists(path):
-                        os.remove(path)
-        _move_rest(output_dir)
-        remove_temporaries(output_dir)     # interrupted writes of an earlier, resumed attempt
+                    folder.delete(shard_path)
+        _move_rest(folder)
+        folder.remove_leftovers()     # interrupted writes of an earlier, resumed attempt
         datasets.append({"writer": kind, "output_dir": output_dir})
     return datasets
 
 
 def write_index(root: str, job: dict, datasets: list[dict]) -> str:
-    """``graphsdg_index.json`` at ``root``: the job and, per writer folder, its files with their sizes."""
+    """``graphsdg_index.json`` at ``root`` (a folder or an ``s3://`` prefix): the job and, per writer folder,
+    its files with their sizes. Returns the index's path or URL."""
+    top = open_location(root)
     entries = []
     for ds in datasets:
-        files = {}
-        for folder, dirs, names in os.walk(ds["output_dir"]):
-            dirs[:] = sorted(d for d in dirs if d != SHARD_FOLDER)
-            for name in sorted(names):
-                if name.startswith("."):
-                    continue
-                path = os.path.join(folder, name)
-                files[os.path.relpath(path, ds["output_dir"])] = os.path.getsize(path)
-        rel = os.path.relpath(ds["output_dir"], root)
-        entries.append({"writer": ds["writer"], "output_dir": rel, "files": len(files),
+        folder = open_location(ds["output_dir"])
+        files = {rel: size for rel, size in folder.files().items()
+                 if not any(part.startswith(".") for part in rel.split("/"))}   # shard folders, temporaries
+        entries.append({"writer": ds["writer"], "output_dir": folder.relative_to(top), "files": len(files),
                         "bytes": sum(files.values()), "sizes": files})
-    path = os.path.join(root, INDEX_FILE)
-    write_file_atomic(path, encode.encode_json({"job": job, "datasets": entries}, indent=2))
-    return path
+    top.write(INDEX_FILE, encode.encode_json({"job": job, "datasets": entries}, indent=2))
+    return top.path_of(INDEX_FILE)

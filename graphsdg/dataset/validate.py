@@ -1,7 +1,7 @@
 """``graphsdg validate``: check a dataset's internal consistency and list every violation.
 
 Checks (BasicWriter layout): every frame has the same set of files and every
-companion file exists; no temporary files are left; each 2D box lies inside the
+companion file exists; no temporary files are left; the dataset is a folder or an ``s3://bucket/prefix``; each 2D box lies inside the
 image and contains the pixels of its instance (when instance segmentation was
 written) or its class (semantic segmentation); box labels agree with the
 segmentation mapping; depth is finite wherever an object is; frames are not empty
@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,8 +29,7 @@ class Violation:
 
 
 def _frame_name(ds: BasicWriterDataset, f: Frame) -> str:
-    rel = os.path.relpath(f.folder, ds.root)
-    return f.frame_id if rel == "." else f"{rel}/{f.frame_id}"
+    return f"{f.folder}/{f.frame_id}" if f.folder else f.frame_id
 
 
 def _check_files(ds: BasicWriterDataset, f: Frame, stems: set[str], out: list[Violation]) -> None:
@@ -39,7 +37,7 @@ def _check_files(ds: BasicWriterDataset, f: Frame, stems: set[str], out: list[Vi
     for stem in sorted(stems - set(f.files)):
         out.append(Violation(name, "complete", f"missing the {stem} file"))
     for expected in f.expected_files():
-        if not os.path.exists(f.path(expected)):
+        if not ds.exists(f.path(expected)):
             out.append(Violation(name, "complete", f"missing {expected}"))
 
 
@@ -113,7 +111,7 @@ def _check_content(ds: BasicWriterDataset, f: Frame, seen: dict[str, str], out: 
     if boxes is not None and len(boxes[0]) == 0:
         out.append(Violation(name, "empty", "no labelled object is visible"))
     if "rgb" in f.files:
-        digest = hashlib.sha1(open(f.path(f.files["rgb"]), "rb").read()).hexdigest()
+        digest = hashlib.sha1(f.read(f.files["rgb"])).hexdigest()
         if digest in seen:
             out.append(Violation(name, "duplicate", f"rgb identical to frame {seen[digest]}"))
         else:
@@ -137,13 +135,14 @@ def _unfinished_run(root: str) -> list[Violation]:
 
 
 def validate(root: str) -> list[Violation]:
-    """Every violation found in the dataset at ``root`` (empty list: consistent)."""
+    """Every violation found in the dataset at ``root``, a folder or an ``s3://bucket/prefix`` (empty list:
+    consistent)."""
     ds = BasicWriterDataset(root)
     out: list[Violation] = []
     if len(ds) == 0:
         return [Violation("-", "complete", f"no BasicWriter frames found under {root}")]
-    for path in ds.stray:
-        out.append(Violation("-", "complete", f"temporary or hidden file left behind: {os.path.relpath(path, root)}"))
+    for rel in ds.stray:
+        out.append(Violation("-", "complete", f"temporary or hidden file left behind: {rel}"))
     out += _unfinished_run(root)
     stems_by_folder: dict[str, set[str]] = {}
     for f in ds.frames.values():

@@ -1,6 +1,6 @@
 """``graphsdg view``: a contact sheet (and HTML gallery) of a dataset with boxes, names and masks drawn.
 
-Reads BasicWriter, COCO, KITTI and YOLO outputs (:mod:`graphsdg.dataset.formats`
+Reads BasicWriter, COCO, KITTI and YOLO outputs, in a folder or under an ``s3://bucket/prefix`` (:mod:`graphsdg.dataset.formats`
 detects which) and reports per-class box counts, empty frames and box-size statistics.
 """
 from __future__ import annotations
@@ -14,6 +14,7 @@ import numpy as np
 
 from graphsdg.annotate.ids import color_of
 from graphsdg.dataset.formats import ViewFrame, read_dataset
+from graphsdg.io.object_store import S3Url, is_s3_url
 from graphsdg.rng import stable_key
 
 THUMB_WIDTH = 320
@@ -87,11 +88,20 @@ def contact_sheet(frames: list[ViewFrame], max_frames: int = 16, columns: int = 
 
 
 def write_view(root: str, out_dir: str | None = None, max_frames: int = 16, html_gallery: bool = False) -> dict:
-    """Write ``contact_sheet.png`` (and ``index.html`` with per-frame overlays) into ``out_dir``."""
+    """Write ``contact_sheet.png`` (and ``index.html`` with per-frame overlays) into ``out_dir``.
+
+    ``root`` is a folder or an ``s3://bucket/prefix``; ``out_dir`` defaults to ``<root>.view`` next to a
+    folder, ``./<last part of the prefix>.view`` for S3.
+    """
     fmt, frames = read_dataset(root)
     if not frames:
         raise ValueError(f"no {fmt} frames with images found under {root}")
-    out_dir = out_dir or os.path.abspath(root).rstrip(os.sep) + ".view"
+    if out_dir is None:
+        if is_s3_url(root):
+            url = S3Url.parse(root)
+            out_dir = os.path.abspath((url.prefix.rsplit("/", 1)[-1] or url.bucket) + ".view")
+        else:
+            out_dir = os.path.abspath(root).rstrip(os.sep) + ".view"
     os.makedirs(out_dir, exist_ok=True)
     sheet = contact_sheet(frames, max_frames)
     sheet_path = os.path.join(out_dir, "contact_sheet.png")

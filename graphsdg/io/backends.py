@@ -1,4 +1,4 @@
-"""Backends: where writers' bytes go. ``DiskBackend`` writes files atomically.
+"""Backends: where writers' bytes go. ``DiskBackend`` writes files atomically, ``S3Backend`` objects.
 
 Example:
     >>> import graphsdg as rep, tempfile
@@ -20,7 +20,8 @@ from typing import Any, Callable
 
 from graphsdg import frame_plan, settings
 from graphsdg.errors import unknown_name
-from graphsdg.io import encode
+from graphsdg.io import encode, object_store
+from graphsdg.io.object_store import S3Url, is_s3_url
 from graphsdg.io.write_queue import get_write_queue
 
 
@@ -36,6 +37,13 @@ class BaseBackend:
 
     def read_blob(self, path: str) -> bytes:
         raise NotImplementedError
+
+    def exists(self, path: str) -> bool:
+        """Whether ``path`` was written (``--resume`` keeps frames whose files all exist).
+
+        A backend that cannot tell answers False, so a resumed run writes the frame again.
+        """
+        return False
 
     def schedule(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
         """Run ``fn(*args, backend_instance=self, **kwargs)`` on the write queue."""
@@ -78,6 +86,10 @@ class DiskBackend(BaseBackend):
         if not output_dir:
             raise ValueError("DiskBackend output_dir must be a non-empty path")
         root = settings.get("/omni/replicator/backends/disk/root_dir")
+        if is_s3_url(output_dir) or (is_s3_url(root) and not os.path.isabs(output_dir)):
+            where = output_dir if is_s3_url(output_dir) else f"{output_dir!r} under the output root {root}"
+            raise ValueError(f"DiskBackend writes to disk, not to {where}; pass the path as a writer's output_dir "
+                             f"(which picks S3Backend) or use rep.backends.get('S3Backend')")
         path = output_dir if os.path.isabs(output_dir) else os.path.join(root or os.getcwd(), output_dir)
         path = os.path.abspath(path)
         if writes_discarded():
@@ -116,6 +128,90 @@ class DiskBackend(BaseBackend):
     def read_blob(self, path: str) -> bytes:
         with open(self.resolve(path), "rb") as f:
             return f.read()
+
+    def exists(self, path: str) -> bool:
+        return os.path.exists(self.resolve(path))
+
+
+class S3Backend(BaseBackend):
+    """Writes objects to ``bucket`` under ``key_prefix``, in the layout ``DiskBackend`` writes under its folder.
+
+    Replicator's keyword arguments (what its ``BackendDispatch`` passes for a writer's ``s3_bucket``,
+    ``s3_region`` and ``s3_endpoint``). Credentials, and the region and endpoint when not given, come
+    from the standard AWS chain (:mod:`graphsdg.io.object_store`). The bucket is checked here, so a
+    missing bucket, wrong credentials or an unreachable endpoint fail now, naming them. Every object
+    appears whole or not at all; a failed write reaches the script at the next ``step()`` as
+    ``WriterError`` naming ``s3://bucket/key``. ``overwrite=False`` picks ``<key_prefix>_0001``, ... when
+    objects exist under the prefix. ``output_dir`` is ``s3://bucket/key_prefix``. Needs boto3
+    (``pip install 'graphsdg[s3]'``).
+    """
+
+    output_dir: str | None = None        # until initialize()
+    key_prefix = ""
+    store: object_store.ObjectStore | None = None
+    _listing: set[str] | None = None
+
+    def __init__(self, key_prefix: str = "", bucket: str | None = None, region: str | None = None,
+                 endpoint_url: str | None = None, overwrite: bool = True) -> None:
+        if not bucket:
+            raise ValueError("S3Backend needs a bucket (Replicator's s3_bucket)")
+        object_store.check_bucket_name(bucket)
+        self.bucket, self.region, self.endpoint_url = bucket, region, endpoint_url
+        prefix = object_store.clean_key(os.fspath(key_prefix or ""), what=str(key_prefix))
+        self.store = None
+        self._listing = None
+        self._lock = threading.Lock()
+        if writes_discarded():    # graphsdg graph: no client, no request, nothing written
+            self.key_prefix, self.output_dir = prefix, str(S3Url(bucket, prefix))
+            return
+        self.store = object_store.store(bucket, region, endpoint_url)
+        # every shard, and a resumed run, must write under the prefix the job started with
+        if not overwrite and frame_plan.current() is None and self._occupied(prefix):
+            i = 1
+            while self._occupied(f"{prefix}_{i:04d}"):
+                i += 1
+            prefix = f"{prefix}_{i:04d}"
+        self.key_prefix = prefix
+        self.output_dir = str(S3Url(bucket, prefix))
+
+    def _occupied(self, prefix: str) -> bool:
+        return next(iter(self.store.list(f"{prefix}/" if prefix else "")), None) is not None
+
+    def resolve(self, path: str) -> str:
+        """The object key of ``path`` (relative to the prefix; ``..`` is refused)."""
+        if self.output_dir is None:
+            raise RuntimeError("S3Backend was not initialized; call backend.initialize(bucket=..., key_prefix=...)")
+        return S3Url(self.bucket, self.key_prefix).join(path)
+
+    def write_blob(self, path: str, data: bytes) -> None:
+        key = self.resolve(path)
+        if self.store is None:        # made while writes are discarded (graphsdg graph)
+            return
+        data = bytes(data)
+        self.store.put(key, data)
+        count_written(len(data))
+        if self._listing is not None:
+            self._listing.add(key)
+
+    def read_blob(self, path: str) -> bytes:
+        if self.store is None:
+            raise FileNotFoundError(f"{self.output_dir}/{path}: writes are discarded (graphsdg graph)")
+        return self.store.get(self.resolve(path))
+
+    def exists(self, path: str) -> bool:
+        """Whether the object exists. In a resumed run, answered from one listing of the prefix (taken at the
+        first call) plus the objects written since: a resume asks about every file of every frame, and the
+        frames this process owns are written by nobody else meanwhile."""
+        if self.store is None:
+            return False
+        key = self.resolve(path)
+        if not frame_plan.resuming():
+            return self.store.exists(key)
+        with self._lock:
+            if self._listing is None:
+                prefix = self.key_prefix
+                self._listing = {k for k, _ in self.store.list(f"{prefix}/" if prefix else "")}
+            return key in self._listing
 
 
 def _file_ancestor(path: str) -> str | None:
@@ -162,6 +258,13 @@ def files_written() -> int:
 
 def bytes_written() -> int:
     return _written["bytes"]
+
+
+def count_written(nbytes: int) -> None:
+    """Add one written file of ``nbytes`` to the totals (every backend's dataset writes count)."""
+    with _counter_lock:
+        _written["files"] += 1
+        _written["bytes"] += nbytes
 
 
 # ".<file name>.<token>.tmp": a 10-hex-digit process token and a serial (earlier builds: 12 hex digits)
@@ -265,6 +368,9 @@ class BackendGroup(BaseBackend):
     def read_blob(self, path: str) -> bytes:
         return self.backends[0].read_blob(path)
 
+    def exists(self, path: str) -> bool:
+        return bool(self.backends) and all(b.exists(path) for b in self.backends)
+
     @property
     def output_dir(self) -> str | None:
         for b in self.backends:
@@ -274,19 +380,44 @@ class BackendGroup(BaseBackend):
 
 
 class BackendDispatch(BackendGroup):
-    """Replicator's legacy dispatcher: ``BackendDispatch({"paths": {"out_dir": d}})`` or ``output_dir=d``."""
+    """Replicator's legacy dispatcher: a disk backend, an S3 backend, or both.
+
+    * ``BackendDispatch({"paths": {"out_dir": d}})`` or ``output_dir=d``: a ``DiskBackend`` at ``d``; an
+      ``s3://bucket/prefix`` URL, or a relative ``d`` while the output root (``graphsdg run --out``,
+      the setting ``/omni/replicator/backends/disk/root_dir``) is such a URL, gives an ``S3Backend``;
+    * ``BackendDispatch({"use_s3": True, "paths": {"out_dir": d, "s3_bucket": b, "s3_region": r,
+      "s3_endpoint_url": e}})`` or ``key_prefix=d, bucket=b, region=r, endpoint_url=e``: an ``S3Backend``
+      writing under the key prefix ``d``.
+    """
 
     def __init__(self, config: dict | None = None, **kwargs: Any) -> None:
         kwargs = dict(kwargs)
         if config:
             paths = config.get("paths", {})
-            if "out_dir" in paths:
+            if config.get("use_s3"):
+                kwargs.setdefault("key_prefix", paths.get("out_dir", ""))
+                for ours, theirs in (("bucket", "s3_bucket"), ("region", "s3_region"),
+                                     ("endpoint_url", "s3_endpoint_url")):
+                    if paths.get(theirs) is not None:
+                        kwargs.setdefault(ours, paths[theirs])
+                if not kwargs.get("bucket"):
+                    raise ValueError("BackendDispatch: use_s3 needs paths['s3_bucket']")
+            elif "out_dir" in paths:
                 kwargs.setdefault("output_dir", paths["out_dir"])
-        if any(k.startswith("s3") or k in ("bucket", "key_prefix") for k in kwargs):
-            raise ValueError("S3 output is not available in graphsdg; use output_dir (DiskBackend) instead")
-        backends = []
+        unknown = sorted(set(kwargs) - {"output_dir", "overwrite", "key_prefix", "bucket", "region", "endpoint_url"})
+        if unknown:
+            raise TypeError(f"BackendDispatch got unknown argument(s) {unknown}; known: output_dir, overwrite, "
+                            f"key_prefix, bucket, region, endpoint_url")
+        overwrite = kwargs.get("overwrite", True)
+        backends: list[BaseBackend] = []
+        if kwargs.get("bucket"):
+            backends.append(S3Backend(key_prefix=kwargs.get("key_prefix") or "", bucket=kwargs["bucket"],
+                                      region=kwargs.get("region"), endpoint_url=kwargs.get("endpoint_url"),
+                                      overwrite=overwrite))
+        elif any(kwargs.get(k) for k in ("region", "endpoint_url")):
+            raise ValueError("BackendDispatch: region/endpoint_url are for S3 output and need bucket")
         if kwargs.get("output_dir") is not None:
-            backends.append(DiskBackend(output_dir=kwargs["output_dir"], overwrite=kwargs.get("overwrite", True)))
+            backends.append(backend_for_output_dir(kwargs["output_dir"], overwrite))
         super().__init__(backends)
 
     @staticmethod
@@ -294,8 +425,26 @@ class BackendDispatch(BackendGroup):
         settings.set("/omni/replicator/backend/queueSize", int(n))
 
 
-_registry: dict[str, type[BaseBackend]] = {"DiskBackend": DiskBackend, "BackendDispatch": BackendDispatch,
-                                           "BackendGroup": BackendGroup}
+def output_root() -> str | None:
+    """The root of relative output folders: ``graphsdg run --out`` (a folder or an ``s3://`` URL), if set."""
+    return settings.get("/omni/replicator/backends/disk/root_dir") or None
+
+
+def backend_for_output_dir(output_dir: str | os.PathLike, overwrite: bool = True) -> BaseBackend:
+    """The backend of a writer's ``output_dir``: an ``S3Backend`` for an ``s3://`` URL, or for a relative path
+    under an ``s3://`` output root; otherwise a ``DiskBackend``."""
+    path = os.fspath(output_dir)
+    root = output_root()
+    if not is_s3_url(path) and is_s3_url(root) and path and not os.path.isabs(path):
+        path = str(S3Url.parse(root).child(path))
+    if is_s3_url(path):
+        url = S3Url.parse(path)
+        return S3Backend(key_prefix=url.prefix, bucket=url.bucket, overwrite=overwrite)
+    return DiskBackend(output_dir=path, overwrite=overwrite)
+
+
+_registry: dict[str, type[BaseBackend]] = {"DiskBackend": DiskBackend, "S3Backend": S3Backend,
+                                           "BackendDispatch": BackendDispatch, "BackendGroup": BackendGroup}
 
 
 def register(backend_cls: type[BaseBackend]) -> None:
@@ -315,7 +464,7 @@ def get(name: str, init_params: dict | None = None) -> BaseBackend:
         backend.__init__(**init_params)  # type: ignore[misc]
     else:
         BaseBackend.__init__(backend)
-        if isinstance(backend, DiskBackend):
+        if isinstance(backend, (DiskBackend, S3Backend)):
             backend.output_dir = None
         if isinstance(backend, BackendGroup):
             backend.backends = []
@@ -326,4 +475,5 @@ def get_registered_backends() -> list[str]:
     return sorted(_registry)
 
 
-__all__ = ["BaseBackend", "DiskBackend", "BackendGroup", "BackendDispatch", "register", "get"]
+__all__ = ["BaseBackend", "DiskBackend", "S3Backend", "BackendGroup", "BackendDispatch", "register", "get",
+           "backend_for_output_dir"]

@@ -50,6 +50,7 @@ import weakref
 from typing import Any, Iterator
 
 from graphsdg import settings
+from graphsdg.io.location import open_location
 
 FILE_NAME = "graphsdg_run.json"
 FORMAT = "graphsdg.run_state"
@@ -196,6 +197,7 @@ class FrameLedger:
 
 
 _ledgers: dict[tuple[int, str], FrameLedger] = {}
+_present: set[str] = set()        # output folders whose run-state file this process wrote or resumed from
 _registry_lock = threading.Lock()
 _last_save = 0.0
 
@@ -223,6 +225,8 @@ def ledger_for(writer: Any, create: bool = True) -> FrameLedger | None:
             ledger = _ledgers[key] = FrameLedger(writer, out)
             if settings.get("/graphsdg/run/resume", False):     # graphsdg run --resume: keep what was complete
                 earlier = _read_quietly(out)
+                if earlier is not None:
+                    _present.add(out)         # the earlier run's file goes when this run completes the folder
                 if earlier is not None and ledger.name in earlier["writers"]:
                     ledger.restore(earlier["writers"][ledger.name])
         return ledger
@@ -265,12 +269,8 @@ def file_name() -> str:
     return f"{FILE_NAME[:-5]}.shard-{int(settings.get('/graphsdg/run/shardIndex', 0) or 0)}-of-{int(count)}.json"
 
 
-def _path(output_dir: str) -> str:
-    return os.path.join(output_dir, file_name())
-
-
 def _save_dir(output_dir: str, ledgers: list[FrameLedger]) -> None:
-    from graphsdg.io.backends import _write_atomic
+    location = open_location(output_dir)      # a folder, or an s3:// prefix
     writers: dict[str, dict] = {}
     for ledger in ledgers:
         name = ledger.name
@@ -279,13 +279,15 @@ def _save_dir(output_dir: str, ledgers: list[FrameLedger]) -> None:
             name, i = f"{ledger.name}#{i}", i + 1
         writers[name] = ledger.entry()
     if all(ledger.all_complete() and ledger.status in _CLEAN for ledger in ledgers):
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(_path(output_dir))
+        if output_dir in _present:    # only a file this process wrote or found (no request for the others: S3)
+            location.delete(file_name())
+            _present.discard(output_dir)
         return
     lines = [f' "format": {json.dumps(FORMAT)},', f' "version": {VERSION},', ' "writers": {']
     lines += [f'  {json.dumps(name)}: {json.dumps(entry)}{"," if i < len(writers) - 1 else ""}'
               for i, (name, entry) in enumerate(writers.items())]
-    _write_atomic(_path(output_dir), ("{\n" + "\n".join(lines) + "\n }\n}\n").encode(), count=False)
+    location.write(file_name(), ("{\n" + "\n".join(lines) + "\n }\n}\n").encode(), count=False)
+    _present.add(output_dir)
 
 
 def save(force: bool = False) -> None:
@@ -381,10 +383,10 @@ def read(output_dir: str | os.PathLike) -> dict | None:
     written). Raises ``ValueError`` for a file that is not a graphsdg run-state file
     of a version this graphsdg reads.
     """
-    path = _path(os.fspath(output_dir))
+    location = open_location(output_dir)      # a folder, or an s3:// prefix
+    path = location.path_of(file_name())
     try:
-        with open(path, "rb") as f:
-            raw = f.read()
+        raw = location.read(file_name())
     except FileNotFoundError:
         return None
     try:

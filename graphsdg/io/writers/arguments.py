@@ -21,17 +21,26 @@ IMAGE_FORMATS = ("png", "jpg", "jpeg")
 
 
 def output_backend(writer: str, output_dir: Any = None, backend: BaseBackend | None = None,
-                   overwrite: bool = True, **s3: Any) -> BaseBackend:
-    """The backend a writer writes through: ``backend``, a disk backend at ``output_dir``, or both.
+                   overwrite: bool = True, s3_bucket: str | None = None, s3_region: str | None = None,
+                   s3_endpoint: str | None = None, use_s3: bool | None = None) -> BaseBackend:
+    """The backend a writer writes through: ``backend``, the backend of ``output_dir``, or both grouped.
 
-    No output at all raises Replicator's ``ValueError``; S3 arguments raise
-    (graphsdg has no S3 backend).
+    ``s3_bucket`` (with ``s3_region`` and ``s3_endpoint``) writes to that bucket under the key prefix
+    ``output_dir``, as Replicator's ``BackendDispatch(key_prefix=output_dir, bucket=..., region=...,
+    endpoint_url=...)``; ``use_s3`` is Isaac's PoseWriter switch for the same. An ``output_dir`` that is an
+    ``s3://bucket/prefix`` URL (or relative, under an ``s3://`` ``graphsdg run --out``) writes there too.
+    No output at all raises Replicator's ``ValueError``.
     """
-    if any(v for v in s3.values()):
+    s3 = {"s3_region": s3_region, "s3_endpoint": s3_endpoint}
+    if use_s3 is not None and not use_s3 and s3_bucket:
+        raise ValueError(f"{writer}: s3_bucket={s3_bucket!r} is given but use_s3 is False; pass use_s3=True to "
+                         f"write to S3")
+    if use_s3 and not s3_bucket:
+        raise ValueError(f"{writer}: use_s3=True needs s3_bucket")
+    if not s3_bucket and any(s3.values()):
         given = sorted(k for k, v in s3.items() if v)
-        raise ValueError(f"{writer}: S3 output ({', '.join(given)}) is not available in graphsdg; pass output_dir "
-                         f"or a backend")
-    if output_dir is None and backend is None:
+        raise ValueError(f"{writer}: {', '.join(given)} describe S3 output and need s3_bucket")
+    if output_dir is None and backend is None and not s3_bucket:
         raise ValueError(f"No `backend`, `output_dir` or `s3_` parameter specified; {writer} needs somewhere to "
                          f"write (e.g. output_dir='_out')")
     if output_dir is not None and not isinstance(output_dir, (str, os.PathLike)):
@@ -39,7 +48,12 @@ def output_backend(writer: str, output_dir: Any = None, backend: BaseBackend | N
     if backend is not None and not isinstance(backend, BaseBackend):
         raise TypeError(f"{writer}: backend must be a backend from rep.backends.get(...), got {backend!r}")
     backends = [backend] if backend is not None else []
-    if output_dir is not None:
+    if s3_bucket:
+        if not isinstance(s3_bucket, str):
+            raise TypeError(f"{writer}: s3_bucket must be a bucket name, got {s3_bucket!r}")
+        backends.append(BackendDispatch(key_prefix=os.fspath(output_dir or ""), bucket=s3_bucket, region=s3_region,
+                                        endpoint_url=s3_endpoint, overwrite=overwrite))
+    elif output_dir is not None:
         backends.append(BackendDispatch(output_dir=output_dir, overwrite=overwrite))
     return backends[0] if len(backends) == 1 else BackendGroup(backends)
 

@@ -16,7 +16,6 @@ Example:
 """
 from __future__ import annotations
 
-import os
 from typing import Any
 
 import numpy as np
@@ -185,9 +184,8 @@ class BasicWriter(Writer):
         return out
 
     def frame_complete(self, frame_index: int) -> bool:
-        root = getattr(self.backend, "output_dir", None)
-        return root is not None and all(os.path.exists(os.path.join(root, f))
-                                        for f in self.expected_files(frame_index))
+        """Whether every file of frame ``frame_index`` exists in the backend (a folder or a bucket)."""
+        return all(self.backend.exists(f) for f in self.expected_files(frame_index))
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
         b = self.backend

@@ -33,7 +33,7 @@ Example:
 from __future__ import annotations
 
 import json
-import os
+import posixpath
 import random
 import string
 from typing import Any, Sequence
@@ -241,20 +241,22 @@ class CocoWriter(Writer):
     def _image_files(self, image: dict) -> list[str]:
         files = [image["file_name"]]
         if self._write_panoptic:
-            folder, name = os.path.split(image["file_name"])
-            files.append(os.path.join(folder, "panoptic_" + name[len("rgb_"):]))
+            folder, name = posixpath.split(image["file_name"])
+            files.append(posixpath.join(folder, "panoptic_" + name[len("rgb_"):]))
         return files
 
     def _adopt_existing(self) -> None:
-        """Resume: take over the images (whose files are on disk), annotations and categories already written."""
-        root = self.output_dir
-        found = [os.path.join(root, p) for p in dict.fromkeys([self.annotation_path, self._file.path])
-                 if root and os.path.exists(os.path.join(root, p))]
+        """Resume: take over the images (whose files were written), annotations and categories already written.
+
+        Reads through the backend, so a dataset in a bucket resumes as one on disk does.
+        """
         images: dict[int, dict] = {}
         annotations: dict[int, list] = {}
-        for path in found:
-            with open(path, encoding="utf-8") as f:
-                doc = json.load(f)
+        for path in dict.fromkeys([self.annotation_path, self._file.path]):
+            try:
+                doc = json.loads(self.backend.read_blob(path))
+            except (FileNotFoundError, NotImplementedError):
+                continue
             self.coco["info"] = doc.get("info", self.coco["info"])
             self._date = self.coco["info"].get("date_created", self._date)
             for cat in sorted(doc.get("categories", []), key=lambda c: int(c["id"])):
@@ -262,7 +264,7 @@ class CocoWriter(Writer):
                 if self._categories is None:
                     self._auto.id_of(cat["name"])
             for image in doc.get("images", []):
-                if all(os.path.exists(os.path.join(root, f)) for f in self._image_files(image)):
+                if all(self.backend.exists(f) for f in self._image_files(image)):
                     images[int(image["id"])] = image
             for a in doc.get("annotations", []):
                 annotations.setdefault(int(a["image_id"]), []).append(a)

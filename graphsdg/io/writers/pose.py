@@ -71,8 +71,8 @@ class PoseWriter(Writer):
         name = type(self).__name__
         self.version = "0.0.1"
         self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend, use_s3=use_s3, s3_bucket=s3_bucket,
-                                                s3_endpoint_url=s3_endpoint_url, s3_region=s3_region)
+        self.backend = arguments.output_backend(name, output_dir, backend, use_s3=bool(use_s3), s3_bucket=s3_bucket,
+                                                s3_endpoint=s3_endpoint_url, s3_region=s3_region)
         self.output_dir = getattr(self.backend, "output_dir", None)
         if format is not None and str(format).lower() not in FORMATS:
             raise ValueError(f"{name}: unsupported format {format!r}; supported: {FORMATS} or None")
