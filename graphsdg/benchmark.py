@@ -256,7 +256,21 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     model.vis.global_.offwidth, model.vis.global_.offheight = max(w, 64), max(h, 64)
     vfov = np.degrees(2 * np.arctan(20.955 / 24.0 / 2 * h / w))
     model.vis.global_.fovy = vfov
-    renderer = mujoco.Renderer(model, h, w)
+    # MuJoCo's own scene is sized 10,000 geoms by default: crowded benches (--asset-count 5000) need more
+    max_geom = model.ngeom + 100
+    renderer = mujoco.Renderer(model, h, w, max_geom=max_geom)
+    # Depth and ids from a single-sample context of their own. mujoco.Renderer reads them out of its
+    # multisampled buffer; MuJoCo turns multisampling off for id colours, which Mesa honours but
+    # NVIDIA's driver does not: resolving blends neighbouring ids byte by byte into codes of a third
+    # geom, or (256 geoms and more, two bytes a code) into codes beyond the scene, where the
+    # renderer's own segid -> object table raised "index 502 is out of bounds for axis 0 with size
+    # 501" at 500 assets (tests/test_id_range.py replays such a resolve).
+    samples = int(model.vis.quality.offsamples)
+    model.vis.quality.offsamples = 0
+    try:
+        id_renderer = mujoco.Renderer(model, h, w, max_geom=max_geom)
+    finally:
+        model.vis.quality.offsamples = samples
     want = set(config.annotators)
     need_depth = bool(want & {"distance_to_image_plane", "distance_to_camera"})
     need_seg = bool(want - {"rgb", "distance_to_image_plane", "distance_to_camera"})
@@ -294,26 +308,26 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
             cam.distance = d
             cam.azimuth = np.degrees(np.arctan2(pos[1], pos[0])) + 180
             cam.elevation = -np.degrees(np.arcsin(pos[2] / d))
-            renderer.disable_depth_rendering()
-            renderer.disable_segmentation_rendering()
             renderer.update_scene(data, cam)
             with profiling.timed("baseline:render:rgb"):
                 rgb = renderer.render()
             if not config.skip_write:
                 pending.append(pool.submit(write, f"{tmp}/rgb_{c}_{index}.png", rgb[..., ::-1].copy()))
+            if need_depth or need_seg:
+                id_renderer.update_scene(data, cam)
             if need_depth:
-                renderer.enable_depth_rendering()
+                id_renderer.enable_depth_rendering()
                 with profiling.timed("baseline:render:depth"):
-                    depth = renderer.render()
-                renderer.disable_depth_rendering()
+                    depth = id_renderer.render()
+                id_renderer.disable_depth_rendering()
                 if not config.skip_write:
                     pending.append(pool.submit(write, f"{tmp}/depth_{c}_{index}.npy", depth))
             if need_seg:
-                renderer.enable_segmentation_rendering()
+                id_renderer.enable_segmentation_rendering()
                 with profiling.timed("baseline:render:segmentation"):
-                    seg = renderer.render()
+                    seg = id_renderer.render()
                 t1 = time.perf_counter()
-                renderer.disable_segmentation_rendering()
+                id_renderer.disable_segmentation_rendering()
                 ids = np.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
                 inst = geom_to_asset[ids]
                 flat = inst.ravel()
@@ -357,6 +371,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     result.profile = profiling.snapshot()
     pool.shutdown()
     renderer.close()
+    id_renderer.close()
     import shutil
     shutil.rmtree(tmp, ignore_errors=True)
     for rp in rps:

@@ -46,6 +46,7 @@ from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
 from graphsdg.render.motion_blur import MotionSamples
 from graphsdg.render.readback import PixelReads, code_bits
+from graphsdg.render.scene_geoms import geom_array
 from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 from graphsdg.sim.scene import SimScene
 
@@ -163,6 +164,7 @@ class Rasterizer:
         self._model: mujoco.MjModel | None = None
         # inverse of SimScene.mesh_maps when the meshes were uploaded (a mesh absent: identity)
         self._uploaded_inverse: dict[int, np.ndarray] = {}
+        self._undo = _undo_table({})   # the same by mesh id, as arrays
         self._reads: PixelReads | None = None
         self._flat_sky: tuple[float, float, float] | None = None   # the skybox's colour when uniform
         self._ids: IdFramebuffer | None = None   # where id passes draw (single-sample, float depth)
@@ -203,6 +205,7 @@ class Rasterizer:
             self._version = sim.model_version
             self._model = model
             self._uploaded_inverse = {mid: np.linalg.inv(m) for mid, m in sim.mesh_maps.items()}
+            self._undo = _undo_table(self._uploaded_inverse)
             self._flat_sky = sky.uniform_sky(model)
         if sim.meshes_to_upload:   # deformables' meshes moved by physics
             for mid in sorted(sim.meshes_to_upload):
@@ -310,6 +313,10 @@ class Rasterizer:
         maps, uploaded_inverse = sim.mesh_maps, self._uploaded_inverse
         # ints, not the enums: comparing with a pybind11 enum costs microseconds per geom
         dataid, geom_obj, mesh = sim.model.geom_dataid, int(mujoco.mjtObj.mjOBJ_GEOM), int(mujoco.mjtGeom.mjGEOM_MESH)
+        geoms = geom_array(scene)
+        if geoms is not None:
+            _fold_mesh_maps(geoms, dataid, maps, self._undo, mesh, geom_obj)
+            return
         for g in scene.geoms[:scene.ngeom]:
             if g.type != mesh or g.objtype != geom_obj:
                 continue
@@ -562,6 +569,51 @@ def _depth_decoder(far: float, view: CameraView) -> Callable[[np.ndarray], np.nd
     return lambda raw: _linearize_depth(raw, near, SKY_FAR_FACTOR * far, far, orthographic=orthographic)
 
 
+def _undo_table(uploaded_inverse: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """``Rasterizer._uploaded_inverse`` as arrays by mesh id: (which meshes have one, (n, 3, 3) matrices)."""
+    if not uploaded_inverse:
+        return np.zeros(0, dtype=bool), np.zeros((0, 3, 3))
+    size = max(uploaded_inverse) + 1
+    has, undo = np.zeros(size, dtype=bool), np.zeros((size, 3, 3))
+    ids = np.fromiter(uploaded_inverse.keys(), dtype=np.int64, count=len(uploaded_inverse))
+    has[ids] = True
+    undo[ids] = np.array(list(uploaded_inverse.values()), dtype=np.float64).reshape(-1, 3, 3)
+    return has, undo
+
+
+def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: dict[int, np.ndarray],
+                    uploaded_inverse: tuple[np.ndarray, np.ndarray], mesh: int, geom_obj: int) -> None:
+    """:meth:`Rasterizer._draw_rescaled_meshes` over the scene's geoms as one array (``scene_geoms``);
+    ``uploaded_inverse`` as :func:`_undo_table` gives it.
+
+    The products are those of the per-geom loop, batched: ``current @ undo`` per
+    mesh, then each geom's float32 matrix times it in float64, rounded back to
+    float32 as it is stored (the same numbers, bit for bit: tests compare both).
+    """
+    rows = np.flatnonzero((geoms["type"] == mesh) & (geoms["objtype"] == geom_obj))
+    if not rows.size:
+        return
+    mids = np.asarray(dataid)[geoms["objid"][rows]]
+    ids = np.fromiter(maps.keys(), dtype=np.int64, count=len(maps))
+    if not ids.size:
+        return
+    table = np.full(max(int(ids.max()), int(mids.max())) + 1, -1, dtype=np.int64)
+    table[ids] = np.arange(ids.size)
+    slot = table[mids]
+    keep = slot >= 0
+    if not keep.any():
+        return
+    rows, slot = rows[keep], slot[keep]
+    folds = np.array(list(maps.values()), dtype=np.float64).reshape(-1, 3, 3)
+    has_undo, undo = uploaded_inverse
+    inside = np.flatnonzero(ids < has_undo.size)
+    undone = inside[has_undo[ids[inside]]]    # the maps' slots of meshes uploaded already rescaled
+    if undone.size:
+        folds[undone] = np.matmul(folds[undone], undo[ids[undone]])
+    mats = geoms["mat"][rows].reshape(-1, 3, 3)
+    geoms["mat"][rows] = np.matmul(mats, folds[slot]).reshape(-1, 9)
+
+
 def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
     """MuJoCo's id colours (segid + 1) -> geom id for the geoms of ``scene`` now; -1 for anything else.
 
@@ -571,6 +623,12 @@ def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
     size = next((1 << b for b in (8, 16) if scene.ngeom < (1 << b)), scene.ngeom + 2)
     lut = np.full(size, -1, dtype=np.int32)
     geom_obj = int(mujoco.mjtObj.mjOBJ_GEOM)   # an int: comparing with the enum costs microseconds per geom
+    geoms = geom_array(scene)
+    if geoms is not None:
+        segid = geoms["segid"]
+        drawn = (segid >= 0) & (geoms["objtype"] == geom_obj)
+        lut[segid[drawn] + 1] = geoms["objid"][drawn]
+        return lut
     for g in scene.geoms[:scene.ngeom]:
         if g.segid >= 0 and g.objtype == geom_obj:
             lut[g.segid + 1] = g.objid

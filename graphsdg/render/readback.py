@@ -143,8 +143,7 @@ class PixelReads:
             return self._read(ctx, width, height, "red")
         if bits == 16:
             return self._read(ctx, width, height, "red_green")
-        return self._read(ctx, width, height, "rgba", lambda rgba: np.minimum(
-            rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), np.uint32(size - 1)))
+        return self._read(ctx, width, height, "rgba", codes_from_rgba(size))
 
     def read_depth(self, ctx: mujoco.MjrContext, width: int, height: int,
                    decode: Callable[[np.ndarray], np.ndarray] = _copy) -> PendingPixels:
@@ -233,6 +232,14 @@ def wait_for_fence(fence) -> None:
         flags = 0
         time.sleep(pause)
         pause = min(2 * pause, _LONGEST_SLEEP)
+
+
+def codes_from_rgba(size: int) -> Callable[[np.ndarray], np.ndarray]:
+    """The decoder of 24-bit id colours read as RGBA words: uint32 codes, any code at or above ``size``
+    (nothing drawn has one; a driver that blends id colours can make one) clipped to ``size - 1``, which
+    the code -> geom table keeps for the background, so every code indexes the table."""
+    top = np.uint32(size - 1)
+    return lambda rgba: np.minimum(rgba.view(np.uint32)[..., 0] & np.uint32(0xFFFFFF), top)
 
 
 def code_bits(size: int) -> int:
