@@ -316,8 +316,12 @@ CASES: list[Case] = [
       'semantic_filter_predicate="class:*")',
       "ValueError", "BasicWriter: `semantic_types` (['class']) and `semantic_filter_predicate` ('class:*') are "
                     "mutually exclusive; pass one"),
-    C("writers", "S3 output", 'rep.writers.get("BasicWriter").initialize(output_dir=tmp, rgb=True, s3_bucket="b")',
-      "ValueError", "BasicWriter: S3 output (s3_bucket) is not available in graphsdg; pass output_dir or a backend"),
+    C("writers", "an S3 bucket name that S3 refuses",
+      'rep.writers.get("BasicWriter").initialize(output_dir=tmp, rgb=True, s3_bucket="B")',
+      "ValueError", "'B' is not an S3 bucket name (3-63 characters: lower-case letters, digits, '.', '-')"),
+    C("writers", "an S3 region without a bucket",
+      'rep.writers.get("BasicWriter").initialize(output_dir=tmp, rgb=True, s3_region="us-east-1")',
+      "ValueError", "BasicWriter: s3_region given without s3_bucket; S3 output needs the bucket (s3_bucket=...)"),
     C("writers", "attaching a writer before initialize()", 'rep.writers.get("BasicWriter").attach(rp)',
       "ValueError", "BasicWriter.attach() before initialize(): call writer.initialize(...) first (BasicWriter: e.g. "
                     "output_dir='_out', rgb=True)"),
@@ -335,7 +339,7 @@ CASES: list[Case] = [
     # ---- backends ------------------------------------------------------------------------------------------------
     C("backends", "a misspelt backend name", 'rep.backends.get("DiskBackendd")',
       "UnknownNameError", "unknown backend 'DiskBackendd' (did you mean 'DiskBackend'?); known backends: "
-                          "BackendDispatch, BackendGroup, DiskBackend"),
+                          "BackendDispatch, BackendGroup, DiskBackend, S3Backend"),
     C("backends", "writing through a backend that was never initialized", 'rep.backends.get("DiskBackend").write_blob("a.txt", b"x")',
       "RuntimeError", "DiskBackend was not initialized; call backend.initialize(output_dir=...)"),
     C("backends", "a path that leaves the output folder",

@@ -725,11 +725,13 @@ def test_writer_without_output_unknown_flag_and_file_as_dir(name, tmp_path):
         rep.writers.get(name).initialize(output_dir=str(blocker), **FLAGS.get(name, {}))
     with pytest.raises(NotADirectoryError, match=r"'.*/file' is a file"):
         rep.writers.get(name).initialize(output_dir=str(blocker / "sub"), **FLAGS.get(name, {}))
-    s3 = {"PoseWriter": {"use_s3": True}, "BasicWriter": {"s3_bucket": "b"}, "CocoWriter": {"s3_bucket": "b"},
-          "KittiWriter": {"s3_bucket": "b"}}
-    if name in s3:                                                    # Replicator's S3 arguments: a clear refusal
-        with pytest.raises(ValueError, match="S3"):
-            rep.writers.get(name).initialize(output_dir=str(tmp_path / "o"), **FLAGS.get(name, {}), **s3[name])
+    s3 = {"PoseWriter": ({"use_s3": True}, "use_s3=True needs s3_bucket"),
+          "BasicWriter": ({"s3_bucket": "b"}, "'b' is not an S3 bucket name"),
+          "CocoWriter": ({"s3_region": "r"}, "s3_region given without s3_bucket"),
+          "KittiWriter": ({"s3_endpoint": "http://127.0.0.1:1"}, "s3_endpoint given without s3_bucket")}
+    if name in s3:        # Replicator's S3 arguments, wrong: a clear error before any request (tests/test_s3_output.py)
+        with pytest.raises(ValueError, match=s3[name][1]):
+            rep.writers.get(name).initialize(output_dir=str(tmp_path / "o"), **FLAGS.get(name, {}), **s3[name][0])
     with pytest.raises(TypeError, match="backend must be a backend from rep.backends.get"):
         rep.writers.get(name).initialize(backend="DiskBackend", **FLAGS.get(name, {}))
 

@@ -39,7 +39,8 @@ def output_backend(writer: str, output_dir: Any = None, backend: BaseBackend | N
         raise ValueError(f"{writer}: use_s3=True needs s3_bucket")
     if not s3_bucket and any(s3.values()):
         given = sorted(k for k, v in s3.items() if v)
-        raise ValueError(f"{writer}: {', '.join(given)} describe S3 output and need s3_bucket")
+        raise ValueError(f"{writer}: {', '.join(given)} given without s3_bucket; S3 output needs the bucket "
+                         f"(s3_bucket=...)")
     if output_dir is None and backend is None and not s3_bucket:
         raise ValueError(f"No `backend`, `output_dir` or `s3_` parameter specified; {writer} needs somewhere to "
                          f"write (e.g. output_dir='_out')")
