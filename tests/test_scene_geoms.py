@@ -100,3 +100,27 @@ def test_too_few_geoms_to_check_the_layout_fall_back_to_the_attributes():
         assert scene_geoms.geom_array(scene) is None and "size_offset" not in scene_geoms._layout
     finally:
         scene_geoms._layout.update(saved)
+
+
+def test_mesh_maps_compose_as_the_per_mesh_loop_did():
+    """SimScene.mesh_maps as arrays: the composed maps are the dict loop's, bit for bit, repeats in order."""
+    from graphsdg.sim.mesh_scaling import MeshMaps
+    rng = np.random.default_rng(5)
+    maps, reference = MeshMaps(), {}
+    for ids in ([3, 7, 1], [7, 2, 9, 3], [4, 4, 7], list(range(40))):
+        linears = rng.normal(size=(len(ids), 3, 3))
+        maps.compose(np.array(ids), linears)
+        for mesh_id, linear in zip(ids, linears):
+            previous = reference.get(mesh_id)
+            reference[mesh_id] = linear if previous is None else linear @ previous
+        assert sorted(maps) == sorted(reference) and len(maps) == len(reference)
+        for mesh_id, matrix in reference.items():
+            np.testing.assert_array_equal(maps[mesh_id], matrix)
+        ids_now, stacked = maps.stacked()
+        np.testing.assert_array_equal(stacked, np.array([reference[i] for i in ids_now.tolist()]))
+    maps[3][:] = 0                                       # a value read is a copy
+    assert maps[3].any() and maps.get(1000) is None and 1000 not in maps
+    del maps[3]
+    assert 3 not in maps and len(maps) == len(reference) - 1
+    maps.clear()
+    assert not maps and maps.stacked()[0].size == 0

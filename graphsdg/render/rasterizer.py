@@ -48,6 +48,7 @@ from graphsdg.render.motion_blur import MotionSamples
 from graphsdg.render.readback import PixelReads, code_bits
 from graphsdg.render.scene_geoms import geom_array
 from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
+from graphsdg.sim.mesh_scaling import MeshMaps
 from graphsdg.sim.scene import SimScene
 
 PASSES = ("color", "hdr", "depth", "segmentation")
@@ -581,7 +582,7 @@ def _undo_table(uploaded_inverse: dict[int, np.ndarray]) -> tuple[np.ndarray, np
     return has, undo
 
 
-def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: dict[int, np.ndarray],
+def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: MeshMaps | dict[int, np.ndarray],
                     uploaded_inverse: tuple[np.ndarray, np.ndarray], mesh: int, geom_obj: int) -> None:
     """:meth:`Rasterizer._draw_rescaled_meshes` over the scene's geoms as one array (``scene_geoms``);
     ``uploaded_inverse`` as :func:`_undo_table` gives it.
@@ -594,7 +595,11 @@ def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: dict[int, np.nd
     if not rows.size:
         return
     mids = np.asarray(dataid)[geoms["objid"][rows]]
-    ids = np.fromiter(maps.keys(), dtype=np.int64, count=len(maps))
+    if isinstance(maps, MeshMaps):
+        ids, folds = maps.stacked()
+    else:
+        ids = np.fromiter(maps.keys(), dtype=np.int64, count=len(maps))
+        folds = np.array(list(maps.values()), dtype=np.float64).reshape(-1, 3, 3)
     if not ids.size:
         return
     table = np.full(max(int(ids.max()), int(mids.max())) + 1, -1, dtype=np.int64)
@@ -604,7 +609,6 @@ def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: dict[int, np.nd
     if not keep.any():
         return
     rows, slot = rows[keep], slot[keep]
-    folds = np.array(list(maps.values()), dtype=np.float64).reshape(-1, 3, 3)
     has_undo, undo = uploaded_inverse
     inside = np.flatnonzero(ids < has_undo.size)
     undone = inside[has_undo[ids[inside]]]    # the maps' slots of meshes uploaded already rescaled

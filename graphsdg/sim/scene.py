@@ -36,7 +36,7 @@ from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, VELOCITY_A
                                    CompiledScene, authored_velocity, compile_stage,
                                    display_rgba, light_dir_and_pos, place_directional_lights, primitive_size,
                                    rigid_root)
-from graphsdg.sim.mesh_scaling import rescale_mesh_geoms
+from graphsdg.sim.mesh_scaling import MeshMaps, rescale_mesh_geoms
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
@@ -95,7 +95,7 @@ class SimScene:
         self.meshes_to_upload: set[int] = set()   # meshes whose vertices moved (deformables), for renderers
         # mesh id -> 3x3 map from the compiled vertices to the current ones, for meshes rescaled in
         # place since the compile; renderers draw the copy they uploaded through it (no re-upload)
-        self.mesh_maps: dict[int, np.ndarray] = {}
+        self.mesh_maps = MeshMaps()
         # per mesh: the count of vertex changes since the compile (rescales, deformables), so renderers that
         # keep their own copy (the pbr backend's BVHs) find the meshes to refit with one comparison
         self.mesh_stamps = np.zeros(0, dtype=np.int64)
@@ -137,10 +137,7 @@ class SimScene:
     def rescale_meshes(self, geom_ids: np.ndarray, old_scales: np.ndarray, new_scales: np.ndarray) -> None:
         """:meth:`rescale_mesh` for many visual mesh geoms at once (their scales as (N, 3) arrays)."""
         mesh_ids, linears = rescale_mesh_geoms(self.model, geom_ids, old_scales, new_scales)
-        maps = self.mesh_maps
-        for mesh_id, linear in zip(mesh_ids.tolist(), linears):
-            previous = maps.get(mesh_id)
-            maps[mesh_id] = linear if previous is None else linear @ previous
+        self.mesh_maps.compose(mesh_ids, linears)
         self.stamp_meshes(mesh_ids)
 
     def stamp_meshes(self, mesh_ids) -> None:
