@@ -310,7 +310,7 @@ def test_two_nodes_write_through_s3_the_single_process_disk_dataset(job_script, 
 
 
 def test_a_node_dies_mid_run_and_resume_finishes_it(job_script, bucket, s3_server, cluster, tmp_path, capsys):
-    frames = 60     # BasicWriter only: its frames are complete as soon as their files are in the bucket
+    frames = 80     # BasicWriter only: its frames are complete as soon as their files are in the bucket
     run_job(JobSpec(job_script, args=("--no-coco",), seed=8, out=str(tmp_path / "single"), frames=frames))
     rep.orchestrator.wait_until_complete()
     url = f"s3://{bucket}/killed"

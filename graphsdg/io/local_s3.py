@@ -37,6 +37,17 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def _die_with_parent() -> None:
+    """In the child, before exec: Linux sends it SIGTERM when the process that started it dies, so a killed
+    test run leaves no server behind (elsewhere nothing is done)."""
+    try:
+        import ctypes
+        import signal
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)     # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
 class LocalS3Server:
     """moto's S3 server in a child process on ``127.0.0.1:port``, with credentials checked."""
 
@@ -58,7 +69,8 @@ class LocalS3Server:
         env = {k: v for k, v in os.environ.items() if not k.startswith("AWS_")}
         env["AWS_EC2_METADATA_DISABLED"] = "true"
         self._proc = subprocess.Popen([sys.executable, "-m", "moto.server", "-H", "127.0.0.1", "-p", str(self.port)],
-                                      stdout=self._log, stderr=subprocess.STDOUT, env=env)
+                                      stdout=self._log, stderr=subprocess.STDOUT, env=env,
+                                      preexec_fn=_die_with_parent)
         deadline = time.monotonic() + self.start_timeout_s
         while True:
             if self._proc.poll() is not None:
@@ -113,6 +125,14 @@ class LocalS3Server:
                 rel = item["Key"][len(prefix):].lstrip("/")
                 out[rel] = s3.get_object(Bucket=bucket, Key=item["Key"])["Body"].read()
         return out
+
+    def cpu_seconds(self) -> float:
+        """CPU time the server process used so far (Linux ``/proc``): what serving the requests cost."""
+        if self._proc is None:
+            return 0.0
+        with open(f"/proc/{self._proc.pid}/stat", encoding="ascii") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")     # utime + stime
 
     def output(self) -> str:
         """What the server printed so far."""
