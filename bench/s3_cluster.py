@@ -120,10 +120,13 @@ def main() -> None:
                 ray.shutdown()
             cluster.shutdown()
         disk = _disk_files(os.path.join(work, "disk1"))
-        for prefix in ("single/basic/", "cluster/basic/"):
-            objects = server.objects("bench", prefix)
-            if objects != disk or _disk_files(os.path.join(work, "disk2")) != disk:
-                raise RuntimeError(f"s3://bench/{prefix} differs from the disk dataset")
+        for name, other in (("s3://bench/single/basic", server.objects("bench", "single/basic/")),
+                            ("s3://bench/cluster/basic", server.objects("bench", "cluster/basic/")),
+                            ("the 2-node disk run", _disk_files(os.path.join(work, "disk2")))):
+            differ = sorted(k for k in set(disk) | set(other) if disk.get(k) != other.get(k))
+            if differ:
+                raise RuntimeError(f"{name} differs from the 1-process disk dataset in {len(differ)} files: "
+                                   f"{differ[:6]}")
     shutil.rmtree(work, ignore_errors=True)
 
     base = {r["run"]: r for r in rows}
