@@ -201,6 +201,39 @@ def test_a_failed_multipart_upload_leaves_nothing(bucket, s3_server, monkeypatch
     assert s3_server.s3().list_multipart_uploads(Bucket=bucket).get("Uploads", []) == []   # aborted
 
 
+def test_dropped_connections_and_throttling_are_retried(bucket):
+    """The first sends of a put fail as a dropped connection and as S3's 503 SlowDown; the client retries."""
+    from botocore.awsrequest import AWSResponse
+    from botocore.exceptions import ConnectionClosedError
+    store = object_store.store(bucket)
+    sends = []
+
+    def flaky(request, **_):
+        sends.append(request.url)
+        if len(sends) == 1:
+            raise ConnectionClosedError(endpoint_url=request.url)
+        if len(sends) == 2:
+            body = b"<Error><Code>SlowDown</Code><Message>Please reduce your request rate.</Message></Error>"
+            return AWSResponse(request.url, 503, {}, _RawBody(body))
+        return None            # the real request
+    store.client.meta.events.register("before-send.s3.PutObject", flaky)
+    try:
+        store.put("retried/object.bin", b"payload")
+    finally:
+        store.client.meta.events.unregister("before-send.s3.PutObject", flaky)
+    assert len(sends) == 3 and store.get("retried/object.bin") == b"payload"
+
+
+class _RawBody:
+    """The raw stream botocore reads an HTTP response body from."""
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+
+    def stream(self, **_):
+        yield self.data
+
+
 # ---- bad input: clear errors within seconds, nothing written -----------------------------------
 def _initialize_fails(output_dir: str, **kwargs) -> str:
     start = time.monotonic()
