@@ -29,6 +29,7 @@ import os
 from dataclasses import dataclass, field
 
 from graphsdg import settings
+from graphsdg.io.object_store import is_s3_url
 
 SHARD_FOLDER = ".graphsdg-shards"   # per-shard aggregate files, inside a writer's output folder
 
@@ -112,7 +113,7 @@ def record_writer(writer) -> None:
     if output_dir is None:
         return
     info = writer.shard_info() if hasattr(writer, "shard_info") else {}
-    folder = output_dir if output_dir.startswith("s3://") else os.path.abspath(output_dir)   # or an S3 prefix
+    folder = output_dir if is_s3_url(output_dir) else os.path.abspath(output_dir)   # a folder or an S3 prefix
     _records[id(writer)] = WriterRecord(type(writer).__name__, folder,
                                         dict(info.pop("aggregates", {})), info)
 

@@ -67,6 +67,7 @@ class ShardWorker:
         import ray
         from graphsdg.render.egl_device import follow_assigned_gpu
         self.gpu_ids = list(ray.get_gpu_ids())
+        self.node = ray.get_runtime_context().get_node_id()
         self.egl_device = follow_assigned_gpu(self.gpu_ids)   # before the first GL context
 
     def run(self, job: JobSpec, index: int, count: int, write_threads: int | None = None,
@@ -83,8 +84,8 @@ class ShardWorker:
         if image_threads is not None:
             limit_image_threads(image_threads)
         summary = run_job(script_here(job), FramePlan(index, count, job.resume))
-        import ray
-        summary.update(node=ray.get_runtime_context().get_node_id(), pid=os.getpid(), gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
+        summary.update(node=self.node, pid=os.getpid(),
+                       gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
                        write_threads=get_write_queue().num_threads, image_threads=image_threads)
         return summary
 
@@ -134,7 +135,8 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         env = {k: v for k, v in os.environ.items() if k in FORWARDED_ENV}
         with open(job.script, "rb") as f:
             source = f.read()
-        job = replace(job, out=normalize(job.out), script=os.path.abspath(job.script), env=env, script_source=source)
+        job = replace(job, out=normalize(job.out), script=os.path.abspath(job.script), env=env,
+                      script_source=source)
         # one shard per node first: on a cluster each node's cores and GPUs are used
         actor = ray.remote(num_cpus=1, num_gpus=per_worker, scheduling_strategy="SPREAD")(ShardWorker)
         actors = [actor.remote() for _ in range(workers)]

@@ -1,11 +1,12 @@
 """``graphsdg validate``: check a dataset's internal consistency and list every violation.
 
-Checks (BasicWriter layout): every frame has the same set of files and every
-companion file exists; no temporary files are left; the dataset is a folder or an ``s3://bucket/prefix``; each 2D box lies inside the
-image and contains the pixels of its instance (when instance segmentation was
-written) or its class (semantic segmentation); box labels agree with the
-segmentation mapping; depth is finite wherever an object is; frames are not empty
-(no labelled pixel) and not duplicates of another frame.
+Checks (BasicWriter layout, in a folder or under an ``s3://bucket/prefix``): every
+frame has the same set of files and every companion file exists; no temporary
+files are left; each 2D box lies inside the image and contains the pixels of its
+instance (when instance segmentation was written) or its class (semantic
+segmentation); box labels agree with the segmentation mapping; depth is finite
+wherever an object is; frames are not empty (no labelled pixel) and not
+duplicates of another frame.
 """
 from __future__ import annotations
 

@@ -1,7 +1,8 @@
 """``graphsdg view``: a contact sheet (and HTML gallery) of a dataset with boxes, names and masks drawn.
 
-Reads BasicWriter, COCO, KITTI and YOLO outputs, in a folder or under an ``s3://bucket/prefix`` (:mod:`graphsdg.dataset.formats`
-detects which) and reports per-class box counts, empty frames and box-size statistics.
+Reads BasicWriter, COCO, KITTI and YOLO outputs, in a folder or under an
+``s3://bucket/prefix`` (:mod:`graphsdg.dataset.formats` detects which) and
+reports per-class box counts, empty frames and box-size statistics.
 """
 from __future__ import annotations
 

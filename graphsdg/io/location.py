@@ -225,16 +225,9 @@ def open_location(path: str | os.PathLike | Location) -> Location:
     return S3Location(text) if is_s3_url(text) else LocalLocation(text)
 
 
-def join(root: str, rel: str) -> str:
-    """``rel`` below ``root`` for a folder path or an ``s3://`` URL (``rel`` absolute: ``rel`` itself)."""
-    if is_s3_url(root):
-        return str(S3Url.parse(root).child(rel))
-    return os.path.join(root, rel)
-
-
 def normalize(path: str) -> str:
     """An absolute folder path, or the ``s3://`` URL in canonical form."""
     return str(S3Url.parse(path)) if is_s3_url(path) else os.path.abspath(path)
 
 
-__all__ = ["Location", "LocalLocation", "S3Location", "open_location", "join", "normalize"]
+__all__ = ["Location", "LocalLocation", "S3Location", "open_location", "normalize"]
