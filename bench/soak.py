@@ -9,7 +9,8 @@ Two measurements, each printed as a table of samples and a verdict:
   must stay under ``--limit`` percent.
 * ``pipelined``: the same for the ``graphsdg bench`` scene stepped with
   ``wait_for_render=False`` (pixel-buffer readback, captures finished at the
-  next step).
+  next step); ``--assets`` sets its size (a total over the 5 shapes, default 50;
+  crowded scenes: 5000).
 * ``cycles``: ``--cycles`` times: create a render product (resolutions rotate
   through a few sizes), get annotators and a BasicWriter, attach, capture one
   frame, detach, destroy.
@@ -21,6 +22,7 @@ Two measurements, each printed as a table of samples and a verdict:
 
     python bench/soak.py frames --frames 10000 --resolution 128 96
     python bench/soak.py pipelined --frames 10000 --resolution 128 96
+    python bench/soak.py pipelined --assets 5000 --frames 10000 --every 500 --resolution 512 512   # GPU host
     python bench/soak.py cycles --cycles 1000
 
 Both run in this process; ``--out`` is deleted at the end unless ``--keep``.
@@ -103,11 +105,17 @@ def soak_frames(out: str, frames: int, every: int, resolution: tuple[int, int], 
     return samples
 
 
-def soak_pipelined(out: str, frames: int, every: int, resolution: tuple[int, int], seed: int) -> list[tuple]:
-    """The ``graphsdg bench`` scene written by BasicWriter with pipelined steps (``wait_for_render=False``):
-    the pixel-buffer pool and the pending captures, for ``frames`` frames."""
+def soak_pipelined(out: str, frames: int, every: int, resolution: tuple[int, int], seed: int,
+                   assets: int = 50) -> list[tuple]:
+    """The ``graphsdg bench`` scene of ``assets`` assets (a multiple of its 5 shapes) written by BasicWriter with
+    pipelined steps (``wait_for_render=False``): the pixel-buffer pool and the pending captures, for ``frames``
+    frames."""
     from graphsdg import benchmark
+    if assets < len(benchmark.SHAPES) or assets % len(benchmark.SHAPES):
+        raise ValueError(f"--assets is a total over the bench's {len(benchmark.SHAPES)} shapes: a positive multiple "
+                         f"of {len(benchmark.SHAPES)}, got {assets}")
     config = benchmark.BenchConfig(frames=frames, resolution=resolution, seed=seed,
+                                   asset_count=assets // len(benchmark.SHAPES),
                                    annotators=("rgb", "distance_to_image_plane", "semantic_segmentation",
                                                "bounding_box_2d_tight"))
     assets, cams, rps = benchmark.build_scene(config)
@@ -188,6 +196,8 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument("--warmup", type=int, default=1000)
         p.add_argument("--resolution", type=int, nargs=2, default=(128, 96))
         p.add_argument("--seed", type=int, default=0)
+    pl.add_argument("--assets", type=int, default=50,
+                    help="assets in the bench scene, a multiple of its 5 shapes (default: 50)")
     c = sub.add_parser("cycles", help="render products, annotators and writers attached and detached")
     c.add_argument("--cycles", type=int, default=1000)
     c.add_argument("--every", type=int, default=100)
@@ -199,14 +209,18 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument("--keep", action="store_true", help="keep the written dataset")
         p.add_argument("--trim", action="store_true", help="malloc_trim(0) before each RSS sample (glibc)")
     args = parser.parse_args(argv)
+    if args.what == "pipelined" and (args.assets < 5 or args.assets % 5):
+        parser.error(f"--assets is a total over the bench's 5 shapes: a positive multiple of 5, got {args.assets}")
     global TRIM
     TRIM = args.trim
     out = args.out or tempfile.mkdtemp(prefix="graphsdg-soak-")
     start = time.perf_counter()
     try:
         if args.what in ("frames", "pipelined"):
+            extra = {"assets": args.assets} if args.what == "pipelined" else {}
             soak = soak_frames if args.what == "frames" else soak_pipelined
-            samples = soak(os.path.join(out, args.what), args.frames, args.every, tuple(args.resolution), args.seed)
+            samples = soak(os.path.join(out, args.what), args.frames, args.every, tuple(args.resolution), args.seed,
+                           **extra)
             print("| frames | RSS MiB | frames/s so far | queued writes |\n|---|---|---|---|")
             for n, mb, fps, pending in samples:
                 print(f"| {n} | {mb:.1f} | {fps:.1f} | {pending} |")
@@ -230,7 +244,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\nRSS after warm-up ({args.warmup}): {base:.1f} MiB, largest later: {peak:.1f} MiB, growth {pct:+.2f} % "
           f"(limit {args.limit} %){' after malloc_trim' if TRIM else ''}: {'OK' if ok else 'FAIL'}; "
           f"{time.perf_counter() - start:.0f} s, "
-          f"Python {sys.version.split()[0]}, MUJOCO_GL={os.environ.get('MUJOCO_GL', 'egl')}")
+          + (f"{args.assets} assets at {args.resolution[0]}x{args.resolution[1]}, " if args.what == "pipelined" else "")
+          + f"Python {sys.version.split()[0]}, MUJOCO_GL={os.environ.get('MUJOCO_GL', 'egl')}")
     return 0 if ok else 1
 
 

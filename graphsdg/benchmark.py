@@ -68,6 +68,22 @@ class BenchConfig:
     msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
     shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
     image_threads: int | None = None     # OpenCV's pool; None: its default, or with --processes each one's share
+    render_backend: str | None = None    # /graphsdg/render/backend (classic, pbr, auto); None: the setting as it is
+    seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
+
+
+MIN_TIMED_FRAMES = 20
+
+
+def timed_frames(config: BenchConfig, warmup_times: list[float]) -> int:
+    """Frames to time: ``config.frames``, or with ``config.seconds`` what the warm-up's rate (its second half:
+    the first frames compile and upload) fits in those seconds, at least ``MIN_TIMED_FRAMES`` and at most
+    ``config.frames``."""
+    if config.seconds is None or not warmup_times:
+        return config.frames
+    recent = warmup_times[len(warmup_times) // 2:]
+    per_frame = max(sum(recent) / len(recent), 1e-6)
+    return max(min(config.frames, MIN_TIMED_FRAMES), min(config.frames, int(config.seconds / per_frame)))
 
 
 @dataclass
@@ -100,7 +116,7 @@ class BenchResult:
 
     def summary(self) -> dict[str, float | str]:
         ft = np.array(self.frame_times) * 1000 if self.frame_times else np.zeros(1)
-        return {"run": self.label, "frames/s": round(self.fps, 2), "images/s": round(self.images_per_second, 2),
+        return {"run": self.label, "frames": self.frames, "frames/s": round(self.fps, 2), "images/s": round(self.images_per_second, 2),
                 "frames/s incl. drain": round(self.fps_with_drain, 2), "min ms": round(float(ft.min()), 2),
                 "mean ms": round(float(ft.mean()), 2), "max ms": round(float(ft.max()), 2),
                 "CPU ms/frame": round(1000 * self.cpu_seconds / self.frames, 1) if self.frames else 0.0,
@@ -144,6 +160,8 @@ def build_scene(config: BenchConfig):
         rep.settings.set("/graphsdg/render/msaaSamples", int(config.msaa_samples))
     if config.shadow_size is not None:
         rep.settings.set("/graphsdg/render/shadowSize", int(config.shadow_size))
+    if config.render_backend is not None:
+        rep.settings.set("/graphsdg/render/backend", config.render_backend)
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)
@@ -198,18 +216,22 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
         writer.initialize(output_dir=out, **flags)
         writer.attach(rps)
     draws = Randomization(config)
-    result = BenchResult(label="graphsdg", frames=config.frames, cameras=config.num_cameras)
+    warmup_times = []
     for _ in range(config.warmup):
+        t = time.perf_counter()
         _apply(draws.draw(), assets, cams)
         rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
+        warmup_times.append(time.perf_counter() - t)
     rep.orchestrator.wait_until_complete()
+    frames = timed_frames(config, warmup_times)
+    result = BenchResult(label="graphsdg", frames=frames, cameras=config.num_cameras)
     if before_timing is not None:
         before_timing()
     rep.orchestrator.reset_profile()
     result.started_at = time.time()
     cpu_start = _cpu_seconds()
     start = last = time.perf_counter()
-    for _ in range(config.frames):
+    for _ in range(frames):
         t = time.perf_counter()
         _apply(draws.draw(), assets, cams)
         profiling.add("randomize", time.perf_counter() - t)
@@ -346,15 +368,19 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
                     pending.append(pool.submit(write, f"{tmp}/seg_{c}_{index}.png", sem))
                     pending.append(pool.submit(write, f"{tmp}/boxes_{c}_{index}.npy", boxes))
 
-    result = BenchResult(label="hand-written MuJoCo loop", frames=config.frames, cameras=config.num_cameras)
+    warmup_times = []
     for i in range(config.warmup):
+        t = time.perf_counter()
         frame(draws.draw(), -1 - i)
+        warmup_times.append(time.perf_counter() - t)
     concurrent.futures.wait(pending)
+    frames = timed_frames(config, warmup_times)
+    result = BenchResult(label="hand-written MuJoCo loop", frames=frames, cameras=config.num_cameras)
     pending.clear()
     profiling.reset()
     cpu_start = _cpu_seconds()
     start = last = time.perf_counter()
-    for i in range(config.frames):
+    for i in range(frames):
         frame(draws.draw(), i)
         while len(pending) > 1000:          # the same bounded queue as graphsdg's writer pool
             pending.pop(0).result()

@@ -67,15 +67,18 @@ def run_bench(args: argparse.Namespace) -> None:
         asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
         rt_subframes=args.rt_subframes, wait_for_render=args.wait_for_render,
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
-        msaa_samples=args.msaa, shadow_size=args.shadow_size)
+        msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
                        f", {args.write_threads} write threads" if args.write_threads is not None else "",
                        ", wait_for_render" if args.wait_for_render else ""])
-    settings_line = (f"{args.num_frames} frames, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
+    length = f"{args.num_frames} frames" if args.seconds is None else \
+        f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
+    settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
                      f"{'skip-write' if args.skip_write else 'written'}")
-    machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}"
+    machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}, render backend: " \
+              f"{_render_backend(args.backend)}"
     if args.processes:
         row = benchmark.run_processes(config, args.processes)
         table = benchmark.format_table([row])
@@ -93,15 +96,15 @@ def run_bench(args: argparse.Namespace) -> None:
             prof = rows[0].profile
             frame_ms = 1000.0 / rows[0].fps if rows[0].fps else 0.0
             table += "\n\n" + benchmark.format_table(
-                [{"phase": k, "ms/frame": round(v / config.frames * 1000, 2),
+                [{"phase": k, "ms/frame": round(v / rows[0].frames * 1000, 2),
                   "share of frame": "(worker threads)" if k == "encode+write" else
-                  f"{v / config.frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
+                  f"{v / rows[0].frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
                  for k, v in sorted(prof.items(), key=lambda kv: -kv[1])])
             table += f"\n\ngraphsdg frame time {frame_ms:.2f} ms"
             if len(rows) == 2 and rows[1].profile:
                 base_ms = 1000.0 / rows[1].fps if rows[1].fps else 0.0
                 table += "\n\n" + benchmark.format_table(
-                    [{"hand-written phase": k, "ms/frame": round(v / config.frames * 1000, 2)}
+                    [{"hand-written phase": k, "ms/frame": round(v / rows[1].frames * 1000, 2)}
                      for k, v in sorted(rows[1].profile.items(), key=lambda kv: -kv[1])])
                 table += f"\n\nhand-written frame time {base_ms:.2f} ms"
     text = f"### {settings_line}\n\nMachine: {machine}\n\n{table}\n"
@@ -145,6 +148,20 @@ def _gl_renderer() -> str:
         ctx.free()
         return name
     except Exception as exc:  # noqa: BLE001 - informational only
+        return f"unknown ({exc})"
+
+
+def _render_backend(requested: str | None) -> str:
+    """The renderer a bench run drew with: ``requested`` (or the setting) resolved on this machine."""
+    import dataclasses
+
+    from graphsdg.render.backend import requested_backend, resolve_backend
+    request = requested_backend()
+    if requested is not None:
+        request = dataclasses.replace(request, backend=requested)
+    try:
+        return resolve_backend(request)
+    except Exception as exc:  # noqa: BLE001 - informational only (the run itself reported any error)
         return f"unknown ({exc})"
 
 
@@ -207,6 +224,27 @@ def _positive(value: str) -> int:
     return n
 
 
+def _non_negative(value: str) -> int:
+    n = int(value)
+    if n < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {value}")
+    return n
+
+
+def _positive_float(value: str) -> float:
+    x = float(value)
+    if not x > 0:
+        raise argparse.ArgumentTypeError(f"must be a number > 0, got {value}")
+    return x
+
+
+def _subframes(value: str) -> int:
+    n = int(value)
+    if n < 1 and n != -1:
+        raise argparse.ArgumentTypeError(f"must be -1 (the default) or a positive integer, got {value}")
+    return n
+
+
 def _fraction(value: str) -> float:
     x = float(value)
     if not x >= 0:
@@ -234,29 +272,59 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--frames", type=_positive, default=10, help="frames to capture (default: 10)")
     demo.add_argument("--resolution", type=_positive, nargs=2, default=(512, 512), metavar=("W", "H"))
     demo.add_argument("--seed", type=int, default=0)
-    bench = sub.add_parser("bench", parents=[common],
-                           help="Isaac Sim's SDG benchmark scene vs a hand-written MuJoCo loop", epilog=EPILOG)
-    bench.add_argument("--num-frames", type=int, default=600)
-    bench.add_argument("--warmup", type=int, default=10)
-    bench.add_argument("--num-cameras", type=int, default=1)
-    bench.add_argument("--resolution", type=int, nargs=2, default=(1280, 720), metavar=("W", "H"))
-    bench.add_argument("--asset-count", type=int, default=10, help="assets per shape type (5 types)")
+    bench = sub.add_parser(
+        "bench", parents=[common], help="Isaac Sim's SDG benchmark scene vs a hand-written MuJoCo loop",
+        description="Times Isaac Sim's benchmark_sdg.py scene (cube, cone, cylinder, sphere and torus assets with "
+                    "random poses, scales and colours every frame, a distant and a dome light) captured by "
+                    "graphsdg, then a hand-written MuJoCo loop over the same compiled model in the same process, "
+                    "and prints a Markdown table (docs/performance.md says what is measured; bench/scaling.py "
+                    "sweeps asset counts and resolutions).", epilog=EPILOG)
+    bench.add_argument("--num-frames", type=_positive, default=600,
+                       help="timed frames of each run, after the warm-up (default: 600)")
+    bench.add_argument("--seconds", type=_positive_float,
+                       help="time each run for about this many seconds: fewer than --num-frames frames when the "
+                            "warm-up's rate says so, at least 20 (default: always --num-frames)")
+    bench.add_argument("--warmup", type=_non_negative, default=10,
+                       help="untimed frames captured first, so compiling and first uploads are not timed "
+                            "(default: 10)")
+    bench.add_argument("--num-cameras", type=_positive, default=1,
+                       help="cameras, each with its own render product, all randomized every frame (default: 1)")
+    bench.add_argument("--resolution", type=_positive, nargs=2, default=(1280, 720), metavar=("W", "H"),
+                       help="width and height of every render product in pixels (default: 1280 720)")
+    bench.add_argument("--asset-count", type=_positive, default=10,
+                       help="assets of each of the 5 shapes, so the scene holds 5 times this many "
+                            "(default: 10, i.e. 50 assets)")
     bench.add_argument("--annotators", nargs="+", default=["rgb"],
-                       help="annotator names as in benchmark_sdg.py, or 'all'")
-    bench.add_argument("--skip-write", action="store_true", help="compute annotators but write nothing")
-    bench.add_argument("--rt-subframes", type=int, default=-1)
+                       help="annotators to capture, by their benchmark_sdg.py names, or 'all' (default: rgb)")
+    bench.add_argument("--skip-write", action="store_true",
+                       help="compute the annotators' data but write no files")
+    bench.add_argument("--rt-subframes", type=_subframes, default=-1,
+                       help="jittered renders averaged per frame (anti-aliasing), -1 for the default of 1")
     bench.add_argument("--wait-for-render", action="store_true",
-                       help="finish each frame inside its step (off by default, as in benchmark_sdg.py: steps are pipelined)")
-    bench.add_argument("--no-replicator-write-to-fabric", action="store_true")
-    bench.add_argument("--write-threads", type=int, help="writer threads per process (default: 4, or with "
-                       "--processes each process's share of the cores, at least 1)")
-    bench.add_argument("--msaa", type=int, help="multisample count of the colour pass (default: graphsdg's 4)")
-    bench.add_argument("--shadow-size", type=int, help="shadow map size (default: graphsdg's 1024)")
-    bench.add_argument("--processes", type=int, default=0,
-                       help="run this many graphsdg processes at once and report the aggregate (no baseline)")
+                       help="finish each frame inside its step (off by default, as in benchmark_sdg.py: steps "
+                            "are pipelined)")
+    bench.add_argument("--no-replicator-write-to-fabric", action="store_true",
+                       help="write randomized poses and colours to USD and sync them, instead of straight into "
+                            "MuJoCo (Isaac Sim 6's write-to-fabric, on by default)")
+    bench.add_argument("--write-threads", type=_positive,
+                       help="writer threads per process (default: 4, or with --processes each process's share "
+                            "of the cores, at least 1)")
+    bench.add_argument("--msaa", type=_non_negative,
+                       help="multisample count of the colour pass, 0 for none (default: graphsdg's 4)")
+    bench.add_argument("--shadow-size", type=_positive,
+                       help="shadow map size in texels (default: graphsdg's 1024)")
+    bench.add_argument("--backend", choices=("classic", "pbr", "auto"),
+                       help="graphsdg's renderer: the OpenGL rasteriser (classic), the GPU ray tracer (pbr) or "
+                            "pbr where it can run (auto); the hand-written loop always rasterises (default: the "
+                            "setting /graphsdg/render/backend, auto)")
+    bench.add_argument("--processes", type=_non_negative, default=0,
+                       help="run this many graphsdg processes at once and report their aggregate frames/s "
+                            "(no hand-written loop); 0 runs one process with the loop (default: 0)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
-    bench.add_argument("--profile", action="store_true", help="print where each frame's time goes")
-    bench.add_argument("--report", metavar="MD", help="append the result table to this Markdown file")
+    bench.add_argument("--profile", action="store_true",
+                       help="also print milliseconds per frame of each phase (randomize, render passes, "
+                            "annotators, writing) for both runs")
+    bench.add_argument("--report", metavar="MD", help="append the printed tables to this Markdown file")
     run = sub.add_parser("run", parents=[common],
                          help="run a graphsdg (or, with --compat isaac, an Isaac Sim Replicator) script",
                          usage="graphsdg run SCRIPT [options] [-- SCRIPT_ARGS ...]",

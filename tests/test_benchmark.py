@@ -59,3 +59,35 @@ def test_image_threads_set_opencvs_pool():
         assert cv2.getNumThreads() == 1
     finally:
         cv2.setNumThreads(before)
+
+
+def test_every_bench_option_is_described_in_its_help():
+    from graphsdg.cli import build_parser
+    commands = next(a for a in build_parser()._actions if isinstance(a, __import__("argparse")._SubParsersAction))
+    bench = commands.choices["bench"]
+    options = [a for a in bench._actions if a.option_strings and a.dest != "help"]
+    assert len(options) >= 18
+    for action in options:
+        assert action.help and len(action.help.split()) >= 4, f"{action.option_strings} has no description"
+    assert bench.description and "hand-written MuJoCo loop" in bench.description
+
+
+@pytest.mark.parametrize("bad", [["--asset-count", "0"], ["--num-frames", "-1"], ["--msaa", "-2"],
+                                 ["--rt-subframes", "0"], ["--seconds", "0"], ["--backend", "rtx"]])
+def test_bench_refuses_bad_values_naming_them(bad, capsys):
+    from graphsdg.cli import build_parser
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["bench", *bad])
+    assert bad[1] in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("frames, seconds, warmup_times, expected", [
+    (600, None, [0.1] * 10, 600),            # no time budget: every frame asked for
+    (600, 8.0, [1.0] * 5 + [0.1] * 5, 80),   # the warm-up's second half: 10 frames/s for 8 s
+    (600, 8.0, [0.001] * 10, 600),           # never more than asked for
+    (600, 1.0, [1.0] * 10, 20),              # at least 20
+    (5, 1.0, [1.0] * 10, 5),                 # ... unless fewer were asked for
+])
+def test_timed_frames_fit_the_time_budget(frames, seconds, warmup_times, expected):
+    from graphsdg.benchmark import BenchConfig, timed_frames
+    assert timed_frames(BenchConfig(frames=frames, seconds=seconds), warmup_times) == expected

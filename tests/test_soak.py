@@ -45,3 +45,15 @@ def test_long_demo_run_memory_is_flat(soak, tmp_path):
     assert len(os.listdir(tmp_path / "demo")) > 400 * 4
     assert peak - base < 8.0, rss
     gc.collect()
+
+
+def test_pipelined_soak_builds_the_asked_asset_count(soak, tmp_path):
+    from graphsdg.runtime import runtime
+    samples = soak.soak_pipelined(str(tmp_path / "pipelined"), frames=6, every=3, resolution=(32, 24), seed=0,
+                                  assets=15)
+    assert [n for n, *_ in samples] == [0, 3, 6]
+    paths = [p for p in runtime().sim.compiled.geoms if p.startswith("/World/")]
+    assert len(paths) == 15 and sum("/World/Torus" in p for p in paths) == 3
+    assert len([f for f in os.listdir(tmp_path / "pipelined") if f.startswith("rgb_")]) == 6
+    with pytest.raises(ValueError, match="multiple of 5, got 12"):
+        soak.soak_pipelined(str(tmp_path / "bad"), frames=1, every=1, resolution=(32, 24), seed=0, assets=12)
