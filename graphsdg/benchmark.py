@@ -64,7 +64,7 @@ class BenchConfig:
     write_to_fabric: bool = True
     seed: int = 11
     out_dir: str | None = None
-    write_threads: int | None = None     # None: 4, or each process's share of the cores with --processes
+    write_threads: int | None = None     # None: write_queue.default_threads(), or with --processes their share
     msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
     shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
     image_threads: int | None = None     # OpenCV's pool; None: its default, or with --processes each one's share
@@ -148,8 +148,9 @@ class Randomization:
 
 
 def _write_threads(config: BenchConfig) -> int:
-    from graphsdg.io.write_queue import DEFAULT_THREADS
-    return DEFAULT_THREADS if config.write_threads is None else config.write_threads
+    """Writer threads of both loops: ``config.write_threads``, or one process's default for this machine's cores."""
+    from graphsdg.io.write_queue import default_threads
+    return default_threads() if config.write_threads is None else config.write_threads
 
 
 def build_scene(config: BenchConfig):

@@ -70,7 +70,8 @@ def run_bench(args: argparse.Namespace) -> None:
         msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
-                       f", {args.write_threads} write threads" if args.write_threads is not None else "",
+                       f", {args.write_threads} write threads" if args.write_threads is not None else
+                       "" if args.processes else f", {_default_write_threads()} write threads",
                        ", wait_for_render" if args.wait_for_render else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
@@ -149,6 +150,11 @@ def _gl_renderer() -> str:
         return name
     except Exception as exc:  # noqa: BLE001 - informational only
         return f"unknown ({exc})"
+
+
+def _default_write_threads() -> int:
+    from graphsdg.io.write_queue import default_threads
+    return default_threads()
 
 
 def _render_backend(requested: str | None) -> str:
@@ -307,8 +313,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="write randomized poses and colours to USD and sync them, instead of straight into "
                             "MuJoCo (Isaac Sim 6's write-to-fabric, on by default)")
     bench.add_argument("--write-threads", type=_positive,
-                       help="writer threads per process (default: 4, or with --processes each process's share "
-                            "of the cores, at least 1)")
+                       help="writer threads per process, shared by both loops (default: 4 on 16 cores or more, "
+                            "a quarter of the cores below, at least 1; with --processes each process's share)")
     bench.add_argument("--msaa", type=_non_negative,
                        help="multisample count of the colour pass, 0 for none (default: graphsdg's 4)")
     bench.add_argument("--shadow-size", type=_positive,

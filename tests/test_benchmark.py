@@ -91,3 +91,9 @@ def test_bench_refuses_bad_values_naming_them(bad, capsys):
 def test_timed_frames_fit_the_time_budget(frames, seconds, warmup_times, expected):
     from graphsdg.benchmark import BenchConfig, timed_frames
     assert timed_frames(BenchConfig(frames=frames, seconds=seconds), warmup_times) == expected
+
+
+@pytest.mark.parametrize("cores, threads", [(1, 1), (2, 1), (7, 1), (8, 2), (12, 3), (16, 4), (64, 4)])
+def test_one_process_gets_writer_threads_for_its_cores(cores, threads):
+    from graphsdg.io.write_queue import default_threads
+    assert default_threads(cores) == threads
