@@ -40,7 +40,7 @@ import mujoco
 import numpy as np
 
 from graphsdg import profiling
-from graphsdg.render import sky
+from graphsdg.render import gl_direct, sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
@@ -129,10 +129,7 @@ def _is_current(gl) -> bool:
     if context is None or os.environ.get("MUJOCO_GL", "").lower() != "egl":
         return False
     import ctypes
-
-    from OpenGL import EGL
-    address = lambda p: ctypes.cast(p, ctypes.c_void_p).value  # noqa: E731
-    return address(EGL.eglGetCurrentContext()) == address(context)
+    return gl_direct.egl_current_context() == ctypes.cast(context, ctypes.c_void_p).value
 
 
 def halton(index: int, base: int) -> float:

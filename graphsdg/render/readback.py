@@ -36,6 +36,7 @@ from OpenGL import GL
 from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no client-array wrapping: a PBO offset
 
 from graphsdg import profiling
+from graphsdg.render import gl_direct as gld
 
 _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
     "rgba": (GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, np.uint8, 4),
@@ -94,19 +95,23 @@ class PendingPixels:
             try:
                 wait_for_fence(fence)
             finally:
-                GL.glDeleteSync(fence)
-        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, self._pbo)
-        pointer = GL.glMapBufferRange(GL.GL_PIXEL_PACK_BUFFER, 0, self._nbytes, GL.GL_MAP_READ_BIT)
+                gld.glDeleteSync(fence)
+        # binds and the map of a buffer whose copy is done keep the interpreter lock (gl_direct)
+        gld.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, self._pbo)
+        pointer = gld.glMapBufferRange(GL.GL_PIXEL_PACK_BUFFER, 0, self._nbytes, GL.GL_MAP_READ_BIT)
         if not pointer:
-            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
-            raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading")
+            gld.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+            error = gld.glGetError()
+            raise RuntimeError(f"could not map a {self._nbytes}-byte pixel buffer for reading (GL error "
+                               f"0x{error:04x})")
         try:
             mapped = np.frombuffer((ctypes.c_ubyte * self._nbytes).from_address(pointer), dtype=self._dtype)
             out = self._decode(mapped.reshape(self._shape)[::-1])
         finally:
-            GL.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
-            GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+            gld.glUnmapBuffer(GL.GL_PIXEL_PACK_BUFFER)
+            gld.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
             self._reads.release(self._pbo, self._nbytes)
+        gld.check("mapping a pixel buffer")
         return out
 
 
@@ -170,16 +175,19 @@ class PixelReads:
             GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
             GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
             source = ctx.offFBO_r
-        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
-        GL.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
+        # the short calls keep the interpreter lock (gl_direct); the read itself (on Mesa it renders the
+        # frame) and the blit release it
+        gld.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, source)
+        gld.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
         pbo = self._acquire(nbytes)
-        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, pbo)
-        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        gld.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, pbo)
+        gld.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
         raw_read_pixels(0, 0, width, height, fmt, gltype, ctypes.c_void_p(0))
         if self._fences is None:
             self._fences = bool(GL.glFenceSync)
-        fence = GL.glFenceSync(GL.GL_SYNC_GPU_COMMANDS_COMPLETE, 0) if self._fences else None
-        GL.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+        fence = gld.glFenceSync(GL.GL_SYNC_GPU_COMMANDS_COMPLETE, 0) if self._fences else None
+        gld.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+        gld.check(f"queuing a read of {kind} pixels")
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # MuJoCo's own bindings back
         shape = (height, width, channels) if channels > 1 else (height, width)
         return PendingPixels(self, pbo, nbytes, shape, dtype, decode, fence)
@@ -224,7 +232,7 @@ def wait_for_fence(fence) -> None:
     flags = GL.GL_SYNC_FLUSH_COMMANDS_BIT   # the first poll also submits the queued commands
     pause = _FIRST_SLEEP
     while True:
-        status = GL.glClientWaitSync(fence, flags, 0)
+        status = gld.glClientWaitSync(fence, flags, 0)   # never blocks (timeout 0): keeps the interpreter lock
         if status in _SIGNALED:
             return
         if status == GL.GL_WAIT_FAILED:

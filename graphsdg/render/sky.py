@@ -25,6 +25,8 @@ import mujoco
 import numpy as np
 from OpenGL import GL
 
+from graphsdg.render import gl_direct as gld
+
 OPAQUE_ALPHA = 0.995   # MuJoCo draws geoms below this alpha in its transparent pass
 
 
@@ -73,31 +75,33 @@ def fill_background(width: int, height: int, rgb: tuple[float, float, float]) ->
 
     One rectangle at window depth 0 (MuJoCo's reversed-Z clear value, the far end)
     with MuJoCo's ``GL_GEQUAL`` depth test passes exactly where the depth buffer
-    still holds the clear value, sample by sample. GL state is saved and restored.
+    still holds the clear value, sample by sample. GL state is saved and restored. The ~30 calls keep the
+    interpreter lock (:mod:`graphsdg.render.gl_direct`), with one error check at the end.
     """
-    GL.glPushAttrib(GL.GL_ALL_ATTRIB_BITS)
+    gld.glPushAttrib(GL.GL_ALL_ATTRIB_BITS)
     try:
-        GL.glViewport(0, 0, width, height)
-        GL.glDepthRange(0.0, 0.0)            # every fragment at window depth 0, whatever the clip convention
-        GL.glEnable(GL.GL_DEPTH_TEST)
-        GL.glDepthFunc(GL.GL_GEQUAL)
-        GL.glDepthMask(GL.GL_FALSE)
+        gld.glViewport(0, 0, width, height)
+        gld.glDepthRange(0.0, 0.0)            # every fragment at window depth 0, whatever the clip convention
+        gld.glEnable(GL.GL_DEPTH_TEST)
+        gld.glDepthFunc(GL.GL_GEQUAL)
+        gld.glDepthMask(GL.GL_FALSE)
         for cap in (GL.GL_LIGHTING, GL.GL_TEXTURE_2D, GL.GL_TEXTURE_CUBE_MAP, GL.GL_FOG, GL.GL_CULL_FACE,
                     GL.GL_SCISSOR_TEST, GL.GL_ALPHA_TEST, GL.GL_STENCIL_TEST, GL.GL_BLEND):
-            GL.glDisable(cap)
-        GL.glPolygonMode(GL.GL_FRONT_AND_BACK, GL.GL_FILL)
-        GL.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
-        GL.glMatrixMode(GL.GL_PROJECTION)
-        GL.glPushMatrix()
-        GL.glLoadIdentity()
-        GL.glMatrixMode(GL.GL_MODELVIEW)
-        GL.glPushMatrix()
-        GL.glLoadIdentity()
-        GL.glColor4f(rgb[0], rgb[1], rgb[2], 1.0)
-        GL.glRectf(-1.0, -1.0, 1.0, 1.0)
-        GL.glPopMatrix()
-        GL.glMatrixMode(GL.GL_PROJECTION)
-        GL.glPopMatrix()
-        GL.glMatrixMode(GL.GL_MODELVIEW)
+            gld.glDisable(cap)
+        gld.glPolygonMode(GL.GL_FRONT_AND_BACK, GL.GL_FILL)
+        gld.glColorMask(GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE, GL.GL_TRUE)
+        gld.glMatrixMode(GL.GL_PROJECTION)
+        gld.glPushMatrix()
+        gld.glLoadIdentity()
+        gld.glMatrixMode(GL.GL_MODELVIEW)
+        gld.glPushMatrix()
+        gld.glLoadIdentity()
+        gld.glColor4f(rgb[0], rgb[1], rgb[2], 1.0)
+        gld.glRectf(-1.0, -1.0, 1.0, 1.0)
+        gld.glPopMatrix()
+        gld.glMatrixMode(GL.GL_PROJECTION)
+        gld.glPopMatrix()
+        gld.glMatrixMode(GL.GL_MODELVIEW)
     finally:
-        GL.glPopAttrib()
+        gld.glPopAttrib()
+    gld.check("filling the sky")
