@@ -144,12 +144,8 @@ def instance_segmentation(frame: FrameView, params: dict) -> dict:
 
 
 def _mesh_ids(frame: FrameView) -> tuple[np.ndarray, dict[int, str]]:
-    geom_ids = frame.require("geom_ids")
-    paths = frame.sim.ensure_compiled().geom_paths
-    table = frame.labels.ids.mesh
-    lut = np.array([table.id_of(p) if p else UNLABELLED_ID for p in paths] + [BACKGROUND_ID], dtype=np.uint32)
-    names = {table.id_of(p): p for p in paths if p}
-    return lut[geom_ids], names
+    lut, names = frame.labels.mesh_id_table(frame.sim)
+    return frame.ids_through(lut), dict(names)
 
 
 def instance_id_segmentation(frame: FrameView, params: dict) -> dict:

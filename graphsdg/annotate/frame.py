@@ -73,6 +73,22 @@ class SceneLabels:
         self.ids = ids
         self._key: tuple[int, int, bool] | None = None
         self._maps: dict[str, InstanceMap] = {}
+        self._mesh_table: tuple[int, np.ndarray, dict[int, str]] | None = None
+
+    def mesh_id_table(self, sim: SimScene) -> tuple[np.ndarray, dict[int, str]]:
+        """(geom index -> mesh id, with index -1 -> background; mesh id -> gprim path) of the compiled model.
+
+        Mesh ids are assigned once per prim path and never reused, so the table is
+        built once per compile instead of once per frame (a Python step per geom).
+        """
+        key = sim.model_version
+        if self._mesh_table is None or self._mesh_table[0] != key:
+            paths = sim.ensure_compiled().geom_paths
+            table = self.ids.mesh
+            lut = np.array([table.id_of(p) if p else UNLABELLED_ID for p in paths] + [BACKGROUND_ID],
+                           dtype=np.uint32)
+            self._mesh_table = (key, lut, {table.id_of(p): p for p in paths if p})
+        return self._mesh_table[1], self._mesh_table[2]
 
     def instance_map(self, sim: SimScene, stage: Usd.Stage, semantic_filter: SemanticFilter) -> InstanceMap:
         key = (sim.model_version, sim.labels_version, geom_subsets.per_subset_segmentation())
@@ -225,10 +241,11 @@ class FrameView:
         imap = self.instance_map(semantic_filter)
         per_instance = imap.semantic_ids if kind == "semantic" else imap.instance_ids
         ids = self._id_lut(per_instance, imap)
-        palette = np.zeros((len(ids), 4), dtype=np.uint8)
-        for i, value in enumerate(ids):
-            palette[i] = colors[int(value)]
-        packed = self.ids_through(palette.view(np.uint32)[:, 0])
+        # one colour per distinct id, spread over the geoms (a Python step per geom cost ~1 us each: 5 ms a frame
+        # at 5,000 assets)
+        distinct, slot = np.unique(ids, return_inverse=True)
+        palette = np.array([colors[int(v)] for v in distinct.tolist()], dtype=np.uint8).reshape(-1, 4)[slot]
+        packed = self.ids_through(np.ascontiguousarray(palette).view(np.uint32)[:, 0])
         return packed.view(np.uint8).reshape(*packed.shape, 4)
 
     def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
