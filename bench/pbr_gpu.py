@@ -24,7 +24,7 @@ import time
 import numpy as np
 
 import graphsdg as rep
-from graphsdg import settings
+from graphsdg import profiling, settings
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
 
@@ -58,17 +58,35 @@ def build_scene(size: int):
     mats = {name: matlib.define_preview_material(stage, f"/World/Looks/{name}", **kw) for name, kw in looks.items()}
     for prim, look in [(floor, "Concrete"), (pallet, "Wood"), (part, "Steel")] + [(b, "Cardboard") for b in boxes]:
         matlib.bind(prim, mats[look])
-    return rep.functional.create.camera(position=(3.2, -3.4, 2.2), look_at=(0.2, 0, 0.3), parent="/World",
-                                        name="Camera")
+    cam = rep.functional.create.camera(position=(3.2, -3.4, 2.2), look_at=(0.2, 0, 0.3), parent="/World",
+                                       name="Camera")
+    return cam, boxes
 
 
-def timed(render, frames: int) -> tuple[float, object]:
-    """Seconds per frame of ``render()`` (after one warm-up call), and the last output."""
+def timed(render, frames: int, vary=None) -> tuple[float, object]:
+    """Seconds per frame of ``vary(i)`` + ``render()`` (after one warm-up call), and the last output."""
     out = render()
     t = time.perf_counter()
-    for _ in range(frames):
+    for i in range(frames):
+        if vary is not None:
+            vary(i)
         out = render()
     return (time.perf_counter() - t) / frames, out
+
+
+def randomizer(boxes, sim):
+    """A per-frame randomization like a script's: box poses and colours drawn from a seeded generator."""
+    rng = np.random.default_rng(7)
+
+    def vary(i: int) -> None:
+        n = len(boxes)
+        rep.functional.modify.pose(boxes, position_value=np.c_[rng.uniform(-0.5, 0.5, (n, 2)),
+                                                               rng.uniform(0.3, 0.5, n)],
+                                   rotation_value=np.c_[np.zeros((n, 2)), rng.uniform(0, 90, n)])
+        rep.functional.modify.display_color(boxes, rng.uniform(0.3, 0.9, (n, 3)))
+        sim.sync_dirty_prims()
+        sim.forward()
+    return vary
 
 
 def digest(out) -> str:
@@ -85,20 +103,25 @@ def main() -> None:
     parser.add_argument("--path-frames", type=int, default=10)
     parser.add_argument("--path-spp", type=int, default=64)
     parser.add_argument("--out", help="folder for classic.png, realtime.png, path.png")
+    parser.add_argument("--randomize", action=argparse.BooleanOptionalAction, default=True,
+                        help="move and recolour the boxes before every frame (both backends)")
+    parser.add_argument("--cprofile", type=int, default=0, metavar="N",
+                        help="also profile N real-time frames with cProfile and print the top functions")
     parser.add_argument("--device", default=None, help="Warp device (default cuda:0; cpu for a smoke test)")
     args = parser.parse_args()
     from graphsdg.render.pbr import PbrRenderer
 
     size = args.size
-    cam = build_scene(size)
+    cam, boxes = build_scene(size)
     rt = runtime()
     pbr = PbrRenderer(args.device)   # before the compile: the model gets the PBR camera
     sim = rt.sim
     sim.require_offscreen(size, size)
     view = camera_view(cam, size, size)
-    rows, images, hashes = [], {}, {}
+    rows, images, hashes, phases = [], {}, {}, {}
 
-    s, out = timed(lambda: rt.rasterizer.render(sim, view, PASSES), args.frames)
+    vary = randomizer(boxes, sim) if args.randomize else None
+    s, out = timed(lambda: rt.rasterizer.render(sim, view, PASSES), args.frames, vary)
     rows.append(("classic (OpenGL rasteriser)", s, None))
     images["classic"] = out.color
 
@@ -106,7 +129,9 @@ def main() -> None:
         t = time.perf_counter()
         first = pbr.render(sim, view, PASSES)
         first_s = time.perf_counter() - t
-        s, out = timed(lambda: pbr.render(sim, view, PASSES), frames)
+        profiling.reset()
+        s, out = timed(lambda: pbr.render(sim, view, PASSES), frames, vary)
+        phases[name] = {k: v / frames * 1000 for k, v in profiling.snapshot().items() if "pbr" in k}
         rows.append((f"pbr {name}", s, first_s))
         images[name] = out.color
         # same seeds, new renderer: same bytes?
@@ -119,6 +144,12 @@ def main() -> None:
 
     settings.set("/rtx/rendermode", "RaytracedLighting")
     pbr_tier("realtime", args.frames)
+    if args.cprofile:
+        import cProfile
+        import pstats
+        profiler = cProfile.Profile()
+        profiler.runcall(timed, lambda: pbr.render(sim, view, PASSES), args.cprofile, vary)
+        pstats.Stats(profiler).sort_stats("tottime").print_stats(25)
     settings.set("/rtx/rendermode", "PathTracing")
     settings.set("/rtx/pathtracing/totalSpp", args.path_spp)
     pbr_tier("path", args.path_frames)
@@ -131,6 +162,8 @@ def main() -> None:
         print(f"| {name} | {s * 1000:.2f} | {1 / s:.0f} | {'' if first is None else f'{first:.1f}'} |")
     for name, (a, b) in hashes.items():
         print(f"determinism {name}: {a} vs {b} -> {'same bytes' if a == b else 'DIFFERENT'}")
+    for name, by_phase in phases.items():
+        print(f"pbr {name} phases, ms/frame: " + ", ".join(f"{k} {v:.3f}" for k, v in sorted(by_phase.items())))
     print(f"pbr stats {pbr.stats}")
     if args.out:
         from PIL import Image
