@@ -593,26 +593,34 @@ def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: MeshMaps | dict
         return
     mids = np.asarray(dataid)[geoms["objid"][rows]]
     if isinstance(maps, MeshMaps):
-        ids, folds = maps.stacked()
+        present, matrices = maps.present, maps.matrices
     else:
         ids = np.fromiter(maps.keys(), dtype=np.int64, count=len(maps))
-        folds = np.array(list(maps.values()), dtype=np.float64).reshape(-1, 3, 3)
-    if not ids.size:
-        return
-    table = np.full(max(int(ids.max()), int(mids.max())) + 1, -1, dtype=np.int64)
-    table[ids] = np.arange(ids.size)
-    slot = table[mids]
-    keep = slot >= 0
+        present = np.zeros(int(ids.max()) + 1 if ids.size else 0, dtype=bool)
+        present[ids] = True
+        matrices = np.zeros((present.size, 3, 3))
+        matrices[ids] = np.array(list(maps.values()), dtype=np.float64).reshape(-1, 3, 3)
+    keep = _flags_at(present, mids)
     if not keep.any():
         return
-    rows, slot = rows[keep], slot[keep]
+    rows, mids = rows[keep], mids[keep]
+    folds = matrices[mids]                            # current maps, one per drawn mesh geom
     has_undo, undo = uploaded_inverse
-    inside = np.flatnonzero(ids < has_undo.size)
-    undone = inside[has_undo[ids[inside]]]    # the maps' slots of meshes uploaded already rescaled
-    if undone.size:
-        folds[undone] = np.matmul(folds[undone], undo[ids[undone]])
+    undone = _flags_at(has_undo, mids)                # meshes uploaded already rescaled
+    if undone.any():
+        folds[undone] = np.matmul(folds[undone], undo[mids[undone]])
     mats = geoms["mat"][rows].reshape(-1, 3, 3)
-    geoms["mat"][rows] = np.matmul(mats, folds[slot]).reshape(-1, 9)
+    geoms["mat"][rows] = np.matmul(mats, folds).reshape(-1, 9)
+
+
+def _flags_at(flags: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """``flags[ids]`` with ids at or beyond the end of ``flags`` False."""
+    if ids.size and int(ids.max()) < flags.size:
+        return flags[ids]
+    out = np.zeros(ids.shape, dtype=bool)
+    inside = ids < flags.size
+    out[inside] = flags[ids[inside]]
+    return out
 
 
 def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:

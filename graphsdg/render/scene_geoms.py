@@ -42,6 +42,7 @@ _MIN_GEOMS_TO_CHECK = 4    # fewer geoms could match a wrong layout by chance; t
 
 _layout: dict[str, int | None] = {}          # "size_offset" once a layout matched (None: none did)
 _views: dict[tuple[int, int], np.ndarray] = {}   # (address, maxgeom) -> view of the whole geom buffer
+_last: dict[str, object] = {}   # the last scene asked about and its view: every render asks about the same one
 
 
 def _address(array: np.ndarray) -> int:
@@ -78,6 +79,9 @@ def geom_array(scene: mujoco.MjvScene) -> np.ndarray | None:
 
     Valid while ``scene`` is alive and not reallocated; take it again for each pass.
     """
+    last = _last.get("scene")
+    if last is scene:          # the renderer's scene again (held here, so its memory is the view's)
+        return _last["view"][:scene.ngeom]
     ngeom, maxgeom = int(scene.ngeom), int(scene.maxgeom)
     if maxgeom < 2:
         return None
@@ -87,6 +91,7 @@ def geom_array(scene: mujoco.MjvScene) -> np.ndarray | None:
     key = (first, maxgeom)
     view = _views.get(key)
     if view is not None and view.dtype.itemsize == stride:
+        _last.update(scene=scene, view=view)
         return view[:ngeom]
     size_offset = _layout.get("size_offset", 0)
     if size_offset is None:
@@ -103,4 +108,5 @@ def geom_array(scene: mujoco.MjvScene) -> np.ndarray | None:
     if len(_views) > 16:   # scenes come and go with recompiles: keep the few alive now
         _views.clear()
     view = _views[key] = _view(first - size_offset, maxgeom, size_offset, stride)
+    _last.update(scene=scene, view=view)
     return view[:ngeom]
