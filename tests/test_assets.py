@@ -180,7 +180,8 @@ def test_image_assets_decode(key):
 
 def test_pack_stays_small():
     total = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(ROOT) for f in fs)
-    assert total < 4e6, f"asset pack is {total / 1e6:.1f} MB"
+    # 4.1 MB with the pbr normal and ORM maps (0.44 MB of it); a guard against bloat, not a target
+    assert total < 4.5e6, f"asset pack is {total / 1e6:.1f} MB"
 
 
 def test_pack_regenerates_identically(tmp_path):
@@ -214,3 +215,45 @@ def test_materials_bind_through_references():
     mat = UsdShade.MaterialBindingAPI(mesh).ComputeBoundMaterial()[0]
     assert str(mat.GetPath()) == "/Box/Looks/Cardboard"
     assert matlib.describe(mat).texture.endswith("SM_CardBoxD_04_BaseColor.png")
+
+
+def test_normal_map_of_a_ramp_tilts_against_its_slope_and_tiles():
+    """Luminance rising along +u (columns) reads as a surface rising along u: its normal leans towards -u;
+    a constant image gives the flat normal; the map wraps at the edges like the texture."""
+    from graphsdg.assets import textures as tx
+    cols = np.arange(64)
+    ramp = np.repeat((0.5 + 0.25 * np.sin(cols / 64 * 2 * np.pi))[None, :, None], 32, axis=0).repeat(3, axis=2)
+    n = tx.normal_map(ramp) * 2 - 1
+    assert np.allclose(np.linalg.norm(n, axis=-1), 1.0)
+    rising = np.cos(cols / 64 * 2 * np.pi) > 0.5            # where luminance increases with u
+    assert (n[:, rising, 0] < -0.01).all() and np.allclose(n[..., 1], 0.0, atol=1e-9)
+    # tileable: the first column's slope comes from its wrapped neighbour (the image's last column)
+    assert n[0, 0, 0] == pytest.approx(n[0, 32, 0] * -1, abs=1e-9)
+    flat = tx.normal_map(np.full((16, 16, 3), 0.4)) * 2 - 1
+    assert np.allclose(flat, [0, 0, 1])
+    orm = tx.orm_map(ramp, roughness=0.6, metallic=1.0)
+    assert np.allclose(orm[..., 2], 1.0) and orm[..., 1].min() >= 0.4 - 1e-9 and orm[..., 1].max() <= 0.8 + 1e-9
+    assert ((orm[..., 0] > 0.6) & (orm[..., 0] <= 1.0)).all()
+
+
+def test_pack_materials_carry_normal_and_orm_maps():
+    """The pallet, cardboard boxes and warehouse surfaces read normal and ORM maps that exist in the pack."""
+    import os
+
+    from pxr import Usd, UsdShade
+
+    from graphsdg.assets.root import builtin_pack_root
+    from graphsdg.stage.materials import texture_maps
+    root = builtin_pack_root()
+    for rel in ("Isaac/Environments/Simple_Warehouse/Props/SM_PaletteA_01.usd",
+                "Isaac/Environments/Simple_Warehouse/Props/SM_CardBoxD_04.usd",
+                "Isaac/Environments/Simple_Warehouse/warehouse.usd"):
+        stage = Usd.Stage.Open(os.path.join(root, rel))
+        looks = [UsdShade.Material(p) for p in stage.Traverse() if p.IsA(UsdShade.Material)]
+        assert looks
+        for material in looks:
+            maps = texture_maps(material)
+            if "Plywood" in str(material.GetPath()):
+                continue
+            assert sorted(maps) == ["base_color", "normal", "orm"], (rel, material.GetPath(), maps)
+            assert all(os.path.isfile(f) for f in maps.values())

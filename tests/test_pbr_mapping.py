@@ -252,3 +252,43 @@ def test_a_dome_turned_about_up_keeps_its_map_and_passes_the_turn_as_yaw():
 def test_uniform_dome_is_constant_radiance_in_nits():
     env = ps.dome_environment(None, np.eye(3), nits=(600.0, 300.0, 150.0), width=16)
     assert env.shape == (8, 16, 3) and np.all(env == np.array([600.0, 300.0, 150.0], dtype=np.float32))
+
+
+def test_maps_compile_as_mujoco_texture_roles_only_where_pbr_draws(tmp_path, monkeypatch):
+    """A Preview material's normal and ORM maps become MuJoCo textures of those roles, linear (never
+    sRGB-decoded), with their pixels; the classic model stays without them."""
+    import cv2
+    import mujoco
+
+    from graphsdg.render import backend
+    from graphsdg.runtime import runtime
+    rng = np.random.default_rng(3)
+    files = {}
+    for name in ("albedo", "normal", "orm"):
+        files[name] = str(tmp_path / f"{name}.png")
+        cv2.imwrite(files[name], rng.integers(0, 256, (8, 16, 3), dtype=np.uint8))
+    material, shader = _preview("/Looks/Wood")
+    _texture("/Looks/Wood/Albedo", files["albedo"], shader, {"diffuseColor": "rgb"})
+    _texture("/Looks/Wood/Normal", files["normal"], shader, {"normal": "rgb"})
+    _texture("/Looks/Wood/ORM", files["orm"], shader, {"occlusion": "r", "roughness": "g", "metallic": "b"})
+    cube = rep.functional.create.cube(name="Crate")
+    rep.functional.modify.material(cube, material)
+    role = mujoco.mjtTextureRole
+
+    def compiled_roles():
+        model = runtime().sim.recompile().model
+        mat = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, "/Looks/Wood")
+        return model, {r: int(model.mat_texid[mat, int(r)]) for r in (role.mjTEXROLE_RGB, role.mjTEXROLE_NORMAL,
+                                                                        role.mjTEXROLE_ORM)}
+
+    model, ids = compiled_roles()
+    assert ids[role.mjTEXROLE_RGB] >= 0 and ids[role.mjTEXROLE_NORMAL] == -1 and ids[role.mjTEXROLE_ORM] == -1
+    monkeypatch.setattr(backend, "pbr_in_use", True)
+    model, ids = compiled_roles()
+    for r, name in ((role.mjTEXROLE_NORMAL, "normal"), (role.mjTEXROLE_ORM, "orm")):
+        tex = ids[r]
+        assert tex >= 0 and model.tex_colorspace[tex] == mujoco.mjtColorSpace.mjCOLORSPACE_LINEAR
+        adr, h, w = model.tex_adr[tex], model.tex_height[tex], model.tex_width[tex]
+        pixels = model.tex_data[adr:adr + h * w * 3].reshape(h, w, 3)
+        expected = cv2.cvtColor(cv2.imread(files[name]), cv2.COLOR_BGR2RGB)
+        assert np.array_equal(pixels, expected) or np.array_equal(pixels, expected[::-1])

@@ -58,10 +58,13 @@ def define_mesh(stage: Usd.Stage, path: str, mesh: MeshData) -> UsdGeom.Mesh:
 
 
 def define_textured_material(stage: Usd.Stage, path: str, texture: str, roughness: float = 0.7,
-                             metallic: float = 0.0) -> UsdShade.Material:
+                             metallic: float = 0.0, normal_texture: str | None = None,
+                             orm_texture: str | None = None) -> UsdShade.Material:
     """A UsdPreviewSurface material whose ``diffuseColor`` is the sRGB image ``texture`` (a relative path).
 
-    Network: ``UsdPrimvarReader_float2(st) -> UsdUVTexture(file) -> UsdPreviewSurface``.
+    Network: ``UsdPrimvarReader_float2(st) -> UsdUVTexture(file) -> UsdPreviewSurface``. ``normal_texture``
+    (tangent space, ``n * 0.5 + 0.5``) feeds ``normal`` through a raw texture with the Preview spec's scale 2 and
+    bias -1; ``orm_texture`` feeds ``occlusion`` (r), ``roughness`` (g) and ``metallic`` (b) from one raw texture.
     """
     parent = Sdf.Path(path).GetParentPath()
     if not stage.GetPrimAtPath(parent):
@@ -85,7 +88,30 @@ def define_textured_material(stage: Usd.Stage, path: str, texture: str, roughnes
     tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
     tex.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
     surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(tex.ConnectableAPI(), "rgb")
+    if normal_texture:
+        normal = _data_texture(stage, f"{path}/NormalTexture", normal_texture, reader)
+        normal.CreateInput("scale", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(2, 2, 2, 1))
+        normal.CreateInput("bias", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(-1, -1, -1, 0))
+        normal.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
+        surface.CreateInput("normal", Sdf.ValueTypeNames.Normal3f).ConnectToSource(normal.ConnectableAPI(), "rgb")
+    if orm_texture:
+        orm = _data_texture(stage, f"{path}/ORMTexture", orm_texture, reader)
+        for name, channel in (("occlusion", "r"), ("roughness", "g"), ("metallic", "b")):
+            orm.CreateOutput(channel, Sdf.ValueTypeNames.Float)
+            surface.CreateInput(name, Sdf.ValueTypeNames.Float).ConnectToSource(orm.ConnectableAPI(), channel)
     return material
+
+
+def _data_texture(stage: Usd.Stage, path: str, file: str, reader: UsdShade.Shader) -> UsdShade.Shader:
+    """A UsdUVTexture of non-colour data (``sourceColorSpace`` raw) read at the material's ``st``."""
+    tex = UsdShade.Shader.Define(stage, path)
+    tex.CreateIdAttr("UsdUVTexture")
+    tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(file))
+    tex.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set("raw")
+    tex.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("repeat")
+    tex.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("repeat")
+    tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+    return tex
 
 
 def bind_material(prim: Usd.Prim, material: UsdShade.Material) -> None:

@@ -123,13 +123,28 @@ def pallet_parts() -> list[tuple[str, tuple[float, float, float], tuple[float, f
     return parts
 
 
+def write_pbr_maps(root: str, colour_rel: str, rgb: np.ndarray, roughness: float,
+                   metallic: float = 0.0) -> tuple[str, str]:
+    """Write the normal and ORM maps of colour texture ``colour_rel`` (``*_BaseColor.png`` -> ``*_Normal.png``,
+    ``*_ORM.png`` beside it); returns their pack-relative paths."""
+    stem = colour_rel.rsplit("_BaseColor.png", 1)[0]
+    normal_rel, orm_rel = f"{stem}_Normal.png", f"{stem}_ORM.png"
+    textures.write_png(_abs(root, normal_rel), textures.normal_map(rgb))
+    textures.write_png(_abs(root, orm_rel), textures.orm_map(rgb, roughness, metallic))
+    return normal_rel, orm_rel
+
+
 def build_pallet(root: str) -> list[str]:
     rel = f"{PROPS}/SM_PaletteA_01.usd"
     tex_rel = f"{PROPS}/Textures/SM_PaletteA_01_BaseColor.png"
-    textures.write_png(_abs(root, tex_rel), textures.wood((512, 512), textures.WOOD_STYLES["PalletPine"]))
+    wood = textures.wood((512, 512), textures.WOOD_STYLES["PalletPine"])
+    textures.write_png(_abs(root, tex_rel), wood)
+    normal_rel, orm_rel = write_pbr_maps(root, tex_rel, wood, roughness=0.85)
     stage, prim = authoring.new_asset_stage(_abs(root, rel), "SM_PaletteA_01")
     material = authoring.define_textured_material(stage, "/SM_PaletteA_01/Looks/PalletWood",
-                                                  "./Textures/SM_PaletteA_01_BaseColor.png", roughness=0.85)
+                                                  "./Textures/SM_PaletteA_01_BaseColor.png", roughness=0.85,
+                                                  normal_texture="./Textures/" + normal_rel.rsplit("/", 1)[1],
+                                                  orm_texture="./Textures/" + orm_rel.rsplit("/", 1)[1])
     for i, (name, lo, hi, grain) in enumerate(pallet_parts()):
         # each board shows a different stretch of the wood
         offset = (float(hash01(i, 0, 71)), float(hash01(i, 1, 71)))
@@ -137,7 +152,7 @@ def build_pallet(root: str) -> list[str]:
         authoring.define_mesh(stage, f"/SM_PaletteA_01/{name}", mesh)
     authoring.bind_material(prim, material)
     authoring.save(stage)
-    return [rel, tex_rel]
+    return [rel, tex_rel, normal_rel, orm_rel]
 
 
 # ---- card boxes -------------------------------------------------------------------
@@ -166,15 +181,19 @@ def _card_box_builder(box: CardBox) -> Callable[[str], list[str]]:
     def build(root: str) -> list[str]:
         rel = f"{PROPS}/{box.name}.usd"
         tex_rel = f"{PROPS}/Textures/{box.name}_BaseColor.png"
-        textures.write_png(_abs(root, tex_rel), textures.cardboard(box.length, box.width, box.height, box.print_))
+        board = textures.cardboard(box.length, box.width, box.height, box.print_)
+        textures.write_png(_abs(root, tex_rel), board)
+        normal_rel, orm_rel = write_pbr_maps(root, tex_rel, board, roughness=0.9)
         stage, prim = authoring.new_asset_stage(_abs(root, rel), box.name)
         material = authoring.define_textured_material(stage, f"/{box.name}/Looks/Cardboard",
-                                                      f"./Textures/{box.name}_BaseColor.png", roughness=0.9)
+                                                      f"./Textures/{box.name}_BaseColor.png", roughness=0.9,
+                                                      normal_texture="./Textures/" + normal_rel.rsplit("/", 1)[1],
+                                                      orm_texture="./Textures/" + orm_rel.rsplit("/", 1)[1])
         mesh = authoring.define_mesh(stage, f"/{box.name}/Box",
                                      geometry.shipping_box(box.length, box.width, box.height))
         authoring.bind_material(mesh.GetPrim(), material)
         authoring.save(stage)
-        return [rel, tex_rel]
+        return [rel, tex_rel, normal_rel, orm_rel]
     return build
 
 
@@ -223,12 +242,14 @@ def build_warehouse(root: str) -> list[str]:
         "FloorMarking": (textures.safety_paint((128, 128), seed=305), 0.5),
     }
     written = [rel]
-    for name, (img, _) in tex.items():
+    for name, (img, r) in tex.items():
         textures.write_png(_abs(root, f"{tex_dir}/{name}_BaseColor.png"), img)
-        written.append(f"{tex_dir}/{name}_BaseColor.png")
+        written += [f"{tex_dir}/{name}_BaseColor.png", *write_pbr_maps(root, f"{tex_dir}/{name}_BaseColor.png", img, r)]
     stage, prim = authoring.new_asset_stage(_abs(root, rel), "Warehouse", kind=Kind.Tokens.assembly)
     looks = {name: authoring.define_textured_material(stage, f"/Warehouse/Looks/{name}",
-                                                      f"./Materials/Textures/{name}_BaseColor.png", roughness=r)
+                                                      f"./Materials/Textures/{name}_BaseColor.png", roughness=r,
+                                                      normal_texture=f"./Materials/Textures/{name}_Normal.png",
+                                                      orm_texture=f"./Materials/Textures/{name}_ORM.png")
              for name, (_, r) in tex.items()}
     looks["Plywood"] = authoring.define_textured_material(
         stage, "/Warehouse/Looks/Plywood", "../../../NVIDIA/Materials/Base/Wood/Plywood/Plywood_BaseColor.png",

@@ -371,6 +371,48 @@ def roughness_map(size: tuple[int, int], seed: int, mean: float = 0.8, spread: f
     return np.repeat(r[..., None], 3, axis=-1)
 
 
+# ---- maps for physically based renderers -------------------------------------------------------------
+_LUMA = np.array([0.2126, 0.7152, 0.0722])
+MAP_SIZE = 256     # normal and ORM maps need less resolution than colour: at most this many pixels a side
+
+
+def _map_source(rgb: np.ndarray) -> np.ndarray:
+    """Luminance of ``rgb`` at most :data:`MAP_SIZE` a side (area-averaged: the image still tiles)."""
+    lum = np.asarray(rgb, dtype=np.float64) @ _LUMA
+    rows, cols = lum.shape
+    k = max(rows, cols) / MAP_SIZE
+    if k > 1:
+        lum = cv2.resize(lum, (max(1, round(cols / k)), max(1, round(rows / k))), interpolation=cv2.INTER_AREA)
+    return lum
+
+
+def normal_map(rgb: np.ndarray, strength: float = 4.0) -> np.ndarray:
+    """Tangent-space normal map (x along ``u``, y along ``v``, z out; stored as ``n * 0.5 + 0.5``) of the
+    relief a colour texture suggests: darker is deeper (grain lines, joints, print, dents). Gradients wrap
+    around the edges, so a tileable colour gives a tileable normal map."""
+    h = _map_source(rgb) * strength
+    du = (np.roll(h, -1, axis=1) - np.roll(h, 1, axis=1)) * 0.5
+    d_row = (np.roll(h, -1, axis=0) - np.roll(h, 1, axis=0)) * 0.5
+    # row 0 is the v = 1 edge: along +v the row index falls
+    n = np.stack([-du, d_row, np.ones_like(h)], axis=-1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    return n * 0.5 + 0.5
+
+
+def orm_map(rgb: np.ndarray, roughness: float, metallic: float = 0.0, roughness_spread: float = 0.2,
+            occlusion_depth: float = 0.35) -> np.ndarray:
+    """ORM map (R ambient occlusion, G perceptual roughness, B metallic) for a colour texture: cavities
+    (darker than their surroundings) are occluded, and roughness varies around ``roughness`` with the colour
+    (worn, lighter patches smoother)."""
+    lum = _map_source(rgb)
+    local = cv2.blur(np.pad(lum, 4, mode="wrap"), (9, 9))[4:-4, 4:-4]
+    cavity = np.clip((local - lum) * 4.0, 0.0, 1.0)
+    spread = lum - lum.mean()
+    scale = max(float(np.abs(spread).max()), 1e-6)
+    rough = np.clip(roughness - roughness_spread * spread / scale, 0.0, 1.0)
+    return np.stack([1.0 - occlusion_depth * cavity, rough, np.full_like(lum, float(metallic))], axis=-1)
+
+
 def write_jpg(path: str, rgb: np.ndarray, quality: int = 92) -> None:
     """Write a float RGB image in [0, 1] as a JPEG (parent folders are created)."""
     os.makedirs(os.path.dirname(path) or ".", exist_ok=True)

@@ -157,18 +157,6 @@ def reflectance_from_f0(f0: float) -> float:
     return float(np.clip(math.sqrt(max(f0, 0.0) / 0.16), 0.0, 1.0))
 
 
-def _source_file(inp: UsdShade.Input | None) -> str | None:
-    """The texture file feeding a Preview surface input through a UsdUVTexture, or None."""
-    if not inp or not inp.HasConnectedSource():
-        return None
-    sources = inp.GetConnectedSources()[0]
-    if not sources:
-        return None
-    tex = UsdShade.Shader(sources[0].source.GetPrim())
-    file_in = tex.GetInput("file")
-    return matlib.texture_file_path(file_in) if file_in else None
-
-
 def _value(shader: UsdShade.Shader, name: str, default):
     inp = shader.GetInput(name)
     if not inp or inp.HasConnectedSource():
@@ -185,13 +173,13 @@ def surface_fields(material: UsdShade.Material) -> SurfaceFields:
                 metallic=float(desc.metallic), roughness=float(desc.roughness))
     shader = matlib.surface_shader(material)
     if shader is not None:
-        return _preview_fields(shader, base, desc)
+        return _preview_fields(material, shader, base)
     mdl = material.ComputeSurfaceSource("mdl")
     mdl_shader = mdl[0] if mdl and mdl[0] and mdl[0].GetPrim().IsValid() else None
-    return _omnipbr_fields(mdl_shader, base, desc) if mdl_shader is not None else SurfaceFields(**base)
+    return _omnipbr_fields(material, mdl_shader, base) if mdl_shader is not None else SurfaceFields(**base)
 
 
-def _preview_fields(shader: UsdShade.Shader, base: dict, desc: matlib.MaterialDesc) -> SurfaceFields:
+def _preview_fields(material: UsdShade.Material, shader: UsdShade.Shader, base: dict) -> SurfaceFields:
     if int(_value(shader, "useSpecularWorkflow", 0)):
         spec = np.asarray(_value(shader, "specularColor", Gf.Vec3f(0, 0, 0)), dtype=np.float64)
         base["reflectance"] = reflectance_from_f0(float(LUMA @ spec))
@@ -201,55 +189,20 @@ def _preview_fields(shader: UsdShade.Shader, base: dict, desc: matlib.MaterialDe
     emissive = np.asarray(_value(shader, "emissiveColor", Gf.Vec3f(0, 0, 0)), dtype=np.float64)
     # Preview emission is a display value (1 shows white): in nits at graphsdg's reference exposure
     base["emissive_nits"] = tuple(float(c) for c in emissive * WHITE_NITS)
-    maps = {}
-    for role, name in (("base_color", "diffuseColor"), ("normal", "normal"), ("roughness", "roughness"),
-                       ("metallic", "metallic"), ("occlusion", "occlusion"), ("emissive", "emissiveColor"),
-                       ("opacity", "opacity")):
-        f = _source_file(shader.GetInput(name))
-        if f:
-            maps[role] = f
-    if desc.texture and "base_color" not in maps:
-        maps["base_color"] = desc.texture
-    # one file feeding occlusion, roughness and metallic is an ORM map (R occlusion, G roughness, B metallic)
-    orm = {maps.get(r) for r in ("occlusion", "roughness", "metallic")}
-    if len(orm) == 1 and None not in orm:
-        maps["orm"] = maps.pop("occlusion")
-        del maps["roughness"], maps["metallic"]
-    return SurfaceFields(maps=maps, **base)
+    return SurfaceFields(maps=matlib.texture_maps(material), **base)
 
 
-def _omnipbr_fields(shader: UsdShade.Shader, base: dict, desc: matlib.MaterialDesc) -> SurfaceFields:
+def _omnipbr_fields(material: UsdShade.Material, shader: UsdShade.Shader, base: dict) -> SurfaceFields:
     def get(name: str, default):
         inp = shader.GetInput(name)
         v = matlib._input_value(inp) if inp else None
         return default if v is None else v
 
-    def file(name: str) -> str | None:
-        inp = shader.GetInput(name)
-        return matlib.texture_file_path(matlib._interface_input(inp)) if inp else None
-
     base["reflectance"] = float(np.clip(float(get("specular_level", 0.5)), 0.0, 1.0))
     if bool(get("enable_emission", False)):
         colour = np.asarray(get("emissive_color", Gf.Vec3f(1, 0.1, 0.1)), dtype=np.float64)
         base["emissive_nits"] = tuple(float(c) for c in colour * float(get("emissive_intensity", 40.0)))
-    maps = {}
-    for role, name in (("base_color", "diffuse_texture"), ("normal", "normalmap_texture"),
-                       ("roughness", "reflectionroughness_texture"), ("metallic", "metallic_texture"),
-                       ("occlusion", "ao_texture"), ("emissive", "emissive_color_texture"),
-                       ("opacity", "opacity_texture")):
-        f = file(name)
-        if f:
-            maps[role] = f
-    orm = file("ORM_texture")
-    if orm and bool(get("enable_ORM_texture", False)):
-        maps["orm"] = orm
-        for role in ("occlusion", "roughness", "metallic"):
-            maps.pop(role, None)
-    if "opacity" in maps and not bool(get("enable_opacity_texture", False)):
-        del maps["opacity"]             # OmniPBR ignores its opacity map unless enabled
-    if "emissive" in maps and not bool(get("enable_emission", False)):
-        del maps["emissive"]
-    return SurfaceFields(maps=maps, **base)
+    return SurfaceFields(maps=matlib.texture_maps(material), **base)
 
 
 @dataclass

@@ -67,7 +67,21 @@ route_warnings()   # before the first compile: MuJoCo's warnings are logged, not
 HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)
 COLLISION_ONLY_GROUP = 4    # proxy collision shapes (not drawn)
 UNDRAWN_GROUPS = (COLLISION_ONLY_GROUP, HIDDEN_GROUP)
-PBR_CAMERA = "graphsdg:pbr_camera"   # the camera the PBR backend renders from (render products' poses)
+PBR_CAMERA = "graphsdg:pbr_camera"
+_ROLE = mujoco.mjtTextureRole
+
+
+def _pbr_draws() -> bool:
+    """Whether the pbr backend draws in this process (its camera and texture maps are compiled in)."""
+    from graphsdg.render.backend import pbr_draws   # render/ sits above sim/: asked at compile time only
+    return pbr_draws()
+
+
+#: texture map roles (graphsdg.stage.materials.texture_maps) -> MuJoCo's texture roles, which the pbr backend reads
+MAP_TEXTURE_ROLES = {"normal": _ROLE.mjTEXROLE_NORMAL, "orm": _ROLE.mjTEXROLE_ORM,
+                     "occlusion": _ROLE.mjTEXROLE_OCCLUSION, "roughness": _ROLE.mjTEXROLE_ROUGHNESS,
+                     "metallic": _ROLE.mjTEXROLE_METALLIC, "emissive": _ROLE.mjTEXROLE_EMISSIVE,
+                     "opacity": _ROLE.mjTEXROLE_OPACITY}   # the camera the PBR backend renders from (render products' poses)
 DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
 MUJOCO_DEFAULT_RGBA = (0.5, 0.5, 0.5, 1.0)   # geom rgba that lets a bound material show through
 GPRIM_TYPES = ("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh")
@@ -402,6 +416,7 @@ class _Builder:
         self.collider_records: list[tuple] = []
         self.material_descs: dict[str, matlib.MaterialDesc] = {}
         self.texture_names: dict[str, str] = {}       # texture file -> MuJoCo texture name
+        self.pbr_maps = _pbr_draws()                   # materials carry normal / ORM / ... maps for the pbr backend
         self.part_records: dict[str, list[geom_subsets.PartGeom]] = {}   # mesh -> its GeomSubset part geoms
         self.mesh_count = 0
         self.has_lights = False
@@ -479,24 +494,32 @@ class _Builder:
             m.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = self.texture(desc.texture, path)
             m.texrepeat = [desc.texture_scale[0], desc.texture_scale[1]]
             m.texuniform = False
+            if self.pbr_maps:     # the classic rasteriser reads only the colour role: the rest only where pbr draws
+                for role, file in matlib.texture_maps(material).items():
+                    if role in MAP_TEXTURE_ROLES:
+                        m.textures[MAP_TEXTURE_ROLES[role]] = self.texture(file, path, linear=role != "emissive")
         self.material_names[path] = path
         self.material_descs[path] = desc
         return path
 
-    def texture(self, file: str, material_path: str) -> str:
-        """The MuJoCo texture holding image ``file`` (added once, however many materials use it)."""
-        name = self.texture_names.get(file)
+    def texture(self, file: str, material_path: str, linear: bool = False) -> str:
+        """The MuJoCo texture holding image ``file`` (added once, however many materials use it); ``linear``:
+        data, not colour (normal, occlusion / roughness / metallic, opacity maps), so never sRGB-decoded."""
+        key = f"{file}#linear" if linear else file
+        name = self.texture_names.get(key)
         if name is not None:
             return name
         try:
             rgb = texture_images.load_rgb(file)
         except texture_images.TextureFileError as exc:
             raise CompileError(f"material {material_path}: {exc}") from None
-        name = f"tex:{file}"
+        name = f"tex:{key}"
         tex = self.spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, width=rgb.shape[1],
                                     height=rgb.shape[0], nchannel=3)
         tex.data = rgb.tobytes()
-        self.texture_names[file] = name
+        if linear:
+            tex.colorspace = mujoco.mjtColorSpace.mjCOLORSPACE_LINEAR
+        self.texture_names[key] = name
         return name
 
     def mesh_uvs(self, prim: Usd.Prim, material: str | None):
@@ -847,8 +870,7 @@ class _Builder:
         """One MuJoCo camera for the PBR backend to pose at each render product's USD camera (its rays are
         per pixel, so no field of view is needed); only where that backend draws, so the classic model is
         unchanged."""
-        from graphsdg.render.backend import pbr_draws
-        if pbr_draws():
+        if self.pbr_maps:
             self.spec.worldbody.add_camera(name=PBR_CAMERA)
 
     def size_memory(self) -> None:

@@ -272,6 +272,80 @@ def _uv_source(texture: UsdShade.Shader) -> dict:
     return out
 
 
+#: a UsdPreviewSurface input -> the texture map role it feeds (see :func:`texture_maps`)
+PREVIEW_MAP_INPUTS = (("base_color", "diffuseColor"), ("normal", "normal"), ("roughness", "roughness"),
+                      ("metallic", "metallic"), ("occlusion", "occlusion"), ("emissive", "emissiveColor"),
+                      ("opacity", "opacity"))
+#: an OmniPBR input -> the role its texture feeds
+OMNIPBR_MAP_INPUTS = (("base_color", "diffuse_texture"), ("normal", "normalmap_texture"),
+                      ("roughness", "reflectionroughness_texture"), ("metallic", "metallic_texture"),
+                      ("occlusion", "ao_texture"), ("emissive", "emissive_color_texture"),
+                      ("opacity", "opacity_texture"))
+ORM_ROLES = ("occlusion", "roughness", "metallic")
+
+
+def _connected_file(inp: UsdShade.Input | None) -> str | None:
+    """The texture file feeding a Preview surface input through a UsdUVTexture, or None."""
+    if not inp or not inp.HasConnectedSource():
+        return None
+    sources = inp.GetConnectedSources()[0]
+    if not sources:
+        return None
+    file_in = UsdShade.Shader(sources[0].source.GetPrim()).GetInput("file")
+    return texture_file_path(file_in) if file_in else None
+
+
+def texture_maps(material: UsdShade.Material) -> dict[str, str]:
+    """The texture maps of ``material`` by role: ``base_color``, ``normal``, ``orm`` (R occlusion, G roughness,
+    B metallic) or separate ``occlusion`` / ``roughness`` / ``metallic``, ``emissive``, ``opacity``.
+
+    Reads a UsdPreviewSurface network (one file feeding occlusion, roughness and metallic is an ORM map) or an
+    OmniPBR shader (its ``enable_*`` flags honoured, as OmniPBR does).
+
+    Example:
+        >>> maps = texture_maps(material)        # doctest: +SKIP
+        >>> maps.get("normal")                   # doctest: +SKIP
+        '/pack/Textures/Oak_Normal.png'
+    """
+    shader = surface_shader(material)
+    if shader is not None:
+        maps = {role: f for role, name in PREVIEW_MAP_INPUTS if (f := _connected_file(shader.GetInput(name)))}
+        desc = describe(material)
+        if desc.texture and "base_color" not in maps:
+            maps["base_color"] = desc.texture
+        orm = {maps.get(r) for r in ORM_ROLES}
+        if len(orm) == 1 and None not in orm:
+            maps["orm"] = maps.pop("occlusion")
+            del maps["roughness"], maps["metallic"]
+        return maps
+    mdl = material.ComputeSurfaceSource("mdl")
+    mdl_shader = mdl[0] if mdl and mdl[0] and mdl[0].GetPrim().IsValid() else None
+    return _omnipbr_maps(mdl_shader) if mdl_shader is not None else {}
+
+
+def _omnipbr_maps(shader: UsdShade.Shader) -> dict[str, str]:
+    def flag(name: str) -> bool:
+        inp = shader.GetInput(name)
+        value = _input_value(inp) if inp else None
+        return bool(value) if value is not None else False
+
+    def file(name: str) -> str | None:
+        inp = shader.GetInput(name)
+        return texture_file_path(_interface_input(inp)) if inp else None
+
+    maps = {role: f for role, name in OMNIPBR_MAP_INPUTS if (f := file(name))}
+    orm = file("ORM_texture")
+    if orm and flag("enable_ORM_texture"):
+        maps["orm"] = orm
+        for role in ORM_ROLES:
+            maps.pop(role, None)
+    if "opacity" in maps and not flag("enable_opacity_texture"):
+        del maps["opacity"]             # OmniPBR ignores its opacity map unless enabled
+    if "emissive" in maps and not flag("enable_emission"):
+        del maps["emissive"]
+    return maps
+
+
 def define_mdl_material(stage: Usd.Stage, path: str | Sdf.Path, mdl_url: str, mdl_name: str) -> UsdShade.Material:
     """Define Kit's MDL material at ``path``: a ``Shader`` child running ``mdl_name`` of ``mdl_url``
     (``info:mdl:sourceAsset`` / ``sourceAsset:subIdentifier``) whose ``out`` drives the material's mdl
