@@ -82,8 +82,9 @@ class Runtime:
         if resolve_backend() == "classic":
             return self.rasterizer
         if self._pbr is None:
+            from graphsdg.render.backend import pbr_device
             from graphsdg.render.pbr import PbrRenderer   # imports Warp: only where pbr was chosen
-            self._pbr = PbrRenderer()
+            self._pbr = PbrRenderer(pbr_device())
         return self._pbr
 
     @property

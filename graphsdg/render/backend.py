@@ -18,6 +18,8 @@ The choice comes from settings (:func:`requested_backend`):
   ``pbr`` where the extra is installed and a CUDA GPU is present, else ``classic``;
   the outcome is logged once per process. ``pbr`` without what it needs raises
   :class:`PbrUnavailableError` naming what is missing.
+* ``/graphsdg/render/pbrDevice``: the Warp device pbr renders on, ``cuda:0`` (default) or ``cpu``
+  (Warp's CPU device: needs the extra but no GPU; slow, for checks at tiny sizes).
 * ``/rtx/rendermode``: ``RaytracedLighting`` (Isaac's default) -> the real-time tier;
   ``PathTracing`` -> the path tier with ``max(/rtx/pathtracing/spp, /rtx/pathtracing/totalSpp)``
   samples per pixel per launch and ``/rtx/pathtracing/optixDenoiser/enabled`` as the denoiser.
@@ -35,6 +37,9 @@ from graphsdg import settings
 log = logging.getLogger("graphsdg.render")
 
 BACKEND_KEY = "/graphsdg/render/backend"
+#: the Warp device the pbr backend renders on: ``cuda:N`` (default ``cuda:0``) or ``cpu`` (Warp's CPU device:
+#: no GPU needed, slow; for checking a script or the mapping on a machine without one)
+DEVICE_KEY = "/graphsdg/render/pbrDevice"
 BACKENDS = ("classic", "pbr", "auto")
 DENOISER_KEY = "/rtx/pathtracing/optixDenoiser/enabled"
 #: the ``graphsdg[gpu]`` extra: import name -> distribution pinned in pyproject.toml
@@ -93,9 +98,17 @@ def requested_backend() -> BackendRequest:
                           denoise=bool(settings.get(DENOISER_KEY, True)))
 
 
+def pbr_device() -> str:
+    """The Warp device the pbr backend renders on (``/graphsdg/render/pbrDevice``)."""
+    device = str(settings.get(DEVICE_KEY, "cuda:0") or "cuda:0")
+    if device != "cpu" and not (device == "cuda" or (device.startswith("cuda:") and device[5:].isdigit())):
+        raise ValueError(f"setting {DEVICE_KEY} must be 'cuda', 'cuda:N' or 'cpu', got {device!r}")
+    return device
+
+
 def pbr_missing(has_module: Callable[[str], bool] | None = None,
                 cuda_devices: Callable[[], int] | None = None,
-                python: tuple[int, int] | None = None) -> list[str]:
+                python: tuple[int, int] | None = None, device: str = "cuda:0") -> list[str]:
     """What this machine lacks to run the PBR backend, each with how to get it; empty when it can.
 
     The checks run cheapest first and stop at the first failing group, so a machine
@@ -110,6 +123,8 @@ def pbr_missing(has_module: Callable[[str], bool] | None = None,
     absent = [pin for name, pin in PBR_MODULES.items() if not has_module(name)]
     if absent:
         return [f"the gpu extra ({', '.join(absent)} not installed): {INSTALL_HINT}"]
+    if device == "cpu":
+        return []
     count = (cuda_devices or _cuda_device_count)()
     if count < 1:
         return ["a CUDA GPU (Warp finds no CUDA device: an NVIDIA GPU and driver are needed)"]
@@ -134,6 +149,8 @@ _machine_lacks: list[str] | None = None
 def _cached_missing() -> list[str]:
     """:func:`pbr_missing` once per process (the machine does not change; the CUDA probe costs a Warp init)."""
     global _machine_lacks
+    if pbr_device() == "cpu":
+        return pbr_missing(device="cpu")
     if _machine_lacks is None:
         _machine_lacks = pbr_missing()
     return _machine_lacks
@@ -170,5 +187,5 @@ def resolve_backend(request: BackendRequest | None = None,
     return chosen
 
 
-__all__ = ["BACKENDS", "BackendRequest", "PbrUnavailableError", "RenderBackend", "pbr_missing",
+__all__ = ["BACKENDS", "BackendRequest", "PbrUnavailableError", "RenderBackend", "pbr_device", "pbr_missing",
            "requested_backend", "resolve_backend"]

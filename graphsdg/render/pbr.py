@@ -31,7 +31,6 @@ Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -87,7 +86,6 @@ class PbrRenderer:
         self._renders: dict[str, int] = {}       # per camera path: the seed of its next path-traced launch
         self._isolated = None                    # classic rasteriser for render_isolated footprints
         self.stats: dict[str, int] = {"color": 0, "contexts": 0}
-        self._warned_motion = False
 
     # ---- contexts ------------------------------------------------------
     def _key(self, sim: SimScene, view: CameraView, subframes: int) -> tuple:
@@ -177,10 +175,6 @@ class PbrRenderer:
             raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
         if subframes < 1:
             raise ValueError(f"subframes must be >= 1, got {subframes}")
-        if motion is not None and not self._warned_motion:
-            self._warned_motion = True
-            warnings.warn("motion blur is not rendered by the pbr backend yet: frames show the step's end state",
-                          stacklevel=2)
         wp = self._wp
         ctx = self._context(sim, view, subframes)
         with wp.ScopedDevice(self._device):
@@ -188,17 +182,20 @@ class PbrRenderer:
                 self._upload_state(sim, view, ctx)
             path = requested_backend().tier == "path"
             launches = max(1, math.ceil(subframes / max(1, ctx.rc.path_samples))) if path else 1
-            acc = None
+            acc = self._motion_blur(sim, ctx, motion, launches) if motion is not None else None
+            if acc is not None:
+                self._upload_state(sim, view, ctx)     # labels from the capture's own instant
+                launches = 1
             with profiling.timed("render:pbr"):
                 for _ in range(launches):
                     seed = self._renders.get(view.path, 0)
                     self._renders[view.path] = seed + 1
                     self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
                     self.stats["color"] += 1
-                    if launches > 1:      # several path launches: average their display colours
-                        self._mjpbr.get_rgb(ctx.rc, 0, ctx.rgb)
-                        rgb = ctx.rgb.numpy()[0]
-                        acc = rgb if acc is None else acc + rgb
+                    if motion is None and launches > 1:   # several path launches: average their display colours
+                        acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
+                if acc is not None and motion is None:
+                    acc = acc / launches
                 ctx.layout.convert(ctx.rc.base, 0)
             with profiling.timed("readback:pbr"):
                 want_ids = "segmentation" in passes or "depth" in passes
@@ -206,7 +203,7 @@ class PbrRenderer:
                                        depth="depth" in passes, ids=want_ids)
         out = RenderOutputs()
         if acc is not None:
-            colour = np.clip(acc / launches, 0.0, 1.0).astype(np.float32)
+            colour = np.clip(acc, 0.0, 1.0).astype(np.float32)
             rgba = np.full((view.height, view.width, 4), 255, dtype=np.uint8)
             rgba[..., :3] = np.rint(colour * 255.0)
         else:
@@ -225,17 +222,41 @@ class PbrRenderer:
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
         return out
 
-    def _upload_state(self, sim: SimScene, view: CameraView, ctx: _Context) -> None:
+    def _colour(self, ctx: _Context) -> np.ndarray:
+        """The last launch's display colour, (H, W, 3) float in [0, 1]."""
+        self._mjpbr.get_rgb(ctx.rc, 0, ctx.rgb)
+        return ctx.rgb.numpy()[0]
+
+    def _motion_blur(self, sim: SimScene, ctx: _Context, motion, launches: int) -> np.ndarray:
+        """Mean display colour of renders at the motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`):
+        each sub-frame's geometry, lights and camera, and the next seed (its own soft-shadow and path samples)."""
+        acc = None
+        with profiling.timed("render:pbr_motion"):
+            for i in range(motion.count):
+                posed, seen = motion.pose(i)
+                self._upload_state(sim, seen, ctx, data=posed)
+                for _ in range(launches):
+                    seed = self._renders.get(seen.path, 0)
+                    self._renders[seen.path] = seed + 1
+                    self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
+                    self.stats["color"] += 1
+                    acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
+        return acc / (motion.count * launches)
+
+    def _upload_state(self, sim: SimScene, view: CameraView, ctx: _Context, data=None) -> None:
         """The simulation's poses and randomized model fields into the renderer (no recompile).
 
         Poses change every frame and always go up; model fields that randomizers may write (colours,
         material bindings, sizes, light colours) go up only when they differ from the last upload."""
-        model, data, m, d, rc = sim.model, sim.data, ctx.model, ctx.data, ctx.rc
+        model, m, d, rc = sim.model, ctx.model, ctx.data, ctx.rc
+        data = sim.data if data is None else data
         d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
         d.geom_xmat.assign(np.asarray(data.geom_xmat, dtype=np.float32).reshape(1, -1, 3, 3))
         if model.nlight:
             d.light_xpos.assign(np.asarray(data.light_xpos, dtype=np.float32)[None])
             d.light_xdir.assign(np.asarray(data.light_xdir, dtype=np.float32)[None])
+        if model.nflex:     # deformables: their vertices as physics left them (refit_bvh refits the flex BVHs)
+            d.flexvert_xpos.assign(np.asarray(data.flexvert_xpos, dtype=np.float32)[None])
         self._pose_camera(view, ctx)
         changed = self._upload_changed(ctx, [
             (m.geom_rgba, "geom_rgba", model.geom_rgba, np.float32),
