@@ -3,8 +3,8 @@
 Run on a machine with an NVIDIA GPU and ``graphsdg[gpu]`` (Python >= 3.12):
 ``MUJOCO_GL=egl python bench/pbr_gpu.py [--size 512] [--frames 200] [--out DIR]``.
 
-Builds a small warehouse scene (floor, pallet, cardboard boxes, a metal part, a textured dome HDR from the
-asset pack, a distant light), then renders one 512x512 render product's colour + depth + segmentation through
+Builds a warehouse scene from the asset pack (the warehouse, a pallet with four cardboard boxes, all with
+colour, normal and ORM maps; a steel part; the autoshop HDR dome; a distant light), then renders one 512x512 render product's colour + depth + segmentation through
 
 * ``classic``: the OpenGL rasteriser (``graphsdg.render.rasterizer``), and
 * ``pbr realtime`` / ``pbr path``: ``graphsdg.render.pbr`` with ``/rtx/rendermode`` RaytracedLighting and
@@ -33,34 +33,43 @@ SKY = os.path.join(os.path.dirname(rep.__file__), "assets", "pack", "NVIDIA", "A
                    "autoshop_01_4k.hdr")
 
 
+PACK = os.path.join(os.path.dirname(rep.__file__), "assets", "pack")
+WAREHOUSE = os.path.join(PACK, "Isaac", "Environments", "Simple_Warehouse")
+#: (prop, x, y, yaw) of the cardboard boxes on the pallet
+BOXES = [("SM_CardBoxC_01", -0.28, -0.2, 0.0), ("SM_CardBoxD_01", 0.32, -0.25, 8.0),
+         ("SM_CardBoxD_04", 0.3, 0.22, -12.0), ("SM_CardBoxD_01", -0.3, 0.25, 90.0)]
+PALLET_TOP = 0.144
+
+
 def build_scene(size: int):
-    """The warehouse scene; returns the camera prim."""
+    """The asset pack's warehouse with a pallet of cardboard boxes, a steel part and the autoshop HDR dome;
+    returns the camera prim, the boxes and their resting heights."""
+    from pxr import UsdGeom
+
     from graphsdg.stage import materials as matlib
     stage = rep.stage.new_stage()
     rep.functional.create.xform(name="World")
     dome = rep.functional.create.dome_light(intensity=400, parent="/World", name="Sky")
     dome.GetAttribute("inputs:texture:file").Set(SKY)
     rep.functional.create.distant_light(intensity=1500, rotation=(40, 25, 0), parent="/World", name="Sun")
-    floor = rep.functional.create.plane(scale=8, parent="/World", name="Floor")
-    pallet = rep.functional.create.cube(position=(0, 0, 0.07), scale=(1.2, 1.0, 0.14), parent="/World",
-                                        name="Pallet")
-    boxes = [rep.functional.create.cube(position=(x, y, 0.14 + h / 2), scale=(0.4, 0.4, h), parent="/World",
-                                        name=f"Box{i}")
-             for i, (x, y, h) in enumerate([(-0.3, -0.25, 0.4), (0.25, -0.2, 0.3), (-0.25, 0.25, 0.5),
-                                            (0.3, 0.3, 0.35)])]
-    part = rep.functional.create.sphere(position=(1.1, -0.6, 0.3), scale=0.6, parent="/World", name="MetalPart")
-    looks = {
-        "Concrete": dict(diffuse=(0.45, 0.45, 0.43), roughness=0.9),
-        "Wood": dict(diffuse=(0.55, 0.38, 0.22), roughness=0.7),
-        "Cardboard": dict(diffuse=(0.62, 0.46, 0.3), roughness=0.85),
-        "Steel": dict(diffuse=(0.8, 0.8, 0.82), roughness=0.2, metallic=1.0),
-    }
-    mats = {name: matlib.define_preview_material(stage, f"/World/Looks/{name}", **kw) for name, kw in looks.items()}
-    for prim, look in [(floor, "Concrete"), (pallet, "Wood"), (part, "Steel")] + [(b, "Cardboard") for b in boxes]:
-        matlib.bind(prim, mats[look])
-    cam = rep.functional.create.camera(position=(3.2, -3.4, 2.2), look_at=(0.2, 0, 0.3), parent="/World",
+    rep.functional.create.reference(os.path.join(WAREHOUSE, "warehouse.usd"), parent="/World", name="Warehouse")
+    rep.functional.create.reference(os.path.join(WAREHOUSE, "Props", "SM_PaletteA_01.usd"), parent="/World",
+                                    name="Pallet")
+    boxes, rest = [], []
+    for i, (prop, x, y, yaw) in enumerate(BOXES):
+        box = rep.functional.create.reference(os.path.join(WAREHOUSE, "Props", f"{prop}.usd"), parent="/World",
+                                              name=f"Box{i}", position=(x, y, PALLET_TOP), rotation=(0, 0, yaw))
+        boxes.append(box)
+        rest.append(PALLET_TOP)
+    part = rep.functional.create.cylinder(position=(1.0, -0.7, 0.25), scale=(0.35, 0.35, 0.5), parent="/World",
+                                          name="SteelPart")
+    steel = matlib.define_preview_material(stage, "/World/Looks/Steel", diffuse=(0.8, 0.8, 0.82), roughness=0.25,
+                                           metallic=1.0)
+    matlib.bind(part, steel)
+    cam = rep.functional.create.camera(position=(2.6, -2.9, 1.7), look_at=(0.2, -0.1, 0.35), parent="/World",
                                        name="Camera")
-    return cam, boxes
+    UsdGeom.Camera(cam).GetFocalLengthAttr().Set(24.0)
+    return cam, boxes, rest
 
 
 def timed(render, frames: int, vary=None) -> tuple[float, object]:
@@ -74,18 +83,26 @@ def timed(render, frames: int, vary=None) -> tuple[float, object]:
     return (time.perf_counter() - t) / frames, out
 
 
-def randomizer(boxes, sim):
-    """A per-frame randomization like a script's: box poses and colours drawn from a seeded generator."""
+def randomizer(boxes, rest, sim):
+    """A per-frame randomization like a script's: the boxes slide and turn on the pallet (seeded); the
+    last frame puts them back, so the saved images show the scene as built."""
     rng = np.random.default_rng(7)
+    home = [(x, y, z, yaw) for (_, x, y, yaw), z in zip(BOXES, rest)]
 
     def vary(i: int) -> None:
         n = len(boxes)
-        rep.functional.modify.pose(boxes, position_value=np.c_[rng.uniform(-0.5, 0.5, (n, 2)),
-                                                               rng.uniform(0.3, 0.5, n)],
-                                   rotation_value=np.c_[np.zeros((n, 2)), rng.uniform(0, 90, n)])
-        rep.functional.modify.display_color(boxes, rng.uniform(0.3, 0.9, (n, 3)))
+        xy = np.array([h[:2] for h in home]) + rng.uniform(-0.05, 0.05, (n, 2))
+        yaw = np.array([h[3] for h in home]) + rng.uniform(-15, 15, n)
+        rep.functional.modify.pose(boxes, position_value=np.c_[xy, rest], rotation_value=np.c_[np.zeros((n, 2)), yaw])
         sim.sync_dirty_prims()
         sim.forward()
+
+    def put_back() -> None:
+        rep.functional.modify.pose(boxes, position_value=[h[:3] for h in home],
+                                   rotation_value=[(0, 0, h[3]) for h in home])
+        sim.sync_dirty_prims()
+        sim.forward()
+    vary.put_back = put_back
     return vary
 
 
@@ -112,7 +129,7 @@ def main() -> None:
     from graphsdg.render.pbr import PbrRenderer
 
     size = args.size
-    cam, boxes = build_scene(size)
+    cam, boxes, rest = build_scene(size)
     rt = runtime()
     pbr = PbrRenderer(args.device)   # before the compile: the model gets the PBR camera
     sim = rt.sim
@@ -120,10 +137,12 @@ def main() -> None:
     view = camera_view(cam, size, size)
     rows, images, hashes, phases = [], {}, {}, {}
 
-    vary = randomizer(boxes, sim) if args.randomize else None
+    vary = randomizer(boxes, rest, sim) if args.randomize else None
     s, out = timed(lambda: rt.rasterizer.render(sim, view, PASSES), args.frames, vary)
     rows.append(("classic (OpenGL rasteriser)", s, None))
-    images["classic"] = out.color
+    if vary is not None:
+        vary.put_back()
+    images["classic"] = rt.rasterizer.render(sim, view, PASSES).color
 
     def pbr_tier(name: str, frames: int) -> None:
         t = time.perf_counter()
@@ -133,7 +152,9 @@ def main() -> None:
         s, out = timed(lambda: pbr.render(sim, view, PASSES), frames, vary)
         phases[name] = {k: v / frames * 1000 for k, v in profiling.snapshot().items() if "pbr" in k}
         rows.append((f"pbr {name}", s, first_s))
-        images[name] = out.color
+        if vary is not None:
+            vary.put_back()
+        images[name] = pbr.render(sim, view, PASSES).color
         # same seeds, new renderer: same bytes?
         pbr._renders.clear()
         a = digest(pbr.render(sim, view, PASSES))
@@ -149,6 +170,8 @@ def main() -> None:
         import pstats
         profiler = cProfile.Profile()
         profiler.runcall(timed, lambda: pbr.render(sim, view, PASSES), args.cprofile, vary)
+        if vary is not None:
+            vary.put_back()
         pstats.Stats(profiler).sort_stats("tottime").print_stats(25)
     settings.set("/rtx/rendermode", "PathTracing")
     settings.set("/rtx/pathtracing/totalSpp", args.path_spp)
