@@ -163,3 +163,41 @@ def test_bounding_radius_of_an_x_axis_cylinder_matches_a_compile():
 
     compiled = rbound(False)
     assert compiled > 1.0 and rbound(True) == pytest.approx(compiled, rel=1e-9)
+
+
+def test_scales_stay_right_when_usd_and_direct_writes_alternate():
+    """A direct write after a scale synced through USD starts from the synced scale (the bindings' scales are
+    rows of one array; a binding given a new scale object is taken back into it)."""
+    prims = _batch_scene()
+    sim = runtime().sim
+    cone = prims[0]
+    rep.functional.modify.pose(prims, scale_value=0.5)                        # direct
+    binding = sim.compiled.geoms[str(cone.GetPath())]
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", False)
+    rep.functional.modify.pose([cone], scale_value=2.0)                        # through USD, synced
+    sim.sync_dirty_prims()
+    assert np.allclose(binding.scale, 2.0)
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", True)
+    rep.functional.modify.pose(prims, scale_value=0.8)                        # direct again, from 2.0
+    rbound = sim.model.geom_rbound[binding.geom_id]
+    assert np.allclose(binding.scale, 0.8)
+    compiled = sim.recompile(keep_state=False)                                  # the stage says 2.0 (USD)
+    fresh = compiled.model.geom_rbound[compiled.geoms[str(cone.GetPath())].geom_id]
+    assert np.isclose(rbound, fresh * 0.8 / 2.0, rtol=1e-5)
+
+
+def test_a_batch_checked_valid_is_checked_again_after_a_removal():
+    from graphsdg.errors import PrimNotFoundError
+    from graphsdg.stage import prims as prim_lookup
+    rep.functional.create.xform(name="World")
+    cubes = rep.functional.create_batch.cube(count=40, parent="/World")
+    assert prim_lookup.resolve_prims(cubes) == cubes and prim_lookup._checked.holds(cubes)
+    assert not prim_lookup._checked.holds(cubes[:-1]) and not prim_lookup._checked.holds(cubes[::-1])
+    cubes[0].GetStage().RemovePrim(cubes[7].GetPath())
+    assert not prim_lookup._checked.holds(cubes)
+    with pytest.raises(PrimNotFoundError, match="Cube_07"):
+        prim_lookup.resolve_prims(cubes)
+    others = rep.functional.create_batch.cube(count=40, parent="/World")
+    prim_lookup.resolve_prims(others)
+    rep.stage.new_stage()                                                      # its prims expire with it
+    assert not prim_lookup._checked.holds(others)

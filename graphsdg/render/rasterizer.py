@@ -584,9 +584,10 @@ def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: MeshMaps | dict
     """:meth:`Rasterizer._draw_rescaled_meshes` over the scene's geoms as one array (``scene_geoms``);
     ``uploaded_inverse`` as :func:`_undo_table` gives it.
 
-    The products are those of the per-geom loop, batched: ``current @ undo`` per
-    mesh, then each geom's float32 matrix times it in float64, rounded back to
-    float32 as it is stored (the same numbers, bit for bit: tests compare both).
+    The products are those of the per-geom loop, batched: for each drawn mesh geom
+    ``current @ undo`` of its mesh, then the geom's float32 matrix times that in
+    float64, rounded back to float32 as it is stored (the same numbers, bit for bit:
+    tests compare both).
     """
     rows = np.flatnonzero((geoms["type"] == mesh) & (geoms["objtype"] == geom_obj))
     if not rows.size:
