@@ -8,23 +8,27 @@ the classic layout, so annotators and writers do not know which backend drew.
 * **Same state.** Each render writes the simulation's geom, light and camera poses
   (``geom_xpos``/``geom_xmat`` as MuJoCo computed them on the CPU: mocap poses,
   physics, randomizers) straight into the renderer's data and refits the scene
-  BVH; no kinematics run on the GPU. Colours, material bindings and light colours
-  are copied into the renderer's model every render (per-world arrays: nothing
-  recompiles). A change that alters geometry (a new model, mesh rescaling, a geom
-  shown or hidden) builds a new render context: mesh BVHs are built from the
-  model's rescaled vertices.
+  BVH; no kinematics run on the GPU. Colours, material bindings, sizes and light
+  colours go into the renderer's model when they differ from the last upload
+  (per-world arrays: nothing recompiles); meshes rescaled in place
+  (:attr:`SimScene.mesh_stamps`) get their BVHs refit (:mod:`graphsdg.render.pbr_meshes`).
+  A new model, resolution, or a geom shown or hidden builds a new render context.
 * **Same camera.** The model carries one camera (``graphsdg:pbr_camera``, added by
   the compiler where this backend draws); each render poses it at the USD camera
   and renders per-pixel rays (:func:`graphsdg.render.pbr_scene.camera_rays`), so
-  aperture fit, offsets and clipping are the classic path's exactly.
+  aperture fit, offsets and clipping are the classic path's exactly; new
+  intrinsics give new rays without recompiling.
 * **Labels from the same rays.** Depth (planar z, ``inf`` background) and geom ids
-  (-1 background) come from the colour render's primary rays.
+  (-1 background) come from the colour render's primary rays, converted to the
+  classic layout on the GPU (:mod:`graphsdg.render.pbr_outputs`).
   ``render_isolated`` (unoccluded footprints for occlusion and loose boxes) is
   drawn by the classic rasteriser, which samples the same pixel centres.
 * **Tiers.** ``RaytracedLighting``: the real-time tier; ``rt_subframes`` N gives
   ceil(sqrt(N))^2 stratified samples per pixel (anti-aliasing, as on the
   rasteriser). ``PathTracing``: the path tier with the settings' samples and
   denoiser; subframes beyond one launch's samples are further launches, averaged.
+* **Motion blur.** The mean display colour of renders at the shutter's sub-frames
+  (:mod:`graphsdg.render.motion_blur`); labels from the capture's instant.
 
 Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``).
 """
