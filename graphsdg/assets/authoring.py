@@ -79,35 +79,30 @@ def define_textured_material(stage: Usd.Stage, path: str, texture: str, roughnes
     reader.CreateIdAttr("UsdPrimvarReader_float2")
     reader.CreateInput("varname", Sdf.ValueTypeNames.String).Set("st")
     reader.CreateOutput("result", Sdf.ValueTypeNames.Float2)
-    tex = UsdShade.Shader.Define(stage, f"{path}/DiffuseTexture")
-    tex.CreateIdAttr("UsdUVTexture")
-    tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(texture))
-    tex.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set("sRGB")
-    tex.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("repeat")
-    tex.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("repeat")
-    tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+    tex = _uv_texture(stage, f"{path}/DiffuseTexture", texture, reader, "sRGB")
     tex.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
     surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(tex.ConnectableAPI(), "rgb")
     if normal_texture:
-        normal = _data_texture(stage, f"{path}/NormalTexture", normal_texture, reader)
+        normal = _uv_texture(stage, f"{path}/NormalTexture", normal_texture, reader, "raw")
         normal.CreateInput("scale", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(2, 2, 2, 1))
         normal.CreateInput("bias", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(-1, -1, -1, 0))
         normal.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
         surface.CreateInput("normal", Sdf.ValueTypeNames.Normal3f).ConnectToSource(normal.ConnectableAPI(), "rgb")
     if orm_texture:
-        orm = _data_texture(stage, f"{path}/ORMTexture", orm_texture, reader)
+        orm = _uv_texture(stage, f"{path}/ORMTexture", orm_texture, reader, "raw")
         for name, channel in (("occlusion", "r"), ("roughness", "g"), ("metallic", "b")):
             orm.CreateOutput(channel, Sdf.ValueTypeNames.Float)
             surface.CreateInput(name, Sdf.ValueTypeNames.Float).ConnectToSource(orm.ConnectableAPI(), channel)
     return material
 
 
-def _data_texture(stage: Usd.Stage, path: str, file: str, reader: UsdShade.Shader) -> UsdShade.Shader:
-    """A UsdUVTexture of non-colour data (``sourceColorSpace`` raw) read at the material's ``st``."""
+def _uv_texture(stage: Usd.Stage, path: str, file: str, reader: UsdShade.Shader, colour_space: str) -> UsdShade.Shader:
+    """A repeating UsdUVTexture of ``file`` read at the material's ``st`` (``colour_space``: ``sRGB`` for colour,
+    ``raw`` for data such as normals and ORM)."""
     tex = UsdShade.Shader.Define(stage, path)
     tex.CreateIdAttr("UsdUVTexture")
     tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(file))
-    tex.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set("raw")
+    tex.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set(colour_space)
     tex.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("repeat")
     tex.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("repeat")
     tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
