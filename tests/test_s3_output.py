@@ -313,6 +313,29 @@ def cluster(s3_server):
     c.shutdown()
 
 
+def _describe_mismatch(keys: list[str], single: dict, objects: dict, keep) -> str:
+    """Keep both sides of each differing file under ``keep`` and say, for images, how many pixels differ and
+    which colours each side has there (a flaky mismatch of a sharded frame's labels was once seen in CI)."""
+    import io
+
+    from PIL import Image
+    keep.mkdir(parents=True, exist_ok=True)
+    lines = [f"files differ (both kept in {keep}):"]
+    for key in keys:
+        name = key.replace("/", "__")
+        (keep / f"single__{name}").write_bytes(single[key])
+        (keep / f"sharded__{name}").write_bytes(objects[key])
+        if key.endswith(".png"):
+            a, b = (np.array(Image.open(io.BytesIO(d))) for d in (single[key], objects[key]))
+            if a.shape == b.shape:
+                where = (a != b).any(axis=-1) if a.ndim == 3 else a != b
+                lines.append(f"{key}: {int(where.sum())} pixels differ; single {np.unique(a[where], axis=0)[:6]} "
+                             f"sharded {np.unique(b[where], axis=0)[:6]}")
+                continue
+        lines.append(f"{key}: {len(single[key])} vs {len(objects[key])} bytes")
+    return "\n".join(lines)
+
+
 def _node_ids(cluster) -> set[str]:
     return {n.node_id for n in cluster.list_all_nodes()}
 
@@ -328,7 +351,8 @@ def test_two_nodes_write_through_s3_the_single_process_disk_dataset(job_script, 
     assert {s["node"] for s in summary["shards"]} == _node_ids(cluster)          # one shard on each node
     single, objects = _files(tmp_path / "single"), s3_server.objects(bucket, "job/")
     assert sorted(_datasets(single)) == sorted(_datasets(objects))
-    assert [k for k in _datasets(single) if single[k] != objects[k]] == []
+    differing = [k for k in _datasets(single) if single[k] != objects[k]]
+    assert differing == [], _describe_mismatch(differing, single, objects, tmp_path / "mismatch")
     assert not any(".graphsdg-shards" in k or "graphsdg_run" in k for k in objects)   # merged in the bucket
     import json
     index = json.loads(objects["graphsdg_index.json"])
