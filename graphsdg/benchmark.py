@@ -69,6 +69,8 @@ class BenchConfig:
     shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
     image_threads: int | None = None     # OpenCV's pool; None: its default, or with --processes each one's share
     render_backend: str | None = None    # /graphsdg/render/backend (classic, pbr, auto); None: the setting as it is
+    render_mode: str | None = None       # /rtx/rendermode (RaytracedLighting, PathTracing); None: the setting as it is
+    path_spp: int | None = None          # /rtx/pathtracing/spp of the path tier; None: the setting as it is
     seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
 
 
@@ -163,6 +165,10 @@ def build_scene(config: BenchConfig):
         rep.settings.set("/graphsdg/render/shadowSize", int(config.shadow_size))
     if config.render_backend is not None:
         rep.settings.set("/graphsdg/render/backend", config.render_backend)
+    if config.render_mode is not None:
+        rep.settings.set("/rtx/rendermode", config.render_mode)
+    if config.path_spp is not None:
+        rep.settings.set("/rtx/pathtracing/spp", int(config.path_spp))
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)

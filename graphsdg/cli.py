@@ -67,12 +67,15 @@ def run_bench(args: argparse.Namespace) -> None:
         asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
         rt_subframes=args.rt_subframes, wait_for_render=args.wait_for_render,
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
-        msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds)
+        msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds,
+        render_mode=args.rendermode, path_spp=args.spp)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
                        f", {args.write_threads} write threads" if args.write_threads is not None else
                        "" if args.processes else f", {_default_write_threads()} write threads",
-                       ", wait_for_render" if args.wait_for_render else ""])
+                       ", wait_for_render" if args.wait_for_render else "",
+                       f", {args.rendermode}" if args.rendermode else "",
+                       f", {args.spp} path samples" if args.spp else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
     settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
@@ -323,6 +326,12 @@ def build_parser() -> argparse.ArgumentParser:
                        help="graphsdg's renderer: the OpenGL rasteriser (classic), the GPU ray tracer (pbr) or "
                             "pbr where it can run (auto); the hand-written loop always rasterises (default: the "
                             "setting /graphsdg/render/backend, auto)")
+    bench.add_argument("--rendermode", choices=("RaytracedLighting", "PathTracing"),
+                       help="Isaac's /rtx/rendermode: on pbr the real-time or the path-traced tier, on classic "
+                            "PathTracing raises the quality (default: the setting, RaytracedLighting)")
+    bench.add_argument("--spp", type=_positive,
+                       help="path-traced samples per pixel of one launch, /rtx/pathtracing/spp (default: the larger of "
+                            "the settings spp and totalSpp)")
     bench.add_argument("--processes", type=_non_negative, default=0,
                        help="run this many graphsdg processes at once and report their aggregate frames/s "
                             "(no hand-written loop); 0 runs one process with the loop (default: 0)")

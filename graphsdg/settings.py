@@ -61,6 +61,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/graphsdg/render/backend": ("auto", "renderer: classic (MuJoCo's OpenGL rasteriser), pbr (mujoco-warp-pbr on "
                                          "a CUDA GPU; pip install 'graphsdg[gpu]', Python >= 3.12) or auto (pbr "
                                          "where it can run, else classic; said once in the log)"),
+    "/graphsdg/render/pbrDevice": ("cuda:0", "the Warp device the pbr backend renders on: cuda:N, or cpu (Warp's "
+                                             "CPU device: slow, for checks on machines without a GPU)"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
     "/app/player/timelineSubsampleRate": (1, "timeline ticks per frame: each app update's frame is split into this "
@@ -119,6 +121,12 @@ def _choice(*options: str) -> Callable[[str, Any], None]:
     return check
 
 
+def _warp_device(key: str, value: Any) -> None:
+    ok = isinstance(value, str) and (value in ("cpu", "cuda") or (value.startswith("cuda:") and value[5:].isdigit()))
+    if not ok:
+        raise ValueError(f"setting {key} must be 'cuda', 'cuda:N' or 'cpu', got {value!r}")
+
+
 def _path_or_none(key: str, value: Any) -> None:
     if value is not None and not isinstance(value, (str, os.PathLike)):
         raise ValueError(f"setting {key} must be a folder path or None, got {value!r}")
@@ -146,6 +154,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/exposure": _positive_number,
     "/graphsdg/render/maxResolution": _integer(1),
     "/graphsdg/render/backend": _choice("classic", "pbr", "auto"),
+    "/graphsdg/render/pbrDevice": _warp_device,
     "/rtx/pathtracing/spp": _integer(1),
     "/rtx/pathtracing/optixDenoiser/enabled": _boolean,
     "/omni/replicator/captureMotionBlur": _boolean,

@@ -292,3 +292,64 @@ def test_maps_compile_as_mujoco_texture_roles_only_where_pbr_draws(tmp_path, mon
         pixels = model.tex_data[adr:adr + h * w * 3].reshape(h, w, 3)
         expected = cv2.cvtColor(cv2.imread(files[name]), cv2.COLOR_BGR2RGB)
         assert np.array_equal(pixels, expected) or np.array_equal(pixels, expected[::-1])
+
+
+# ---- rescaled meshes folded into the traced geom frame (graphsdg/render/mesh_folds.py) ----
+
+def _rotation(rng):
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    return q * np.sign(np.linalg.det(q))
+
+
+@pytest.mark.parametrize("kind", ["uniform", "axes", "general"])
+def test_folded_frame_traces_the_rescaled_mesh(kind):
+    """A ray mapped by the folded frame's transpose meets the built vertices at the world parameter t of the
+    rescaled mesh's surface point; the folded frame maps the built face normal onto the rescaled face's
+    normal; the folded bounds contain every rescaled vertex."""
+    from graphsdg.render import mesh_folds
+    rng = np.random.default_rng({"uniform": 1, "axes": 2, "general": 3}[kind])
+    built = rng.normal(size=(40, 3))                      # the vertices the BVH was built from (mesh frame)
+    g = {"uniform": 1.7 * np.eye(3), "axes": np.diag([0.3, 2.2, 0.9]),
+         "general": np.diag([0.5, 1.6, 1.1]) @ _rotation(rng) + 0.2 * rng.normal(size=(3, 3))}[kind]
+    xmat, pos = _rotation(rng), rng.normal(size=3)
+    frames = mesh_folds.traced_frames(xmat[None], np.array([0]), g[None], np.array([True]))
+    x = frames[0]
+    # a ray from o through the world point of built vertex 5 arrives there at t = 1
+    world = pos + xmat @ (g @ built[5])
+    o = world + rng.normal(size=3) * 3.0
+    d = world - o
+    local_o, local_d = x.T @ (o - pos), x.T @ d
+    np.testing.assert_allclose(local_o + 1.0 * local_d, built[5], atol=1e-9)
+    # normals: X n_built is parallel to the rescaled triangle's world normal
+    tri = built[:3]
+    n_built = np.cross(tri[1] - tri[0], tri[2] - tri[0])
+    w = pos + (xmat @ g @ tri.T).T
+    n_world = np.cross(w[1] - w[0], w[2] - w[0])
+    mapped = x @ n_built
+    np.testing.assert_allclose(mapped / np.linalg.norm(mapped), n_world / np.linalg.norm(n_world), atol=1e-9)
+    # bounds: the scene BVH's box of |X| times the folded half extents holds the rescaled mesh
+    half = np.abs(built).max(axis=0)
+    folded = mesh_folds.folded_bounds(g[None], half[None])[0]
+    reach = np.abs(x) @ folded
+    assert (np.abs((xmat @ g @ built.T).T) <= reach + 1e-9).all()
+    if kind != "general":   # axis scales: the box is the rescaled mesh's own, not a looser one
+        np.testing.assert_allclose(folded, np.abs(np.diag(g)) ** 2 * half)
+
+
+def test_folded_frames_touch_only_moved_mesh_geoms():
+    from graphsdg.render import mesh_folds
+    from graphsdg.sim.mesh_scaling import MeshMaps
+    maps = MeshMaps()
+    maps[1] = 2.0 * np.eye(3)
+    now = mesh_folds.current_maps(maps, 3)
+    np.testing.assert_array_equal(now[0], np.eye(3))
+    np.testing.assert_array_equal(now[1], 2.0 * np.eye(3))
+    built = np.stack([np.eye(3), 0.5 * np.eye(3), np.eye(3)])
+    relative = mesh_folds.relative_maps(now, built)
+    np.testing.assert_allclose(relative[1], 4.0 * np.eye(3))
+    moved = np.array([False, True, False])
+    xmat = np.tile(np.eye(3), (4, 1, 1))
+    geom_mesh = np.array([-1, 0, 1, 1])                  # a primitive, an unmoved mesh, two geoms of mesh 1
+    frames = mesh_folds.traced_frames(xmat, geom_mesh, relative, moved)
+    np.testing.assert_array_equal(frames[:2], xmat[:2])
+    np.testing.assert_allclose(frames[2:], np.tile(0.25 * np.eye(3), (2, 1, 1)))

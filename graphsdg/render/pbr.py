@@ -10,8 +10,9 @@ the classic layout, so annotators and writers do not know which backend drew.
   physics, randomizers) straight into the renderer's data and refits the scene
   BVH; no kinematics run on the GPU. Colours, material bindings, sizes and light
   colours go into the renderer's model when they differ from the last upload
-  (per-world arrays: nothing recompiles); meshes rescaled in place
-  (:attr:`SimScene.mesh_stamps`) get their BVHs refit (:mod:`graphsdg.render.pbr_meshes`).
+  (per-world arrays: nothing recompiles); meshes rescaled in place are traced through
+  their rescale folded into the geom frame (no BVH refit), meshes deformed otherwise get
+  their BVHs refit (:mod:`graphsdg.render.pbr_meshes`).
   A new model, resolution, or a geom shown or hidden builds a new render context.
 * **Same camera.** The model carries one camera (``graphsdg:pbr_camera``, added by
   the compiler where this backend draws); each render poses it at the USD camera
@@ -43,7 +44,7 @@ import numpy as np
 from pxr import UsdShade
 
 from graphsdg import profiling, settings
-from graphsdg.render import pbr_scene
+from graphsdg.render import mesh_folds, pbr_scene
 from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend
 from graphsdg.render.camera import CameraView
 from graphsdg.render.rasterizer import PASSES, RenderOutputs
@@ -66,8 +67,24 @@ class _Context:
     env_yaw: float
     layout: Any         # pbr_outputs.ClassicLayout: device-side conversion and host buffers
     rays_key: tuple     # the camera intrinsics the rays were made from
-    mesh_stamps: np.ndarray   # SimScene.mesh_stamps when the BVHs were last brought up to date
+    meshes: "_MeshState"     # how the device's mesh BVHs relate to the model's current vertices
     uploaded: dict = field(default_factory=dict)   # field name -> host copy last uploaded
+
+
+@dataclass
+class _MeshState:
+    """The context's mesh BVHs against the simulation's meshes (:mod:`graphsdg.render.pbr_meshes`)."""
+
+    geom_mesh: np.ndarray      # (ngeom,) each geom's mesh id, -1 for other geom types
+    built_maps: np.ndarray     # (nmesh, 3, 3) SimScene.mesh_maps (identity where none) the BVHs' vertices had
+    half_extents: np.ndarray   # (nmesh, 3) the scene BVH's mesh bounds for those vertices
+    reshapes: np.ndarray       # SimScene.mesh_reshapes when the BVHs last took new vertices
+    stamps: np.ndarray         # SimScene.mesh_stamps when the traced frames below were computed
+    mirror_vert: np.ndarray    # host copies of the device's mesh vertices and normals
+    mirror_normal: np.ndarray
+    relative: np.ndarray       # (nmesh, 3, 3) built vertices -> current ones
+    moved: np.ndarray          # (nmesh,) meshes whose relative map is not the identity
+    bounds: np.ndarray | None = None   # the mesh bounds last uploaded
 
 
 class PbrRenderer:
@@ -138,10 +155,20 @@ class PbrRenderer:
             rgb = wp.zeros((1, view.height, view.width), dtype=wp.vec3)
         layout = self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
                                              view.far, self._device)
-        # the context was built from the model's current vertices: every mesh is up to date
-        stamps = sim.mesh_stamps.copy() if sim.mesh_stamps.shape[0] == model.nmesh else np.zeros(model.nmesh, np.int64)
         return _Context(key=key, model=m, data=d, rc=rc, camera=camera, rgb=rgb, env_yaw=yaw, layout=layout,
-                        rays_key=_rays_key(view), mesh_stamps=stamps)
+                        rays_key=_rays_key(view), meshes=self._mesh_state(sim, rc))
+
+    def _mesh_state(self, sim: SimScene, rc) -> _MeshState:
+        """The context was built from the model's current vertices: every mesh's BVH is up to date."""
+        model, nmesh = sim.model, sim.model.nmesh
+        geom_mesh = np.where(model.geom_type == mujoco.mjtGeom.mjGEOM_MESH, model.geom_dataid, -1).astype(np.int64)
+        half = rc.base.mesh_bounds_size.numpy().astype(np.float64) if nmesh else np.zeros((0, 3))
+        return _MeshState(geom_mesh=geom_mesh, built_maps=mesh_folds.current_maps(sim.mesh_maps, nmesh),
+                          half_extents=half, reshapes=_counts(sim.mesh_reshapes, nmesh),
+                          stamps=_counts(sim.mesh_stamps, nmesh),
+                          mirror_vert=np.array(model.mesh_vert, dtype=np.float32),
+                          mirror_normal=np.array(model.mesh_normal, dtype=np.float32),
+                          relative=np.tile(np.eye(3), (nmesh, 1, 1)), moved=np.zeros(nmesh, dtype=bool))
 
     def _environment(self, sim: SimScene) -> tuple[np.ndarray | None, float]:
         """The stage's dome lights as one environment map in nits, and its yaw (0 when resampled)."""
@@ -255,7 +282,8 @@ class PbrRenderer:
         model, m, d, rc = sim.model, ctx.model, ctx.data, ctx.rc
         data = sim.data if data is None else data
         d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
-        d.geom_xmat.assign(np.asarray(data.geom_xmat, dtype=np.float32).reshape(1, -1, 3, 3))
+        xmat = self._traced_frames(sim, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3))
+        d.geom_xmat.assign(np.asarray(xmat, dtype=np.float32)[None])
         if model.nlight:
             d.light_xpos.assign(np.asarray(data.light_xpos, dtype=np.float32)[None])
             d.light_xdir.assign(np.asarray(data.light_xdir, dtype=np.float32)[None])
@@ -277,12 +305,34 @@ class PbrRenderer:
             if model.nlight:
                 rc.light_intensity.assign(world.light_intensity[None])
             ctx.uploaded["surfaces"] = True
-        if model.nmesh and not np.array_equal(sim.mesh_stamps, ctx.mesh_stamps):
-            with profiling.timed("render:pbr_mesh_refit"):
-                moved = self._meshes.changed(ctx.mesh_stamps, sim.mesh_stamps)
-                self._meshes.refit(model, m, rc, moved)
-            ctx.mesh_stamps = sim.mesh_stamps.copy()
         self._mjw.refit_bvh(m, d, rc.base)
+
+    def _traced_frames(self, sim: SimScene, ctx: _Context, xmat: np.ndarray) -> np.ndarray:
+        """Geom frames for the tracer: rescaled meshes folded in, other vertex changes refit into their BVHs
+        (:mod:`graphsdg.render.pbr_meshes`); the scene BVH's mesh bounds follow."""
+        model, state, meshes, folds = sim.model, ctx.meshes, self._meshes, mesh_folds
+        if not model.nmesh:
+            return xmat
+        stamps = _counts(sim.mesh_stamps, model.nmesh)
+        if not np.array_equal(stamps, state.stamps):
+            now = folds.current_maps(sim.mesh_maps, model.nmesh)
+            reshapes = _counts(sim.mesh_reshapes, model.nmesh)
+            reshaped = meshes.changed(state.reshapes, reshapes)
+            if reshaped.size:      # vertices no map describes (deformables): new vertices into the BVHs
+                with profiling.timed("render:pbr_mesh_refit"):
+                    meshes.refit(model, ctx.model, ctx.rc, reshaped, state.mirror_vert, state.mirror_normal)
+                state.built_maps[reshaped] = now[reshaped]
+                state.half_extents[reshaped] = folds.vertex_extents(model)[reshaped]
+                state.reshapes = reshapes
+                state.bounds = None
+            state.relative = folds.relative_maps(now, state.built_maps)
+            state.moved = ~np.all(np.abs(state.relative - np.eye(3)) <= 0.0, axis=(1, 2))
+            state.stamps = stamps
+            bounds = folds.folded_bounds(state.relative, state.half_extents).astype(np.float32)
+            if state.bounds is None or not np.array_equal(bounds, state.bounds):
+                ctx.rc.base.mesh_bounds_size.assign(bounds)
+                state.bounds = bounds
+        return folds.traced_frames(xmat, state.geom_mesh, state.relative, state.moved)
 
     @staticmethod
     def _upload_changed(ctx: _Context, fields: list) -> set[str]:
@@ -342,6 +392,11 @@ class PbrRenderer:
         if self._isolated is not None:
             self._isolated.close()
             self._isolated = None
+
+
+def _counts(stamps: np.ndarray, n: int) -> np.ndarray:
+    """A copy of per-mesh counts, zeros when they were not sized for this model yet."""
+    return stamps.copy() if stamps.shape[0] == n else np.zeros(n, dtype=np.int64)
 
 
 def _rays_key(view: CameraView) -> tuple:

@@ -1,10 +1,9 @@
-"""Meshes whose vertices changed since the PBR render context was built: new vertices into its BVHs.
+"""Meshes whose vertices changed in ways no rescale map describes (deformables): new vertices into the PBR
+render context's BVHs.
 
-The classic rasteriser draws a rescaled mesh through a matrix (:attr:`SimScene.mesh_maps`); a ray tracer
-traces the vertices themselves. Rescaling randomizers (and deformables) change a few meshes per frame, so
-rebuilding the render context would cost far more than the frame: instead each changed mesh's Warp BVH gets
-its new vertices and is refit in place, its bound for the scene BVH is recomputed, and the device copies of
-the vertices and normals that shading interpolates are replaced.
+Rescaled meshes need none of this: they are traced through their rescale folded into the geom frame
+(:mod:`graphsdg.render.mesh_folds`). For the others, each changed mesh's Warp BVH gets its new vertices and
+is refit in place, and the device copies of the vertices and normals that shading interpolates are replaced.
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
 """
@@ -35,22 +34,29 @@ def _framed_points(vert: wp.array[wp.vec3], start: int, frame: wp.mat33, points:
     points[i] = frame @ vert[start + i]
 
 
-def refit(model: mujoco.MjModel, device_model, rc, mesh_ids: np.ndarray) -> None:
+def refit(model: mujoco.MjModel, device_model, rc, mesh_ids: np.ndarray, mirror_vert: np.ndarray,
+          mirror_normal: np.ndarray) -> None:
     """Bring the render context's copies of meshes ``mesh_ids`` up to ``model``'s vertices and normals.
 
-    One host-to-device copy of all vertices (and normals); each changed mesh's BVH points are then copied
-    (or rotated into its tracing frame) on the device and its BVH refit, all queued without waiting."""
+    ``mirror_vert`` / ``mirror_normal`` are host copies of what the device holds; only these meshes' ranges
+    change in them (the others stay as their BVHs were built, which their traced frames assume), then one
+    host-to-device copy each. Each mesh's BVH points are copied (or rotated into its tracing frame) on the
+    device and its BVH refit, all queued without waiting."""
     if len(mesh_ids) == 0:
         return
     base = rc.base
-    device_model.mesh_vert.assign(np.asarray(model.mesh_vert, dtype=np.float32))
-    device_model.mesh_normal.assign(np.asarray(model.mesh_normal, dtype=np.float32))
+    for mesh_id in np.asarray(mesh_ids, dtype=np.int64).tolist():
+        v0, nv = int(model.mesh_vertadr[mesh_id]), int(model.mesh_vertnum[mesh_id])
+        n0, nn = int(model.mesh_normaladr[mesh_id]), int(model.mesh_normalnum[mesh_id])
+        mirror_vert[v0:v0 + nv] = model.mesh_vert[v0:v0 + nv]
+        mirror_normal[n0:n0 + nn] = model.mesh_normal[n0:n0 + nn]
+    device_model.mesh_vert.assign(mirror_vert)
+    device_model.mesh_normal.assign(mirror_normal)
     vert = device_model.mesh_vert
     base_ids = base.mesh_bvh_id.numpy()
     trace_ids = rc.trace_mesh_bvh_id.numpy() if rc.trace_mesh_bvh_id is not None else None
     traced = {mesh.id: mesh for mesh in (rc.trace_mesh_registry or [])}
-    mesh_ids = np.asarray(mesh_ids, dtype=np.int64)
-    for mesh_id in mesh_ids.tolist():
+    for mesh_id in np.asarray(mesh_ids, dtype=np.int64).tolist():
         start, count = int(model.mesh_vertadr[mesh_id]), int(model.mesh_vertnum[mesh_id])
         mesh = base.mesh_registry.get(int(base_ids[mesh_id]))
         if mesh is not None:
@@ -62,11 +68,6 @@ def refit(model: mujoco.MjModel, device_model, rc, mesh_ids: np.ndarray) -> None
                 wp.launch(_framed_points, dim=count, inputs=[vert, start, wp.mat33(*_mesh_frame(model, mesh_id).ravel())],
                           outputs=[framed.points], device=vert.device)
                 framed.refit()
-    # the scene BVH bounds a mesh geom by its vertices' largest extent from the origin along each axis
-    extent = np.maximum.reduceat(np.abs(np.asarray(model.mesh_vert)), np.asarray(model.mesh_vertadr), axis=0)
-    bounds = base.mesh_bounds_size.numpy()
-    bounds[mesh_ids] = extent[mesh_ids]
-    base.mesh_bounds_size.assign(bounds)
 
 
 __all__ = ["changed", "refit"]

@@ -97,8 +97,11 @@ class SimScene:
         # place since the compile; renderers draw the copy they uploaded through it (no re-upload)
         self.mesh_maps = MeshMaps()
         # per mesh: the count of vertex changes since the compile (rescales, deformables), so renderers that
-        # keep their own copy (the pbr backend's BVHs) find the meshes to refit with one comparison
+        # keep their own copy (the pbr backend's BVHs) find the changed meshes with one comparison
         self.mesh_stamps = np.zeros(0, dtype=np.int64)
+        # per mesh: the count of those changes that mesh_maps does not describe (deformables): a renderer
+        # that draws its copy through the maps must take new vertices only for these
+        self.mesh_reshapes = np.zeros(0, dtype=np.int64)
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
@@ -138,15 +141,20 @@ class SimScene:
         """:meth:`rescale_mesh` for many visual mesh geoms at once (their scales as (N, 3) arrays)."""
         mesh_ids, linears = rescale_mesh_geoms(self.model, geom_ids, old_scales, new_scales)
         self.mesh_maps.compose(mesh_ids, linears)
-        self.stamp_meshes(mesh_ids)
+        self.stamp_meshes(mesh_ids, mapped=True)
 
-    def stamp_meshes(self, mesh_ids) -> None:
-        """Record that meshes ``mesh_ids``' vertices changed (see :attr:`mesh_stamps`)."""
+    def stamp_meshes(self, mesh_ids, mapped: bool = False) -> None:
+        """Record that meshes ``mesh_ids``' vertices changed (see :attr:`mesh_stamps`); ``mapped``: by a linear
+        map composed into :attr:`mesh_maps` (else :attr:`mesh_reshapes` counts the change too)."""
         nmesh = self.model.nmesh
         if self.mesh_stamps.shape[0] != nmesh:
             self.mesh_stamps = np.zeros(nmesh, dtype=np.int64)
-        np.add.at(self.mesh_stamps, np.asarray(list(mesh_ids) if isinstance(mesh_ids, set) else mesh_ids,
-                                               dtype=np.int64), 1)
+        if self.mesh_reshapes.shape[0] != nmesh:
+            self.mesh_reshapes = np.zeros(nmesh, dtype=np.int64)
+        ids = np.asarray(list(mesh_ids) if isinstance(mesh_ids, set) else mesh_ids, dtype=np.int64)
+        np.add.at(self.mesh_stamps, ids, 1)
+        if not mapped:
+            np.add.at(self.mesh_reshapes, ids, 1)
 
     def recompile(self, keep_state: bool = True) -> CompiledScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
@@ -162,6 +170,7 @@ class SimScene:
         self.textures_to_upload.clear()
         self.mesh_maps.clear()
         self.mesh_stamps = np.zeros(new.model.nmesh, dtype=np.int64)
+        self.mesh_reshapes = np.zeros(new.model.nmesh, dtype=np.int64)
         self.meshes_to_upload.clear()
         self.follow_deformables()
         self.stats["compiles"] += 1
