@@ -296,7 +296,7 @@ def test_maps_compile_as_mujoco_texture_roles_only_where_pbr_draws(tmp_path, mon
 
 # ---- rescaled meshes folded into the traced geom frame (graphsdg/render/mesh_folds.py) ----
 
-def _rotation(rng):
+def _random_rotation(rng):
     q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     return q * np.sign(np.linalg.det(q))
 
@@ -310,8 +310,8 @@ def test_folded_frame_traces_the_rescaled_mesh(kind):
     rng = np.random.default_rng({"uniform": 1, "axes": 2, "general": 3}[kind])
     built = rng.normal(size=(40, 3))                      # the vertices the BVH was built from (mesh frame)
     g = {"uniform": 1.7 * np.eye(3), "axes": np.diag([0.3, 2.2, 0.9]),
-         "general": np.diag([0.5, 1.6, 1.1]) @ _rotation(rng) + 0.2 * rng.normal(size=(3, 3))}[kind]
-    xmat, pos = _rotation(rng), rng.normal(size=3)
+         "general": np.diag([0.5, 1.6, 1.1]) @ _random_rotation(rng) + 0.2 * rng.normal(size=(3, 3))}[kind]
+    xmat, pos = _random_rotation(rng), rng.normal(size=3)
     frames = mesh_folds.traced_frames(xmat[None], np.array([0]), g[None], np.array([True]))
     x = frames[0]
     # a ray from o through the world point of built vertex 5 arrives there at t = 1
