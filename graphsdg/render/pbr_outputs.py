@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from graphsdg.render.polling import wait_until
+
 GEOM_TYPE = 5          # mujoco.mjtObj.mjOBJ_GEOM, as the renderer writes it into segmentation pairs
 
 
@@ -92,7 +94,9 @@ class ClassicLayout:
         for want, src, dst in wanted:
             if want:
                 wp.copy(dst, src)
-        wp.synchronize_device(self.device)
+        if wp.get_device(self.device).is_cuda:   # CPU copies are done when wp.copy returns
+            done = wp.record_event()
+            wait_until(lambda: done.is_complete)   # not wp.synchronize_device: CUDA's wait spins a core
         own = [np.array(dst.numpy()) if want else None for want, _, dst in wanted]
         return HostFrame(rgba=None if own[0] is None else own[0].view(np.uint8).reshape(h, w, 4),
                          depth=None if own[1] is None else own[1].reshape(h, w),

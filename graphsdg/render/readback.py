@@ -27,7 +27,6 @@ Example (inside a current GL context, after ``mjr_render``)::
 from __future__ import annotations
 
 import ctypes
-import time
 from typing import Callable
 
 import mujoco
@@ -37,6 +36,7 @@ from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no 
 
 from graphsdg import profiling
 from graphsdg.render import gl_direct as gld
+from graphsdg.render.polling import wait_until
 
 _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
     "rgba": (GL.GL_RGBA, GL.GL_UNSIGNED_BYTE, np.uint8, 4),
@@ -219,27 +219,21 @@ class PixelReads:
 
 
 _SIGNALED = (GL.GL_ALREADY_SIGNALED, GL.GL_CONDITION_SATISFIED)
-_FIRST_SLEEP, _LONGEST_SLEEP = 20e-6, 200e-6   # seconds between polls: short first, doubling up to the longest
 
 
 def wait_for_fence(fence) -> None:
-    """Return once the GPU has passed ``fence`` (a ``glFenceSync`` of the current context).
+    """Return once the GPU has passed ``fence`` (a ``glFenceSync`` of the current context), polling
+    without blocking in the driver (:func:`graphsdg.render.polling.wait_until`)."""
+    flags = [GL.GL_SYNC_FLUSH_COMMANDS_BIT]   # the first poll also submits the queued commands
 
-    Polls without blocking in the driver (a blocking wait spins a core on
-    NVIDIA's driver) and sleeps between polls, 20 us at first and doubling up to
-    200 us, so a wait ends at most ~0.2 ms late and costs a few system calls.
-    """
-    flags = GL.GL_SYNC_FLUSH_COMMANDS_BIT   # the first poll also submits the queued commands
-    pause = _FIRST_SLEEP
-    while True:
-        status = gld.glClientWaitSync(fence, flags, 0)   # never blocks (timeout 0): keeps the interpreter lock
-        if status in _SIGNALED:
-            return
+    def passed() -> bool:
+        status = gld.glClientWaitSync(fence, flags[0], 0)   # never blocks (timeout 0): keeps the interpreter lock
         if status == GL.GL_WAIT_FAILED:
             raise RuntimeError("glClientWaitSync failed while waiting for a pixel read to finish")
-        flags = 0
-        time.sleep(pause)
-        pause = min(2 * pause, _LONGEST_SLEEP)
+        flags[0] = 0
+        return status in _SIGNALED
+
+    wait_until(passed)
 
 
 def codes_from_rgba(size: int) -> Callable[[np.ndarray], np.ndarray]:
