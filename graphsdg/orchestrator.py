@@ -15,13 +15,15 @@ import time
 from fractions import Fraction
 from typing import Any, Callable
 
-from graphsdg import interrupts, profiling, settings
+from graphsdg import settings
+from graphsdg.jobs import interrupts
+from graphsdg.benchmark import profiling
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import run_state
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
-from graphsdg.progress import Progress
+from graphsdg.jobs.progress import Progress
 from graphsdg.render import motion_blur
 from graphsdg.render.camera import CameraView, camera_view
 from graphsdg.runtime import runtime
@@ -100,7 +102,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     wants it running again calls ``timeline.play()``).
     ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
     Ctrl-C (or SIGTERM) during a step takes effect when the frame has been handed
-    to the writers (:mod:`graphsdg.interrupts`).
+    to the writers (:mod:`graphsdg.jobs.interrupts`).
 
     ``wait_for_render=False`` pipelines: the step returns once the frame is drawn
     and its pixels are copying off the GPU; its annotators and writers run at the
@@ -436,7 +438,7 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
         if unlimited:
             raise OrchestratorError(f"run() without num_frames would never stop: trigger(s) {unlimited} have no "
                                     f"max_execs; pass num_frames=N or set max_execs")
-    from graphsdg import frame_plan
+    from graphsdg.jobs import frame_plan
     _state.plan = frame_plan.current()
     if _state.plan is not None:
         num_frames = _planned_length(num_frames, sched)
@@ -507,8 +509,8 @@ def _planned_length(num_frames: int | None, sched) -> int:
 
 
 def _planned_frames(sched, progress: Progress) -> None:
-    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.frame_plan`)."""
-    from graphsdg import frame_plan
+    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.jobs.frame_plan`)."""
+    from graphsdg.jobs import frame_plan
     plan, total = _state.plan, _state.remaining or 0
     writers = list(runtime().writers)
     for writer in writers:

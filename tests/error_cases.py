@@ -45,7 +45,7 @@ class CommandFailed(Exception):
 
 def cli(*args: str) -> None:
     """Run ``graphsdg *args`` in-process; raise :class:`CommandFailed` unless it exits 0."""
-    from graphsdg.cli import main
+    from graphsdg.jobs.cli import main
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
         try:

@@ -19,7 +19,7 @@ import numpy as np
 from PIL import Image
 
 import graphsdg as rep
-from graphsdg.cli import main
+from graphsdg.jobs.cli import main
 from graphsdg.sim import bounds
 
 from conftest import cube_corners, project_box

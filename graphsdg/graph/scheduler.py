@@ -21,7 +21,7 @@ from typing import Any, Iterable
 
 from pxr import Sdf, Usd
 
-from graphsdg import profiling
+from graphsdg.benchmark import profiling
 from graphsdg.graph.builder import ReplicatorItem, current_graph, edit_context, release_graph
 from graphsdg.graph.graph import Graph, effective_triggers
 from graphsdg.graph.node import ExecContext, Node, TriggerNode

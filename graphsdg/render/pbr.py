@@ -42,7 +42,8 @@ import mujoco
 import numpy as np
 from pxr import UsdShade
 
-from graphsdg import profiling, settings
+from graphsdg import settings
+from graphsdg.benchmark import profiling
 from graphsdg.render import pbr_scene
 from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend
 from graphsdg.render.camera import CameraView

@@ -39,7 +39,7 @@ import cv2
 import mujoco
 import numpy as np
 
-from graphsdg import profiling
+from graphsdg.benchmark import profiling
 from graphsdg.render import gl_direct, sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer

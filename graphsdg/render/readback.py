@@ -35,7 +35,7 @@ import numpy as np
 from OpenGL import GL
 from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no client-array wrapping: a PBO offset
 
-from graphsdg import profiling
+from graphsdg.benchmark import profiling
 from graphsdg.render import gl_direct as gld
 
 _FORMATS = {  # kind -> (GL format, GL type, numpy dtype, channels)
