@@ -14,7 +14,7 @@ from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError
 from graphsdg.runtime import runtime
 from graphsdg.sim.bodies import RigidBodyView
-from graphsdg.sim.compiler import CompileError
+from graphsdg.sim.compile_error import CompileError
 
 
 @pytest.fixture

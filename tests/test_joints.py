@@ -18,7 +18,7 @@ from graphsdg.runtime import runtime
 from graphsdg.sim import queries
 from graphsdg.sim.articulations import ArticulationView, fixed_joint_enabled, set_fixed_joint_enabled
 from graphsdg.sim.bodies import RigidBodyView
-from graphsdg.sim.compiler import CompileError
+from graphsdg.sim.compile_error import CompileError
 
 G = 9.81
 

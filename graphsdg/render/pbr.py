@@ -48,8 +48,8 @@ from graphsdg.render import pbr_scene
 from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend
 from graphsdg.render.camera import CameraView
 from graphsdg.render.rasterizer import PASSES, RenderOutputs
-from graphsdg.sim.compiler import PBR_CAMERA, UNDRAWN_GROUPS, drawn_geom_mask
 from graphsdg.sim.scene import SimScene
+from graphsdg.sim.visual import PBR_CAMERA, UNDRAWN_GROUPS, drawn_geom_mask
 
 ENABLED_GROUPS = tuple(g for g in range(mujoco.mjNGROUP) if g not in UNDRAWN_GROUPS)
 

@@ -39,7 +39,8 @@ import numpy as np
 from pxr import Gf, Sdf, UsdPhysics
 
 from graphsdg.sim import joints as jointmap
-from graphsdg.sim.compiler import JointBinding, rigid_root
+from graphsdg.sim.compiled_scene import JointBinding
+from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, world_matrix
 
 

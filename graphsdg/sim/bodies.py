@@ -24,7 +24,7 @@ from typing import Iterable, Sequence
 import numpy as np
 from pxr import Sdf, Usd, UsdPhysics
 
-from graphsdg.sim.compiler import rigid_root
+from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import PrimLike
 from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix

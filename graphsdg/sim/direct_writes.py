@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 from pxr import Usd
 
-from graphsdg.sim.compiler import primitive_size
+from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage.xform import decompose, world_matrix
 

@@ -32,7 +32,8 @@ from typing import Any, Callable, Sequence
 import mujoco
 import numpy as np
 
-from graphsdg.sim.compiler import CompiledScene, rigid_root
+from graphsdg.sim.compiled_scene import CompiledScene
+from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.prims import PrimLike, resolve_prim
 
 NO_PROTO = 0xFFFFFFFF
