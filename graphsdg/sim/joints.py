@@ -29,6 +29,10 @@ reads the stage's joints and decides, for every rigid body, where it hangs:
   excludes contacts between all of that articulation's links (MuJoCo always
   skips parent-child contacts, as PhysX skips jointed pairs).
 
+:func:`add_link_body` and :func:`add_joint_elements` add the plan to a compile's
+``MjSpec``, :func:`bind_joints` finds its joints in the compiled model, and
+:func:`sync_drive` writes a drive's edited targets into it live.
+
 Example:
     >>> import numpy as np
     >>> f = Frame(np.array([0.0, 0.0, 1.0]), rotation_about(2, np.pi / 2))

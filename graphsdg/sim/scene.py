@@ -1,19 +1,26 @@
 """The live MuJoCo side of the stage: compile once, then sync edits into it.
 
-:class:`SimScene` owns the :class:`~graphsdg.sim.compiler.CompiledScene` of the
+:class:`SimScene` owns the :class:`~graphsdg.sim.compiled_scene.CompiledScene` of the
 current stage. Each frame, :meth:`SimScene.sync_dirty_prims` consumes the change
 tracker's :class:`~graphsdg.stage.changes.ChangeSet`:
 
 * value edits (poses, sizes, colours, visibility, material inputs, lights) are
   written straight into ``MjModel``/``MjData`` fields, then kinematics are
-  recomputed: no recompile;
+  recomputed: no recompile. Which aspects an edit touches is
+  :mod:`~graphsdg.sim.edit_aspects`; each aspect is synced by its module
+  (:mod:`~graphsdg.sim.geom_poses`: pose, size and mesh rescales;
+  :mod:`~graphsdg.sim.visual`: visibility; :mod:`~graphsdg.sim.materials`:
+  material and colour; :mod:`~graphsdg.sim.lights`: lights and sky;
+  :mod:`~graphsdg.sim.rigid_bodies`: rigid-body poses; :mod:`~graphsdg.sim.joints`:
+  drive targets), which raises :class:`~graphsdg.sim.needs_recompile.NeedsRecompile`
+  where it cannot;
 * structural edits (prims added or removed, schemas applied, physics
   properties edited, a mesh rescaled, a shape moved inside its rigid body)
   recompile the stage, carrying the simulation state (time, rigid-body poses and
-  velocities) over by prim path.
+  velocities) over by prim path (:mod:`~graphsdg.sim.state_carry`).
 
 :meth:`SimScene.advance` steps physics and authors the rigid bodies' new poses
-on the stage; :meth:`SimScene.body_pose` and :meth:`SimScene.body_velocity`
+on the stage (:mod:`~graphsdg.sim.pose_write_back`); :meth:`SimScene.body_pose` and :meth:`SimScene.body_velocity`
 read a body's state; :meth:`SimScene.snapshot` / :meth:`SimScene.restore`
 implement the timeline's stop (bodies return to where they were at play).
 """
