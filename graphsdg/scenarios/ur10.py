@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
-from graphsdg.sim.joints import Frame, rotation_about
-from graphsdg.stage.xform import matrix_to_quat_wxyz
+from graphsdg.maths.rotations import matrix_to_quat_wxyz, rotation_about
+from graphsdg.sim.joints import Frame
 
 JOINT_NAMES = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
                "wrist_3_joint")

@@ -60,7 +60,8 @@ from graphsdg.sim.texcoords import TexcoordError, UvTransform, mesh_texcoords
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import shapes
 from graphsdg.stage.changes import STATE_PROPERTIES
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, up_axis_vector, world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import up_axis_vector, world_matrix
 
 route_warnings()   # before the first compile: MuJoCo's warnings are logged, not written to MUJOCO_LOG.TXT
 
