@@ -23,8 +23,8 @@ def _scipy_quat_wxyz(r: Rotation) -> np.ndarray:
     return np.where(q[..., :1] < 0, -q, q)
 
 
-def _same_rotation_quats(a: np.ndarray, b: np.ndarray) -> bool:
-    """Quaternions equal up to the sign each rotation leaves open."""
+def _same_up_to_sign(a: np.ndarray, b: np.ndarray) -> bool:
+    """Quaternions (or half-turn rotation vectors) equal up to the sign each rotation leaves open."""
     return bool(np.all(np.isclose(a, b, atol=1e-9).all(-1) | np.isclose(a, -b, atol=1e-9).all(-1)))
 
 
@@ -53,7 +53,7 @@ def test_quaternions_and_matrices_match_scipy():
     q = QUATS / np.linalg.norm(QUATS, axis=1, keepdims=True)
     r = Rotation.from_quat(q[:, [1, 2, 3, 0]])
     assert np.allclose(rot.quat_wxyz_to_matrix(QUATS), r.as_matrix(), atol=1e-12)
-    assert _same_rotation_quats(rot.matrix_to_quat_wxyz(r.as_matrix()), _scipy_quat_wxyz(r))
+    assert _same_up_to_sign(rot.matrix_to_quat_wxyz(r.as_matrix()), _scipy_quat_wxyz(r))
     assert np.all(rot.matrix_to_quat_wxyz(r.as_matrix())[:, 0] >= 0)
 
 
@@ -67,14 +67,14 @@ def test_euler_xyz_extraction_matches_scipy_away_from_gimbal_lock():
 
 def test_euler_quaternions_match_scipy():
     want = _scipy_quat_wxyz(Rotation.from_euler("xyz", ANGLES, degrees=True))
-    assert _same_rotation_quats(rot.euler_xyz_to_quat(ANGLES), want)
+    assert _same_up_to_sign(rot.euler_xyz_to_quat(ANGLES), want)
 
 
 def test_quaternion_products_match_scipy_composition():
     a, b = QUATS[:100], QUATS[100:200]
     ra, rb = Rotation.from_quat(a[:, [1, 2, 3, 0]]), Rotation.from_quat(b[:, [1, 2, 3, 0]])
     product = rot.canonical_quat(rot.quat_multiply(rot.unit_quat(a), rot.unit_quat(b)))
-    assert _same_rotation_quats(product, _scipy_quat_wxyz(ra * rb))
+    assert _same_up_to_sign(product, _scipy_quat_wxyz(ra * rb))
 
 
 def test_slerp_matches_scipy():
@@ -82,9 +82,20 @@ def test_slerp_matches_scipy():
     for i in range(50):
         key = Rotation.from_quat(np.stack([a[i], b[i]])[:, [1, 2, 3, 0]])
         want = Slerp([0.0, 1.0], key)([0.3]).as_quat()[0, [3, 0, 1, 2]]
-        assert _same_rotation_quats(rot.quat_slerp(a[i], b[i], 0.3), want)
-    assert _same_rotation_quats(rot.quat_slerp(a, b, 0.0), a)
-    assert _same_rotation_quats(rot.quat_slerp(a, b, 1.0), b)
+        assert _same_up_to_sign(rot.quat_slerp(a[i], b[i], 0.3), want)
+    assert _same_up_to_sign(rot.quat_slerp(a, b, 0.0), a)
+    assert _same_up_to_sign(rot.quat_slerp(a, b, 1.0), b)
+
+
+def test_rotation_vectors_match_scipy_including_half_turns():
+    mats = rot.quat_wxyz_to_matrix(QUATS)
+    got, want = rot.matrix_to_rotation_vector(mats), Rotation.from_matrix(mats).as_rotvec()
+    half_turn = np.isclose(np.linalg.norm(want, axis=1), math.pi)     # +-axis: the same rotation
+    assert np.allclose(got[~half_turn], want[~half_turn], atol=1e-7)
+    assert _same_up_to_sign(got[half_turn], want[half_turn])
+    half = rot.matrix_to_rotation_vector(rot.rotation_about(1, np.full(3, math.pi)))
+    assert np.allclose(np.abs(half), [0.0, math.pi, 0.0], atol=1e-9)
+    assert np.allclose(rot.matrix_to_rotation_vector(np.eye(3)), 0.0)
 
 
 # ---- round trips and analytic cases -------------------------------------------------------------------------
@@ -99,7 +110,7 @@ def test_euler_round_trip_through_matrices_including_gimbal_lock():
 def test_quaternion_round_trip_keeps_w_non_negative():
     back = rot.matrix_to_quat_wxyz(rot.quat_wxyz_to_matrix(QUATS))
     assert np.all(back[:, 0] >= 0)
-    assert _same_rotation_quats(back, QUATS / np.linalg.norm(QUATS, axis=1, keepdims=True))
+    assert _same_up_to_sign(back, QUATS / np.linalg.norm(QUATS, axis=1, keepdims=True))
 
 
 def test_axis_rotations_turn_the_axes_as_expected():
@@ -155,8 +166,10 @@ def test_euler_matrices_alone_equal_stacked_bit_for_bit(order):
 def test_conversions_alone_equal_stacked_bit_for_bit():
     mats = np.concatenate([rot.euler_to_matrix(ANGLES), rot.quat_wxyz_to_matrix(QUATS),
                            np.round(rot.euler_to_matrix(ANGLES[-10:]))])     # exact axis permutations too
+    mats = np.concatenate([mats, rot.rotation_about(0, np.full(3, math.pi)), np.eye(3)[None]])   # half turn, none
     for one, stacked in ((rot.matrix_to_euler_xyz, rot.matrix_to_euler_xyz(mats)),
-                         (rot.matrix_to_quat_wxyz, rot.matrix_to_quat_wxyz(mats))):
+                         (rot.matrix_to_quat_wxyz, rot.matrix_to_quat_wxyz(mats)),
+                         (rot.matrix_to_rotation_vector, rot.matrix_to_rotation_vector(mats))):
         for m, want in zip(mats, stacked):
             assert np.array_equal(_bits(one(m)), _bits(want)), (one.__name__, m)
     stacked = rot.quat_wxyz_to_matrix(QUATS)

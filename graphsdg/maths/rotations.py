@@ -32,6 +32,7 @@ _PLANE = ((1, 2), (2, 0), (0, 1))    # the coordinate plane a rotation about axi
 # from one CPU to another; Euler angles authored into a stage must not depend on the machine, so they go
 # through libm, element by element.
 _asin = np.frompyfunc(math.asin, 1, 1)
+_acos = np.frompyfunc(math.acos, 1, 1)
 _atan2 = np.frompyfunc(math.atan2, 2, 1)
 
 
@@ -257,6 +258,38 @@ def quat_slerp(a: ArrayLike, b: ArrayLike, u: float) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
+def matrix_to_rotation_vector(r: ArrayLike) -> np.ndarray:
+    """(..., 3, 3) rotations -> (..., 3) rotation vectors (axis times angle in radians, angle in [0, pi])."""
+    m = np.asarray(r, dtype=np.float64)
+    if m.shape == (3, 3):
+        return _rotation_vector_one(m)
+    angle = _libm(_acos, np.clip((np.trace(m, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0))[..., None]
+    v = np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]], axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(angle < 1e-9, 0.5 * v, v * (angle / (2.0 * np.sin(angle))))
+    half_turn = (math.pi - angle[..., 0] < 1e-6) & ~(angle[..., 0] < 1e-9)
+    if np.any(half_turn):
+        out[half_turn] = [_half_turn_vector(x, a) for x, a in zip(m[half_turn], angle[half_turn, 0])]
+    return out
+
+
+def _rotation_vector_one(r: np.ndarray) -> np.ndarray:
+    cos = max(-1.0, min(1.0, (np.trace(r) - 1.0) / 2.0))
+    angle = math.acos(cos)
+    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    if angle < 1e-9:
+        return 0.5 * v
+    if math.pi - angle < 1e-6:
+        return _half_turn_vector(r, angle)
+    return v * (angle / (2.0 * math.sin(angle)))
+
+
+def _half_turn_vector(r: np.ndarray, angle: float) -> np.ndarray:
+    """Near 180 degrees the antisymmetric part vanishes: the axis is the eigenvector of r with eigenvalue 1."""
+    w, vecs = np.linalg.eigh((r + r.T) / 2)
+    return vecs[:, int(np.argmax(w))] * angle
+
+
 # ---- aiming and transforms ----------------------------------------------------------------------------
 def look_at_matrix(eye: Sequence[float], target: Sequence[float],
                    up: Sequence[float] = (0.0, 0.0, 1.0)) -> np.ndarray:
@@ -330,4 +363,4 @@ def _decompose_one(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 __all__ = ["ROTATION_ORDERS", "rotation_about", "euler_to_matrix", "matrix_to_euler_xyz", "euler_xyz_to_quat",
            "quat_wxyz_to_matrix", "matrix_to_quat_wxyz", "quat_multiply", "canonical_quat", "unit_quat",
-           "quat_slerp", "look_at_matrix", "decompose"]
+           "quat_slerp", "matrix_to_rotation_vector", "look_at_matrix", "decompose"]
