@@ -2,6 +2,7 @@
 as in a stack."""
 from __future__ import annotations
 
+import doctest
 import math
 
 import numpy as np
@@ -194,3 +195,7 @@ def test_stacks_keep_their_leading_axes():
     assert rot.euler_xyz_to_quat(a).shape == (3, 4, 4)
     t, r, s = rot.decompose(_transforms(12).reshape(3, 4, 4, 4))
     assert t.shape == (3, 4, 3) and r.shape == (3, 4, 3, 3) and s.shape == (3, 4, 3)
+
+
+def test_module_example_runs():
+    assert doctest.testmod(rot).failed == 0

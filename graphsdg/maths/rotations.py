@@ -14,8 +14,8 @@ angles authored into a stage do not move.
 Example:
     >>> import numpy as np
     >>> from graphsdg.maths.rotations import euler_to_matrix, matrix_to_euler_xyz
-    >>> np.round(matrix_to_euler_xyz(euler_to_matrix([(10, 20, 30), (0, 0, 90)])), 9).tolist()
-    [[10.0, 20.0, 30.0], [0.0, 0.0, 90.0]]
+    >>> np.round(matrix_to_euler_xyz(euler_to_matrix([(10, 20, 30), (5, 10, 90)])), 9).tolist()
+    [[10.0, 20.0, 30.0], [5.0, 10.0, 90.0]]
 """
 from __future__ import annotations
 
