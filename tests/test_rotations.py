@@ -173,9 +173,11 @@ def test_conversions_alone_equal_stacked_bit_for_bit():
                          (rot.matrix_to_rotation_vector, rot.matrix_to_rotation_vector(mats))):
         for m, want in zip(mats, stacked):
             assert np.array_equal(_bits(one(m)), _bits(want)), (one.__name__, m)
-    stacked = rot.quat_wxyz_to_matrix(QUATS)
-    for q, want in zip(QUATS, stacked):
+    stacked, angles = rot.quat_wxyz_to_matrix(QUATS), rot.quat_wxyz_to_euler_xyz(QUATS)
+    assert np.array_equal(_bits(angles), _bits(rot.matrix_to_euler_xyz(stacked)))
+    for q, want, want_angles in zip(QUATS, stacked, angles):
         assert np.array_equal(_bits(rot.quat_wxyz_to_matrix(q)), _bits(want))
+        assert np.array_equal(_bits(rot.quat_wxyz_to_euler_xyz(q)), _bits(want_angles))
 
 
 def test_decompose_alone_equals_stacked_bit_for_bit():

@@ -97,6 +97,32 @@ def _euler_xyz_one(r: np.ndarray) -> tuple[float, float, float]:
     return (math.degrees(a), math.degrees(b), math.degrees(c))
 
 
+def quat_wxyz_to_euler_xyz(q: ArrayLike) -> np.ndarray:
+    """(..., 4) quaternions (w, x, y, z) -> (..., 3) XYZ Euler degrees, as ``matrix_to_euler_xyz`` of their
+    matrices (one quaternion skips building the matrix: physics writes a body's angles back every step)."""
+    arr = np.asarray(q, dtype=np.float64)
+    if arr.shape == (4,):
+        return np.array(_euler_xyz_of_quat_one(*(float(v) for v in arr)))
+    return matrix_to_euler_xyz(quat_wxyz_to_matrix(arr))
+
+
+def _euler_xyz_of_quat_one(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
+    # the matrix entries _euler_xyz_one reads, written out as quat_wxyz_to_matrix computes them
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if n == 0:
+        raise ValueError("quaternion must be non-zero")
+    w, x, y, z = w / n, x / n, y / n, z / n
+    sy = -max(-1.0, min(1.0, 2 * (x * z - y * w)))
+    b = math.asin(sy)
+    if abs(sy) < 1 - 1e-9:
+        a = math.atan2(2 * (y * z + x * w), 1 - 2 * (x * x + y * y))
+        c = math.atan2(2 * (x * y + z * w), 1 - 2 * (y * y + z * z))
+    else:
+        a = math.atan2(-2 * (y * z - x * w), 1 - 2 * (x * x + z * z))
+        c = 0.0
+    return (math.degrees(a), math.degrees(b), math.degrees(c))
+
+
 def euler_xyz_to_quat(angles_deg: ArrayLike) -> np.ndarray:
     """(..., 3) XYZ Euler degrees -> (..., 4) unit quaternions of ``R = Rz Ry Rx``, w >= 0.
 
@@ -361,6 +387,7 @@ def _decompose_one(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return m[3, :3].copy(), r, np.array(scale)
 
 
-__all__ = ["ROTATION_ORDERS", "rotation_about", "euler_to_matrix", "matrix_to_euler_xyz", "euler_xyz_to_quat",
+__all__ = ["ROTATION_ORDERS", "rotation_about", "euler_to_matrix", "matrix_to_euler_xyz", "quat_wxyz_to_euler_xyz",
+           "euler_xyz_to_quat",
            "quat_wxyz_to_matrix", "matrix_to_quat_wxyz", "quat_multiply", "canonical_quat", "unit_quat",
            "quat_slerp", "matrix_to_rotation_vector", "look_at_matrix", "decompose"]

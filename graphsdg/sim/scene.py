@@ -27,6 +27,8 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
+from graphsdg.maths.rotations import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_euler_xyz,
+                                      quat_wxyz_to_matrix)
 from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim import joints as jointmap
@@ -38,7 +40,6 @@ from graphsdg.sim.compiler import (HIDDEN_GROUP, MUJOCO_DEFAULT_RGBA, VELOCITY_A
 from graphsdg.sim.mesh_scaling import MeshMaps, rescale_mesh_geoms
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
-from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.xform import set_local_pose, world_matrix
 
 
@@ -785,7 +786,7 @@ class PoseWriter:
         elif self._rotate_kind == "quatf":
             self._rotate.Set(Gf.Quatf(w, qx, qy, qz))
         else:
-            euler = matrix_to_euler_xyz(quat_wxyz_to_matrix((w, qx, qy, qz)))
+            euler = quat_wxyz_to_euler_xyz((w, qx, qy, qz))
             self._rotate.Set(Gf.Vec3d(*euler) if self._rotate_kind == "eulerd" else Gf.Vec3f(*euler))
 
 

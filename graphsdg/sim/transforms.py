@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from pxr import Gf, Usd, UsdGeom
 
-from graphsdg.stage.prims import PrimLike, resolve_prim
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.stage.prims import PrimLike, resolve_prim
 from graphsdg.stage.xform import world_matrix
 
 
