@@ -2,8 +2,10 @@
 as in a stack."""
 from __future__ import annotations
 
+import ast
 import doctest
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -201,3 +203,13 @@ def test_stacks_keep_their_leading_axes():
 
 def test_module_example_runs():
     assert doctest.testmod(rot).failed == 0
+
+
+def test_maths_imports_nothing_of_graphsdg():
+    """stage/, sim/, render/, compat/ and io/ all import the rotations: the folder must sit below all of them."""
+    folder = pathlib.Path(rot.__file__).parent
+    for path in folder.glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module or ""] if isinstance(node, ast.ImportFrom) else []
+            assert not any(n.split(".")[0] == "graphsdg" for n in names), (path.name, names)
