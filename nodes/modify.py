@@ -78,7 +78,7 @@ def _with_components(ctx: ExecContext, prims: list[Usd.Prim], full: Any, base: s
     ports = [f"{base}_{axis}" for axis in "xyz"]
     if not any(p in ctx.node.inputs and ctx.given(p) for p in ports):
         return full
-    from graphsdg.stage.xform import decompose, matrix_to_euler_xyz
+    from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
     rows = []
     for prim in prims:
         m = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()))

@@ -13,7 +13,7 @@ from graphsdg.render.camera import CameraView
 from graphsdg.runtime import runtime
 from graphsdg.sim import environment_map
 from graphsdg.sim.lights import REFERENCE_IRRADIANCE
-from graphsdg.stage.xform import quat_wxyz_to_matrix
+from graphsdg.maths.rotations import quat_wxyz_to_matrix
 
 
 def _rotation(seed: int) -> np.ndarray:

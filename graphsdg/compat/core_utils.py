@@ -26,8 +26,8 @@ from pxr import Sdf, Usd, UsdGeom
 from graphsdg.compat.modules import CompatModule
 from graphsdg.stage import context as stage_context
 from graphsdg.stage import semantics as semlib
-from graphsdg.stage.xform import (euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
-                                  set_local_pose)
+from graphsdg.maths.rotations import euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import set_local_pose
 
 
 # ---- isaacsim.core.utils.stage -------------------------------------------------------------------

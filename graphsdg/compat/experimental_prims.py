@@ -21,6 +21,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 from graphsdg.compat.modules import CompatObject
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 from graphsdg.stage.context import get_stage
 
 _REGEX_CHARS = re.compile(r"[\\^$.|?*+()\[\]{}]")
@@ -228,7 +229,6 @@ class XformPrim(Prim):
     # ---- xform ops ---------------------------------------------------------------
     def reset_xform_op_properties(self) -> None:
         """Rewrite each prim's ops as ``translate``, ``orient``, ``scale`` (double), keeping its local transform."""
-        from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz
         for prim in self._prims:
             xf = UsdGeom.Xformable(prim)
             m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
@@ -267,7 +267,6 @@ class XformPrim(Prim):
 
     def get_local_poses(self, indices: Any = None) -> tuple[WarpLikeArray, WarpLikeArray]:
         """(translations (k, 3), orientations (k, 4) w, x, y, z) relative to each prim's parent."""
-        from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz
         t_out, q_out = [], []
         for path in self._selected(indices):
             m = np.array(UsdGeom.Xformable(get_stage().GetPrimAtPath(path)).GetLocalTransformation(
@@ -289,7 +288,6 @@ class XformPrim(Prim):
 
     def get_local_scales(self, indices: Any = None) -> WarpLikeArray:
         """Scales (k, 3) of each prim's local transform."""
-        from graphsdg.stage.xform import decompose
         out = []
         for path in self._selected(indices):
             m = np.array(UsdGeom.Xformable(get_stage().GetPrimAtPath(path)).GetLocalTransformation(

@@ -91,7 +91,7 @@ def size_to_scale(prim: Usd.Prim, size: Any) -> np.ndarray:
 
 
 def _apply_pivot(prim: Usd.Prim, pivot: np.ndarray, position: Any) -> None:
-    from graphsdg.stage.xform import decompose
+    from graphsdg.maths.rotations import decompose
     xf = UsdGeom.Xformable(prim)
     m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
     t, r, s = decompose(m)

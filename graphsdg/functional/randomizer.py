@@ -26,7 +26,8 @@ from graphsdg.rng import ReplicatorRNG, as_generator
 from graphsdg.sim import bounds, placement, transforms
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.prims import resolve_prims, sanitize_name
-from graphsdg.stage.xform import matrix_to_euler_xyz, quat_wxyz_to_matrix, set_local_pose, world_matrix
+from graphsdg.maths.rotations import matrix_to_euler_xyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import set_local_pose, world_matrix
 
 LOOKS = "/Replicator/Looks"
 

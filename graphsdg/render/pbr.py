@@ -150,7 +150,8 @@ class PbrRenderer:
 
         from graphsdg.sim import environment_map
         from graphsdg.sim import lights as lightmap
-        from graphsdg.stage.xform import decompose, world_matrix
+        from graphsdg.maths.rotations import decompose
+        from graphsdg.stage.xform import world_matrix
         stage = sim.stage
         domes = [p for p in stage.Traverse() if p.GetTypeName() == "DomeLight"
                  and UsdGeom.Imageable(p).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible]

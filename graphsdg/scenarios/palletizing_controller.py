@@ -28,11 +28,11 @@ from typing import Iterator
 
 import numpy as np
 
+from graphsdg.maths.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, rotation_about
 from graphsdg.scenarios.palletizing_cell import CellLayout
 from graphsdg.scenarios.ur10 import HOME, Ur10Kinematics
 from graphsdg.sim.articulations import ArticulationView, set_fixed_joint_enabled
-from graphsdg.sim.joints import Frame, rotation_about
-from graphsdg.stage.xform import matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.sim.joints import Frame
 
 Z = np.array([0.0, 0.0, 1.0])
 SPEED = 1.0                 # m/s, peak tool speed of swings and long descents

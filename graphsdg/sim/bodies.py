@@ -27,7 +27,8 @@ from pxr import Sdf, Usd, UsdPhysics
 from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import PrimLike
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
+from graphsdg.stage.xform import world_matrix
 
 
 def _rigid_paths(stage: Usd.Stage) -> list[str]:

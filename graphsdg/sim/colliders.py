@@ -40,7 +40,7 @@ from pxr import Usd, UsdPhysics, UsdShade
 
 from graphsdg.sim.compile_error import CompileError
 from graphsdg.sim.visual import COLLISION_ONLY_GROUP
-from graphsdg.stage.xform import matrix_to_quat_wxyz
+from graphsdg.maths.rotations import matrix_to_quat_wxyz
 
 APPROXIMATIONS = ("none", "convexHull", "convexDecomposition", "boundingCube", "boundingSphere",
                   "meshSimplification", "sdf", "sphereFill")

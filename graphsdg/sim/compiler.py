@@ -55,7 +55,8 @@ from graphsdg.sim.mujoco_warnings import route_warnings
 from graphsdg.sim.physics_scene import configure_physics
 from graphsdg.sim.rigid_bodies import SpecBodies, in_body_frame, is_kinematic, rigid_root
 from graphsdg.sim.visual import HIDDEN_GROUP, add_pbr_camera, configure_visual
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
 route_warnings()   # before the first compile: MuJoCo's warnings are logged, not written to MUJOCO_LOG.TXT
 

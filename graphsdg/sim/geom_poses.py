@@ -17,7 +17,8 @@ from pxr import Usd, UsdGeom
 from graphsdg.sim.compiled_scene import CompiledScene, GeomBinding
 from graphsdg.sim.gprims import resize_primitive
 from graphsdg.sim.needs_recompile import NeedsRecompile
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
 
 def sync_geom_pose(c: CompiledScene, stage: Usd.Stage, prim: Usd.Prim, g: GeomBinding, cache: UsdGeom.XformCache,

@@ -35,6 +35,7 @@ reads the stage's joints and decides, for every rigid body, where it hangs:
 
 Example:
     >>> import numpy as np
+    >>> from graphsdg.maths.rotations import rotation_about
     >>> f = Frame(np.array([0.0, 0.0, 1.0]), rotation_about(2, np.pi / 2))
     >>> np.round((f @ f.inverse()).pos, 9).tolist()
     [0.0, 0.0, 0.0]
@@ -52,7 +53,8 @@ from pxr import Usd, UsdGeom, UsdPhysics
 
 from graphsdg.sim.compiled_scene import CompiledScene, JointBinding
 from graphsdg.sim.needs_recompile import NeedsRecompile
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, world_matrix
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 
 JOINT_KINDS = {"PhysicsRevoluteJoint": "revolute", "PhysicsPrismaticJoint": "prismatic",
                "PhysicsFixedJoint": "fixed", "PhysicsSphericalJoint": "spherical"}
@@ -81,16 +83,6 @@ class Frame:
     def of_prim(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -> "Frame":
         t, r, _ = decompose(world_matrix(prim, cache))
         return Frame(t, r)
-
-
-def rotation_about(axis: int, angle: float) -> np.ndarray:
-    """Column-vector rotation by ``angle`` radians about coordinate axis ``axis`` (0, 1, 2)."""
-    c, s = math.cos(angle), math.sin(angle)
-    if axis == 0:
-        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-    if axis == 1:
-        return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 @dataclass

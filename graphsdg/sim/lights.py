@@ -29,7 +29,8 @@ from graphsdg.sim import environment_map
 from graphsdg.sim.compile_error import CompileError
 from graphsdg.sim.compiled_scene import CompiledScene, LightBinding
 from graphsdg.sim.needs_recompile import NeedsRecompile
-from graphsdg.stage.xform import decompose, up_axis_vector, world_matrix
+from graphsdg.stage.xform import up_axis_vector, world_matrix
+from graphsdg.maths.rotations import decompose
 
 REFERENCE_IRRADIANCE = math.pi * 600.0
 SKY_TEXTURE = "graphsdg:sky"

@@ -7,13 +7,12 @@ any xform op stack.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
-from graphsdg.stage.xform import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
-                                  set_local_pose, world_matrix)
+from graphsdg.maths.rotations import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_euler_xyz,
+                                      quat_wxyz_to_matrix)
+from graphsdg.stage.xform import set_local_pose, world_matrix
 
 
 _IDENTITY = Gf.Matrix4d(1.0)
@@ -90,24 +89,8 @@ class PoseWriter:
         elif self._rotate_kind == "quatf":
             self._rotate.Set(Gf.Quatf(w, qx, qy, qz))
         else:
-            euler = _quat_to_euler_xyz(w, qx, qy, qz)
+            euler = quat_wxyz_to_euler_xyz((w, qx, qy, qz))
             self._rotate.Set(Gf.Vec3d(*euler) if self._rotate_kind == "eulerd" else Gf.Vec3f(*euler))
-
-
-def _quat_to_euler_xyz(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """USD rotateXYZ angles (degrees) of a unit quaternion; same convention as ``matrix_to_euler_xyz``."""
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    w, x, y, z = w / n, x / n, y / n, z / n
-    r20 = 2 * (x * z - y * w)
-    sy = -max(-1.0, min(1.0, r20))
-    b = math.asin(sy)
-    if abs(sy) < 1 - 1e-9:
-        a = math.atan2(2 * (y * z + x * w), 1 - 2 * (x * x + y * y))
-        c = math.atan2(2 * (x * y + z * w), 1 - 2 * (y * y + z * z))
-    else:
-        a = math.atan2(-2 * (y * z - x * w), 1 - 2 * (x * x + z * z))
-        c = 0.0
-    return (math.degrees(a), math.degrees(b), math.degrees(c))
 
 
 def set_world_pose_sdf(prim: Usd.Prim, pos: np.ndarray, quat_wxyz: np.ndarray,

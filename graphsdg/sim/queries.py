@@ -32,6 +32,7 @@ from typing import Any, Callable, Sequence
 import mujoco
 import numpy as np
 
+from graphsdg.maths.rotations import quat_wxyz_to_matrix
 from graphsdg.sim.compiled_scene import CompiledScene
 from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.prims import PrimLike, resolve_prim
@@ -102,12 +103,7 @@ def _rotation_xyzw(rotation: Any) -> np.ndarray:
     norm = np.linalg.norm(q)
     if norm < 1e-12:
         raise ValueError(f"rotation quaternion (x, y, z, w) must be non-zero, got {rotation!r}")
-    x, y, z, w = q / norm
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return quat_wxyz_to_matrix(q[[3, 0, 1, 2]])
 
 
 def _scene() -> CompiledScene:

@@ -19,7 +19,8 @@ from graphsdg.sim.compiled_scene import BodyBinding, CompiledScene
 from graphsdg.sim.masses import mass_api_values
 from graphsdg.sim.needs_recompile import NeedsRecompile
 from graphsdg.stage.changes import STATE_PROPERTIES
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, world_matrix
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 
 VELOCITY_ATTRIBUTES = STATE_PROPERTIES   # a rigid body's velocities: live state, not model structure
 

@@ -50,7 +50,8 @@ from graphsdg.sim.rigid_bodies import VELOCITY_ATTRIBUTES, authored_velocity, ri
 from graphsdg.sim.state_carry import carry_state
 from graphsdg.sim.visual import sync_visibility
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
-from graphsdg.stage.xform import decompose, quat_wxyz_to_matrix, world_matrix
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, quat_wxyz_to_matrix
 
 _model_versions = itertools.count()
 

@@ -19,8 +19,9 @@ from __future__ import annotations
 import numpy as np
 from pxr import Gf, Usd, UsdGeom
 
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.prims import PrimLike, resolve_prim
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.stage.xform import world_matrix
 
 
 def get_world_transform_matrix(prim: PrimLike, time: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
@@ -58,7 +59,6 @@ def set_world_pose(prim: PrimLike, position=None, orientation=None) -> None:
         [0.0, 0.0, 3.0]
     """
     from graphsdg.functional import modify
-    from graphsdg.stage.xform import quat_wxyz_to_matrix
 
     p = resolve_prim(prim)
     parent = p.GetParent()
