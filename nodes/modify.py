@@ -7,6 +7,7 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from graphsdg.functional import modify as F
+from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
@@ -98,10 +99,11 @@ def any_random(ctx: ExecContext, ports: tuple[str, ...] | list[str]) -> bool:
 
 @register_node
 class Pose(Node):
-    """``modify.pose``: position, rotation (Euler degrees, ``rotation_order``), scale or size, pivot, look_at."""
+    """Set translation, Euler rotation (degrees), scale (or ``size``), pivot, or aim with ``look_at``."""
 
     type_name = "modify.pose"
     family = "modify"
+    call = Call()
     inputs = {**TARGET, "position": Port("vec3"), "position_x": Port(float), "position_y": Port(float),
               "position_z": Port(float), "rotation": Port("vec3"), "rotation_x": Port(float),
               "rotation_y": Port(float), "rotation_z": Port(float), "rotation_order": Port(str, "XYZ"),
@@ -129,10 +131,11 @@ class Pose(Node):
 
 @register_node
 class Attribute(Node):
-    """``modify.attribute``: set a USD attribute (created with ``attribute_type`` if missing)."""
+    """Set USD attribute ``name`` to ``value`` (creating it when ``attribute_type`` is given)."""
 
     type_name = "modify.attribute"
     family = "modify"
+    call = Call(named=False, renamed={"attribute": "name"}, required=("value",))
     inputs = {**TARGET, "attribute": Port(str, required=True), "value": Port(object), "attribute_type": Port(str)}
     outputs = {"prims": Port("prims")}
 
@@ -150,10 +153,11 @@ class Attribute(Node):
 
 @register_node
 class Semantics(Node):
-    """``modify.semantics``: add, replace or clear semantic labels."""
+    """Add, replace or clear semantic labels (``[("class", "box")]`` or ``{"class": "box"}``)."""
 
     type_name = "modify.semantics"
     family = "modify"
+    call = Call(params=("semantics", "input_prims", "mode"), named=False)
     inputs = {**TARGET, "semantics": Port(list), "mode": Port(str, "add")}
     outputs = {"prims": Port("prims")}
 
@@ -171,10 +175,11 @@ class Semantics(Node):
 
 @register_node
 class Visibility(Node):
-    """``modify.visibility``: show or hide; ``value=None`` draws a random bool per prim each execution."""
+    """Show or hide the prims; ``value=None`` picks a random visibility per prim each execution."""
 
     type_name = "modify.visibility"
     family = "modify"
+    call = Call()
     inputs = {**TARGET, "value": Port(bool)}
     outputs = {"prims": Port("prims")}
 
@@ -193,10 +198,12 @@ class Visibility(Node):
 
 @register_node
 class Material(Node):
-    """``modify.material``: bind a material (item, prim or path; a distribution picks one per prim)."""
+    """Bind material ``value`` (an item, prim or path)."""
 
+    # a distribution of materials picks one per prim each execution
     type_name = "modify.material"
     family = "modify"
+    call = Call()
     inputs = {**TARGET, "value": Port("material", required=True)}
     outputs = {"prims": Port("prims")}
 
