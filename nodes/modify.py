@@ -7,6 +7,7 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from graphsdg.functional import modify as F
+from graphsdg.functional.per_prim import per_prim_array
 from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
@@ -17,16 +18,15 @@ TARGET = {"input_prims": Port("prims", required=True)}
 POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
 
 
-def per_prim_rows(value: Any, n: int, width: int = 3) -> Any:
-    """Sampled values as ``(n, width)`` rows (scalars broadcast across the row); plain values unchanged."""
+def pose_rows(value: Any, n: int, what: str, uniform: bool = False) -> Any:
+    """A pose port's value (sampled or plain) as ``(n, 3)`` rows for ``functional.modify.pose``'s ``what``.
+
+    One number per prim fills that prim's row (a scalar distribution samples one
+    number per prim); a single number fills every row only where ``uniform`` (scale).
+    """
     if value is None:
         return None
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim == 1 and arr.shape[0] == n:
-        return np.repeat(arr[:, None], width, axis=1)
-    if arr.ndim == 2 and arr.shape[1] == 1:
-        return np.repeat(arr, width, axis=1)
-    return arr
+    return per_prim_array(value, n, what, uniform=uniform, uniform_per_prim=True)
 
 
 def look_at_points(value: Any, n: int) -> Any:
@@ -60,13 +60,13 @@ def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
     n = len(prims)
     if n == 0:
         return
-    position = per_prim_rows(sample_port(ctx, "position", n), n)
-    rotation = per_prim_rows(sample_port(ctx, "rotation", n), n)
+    position = pose_rows(sample_port(ctx, "position", n), n, "position_value")
+    rotation = pose_rows(sample_port(ctx, "rotation", n), n, "rotation_value")
     position = _with_components(ctx, prims, position, "position", n)
     rotation = _with_components(ctx, prims, rotation, "rotation", n)
-    scale = per_prim_rows(sample_port(ctx, "scale", n), n)
+    scale = pose_rows(sample_port(ctx, "scale", n), n, "scale_value", uniform=True)
     size = sample_port(ctx, "size", n)
-    pivot = per_prim_rows(sample_port(ctx, "pivot", n), n)
+    pivot = pose_rows(sample_port(ctx, "pivot", n), n, "pivot_value")
     look_at = look_at_points(sample_port(ctx, "look_at", n), n)
     up = ctx.value("look_at_up_axis") if ctx.given("look_at_up_axis") else None
     order = ctx.value("rotation_order") if "rotation_order" in ctx.node.inputs else "XYZ"
