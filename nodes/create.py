@@ -21,7 +21,6 @@ from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
 from graphsdg.graph.node import ExecContext, Node, Port, is_random_value
 from graphsdg.graph.registry import register_node
-from graphsdg.stage import semantics as semlib
 from graphsdg.stage.context import get_stage
 
 from .modify import POSE_PORTS, apply_pose, sample_port
@@ -263,7 +262,7 @@ class CreateMaterialOmniPBR(CreateNode):
                 inputs["emissive_color"] = (1.0, 1.0, 1.0)
             prim = FC.material(mdl="OmniPBR.mdl", name=self.user_name or "OmniPBR", parent=LOOKS, **inputs)
             if self.value_of("semantics"):
-                semlib.apply(prim, self.value_of("semantics"))
+                FM.semantics(prim, self.value_of("semantics"))
             mats.append(prim)
         self.output_values = {"prims": mats}
 
@@ -297,8 +296,7 @@ class CreateGroup(Node):
     def setup(self, ctx: ExecContext) -> None:
         prims = flatten_prims(ctx.value("items"), "create.group items")
         if self.value_of("semantics"):
-            for prim in prims:
-                semlib.apply(prim, self.value_of("semantics"))
+            FM.semantics(prims, self.value_of("semantics"))
         self.output_values = {"prims": prims}
 
     def compute(self, ctx: ExecContext) -> dict:

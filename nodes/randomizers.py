@@ -16,7 +16,6 @@ from graphsdg.graph.graph import REPLICATOR_ROOT
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
-from graphsdg.stage import semantics as semlib
 
 from .modify import TARGET, sample_port
 
@@ -239,7 +238,6 @@ class Instantiate(Randomizer):
         chosen = [paths[int(i)] for i in idx]
         FM.reference(slots, chosen)
         if self.value_of("semantics"):
-            for prim in slots:
-                semlib.apply(prim, self.value_of("semantics"))
+            FM.semantics(slots, self.value_of("semantics"))
         ctx.record("paths", chosen)
         return {"prims": slots}

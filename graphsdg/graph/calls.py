@@ -99,7 +99,8 @@ def call_signature(node_cls: type[Node], spec: Call) -> inspect.Signature:
             default = p.default
         params[param] = _parameter(param, default, _annotation(p, default))
     for old, port in spec.deprecated.items():
-        params[old] = _parameter(old, node_cls.inputs[port].default, _annotation(node_cls.inputs[port], 0))
+        target = node_cls.inputs[port]
+        params[old] = _parameter(old, target.default, _annotation(target, target.default))
     if spec.named:
         params["name"] = _parameter("name", spec.name_default, "str" if spec.name_default else "str | None")
     last = [n for n in (TARGET, "name" if spec.named else "") if n in params]
@@ -133,17 +134,24 @@ def build_node(node_cls: type[Node], spec: Call, arguments: dict[str, Any]) -> R
     values = {port: arguments[spec.renamed.get(port, port)] for port in node_cls.inputs}
     for old, port in spec.deprecated.items():
         values[port] = values[port] or arguments[old]
-    name = values[spec.name_from] if spec.name_from else arguments.get("name") if spec.named else None
+    if spec.name_from:
+        name = values[spec.name_from]
+    else:
+        name = arguments["name"] if spec.named else None
     if TARGET in values:
         values[TARGET] = targets_value(values[TARGET], f"rep.{node_cls.type_name}")
-    if node_cls.family != "trigger":
-        return add_node(node_cls(name=name, **values))
+    if node_cls.family == "trigger":
+        _refuse_nested_trigger(call_name(node_cls), values)
+        return add_node(node_cls(name=name, **values), gated=False)
+    return add_node(node_cls(name=name, **values))
+
+
+def _refuse_nested_trigger(name: str, values: dict[str, Any]) -> None:
     outer = current_trigger()
     if outer is not None:
-        raise GraphBuildError(f"{call_name(node_cls)}({', '.join(f'{k}={v!r}' for k, v in values.items())}) "
-                              f"is nested in trigger {outer.name!r}; triggers cannot be nested: close the outer "
-                              f"'with' block first")
-    return add_node(node_cls(name=name, **values), gated=False)
+        raise GraphBuildError(f"{name}({', '.join(f'{k}={v!r}' for k, v in values.items())}) is nested in "
+                              f"trigger {outer.name!r}; triggers cannot be nested: close the outer 'with' block "
+                              f"first")
 
 
 __all__ = ["Call", "family_calls", "graph_call", "call_name", "call_signature", "build_node"]
