@@ -20,7 +20,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from graphsdg import settings
 from graphsdg.errors import closest
-from graphsdg.functional.create_batch import per_prim, per_prim_array
+from graphsdg.functional.per_prim import per_prim, per_prim_array
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.prims import resolve_prim, resolve_prims
@@ -56,16 +56,18 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
             and _write_to_fabric():
         from graphsdg.runtime import runtime
         from graphsdg.sim import direct_writes
-        arrays = [None if v is None else per_prim_array(v, n, name, width=np.shape(v)[-1] if np.ndim(v) else 3)
-                  for v, name in ((position_value, "position_value"), (rotation_value, "rotation_value"),
-                                  (scale_value, "scale_value"))]
+        arrays = [None if v is None else per_prim_array(v, n, name, width=width, uniform=uniform,
+                                                         uniform_per_prim=uniform)
+                  for v, name, width, uniform in ((position_value, "position_value", 3, False),
+                                                  (rotation_value, "rotation_value", _pose_width(rotation_value),
+                                                   False),
+                                                  (scale_value, "scale_value", 3, True))]
         if direct_writes.write_poses(runtime().sim, targets, *arrays):
             return
     positions = per_prim(position_value, n, "position_value")
-    rotations = per_prim(rotation_value, n, "rotation_value", width=4 if np.ndim(rotation_value) and
-                         np.shape(rotation_value)[-1] == 4 else 3)
-    scales = per_prim(scale_value, n, "scale_value")
-    sizes = per_prim(size_value, n, "scale_value (size)")
+    rotations = per_prim(rotation_value, n, "rotation_value", width=_pose_width(rotation_value))
+    scales = per_prim(scale_value, n, "scale_value", uniform=True, uniform_per_prim=True)
+    sizes = per_prim(size_value, n, "scale_value (size)", uniform=True, uniform_per_prim=True)
     pivots = per_prim(pivot_value, n, "pivot_value")
     looks = per_prim(look_at_value, n, "look_at_value")
     for i, prim in enumerate(targets):
@@ -74,6 +76,11 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
                        look_at_up_axis=look_at_up_axis, rotation_order=rotation_order)
         if pivots[i] is not None:
             _apply_pivot(prim, np.asarray(pivots[i], dtype=np.float64), positions[i])
+
+
+def _pose_width(value: Any) -> int:
+    """4 for quaternions (rows of 4 numbers), else 3."""
+    return 4 if np.ndim(value) and np.shape(value)[-1] == 4 else 3
 
 
 def size_to_scale(prim: Usd.Prim, size: Any) -> np.ndarray:
