@@ -148,7 +148,7 @@ class PbrRenderer:
         """The stage's dome lights as one environment map in nits, and its yaw (0 when resampled)."""
         from pxr import Usd, UsdGeom
 
-        from graphsdg.sim import environment_map
+        from graphsdg.imaging import environment_map
         from graphsdg.sim import lights as lightmap
         from graphsdg.stage.xform import decompose, world_matrix
         stage = sim.stage

@@ -32,7 +32,7 @@ Mapping (USD -> MuJoCo):
 * UsdLux lights become MuJoCo lights (see :mod:`graphsdg.sim.lights`); a dome
   light becomes ambient light plus a soft sky light, and a skybox. A dome
   texture (a lat-long HDR) is the skybox and sets the colour, strength and main
-  direction of that light (:mod:`graphsdg.sim.environment_map`).
+  direction of that light (:mod:`graphsdg.imaging.environment_map`).
 * cameras are not compiled: render products read USD cameras directly.
 
 The result, :class:`CompiledScene`, remembers which MuJoCo elements each prim
@@ -49,7 +49,8 @@ import numpy as np
 from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg import settings
-from graphsdg.sim import colliders, deformables, environment_map, geom_subsets
+from graphsdg.imaging import environment_map
+from graphsdg.sim import colliders, deformables, geom_subsets
 from graphsdg.sim import physx_attributes
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap

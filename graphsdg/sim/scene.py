@@ -490,7 +490,7 @@ class SimScene:
         """Call ``callback(step_size)`` before every physics step (Isaac's ``World.add_physics_callback``).
 
         Controllers read and write simulation state here (joint targets through
-        :class:`graphsdg.sim.articulations.ArticulationView`, weld constraints);
+        :class:`graphsdg.physics.articulations.ArticulationView`, weld constraints);
         the callback must not change the stage's structure.
         """
         if not callable(callback):
@@ -581,7 +581,7 @@ class SimScene:
         b = self.body(path)
         if b.articulated:
             raise ValueError(f"rigid body {path} hangs from a joint; move it through its joints "
-                             f"(graphsdg.sim.articulations.ArticulationView.set_joint_positions)")
+                             f"(graphsdg.physics.articulations.ArticulationView.set_joint_positions)")
         c = self.ensure_compiled()
         d = c.data
         pos, quat = self.body_pose(path)
@@ -669,7 +669,7 @@ def carry_state(old: CompiledScene, new: CompiledScene) -> None:
     render-only edit (a light, a material, a texture) continues the simulation
     bit for bit. Weld constraints are compiled from the stage (whoever switches
     one authors ``physics:jointEnabled`` and the joint frames, see
-    :func:`graphsdg.sim.articulations.set_fixed_joint`); elements new to ``new``
+    :func:`graphsdg.physics.articulations.set_fixed_joint`); elements new to ``new``
     keep what the stage says.
     """
     om, od, nm, nd = old.model, old.data, new.model, new.data

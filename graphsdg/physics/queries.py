@@ -14,7 +14,7 @@ Quaternions follow PhysX here: ``(x, y, z, w)``.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.sim import queries
+    >>> from graphsdg.physics import queries
     >>> _ = rep.stage.new_stage()
     >>> cube = rep.functional.create.cube(position=(0, 0, 0.5), name="Crate")
     >>> rep.functional.physics.apply_collider(cube)
@@ -32,6 +32,7 @@ from typing import Any, Callable, Sequence
 import mujoco
 import numpy as np
 
+from graphsdg.runtime import runtime
 from graphsdg.sim.compiler import CompiledScene, rigid_root
 from graphsdg.stage.prims import PrimLike, resolve_prim
 
@@ -110,7 +111,6 @@ def _rotation_xyzw(rotation: Any) -> np.ndarray:
 
 
 def _scene() -> CompiledScene:
-    from graphsdg.runtime import runtime
     sim = runtime().sim
     sim.sync_dirty_prims()
     return sim.ensure_compiled()

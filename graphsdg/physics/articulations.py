@@ -38,13 +38,13 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, UsdPhysics
 
+from graphsdg.runtime import runtime
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim.compiler import JointBinding, rigid_root
 from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, world_matrix
 
 
 def _sim():
-    from graphsdg.runtime import runtime
     return runtime().sim
 
 
