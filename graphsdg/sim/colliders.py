@@ -18,6 +18,8 @@ mesh's own frame, scale applied):
 
 Example:
     >>> import numpy as np
+
+from graphsdg.errors import closest
     >>> v = np.array([[0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]], dtype=float)
     >>> center, half = bounding_cube(v)
     >>> center.tolist(), half.tolist()
@@ -28,6 +30,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from graphsdg.errors import closest
 
 APPROXIMATIONS = ("none", "convexHull", "convexDecomposition", "boundingCube", "boundingSphere",
                   "meshSimplification", "sdf", "sphereFill")
@@ -44,7 +48,6 @@ def check_approximation(name: object, where: str = "") -> str:
     """Return ``name`` if it is a known approximation token, else raise :class:`ApproximationError`."""
     if isinstance(name, str) and name in APPROXIMATIONS:
         return name
-    from graphsdg.errors import closest
     hint = closest(str(name), APPROXIMATIONS)
     at = f" on {where}" if where else ""
     raise ApproximationError(f"unknown collider approximation {name!r}{at}{hint}; "
