@@ -14,9 +14,16 @@ Attachments belong to the stage's session: when the stage is replaced, the
 render products are destroyed and every writer and annotator detaches.
 
 Example:
-    >>> from graphsdg.render.attachments import attachments
-    >>> len(attachments.writers) >= 0
+    >>> import graphsdg as rep
+    >>> _ = rep.stage.new_stage()
+    >>> cam = rep.functional.create.camera(position=(5, 5, 5), look_at=(0, 0, 0))
+    >>> rp = rep.create.render_product(cam, (64, 48))
+    >>> rgb = rep.annotators.get("rgb").attach(rp)
+    >>> rgb in attachments.annotators
     True
+    >>> _ = rep.stage.new_stage()      # a new stage releases every attachment
+    >>> rgb in attachments.annotators, rp.destroyed
+    (False, True)
 """
 from __future__ import annotations
 
