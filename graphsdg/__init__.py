@@ -28,7 +28,7 @@ from graphsdg.io import writers as _builtin_writers  # noqa: E402,F401  (registe
 from graphsdg.io.backends import BackendDispatch  # noqa: E402
 from graphsdg.io.writer import Writer, WriterRegistry  # noqa: E402
 from graphsdg.rng import get_global_seed, set_global_seed  # noqa: E402
-from graphsdg.sim import timeline  # noqa: E402
+from graphsdg.physics import timeline  # noqa: E402
 
 
 def _import_node_library():

@@ -25,6 +25,7 @@ from graphsdg.io import run_state
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
 from graphsdg.jobs.progress import Progress
 from graphsdg.render import motion_blur
+from graphsdg.render.attachments import attachments
 from graphsdg.render.camera import CameraView, camera_view
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import stage_context
@@ -626,15 +627,12 @@ def reset_profile() -> None:
 
 def _flush_at_exit() -> None:
     """At interpreter exit: flush attached writers, finish every queued write, or say loudly what was lost."""
-    from graphsdg import runtime as runtime_module
     queue = current_write_queue()
-    rt = runtime_module._runtime          # never create a runtime (a GL context) just to exit
-    writers = list(rt.writers) if rt is not None else []
+    writers = list(attachments.writers)   # read from the registry: never create a runtime just to exit
     if queue is None and not writers:
         return
     try:
-        if rt is not None:
-            rt.complete_capture()   # a pipelined step's frame
+        attachments.complete_capture()   # a pipelined step's frame
         for writer in writers:
             writer.flush()
         queue = current_write_queue()

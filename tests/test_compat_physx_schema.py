@@ -13,7 +13,7 @@ import graphsdg as rep
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError
 from graphsdg.runtime import runtime
-from graphsdg.sim.bodies import RigidBodyView
+from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.sim.compile_error import CompileError
 
 

@@ -28,8 +28,8 @@ from graphsdg.runtime import runtime
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
 from graphsdg.scenarios.palletizing import BinStacking
-from graphsdg.sim.articulations import ArticulationView
-from graphsdg.sim.bodies import RigidBodyView
+from graphsdg.physics.articulations import ArticulationView
+from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.sim.bounds import create_bbox_cache
 from graphsdg.sim.timeline import TimelineEventType
 

@@ -11,7 +11,7 @@ import graphsdg as rep
 from graphsdg.render import pbr_scene as ps
 from graphsdg.render.camera import CameraView
 from graphsdg.runtime import runtime
-from graphsdg.sim import environment_map
+from graphsdg.imaging import environment_map
 from graphsdg.sim.lights import REFERENCE_IRRADIANCE
 from graphsdg.maths.rotations import quat_wxyz_to_matrix
 

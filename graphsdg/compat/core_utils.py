@@ -208,7 +208,7 @@ def create_prim(prim_path: str, prim_type: str = "Xform", position: Sequence[flo
         rotation = None if orientation is None else tuple(float(v) for v in orientation)   # w, x, y, z
         set_local_pose(prim, position=translation, rotation=rotation, scale=scale)
     if position is not None:
-        from graphsdg.sim.transforms import set_world_pose
+        from graphsdg.physics.world_pose import set_world_pose
         set_world_pose(prim, position, None)
     if semantic_label is not None:
         semlib.apply(prim, {semantic_type: [semantic_label]}, mode="add")

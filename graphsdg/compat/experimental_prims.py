@@ -6,7 +6,7 @@ them in batches: inputs broadcast to ``(N, width)`` following NumPy's rules,
 ``indices`` selects a subset, and results are numpy arrays that also answer
 warp's ``.numpy()``. Poses go through :mod:`graphsdg.sim.transforms` (world) and
 :func:`graphsdg.stage.xform.set_local_pose` (local); rigid bodies through
-:class:`graphsdg.sim.bodies.RigidBodyView`; collision and physics-material
+:class:`graphsdg.physics.bodies.RigidBodyView`; collision and physics-material
 properties are the ``UsdPhysics`` / ``physx*`` attributes the compiler reads.
 """
 from __future__ import annotations
@@ -258,7 +258,7 @@ class XformPrim(Prim):
 
     def set_world_poses(self, positions: Any = None, orientations: Any = None, indices: Any = None) -> None:
         """Move the prims to world positions and / or orientations (quaternions w, x, y, z)."""
-        from graphsdg.sim.transforms import set_world_pose
+        from graphsdg.physics.world_pose import set_world_pose
         paths = self._selected(indices)
         pos = None if positions is None else rows(positions, len(paths), 3, "positions")
         quat = None if orientations is None else _unit_quats(orientations, len(paths))
@@ -553,7 +553,7 @@ class RigidPrim(XformPrim):
                  scales: Any = None, reset_xform_op_properties: bool = False) -> None:
         super().__init__(paths, resolve_paths=resolve_paths, translations=translations, scales=scales,
                          reset_xform_op_properties=reset_xform_op_properties)
-        from graphsdg.sim.bodies import RigidBodyView
+        from graphsdg.physics.bodies import RigidBodyView
         self._view = RigidBodyView(self.paths)
         if masses is not None or densities is not None:
             self._set_mass_api(masses, densities)

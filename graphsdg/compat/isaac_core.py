@@ -82,20 +82,20 @@ class SceneQueryInterface(CompatObject):
 
     def overlap_box(self, half_extent: Any, position: Any, rotation: Any,
                     report_fn: Callable[[Any], bool] | None = None, any_hit: bool = False) -> int:
-        from graphsdg.sim.queries import overlap_box
+        from graphsdg.physics.queries import overlap_box
         return overlap_box(tuple(half_extent), tuple(position), tuple(rotation), report_fn, any_hit)
 
     def overlap_sphere(self, radius: float, position: Any, report_fn: Callable[[Any], bool] | None = None,
                        any_hit: bool = False) -> int:
-        from graphsdg.sim.queries import overlap_sphere
+        from graphsdg.physics.queries import overlap_sphere
         return overlap_sphere(radius, tuple(position), report_fn, any_hit)
 
     def raycast_closest(self, origin: Any, direction: Any, distance: float) -> dict:
-        from graphsdg.sim.queries import raycast_closest
+        from graphsdg.physics.queries import raycast_closest
         return raycast_closest(tuple(origin), tuple(direction), distance)
 
     def raycast_all(self, origin: Any, direction: Any, distance: float, report_fn: Callable | None = None):
-        from graphsdg.sim.queries import raycast_all
+        from graphsdg.physics.queries import raycast_all
         return raycast_all(tuple(origin), tuple(direction), distance, report_fn)
 
 

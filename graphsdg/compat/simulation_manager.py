@@ -193,7 +193,7 @@ class SimulationManager:
         if cls._started:
             return
         cls._started = True
-        from graphsdg.sim.timeline import get_timeline_interface
+        from graphsdg.physics.timeline import get_timeline_interface
         from graphsdg.stage.context import stage_context
         timeline = get_timeline_interface()
         cls._timeline_subscriptions = [timeline.subscribe(cls._on_play, TimelineEventType.PLAY),
@@ -338,7 +338,7 @@ class SimulationManager:
     @classmethod
     def is_paused(cls) -> bool:
         """Whether the timeline is paused (neither playing nor stopped)."""
-        from graphsdg.sim.timeline import get_timeline_interface
+        from graphsdg.physics.timeline import get_timeline_interface
         timeline = get_timeline_interface()
         return not timeline.is_playing() and not timeline.is_stopped()
 
@@ -371,7 +371,7 @@ class SimulationManager:
         Authors ``physxScene:timeStepsPerSecond = round(1 / dt)`` as Isaac's PhysX scene does.
         """
         from graphsdg.functional.physics import create_physics_scene
-        from graphsdg.sim.timeline import get_timeline_interface
+        from graphsdg.physics.timeline import get_timeline_interface
         if get_timeline_interface().is_playing():
             raise RuntimeError("The physics dt cannot be set while the simulation is running/playing")
         if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= 1.0:
@@ -466,7 +466,7 @@ class SimulationManager:
                                                         observer_name=f"SimulationManager.{event.name}.{uid}")
             cls._callbacks[uid] = _Ended(guard.reset)
         elif event in _TIMELINE_EVENTS:
-            from graphsdg.sim.timeline import get_timeline_interface
+            from graphsdg.physics.timeline import get_timeline_interface
             subscription = get_timeline_interface().subscribe(call, _TIMELINE_EVENTS[event])
             cls._callbacks[uid] = _Ended(subscription.unsubscribe)
         else:   # prim deletion

@@ -1,4 +1,7 @@
-"""MuJoCo: the stage compiler, live sync, physics, and what scripts read back from it.
+"""MuJoCo: the stage compiler, live sync, physics stepping and the timeline (the engine).
+
+Isaac's user-facing physics API over it (prim views, scene queries, the timeline
+interface) is one room up, in :mod:`graphsdg.physics`.
 
 * :mod:`~graphsdg.sim.compiler`: USD -> MjSpec -> MjModel, one module per schema it
   reads (:mod:`~graphsdg.sim.gprims`, :mod:`~graphsdg.sim.materials`,
@@ -9,9 +12,7 @@
   live (each aspect by its module: :mod:`~graphsdg.sim.geom_poses`, ...), physics
   stepped and written back to the stage (:mod:`~graphsdg.sim.pose_write_back`).
 * :mod:`~graphsdg.sim.timeline`: play / pause / stop, time, tick events.
-* :mod:`~graphsdg.sim.bodies` (rigid-body poses and velocities),
-  :mod:`~graphsdg.sim.transforms` (world transforms), :mod:`~graphsdg.sim.bounds`
-  (bounding boxes), :mod:`~graphsdg.sim.queries` (overlaps, ray casts, contacts).
+* :mod:`~graphsdg.sim.bounds`: bounding boxes.
 * :mod:`~graphsdg.sim.placement`: surface and volume sampling behind
   ``rep.functional.randomizer.scatter_2d`` / ``scatter_3d``.
 """

@@ -25,6 +25,8 @@ follows (vertices are in the mesh's own frame, scale applied):
 
 Example:
     >>> import numpy as np
+
+from graphsdg.errors import closest
     >>> v = np.array([[0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]], dtype=float)
     >>> center, half = bounding_cube(v)
     >>> center.tolist(), half.tolist()
@@ -42,6 +44,8 @@ from graphsdg.sim.compile_error import CompileError
 from graphsdg.sim.visual import COLLISION_ONLY_GROUP
 from graphsdg.maths.rotations import matrix_to_quat_wxyz
 
+from graphsdg.errors import closest
+
 APPROXIMATIONS = ("none", "convexHull", "convexDecomposition", "boundingCube", "boundingSphere",
                   "meshSimplification", "sdf", "sphereFill")
 EXACT_APPROXIMATIONS = ("none", "meshSimplification", "sdf", "sphereFill")
@@ -58,7 +62,6 @@ def check_approximation(name: object, where: str = "") -> str:
     """Return ``name`` if it is a known approximation token, else raise :class:`ApproximationError`."""
     if isinstance(name, str) and name in APPROXIMATIONS:
         return name
-    from graphsdg.errors import closest
     hint = closest(str(name), APPROXIMATIONS)
     at = f" on {where}" if where else ""
     raise ApproximationError(f"unknown collider approximation {name!r}{at}{hint}; "

@@ -12,7 +12,7 @@ Reads ``UsdLux`` ``DistantLight``, ``SphereLight``, ``RectLight``, ``DiskLight``
 adds them to a compile: a dome light becomes ambient light plus a soft sky
 light, and a skybox; a dome texture (a lat-long HDR) is the skybox and sets the
 colour, strength and main direction of that light
-(:mod:`graphsdg.sim.environment_map`). A stage without lights is lit from the
+(:mod:`graphsdg.imaging.environment_map`). A stage without lights is lit from the
 camera. :func:`sync_light` writes a light's edits into the compiled model.
 """
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 from pxr import Usd, UsdGeom, UsdLux
 
 from graphsdg import settings
-from graphsdg.sim import environment_map
+from graphsdg.imaging import environment_map
 from graphsdg.sim.compile_error import CompileError
 from graphsdg.sim.compiled_scene import CompiledScene, LightBinding
 from graphsdg.sim.needs_recompile import NeedsRecompile

@@ -325,7 +325,7 @@ class SimScene:
         """Call ``callback(step_size)`` before every physics step (Isaac's ``World.add_physics_callback``).
 
         Controllers read and write simulation state here (joint targets through
-        :class:`graphsdg.sim.articulations.ArticulationView`, weld constraints);
+        :class:`graphsdg.physics.articulations.ArticulationView`, weld constraints);
         the callback must not change the stage's structure.
         """
         if not callable(callback):
@@ -416,7 +416,7 @@ class SimScene:
         b = self.body(path)
         if b.articulated:
             raise ValueError(f"rigid body {path} hangs from a joint; move it through its joints "
-                             f"(graphsdg.sim.articulations.ArticulationView.set_joint_positions)")
+                             f"(graphsdg.physics.articulations.ArticulationView.set_joint_positions)")
         c = self.ensure_compiled()
         d = c.data
         pos, quat = self.body_pose(path)

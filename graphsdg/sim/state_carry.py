@@ -20,7 +20,7 @@ def carry_state(old: CompiledScene, new: CompiledScene) -> None:
     render-only edit (a light, a material, a texture) continues the simulation
     bit for bit. Weld constraints are compiled from the stage (whoever switches
     one authors ``physics:jointEnabled`` and the joint frames, see
-    :func:`graphsdg.sim.articulations.set_fixed_joint`); elements new to ``new``
+    :func:`graphsdg.physics.articulations.set_fixed_joint`); elements new to ``new``
     keep what the stage says.
     """
     om, od, nm, nd = old.model, old.data, new.model, new.data

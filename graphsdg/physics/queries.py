@@ -14,7 +14,7 @@ Quaternions follow PhysX here: ``(x, y, z, w)``.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.sim import queries
+    >>> from graphsdg.physics import queries
     >>> _ = rep.stage.new_stage()
     >>> cube = rep.functional.create.cube(position=(0, 0, 0.5), name="Crate")
     >>> rep.functional.physics.apply_collider(cube)
@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 
 from graphsdg.maths.rotations import quat_wxyz_to_matrix
+from graphsdg.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene
 from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.prims import PrimLike, resolve_prim
@@ -107,7 +108,6 @@ def _rotation_xyzw(rotation: Any) -> np.ndarray:
 
 
 def _scene() -> CompiledScene:
-    from graphsdg.runtime import runtime
     sim = runtime().sim
     sim.sync_dirty_prims()
     return sim.ensure_compiled()

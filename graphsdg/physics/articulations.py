@@ -38,6 +38,7 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, UsdPhysics
 
+from graphsdg.runtime import runtime
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim.compiled_scene import JointBinding
 from graphsdg.sim.rigid_bodies import rigid_root
@@ -46,7 +47,6 @@ from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_t
 
 
 def _sim():
-    from graphsdg.runtime import runtime
     return runtime().sim
 
 
