@@ -25,7 +25,8 @@ from typing import Any, Callable
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg import orchestrator, settings, stage
-from graphsdg.compat import extensions, viewport
+from graphsdg.compat import event_names, extensions, viewport
+from graphsdg.compat.event_names import StageEventType
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
 from graphsdg.runtime import runtime
 
@@ -344,18 +345,6 @@ def command_line_settings(argv: list[str]) -> dict[str, Any]:
 
 
 # ---- USD context ----------------------------------------------------------------
-class StageEventType(enum.IntEnum):
-    """omni.usd.StageEventType values graphsdg emits."""
-
-    SAVED = 0
-    SAVE_FAILED = 1
-    OPENING = 2
-    OPENED = 3
-    OPEN_FAILED = 4
-    CLOSING = 5
-    CLOSED = 6
-
-
 class StageState(enum.IntEnum):
     """omni.usd.StageState."""
 
@@ -442,23 +431,19 @@ class UsdContext(CompatObject):
     # Kit 107+ also sends these events by name through carb.eventdispatcher (graphsdg.compat.event_dispatch)
     def stage_event_name(self, event: "StageEventType") -> str:
         """The event-dispatcher name of a stage event."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_event_name(event)
+        return event_names.stage_event_name(event)
 
     def stage_event_type(self, event: str) -> "StageEventType":
         """The stage event a dispatcher name stands for."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_event_type(event)
+        return event_names.stage_event_type(event)
 
     def stage_rendering_event_name(self, event: int, immediate: bool = False) -> str:
         """The event-dispatcher name of a rendering event (``omni.usd.StageRenderingEventType``)."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_rendering_event_name(event, immediate)
+        return event_names.stage_rendering_event_name(event, immediate)
 
     def stage_rendering_event_type(self, event: str) -> int:
         """The rendering event a dispatcher name stands for."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_rendering_event_type(event)
+        return event_names.stage_rendering_event_type(event)
 
     def save_as_stage(self, url: str) -> bool:
         stage.save(url)
