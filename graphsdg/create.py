@@ -16,7 +16,8 @@ from __future__ import annotations
 import sys
 from typing import Any, Callable
 
-from graphsdg.graph.builder import ReplicatorItem, add_node
+from graphsdg.graph.builder import add_node
+from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function
 from graphsdg.graph.registry import NodeRegistry
 from graphsdg.render.render_product import create_render_product as render_product

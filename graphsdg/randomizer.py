@@ -13,7 +13,8 @@ from __future__ import annotations
 import sys
 from typing import Any, Callable
 
-from graphsdg.graph.builder import ReplicatorItem, add_node, targets_value
+from graphsdg.graph.builder import add_node, targets_value
+from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function
 from graphsdg.graph.registry import NodeRegistry
 

@@ -11,9 +11,12 @@ from __future__ import annotations
 import sys
 from typing import Any, Callable
 
-from graphsdg.graph.builder import GraphBuildError, ReplicatorItem, add_node, current_trigger
+from graphsdg.errors import GraphBuildError
+from graphsdg.graph.builder import add_node
+from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function
 from graphsdg.graph.registry import NodeRegistry
+from graphsdg.graph.scopes import current_trigger
 
 
 def _add_trigger(type_name: str, name: str | None, **values: Any) -> ReplicatorItem:

@@ -6,7 +6,9 @@ function, because an import hidden in a function is still a dependency (it only 
 import time to call time). ``from graphsdg.x import name`` is an edge to ``graphsdg.x.name`` when that is a
 submodule, else to ``graphsdg.x``. Importing ``graphsdg.x.y`` also runs ``graphsdg/x/__init__``, so that
 package is an edge too. Edges to a module's own ancestor packages are left out: Python runs those before
-the module anyway, and a package importing its own children is how packages are built.
+the module anyway, and a package importing its own children is how packages are built. Imports under
+``if TYPE_CHECKING:`` are left out too: they never run, and code cannot use at run time a name imported
+only there, so they name types without making a dependency.
 """
 from __future__ import annotations
 
@@ -60,11 +62,30 @@ def _nearest_module(name: str, modules: dict[str, Path]) -> str | None:
     return None
 
 
+def _is_type_checking(node: ast.AST) -> bool:
+    """``if TYPE_CHECKING:`` (or ``typing.TYPE_CHECKING``)."""
+    test = node.test if isinstance(node, ast.If) else None
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or \
+        (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def _run_time_nodes(tree: ast.AST):
+    """Every node of ``tree`` except the bodies of ``if TYPE_CHECKING:`` blocks (their ``else`` is kept)."""
+    stack = [tree]
+    while stack:
+        node = stack.pop()
+        yield node
+        if _is_type_checking(node):
+            stack.extend(node.orelse)
+        else:
+            stack.extend(ast.iter_child_nodes(node))
+
+
 def _imported_names(module: str, tree: ast.AST, modules: dict[str, Path]) -> set[str]:
     """The dotted module names each import statement of ``module`` asks for (submodules resolved)."""
     package = module if _is_package(module, modules) else module.rpartition(".")[0]
     names: set[str] = set()
-    for node in ast.walk(tree):
+    for node in _run_time_nodes(tree):
         if isinstance(node, ast.Import):
             names.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):

@@ -22,9 +22,9 @@ from typing import Any, Iterable
 from pxr import Sdf, Usd
 
 from graphsdg.benchmark import profiling
-from graphsdg.graph.builder import ReplicatorItem, current_graph, edit_context, release_graph
+from graphsdg.graph.current import current_graph, edit_context, release_graph
 from graphsdg.graph.graph import Graph, effective_triggers
-from graphsdg.graph.node import ExecContext, Node, TriggerNode
+from graphsdg.graph.node import ExecContext, Node, ReplicatorItem, TriggerNode
 
 
 def active_graph() -> Graph | None:
