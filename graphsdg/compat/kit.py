@@ -2,7 +2,7 @@
 
 Each class is a thin adapter: an app update is :func:`graphsdg.orchestrator.update`,
 the timeline is the runtime's :class:`~graphsdg.sim.timeline.Timeline`, the USD
-context is :mod:`graphsdg.stage`, carb settings are :mod:`graphsdg.settings`.
+context is :mod:`graphsdg.stage`, carb settings are :mod:`graphsdg.settings_store`.
 
 App updates and asyncio follow Kit: every coroutine awaiting
 ``next_update_async()`` resumes after the same next update (two coroutines
@@ -24,11 +24,16 @@ from typing import Any, Callable
 
 from pxr import Gf, Sdf, Usd, UsdGeom
 
-from graphsdg import orchestrator, settings, stage
+from graphsdg import orchestrator, stage
+from graphsdg import settings_store as settings
 from graphsdg.compat import event_names, extensions, viewport
 from graphsdg.compat.event_names import StageEventType
+from graphsdg.compat.kit_commands import COMMANDS
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
+from graphsdg.graph import clear as clear_graph
+from graphsdg.graph.graph import REPLICATOR_ROOT
 from graphsdg.runtime import runtime
+from graphsdg.sim import transforms
 
 log = logging.getLogger("carb")
 
@@ -463,8 +468,7 @@ def get_context(name: str = "") -> UsdContext:
 
 def get_world_transform_matrix(prim: Usd.Prim, time_code: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
     """The prim's local-to-world matrix (row-vector, as Kit returns it)."""
-    from graphsdg.sim.transforms import get_world_transform_matrix as world
-    return world(prim, time_code)
+    return transforms.get_world_transform_matrix(prim, time_code)
 
 
 def get_local_transform_matrix(prim: Usd.Prim, time_code: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
@@ -476,9 +480,6 @@ def get_local_transform_matrix(prim: Usd.Prim, time_code: Usd.TimeCode = Usd.Tim
 def delete_prims(paths: list[str], destructive: bool = False) -> None:
     """``DeletePrimsCommand``: remove prims; deleting ``/Replicator`` (or a prim below it) also removes the
     node graph built there, as deleting Replicator's OmniGraph does in Kit."""
-    from graphsdg.graph import clear as clear_graph
-    from graphsdg.graph.graph import REPLICATOR_ROOT
-
     s = stage.get_stage()
     for path in paths:
         path = str(path)
@@ -493,8 +494,7 @@ _COMMANDS: dict[str, Callable[..., Any]] = {"DeletePrimsCommand": delete_prims}
 
 def execute(command: str, **kwargs: Any) -> tuple[bool, Any]:
     """omni.kit.commands.execute for the commands graphsdg maps; returns Kit's ``(success, result)``."""
-    from graphsdg.compat.kit_commands import COMMANDS   # Kit's prim-authoring commands
-    commands = {**_COMMANDS, **COMMANDS}
+    commands = {**_COMMANDS, **COMMANDS}   # Kit's prim-authoring commands and DeletePrims
     # Kit registers a command by its class name less "Command"; either spelling runs it
     fn = commands.get(command) or commands.get(command.removesuffix("Command")) or commands.get(command + "Command")
     if fn is None:
@@ -568,7 +568,7 @@ _asyncify_fixtures(AsyncTestCase)
 
 # ---- carb ------------------------------------------------------------------------
 class CarbSettings(CompatObject):
-    """carb.settings.ISettings over :mod:`graphsdg.settings`."""
+    """carb.settings.ISettings over :mod:`graphsdg.settings_store`."""
 
     _compat_name = "carb.settings.ISettings"
 

@@ -42,7 +42,7 @@ import mujoco
 import numpy as np
 from pxr import UsdShade
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.benchmark import profiling
 from graphsdg.render import pbr_scene
 from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend

@@ -48,7 +48,7 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.sim import colliders, deformables, environment_map, geom_subsets
 from graphsdg.sim import physx_attributes
 from graphsdg.sim import joints as jointmap

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Usd, UsdLux
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 
 REFERENCE_IRRADIANCE = math.pi * 600.0
 LIGHT_KINDS = {
