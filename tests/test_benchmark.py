@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from graphsdg.benchmark import _steady_rate
+from graphsdg.benchmark.throughput import _steady_rate
 from graphsdg.jobs.cpu_share import cores_per_process, limit_image_threads
 from graphsdg.io.write_queue import threads_per_process
 
