@@ -89,7 +89,7 @@ def test_bench_refuses_bad_values_naming_them(bad, capsys):
     (5, 1.0, [1.0] * 10, 5),                 # ... unless fewer were asked for
 ])
 def test_timed_frames_fit_the_time_budget(frames, seconds, warmup_times, expected):
-    from graphsdg.benchmark import BenchConfig, timed_frames
+    from graphsdg.benchmark.throughput import BenchConfig, timed_frames
     assert timed_frames(BenchConfig(frames=frames, seconds=seconds), warmup_times) == expected
 
 
