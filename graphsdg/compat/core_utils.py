@@ -21,7 +21,7 @@ import types
 from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom
+from pxr import Sdf, Usd, UsdGeom, UsdUtils
 
 from graphsdg.compat.kit import get_app
 from graphsdg.compat.modules import CompatModule
@@ -41,7 +41,6 @@ def get_current_stage(fabric: bool = False) -> Usd.Stage:
 
 def get_current_stage_id() -> int:
     """The stage's id in USD's stage cache (inserted on first call)."""
-    from pxr import UsdUtils
     cache = UsdUtils.StageCache.Get()
     return cache.Insert(get_current_stage()).ToLongInt()
 

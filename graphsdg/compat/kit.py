@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import asyncio
 import enum
+import inspect
 import logging
 import sys
 import unittest
@@ -517,8 +518,6 @@ class _Deferred:
 def _asyncify_fixtures(cls: type) -> None:
     """Kit's tests write ``async def setUp``; unittest wants ``asyncSetUp``. Route one to the other, keeping
     ``await super().setUp()`` working."""
-    import inspect
-
     for name, async_name in (("setUp", "asyncSetUp"), ("tearDown", "asyncTearDown")):
         fn = cls.__dict__.get(name)
         if fn is None or not inspect.iscoroutinefunction(fn):

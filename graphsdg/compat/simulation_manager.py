@@ -44,7 +44,7 @@ import warnings
 import weakref
 from typing import Any, Callable
 
-from pxr import Usd, UsdPhysics
+from pxr import Tf, Usd, UsdPhysics
 
 from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.modules import CompatModule, CompatObject
@@ -156,7 +156,6 @@ class _Deletions:
     """Calls ``callback(path)`` for prims removed from the current stage (USD ObjectsChanged resyncs)."""
 
     def __init__(self, callback: Callable[[str], Any]) -> None:
-        from pxr import Tf
         self._stage = get_stage()
         self._callback = callback
         self._listener = Tf.Notice.Register(Usd.Notice.ObjectsChanged, self._on_changed, self._stage)
