@@ -16,8 +16,8 @@ from __future__ import annotations
 import sys
 from typing import Any, Callable
 
-from graphsdg.graph.builder import ReplicatorItem
 from graphsdg.graph.calls import family_calls
+from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function
 
 _calls = family_calls("get")

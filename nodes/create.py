@@ -16,10 +16,9 @@ from pxr import Sdf, Usd
 
 from graphsdg.functional import create as FC
 from graphsdg.functional import modify as FM
-from graphsdg.graph.builder import flatten_prims
 from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
-from graphsdg.graph.node import ExecContext, Node, Port, is_random_value
+from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims, is_random_value
 from graphsdg.graph.registry import register_node
 from graphsdg.stage.context import get_stage
 

@@ -9,9 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from graphsdg.graph.builder import ReplicatorItem, iter_refs
 from graphsdg.graph.calls import Call
-from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.node import ExecContext, Node, Port, ReplicatorItem, iter_refs
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
 from graphsdg.rng import stream

@@ -10,10 +10,9 @@ from pxr import Sdf, Usd
 from graphsdg.functional import create as FC
 from graphsdg.functional import modify as FM
 from graphsdg.functional import randomizer as FR
-from graphsdg.graph.builder import flatten_prims
 from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
-from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
 

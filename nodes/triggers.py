@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.graph.calls import Call
 from graphsdg.graph.node import Port, TriggerNode
 from graphsdg.graph.registry import register_node

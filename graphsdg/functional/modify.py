@@ -18,19 +18,21 @@ from typing import Any
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.errors import closest
 from graphsdg.functional.per_prim import per_prim, per_prim_array
+from graphsdg.runtime import runtime
+from graphsdg.sim import direct_writes
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.prims import resolve_prim, resolve_prims
-from graphsdg.stage.xform import set_local_pose
+from graphsdg.stage.xform import set_local_pose, world_matrix
+from graphsdg.maths.rotations import decompose
 
 
 def _look_at_point(value: Any) -> Any:
     """A look-at target given as a prim (or prim path) becomes its world position."""
     if isinstance(value, Usd.Prim) or (isinstance(value, str) and value.startswith("/")):
-        from graphsdg.stage.xform import world_matrix
         return world_matrix(resolve_prim(value))[3, :3]
     return value
 
@@ -54,8 +56,6 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
     n = len(targets)
     if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
             and _write_to_fabric():
-        from graphsdg.runtime import runtime
-        from graphsdg.sim import direct_writes
         arrays = [None if v is None else per_prim_array(v, n, name, width=width, uniform=uniform,
                                                          uniform_per_prim=uniform)
                   for v, name, width, uniform in ((position_value, "position_value", 3, False),
@@ -98,7 +98,6 @@ def size_to_scale(prim: Usd.Prim, size: Any) -> np.ndarray:
 
 
 def _apply_pivot(prim: Usd.Prim, pivot: np.ndarray, position: Any) -> None:
-    from graphsdg.maths.rotations import decompose
     xf = UsdGeom.Xformable(prim)
     m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
     t, r, s = decompose(m)
@@ -209,8 +208,6 @@ def display_color(prims: Any, value: Any) -> None:
     targets = resolve_prims(prims)
     colors = per_prim_array(value, len(targets), "display color")
     if _write_to_fabric():
-        from graphsdg.runtime import runtime
-        from graphsdg.sim import direct_writes
         if direct_writes.write_colors(runtime().sim, targets, colors[:, :3]):
             return
     for prim, c in zip(targets, colors):

@@ -24,7 +24,7 @@ from pxr import Sdf, Usd, UsdGeom, UsdShade
 from graphsdg.functional import modify
 from graphsdg.functional.per_prim import per_prim
 from graphsdg.rng import ReplicatorRNG, as_generator
-from graphsdg.sim import bounds, placement, transforms
+from graphsdg.sim import bounds, placement
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.prims import resolve_prims, sanitize_name
 from graphsdg.maths.rotations import matrix_to_euler_xyz, quat_wxyz_to_matrix
@@ -179,7 +179,7 @@ def _bounds_offsets(targets: list) -> np.ndarray:
     cache = bounds.create_bbox_cache()
     out = np.zeros((len(targets), 6))
     for i, prim in enumerate(targets):
-        origin = transforms.get_world_position(prim)
+        origin = world_matrix(prim)[3, :3]   # targets are resolved prims
         try:
             box = bounds.compute_aabb(prim, cache)
         except ValueError:

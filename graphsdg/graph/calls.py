@@ -20,7 +20,10 @@ import inspect
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
-from graphsdg.graph.builder import GraphBuildError, ReplicatorItem, add_node, current_trigger, targets_value
+from graphsdg.errors import GraphBuildError
+from graphsdg.graph.builder import add_node, targets_value
+from graphsdg.graph.node import ReplicatorItem
+from graphsdg.graph.scopes import current_trigger
 from graphsdg.graph.node import Node, Port
 from graphsdg.graph.registry import NodeRegistry
 

@@ -18,7 +18,7 @@ import uuid
 from typing import Any, Callable
 
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.jobs import frame_plan
 from graphsdg.errors import unknown_name
 from graphsdg.io import encode, object_store

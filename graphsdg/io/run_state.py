@@ -49,7 +49,7 @@ import time
 import weakref
 from typing import Any, Iterator
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.io.location import open_location
 from graphsdg.render.attachments import attachments
 

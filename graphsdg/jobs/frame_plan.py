@@ -29,7 +29,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.io.object_store import is_s3_url
 
 SHARD_FOLDER = ".graphsdg-shards"   # per-shard aggregate files, inside a writer's output folder

@@ -75,7 +75,7 @@ class ShardWorker:
         """Run shard ``index`` of ``count``; ``write_threads`` is the default writer pool size here
         (the script may still set ``/omni/replicator/backend/writeThreads`` itself), ``image_threads``
         OpenCV's pool size (None: its default)."""
-        from graphsdg import settings
+        from graphsdg import settings_store as settings
         from graphsdg.jobs.cpu_share import limit_image_threads
         from graphsdg.jobs.frame_plan import FramePlan
         from graphsdg.io.write_queue import THREADS_KEY, get_write_queue

@@ -42,7 +42,7 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom, UsdShade
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.benchmark import profiling
 from graphsdg.imaging import environment_map
 from graphsdg.render import pbr_scene
