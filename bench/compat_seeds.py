@@ -28,7 +28,7 @@ def run_once(script: str, scale: float) -> tuple[float, int, int, str]:
     """(wall seconds, files written, peak RSS in MB, error tail or '')."""
     with tempfile.TemporaryDirectory() as cwd:
         start = time.perf_counter()
-        proc = subprocess.run([sys.executable, "-m", "graphsdg.cli", "run", "--compat", "isaac",
+        proc = subprocess.run([sys.executable, "-m", "graphsdg.jobs.cli", "run", "--compat", "isaac",
                                "--resolution-scale", str(scale), script], cwd=cwd, capture_output=True, text=True)
         wall = time.perf_counter() - start
         files = sum(len(f) for _, _, f in os.walk(cwd))

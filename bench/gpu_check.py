@@ -11,7 +11,7 @@ import tempfile
 import time
 
 import graphsdg as rep  # noqa: F401  (selects EGL before mujoco loads)
-from graphsdg.cli import run_demo
+from graphsdg.jobs.cli import run_demo
 
 
 def gl_info() -> dict[str, str]:

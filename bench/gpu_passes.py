@@ -14,7 +14,7 @@ import argparse
 import collections
 
 import graphsdg as rep  # noqa: F401  (selects EGL before mujoco loads)
-from graphsdg import benchmark
+from graphsdg.benchmark import throughput
 from graphsdg.render import readback
 
 
@@ -48,21 +48,21 @@ def main() -> None:
     read = readback.PixelReads._read
     readback.PixelReads._read = lambda self, ctx, w, h, kind, *rest, **kw: timed(f"copy:{kind}", read)(
         self, ctx, w, h, kind, *rest, **kw)
-    config = benchmark.BenchConfig(frames=args.frames, warmup=5, resolution=(512, 512), msaa_samples=args.msaa,
+    config = throughput.BenchConfig(frames=args.frames, warmup=5, resolution=(512, 512), msaa_samples=args.msaa,
                                    shadow_size=args.shadow_size,
                                    annotators=("rgb", "distance_to_image_plane", "semantic_segmentation",
                                                "bounding_box_2d_tight"), wait_for_render=True)
-    assets, cams, rps = benchmark.build_scene(config)
+    assets, cams, rps = throughput.build_scene(config)
     writer = rep.writers.get("BasicWriter")
     import tempfile
     writer.initialize(output_dir=tempfile.mkdtemp(), rgb=True, distance_to_image_plane=True,
                       semantic_segmentation=True, bounding_box_2d_tight=True)
     writer.attach(rps)
-    draws = benchmark.Randomization(config)
+    draws = throughput.Randomization(config)
     for i in range(config.warmup + config.frames):
         if i == config.warmup:
             gpu_ms.clear()
-        benchmark._apply(draws.draw(), assets, cams)
+        throughput._apply(draws.draw(), assets, cams)
         renders = iter(("render:color (shadow map + MSAA colour)", "render:ids (+depth)"))
         rep.orchestrator.step()
     rep.orchestrator.wait_until_complete()
@@ -73,7 +73,7 @@ def main() -> None:
     quality = (f"MSAA {rep.settings.get('/graphsdg/render/msaaSamples', 4)}, "
                f"shadow map {rep.settings.get('/graphsdg/render/shadowSize', 1024)}")
     table = (f"#### GPU time per pass, {config.frames} frames, 512x512, {quality}\n\n"
-             f"GL: {GL.glGetString(GL.GL_RENDERER).decode()}\n\n{benchmark.format_table(rows)}\n")
+             f"GL: {GL.glGetString(GL.GL_RENDERER).decode()}\n\n{throughput.format_table(rows)}\n")
     print(table)
     if args.report:
         with open(args.report, "a") as f:

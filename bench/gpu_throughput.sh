@@ -10,11 +10,11 @@ shift || true
 procs=("${@:-16}")
 export MUJOCO_GL=egl
 four=(--annotators rgb distance_to_image_plane semantic_segmentation bounding_box_2d_tight)
-python3 -m graphsdg.cli bench --num-frames 300 --resolution 512 512 "${four[@]}" --profile --report "$report"
-python3 -m graphsdg.cli bench --num-frames 300 --resolution 1280 720 --annotators rgb --report "$report"
+python3 -m graphsdg.jobs.cli bench --num-frames 300 --resolution 512 512 "${four[@]}" --profile --report "$report"
+python3 -m graphsdg.jobs.cli bench --num-frames 300 --resolution 1280 720 --annotators rgb --report "$report"
 for n in ${procs[@]}; do
   for quality in "" "--msaa 2"; do
-    python3 -m graphsdg.cli bench --num-frames 600 --resolution 512 512 "${four[@]}" --processes "$n" \
+    python3 -m graphsdg.jobs.cli bench --num-frames 600 --resolution 512 512 "${four[@]}" --processes "$n" \
       $quality --report "$report"
   done
 done

@@ -24,7 +24,8 @@ import time
 import numpy as np
 
 import graphsdg as rep
-from graphsdg import profiling, settings
+from graphsdg import settings
+from graphsdg.benchmark import profiling
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
 

@@ -8,7 +8,7 @@ report=${1:-pbr.md}
 procs=${2:-16}
 export MUJOCO_GL=egl
 four=(--resolution 512 512 --annotators rgb distance_to_image_plane semantic_segmentation bounding_box_2d_tight)
-bench() { python3 -m graphsdg.cli bench "${four[@]}" --report "$report" "$@"; }
+bench() { python3 -m graphsdg.jobs.cli bench "${four[@]}" --report "$report" "$@"; }
 bench --num-frames 300 --backend classic --no-baseline
 bench --num-frames 300 --backend pbr --no-baseline --profile          # also compiles Warp's kernels once
 bench --num-frames 300 --backend classic --no-baseline                # classic again: run-to-run spread

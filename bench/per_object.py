@@ -26,24 +26,24 @@ PIECES = ("randomize", "sync", "physics", "mjv_updateScene", "mesh fold", "code 
 def measure(assets: int, frames: int) -> dict[str, float]:
     """Thread-CPU seconds per frame of each of :data:`PIECES` at ``assets`` assets."""
     import graphsdg as rep
-    from graphsdg import benchmark
+    from graphsdg.benchmark import throughput
     from graphsdg.render import rasterizer
     from graphsdg.runtime import runtime
 
-    config = benchmark.BenchConfig(resolution=(64, 64), asset_count=assets // len(benchmark.SHAPES))
-    objects, cams, rps = benchmark.build_scene(config)
+    config = throughput.BenchConfig(resolution=(64, 64), asset_count=assets // len(throughput.SHAPES))
+    objects, cams, rps = throughput.build_scene(config)
     annotator = rep.annotators.get("semantic_segmentation")
     annotator.attach(rps)
-    draws = benchmark.Randomization(config)
+    draws = throughput.Randomization(config)
     for _ in range(3):
-        benchmark._apply(draws.draw(), objects, cams)
+        throughput._apply(draws.draw(), objects, cams)
         rep.orchestrator.step()
     rt = runtime()
     sim, ras = rt.sim, rt.rasterizer
     scene = ras._scene
     categories = mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC
     steps = {
-        "randomize": lambda d: benchmark._apply(d, objects, cams),
+        "randomize": lambda d: throughput._apply(d, objects, cams),
         "sync": lambda d: sim.sync_dirty_prims(),
         "physics": lambda d: rep.orchestrator.advance_time(None),
         "mjv_updateScene": lambda d: mujoco.mjv_updateScene(sim.model, sim.data, ras._option, None, ras._camera,

@@ -76,8 +76,8 @@ def main() -> None:
     import graphsdg as rep
     from graphsdg.io import object_store
     from graphsdg.io.local_s3 import LocalS3Server
-    from graphsdg.job import JobSpec, run_job
-    from graphsdg.scaleout import run_sharded
+    from graphsdg.jobs.job import JobSpec, run_job
+    from graphsdg.jobs.scaleout import run_sharded
 
     work = tempfile.mkdtemp(prefix="graphsdg-s3-bench-")
     script = os.path.join(work, "job.py")

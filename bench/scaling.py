@@ -65,20 +65,20 @@ def total_assets(text: str) -> int:
 
 def run_cell(cell: dict) -> dict:
     """One cell in this process: graphsdg (and the hand-written loop) or N processes; JSON-able numbers."""
-    from graphsdg import benchmark
-    config = benchmark.BenchConfig(frames=cell["max_frames"], warmup=cell["warmup"],
+    from graphsdg.benchmark import throughput
+    config = throughput.BenchConfig(frames=cell["max_frames"], warmup=cell["warmup"],
                                    resolution=tuple(cell["resolution"]), asset_count=cell["assets"] // SHAPES,
                                    annotators=ANNOTATORS, render_backend=cell["backend"], seconds=cell["seconds"])
     if cell["processes"]:
-        row = benchmark.run_processes(config, cell["processes"])
+        row = throughput.run_processes(config, cell["processes"])
         return {"host fps": row["aggregate frames/s (all frames / common window)"],
                 "host steady fps": row["steady frames/s (all processes running)"],
                 "host cpu ms": row["CPU ms per frame (all threads)"]}
-    ours = benchmark.run_graphsdg(config)
+    ours = throughput.run_graphsdg(config)
     out = {"fps": ours.fps, "cpu ms": 1000 * ours.cpu_seconds / ours.frames, "frames": ours.frames,
            "randomize ms": 1000 * ours.profile.get("randomize", 0.0) / ours.frames}
     if cell["baseline"]:
-        hand = benchmark.run_handwritten(config)
+        hand = throughput.run_handwritten(config)
         out.update({"hand fps": hand.fps, "hand cpu ms": 1000 * hand.cpu_seconds / hand.frames})
     return out
 
@@ -203,7 +203,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{n} assets, {res[0]}x{res[1]}, {processes or 1} process(es): {got}", file=sys.stderr,
                       flush=True)
             results[(n, res)] = merged
-    from graphsdg.cli import _gl_renderer
+    from graphsdg.jobs.cli import _gl_renderer
     header = (f"### Scaling: rgb + depth + semantic segmentation + tight boxes, written, ~{args.seconds:g} s a run, "
               f"backend {args.backend}\n\nMachine: {platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}; "
               f"{time.perf_counter() - start:.0f} s in all")

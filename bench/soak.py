@@ -39,7 +39,7 @@ import threading
 import time
 
 import graphsdg as rep
-from graphsdg.cli import run_demo
+from graphsdg.jobs.cli import run_demo
 from graphsdg.io import run_state
 from graphsdg.render.render_product import registry as rp_registry
 from graphsdg.runtime import runtime
@@ -110,24 +110,24 @@ def soak_pipelined(out: str, frames: int, every: int, resolution: tuple[int, int
     """The ``graphsdg bench`` scene of ``assets`` assets (a multiple of its 5 shapes) written by BasicWriter with
     pipelined steps (``wait_for_render=False``): the pixel-buffer pool and the pending captures, for ``frames``
     frames."""
-    from graphsdg import benchmark
-    if assets < len(benchmark.SHAPES) or assets % len(benchmark.SHAPES):
-        raise ValueError(f"--assets is a total over the bench's {len(benchmark.SHAPES)} shapes: a positive multiple "
-                         f"of {len(benchmark.SHAPES)}, got {assets}")
-    config = benchmark.BenchConfig(frames=frames, resolution=resolution, seed=seed,
-                                   asset_count=assets // len(benchmark.SHAPES),
+    from graphsdg.benchmark import throughput
+    if assets < len(throughput.SHAPES) or assets % len(throughput.SHAPES):
+        raise ValueError(f"--assets is a total over the bench's {len(throughput.SHAPES)} shapes: a positive multiple "
+                         f"of {len(throughput.SHAPES)}, got {assets}")
+    config = throughput.BenchConfig(frames=frames, resolution=resolution, seed=seed,
+                                   asset_count=assets // len(throughput.SHAPES),
                                    annotators=("rgb", "distance_to_image_plane", "semantic_segmentation",
                                                "bounding_box_2d_tight"))
-    assets, cams, rps = benchmark.build_scene(config)
+    assets, cams, rps = throughput.build_scene(config)
     writer = rep.writers.get("BasicWriter")
     writer.initialize(output_dir=out, rgb=True, distance_to_image_plane=True, semantic_segmentation=True,
                       bounding_box_2d_tight=True)
     writer.attach(rps)
-    draws = benchmark.Randomization(config)
+    draws = throughput.Randomization(config)
     samples: list[tuple] = [(0, rss_mb(), 0.0, 0)]
     t0 = time.perf_counter()
     for n in range(1, frames + 1):
-        benchmark._apply(draws.draw(), assets, cams)
+        throughput._apply(draws.draw(), assets, cams)
         rep.orchestrator.step(wait_for_render=False)
         if n % every == 0:
             gc.collect()

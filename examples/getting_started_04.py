@@ -13,7 +13,7 @@ Isaac Sim                                        graphsdg
 ``simulation_app.update()``                      ``rep.orchestrator.update()``
 ``omni.timeline.get_timeline_interface()``       ``rep.timeline.get_timeline_interface()``
 ``omni.usd.get_context().new_stage()``           ``rep.stage.new_stage()``
-``isaacsim.core.experimental.prims.RigidPrim``   ``graphsdg.sim.bodies.RigidBodyView``
+``isaacsim.core.experimental.prims.RigidPrim``   ``graphsdg.physics.bodies.RigidBodyView``
 ``get_world_poses(...)[0].numpy()``              ``get_world_poses(...)[0]`` (already numpy)
 ===============================================  ==============================================
 
@@ -25,7 +25,7 @@ import os
 from pxr import UsdGeom
 
 import graphsdg as rep
-from graphsdg.sim.bodies import RigidBodyView
+from graphsdg.physics.bodies import RigidBodyView
 
 
 def run_example(out_dir=None, resolution=(512, 512)):

@@ -22,7 +22,7 @@ Isaac Sim                                                        graphsdg
 ==============================================================  ===========================================
 ``omni.timeline.get_timeline_interface()`` + event stream        ``rep.timeline.get_timeline_interface()``,
                                                                  ``subscribe(callback, event_type)``
-``get_physx_scene_query_interface().overlap_box(...)``           ``graphsdg.sim.queries.overlap_box(...)``
+``get_physx_scene_query_interface().overlap_box(...)``           ``graphsdg.physics.queries.overlap_box(...)``
 ``isaacsim.core.utils.bounds.create_bbox_cache``                 ``graphsdg.sim.bounds.create_bbox_cache``
 ``omni.usd.get_world_transform_matrix``                          ``graphsdg.sim.transforms.get_world_transform_matrix``
 ``DeletePrimsCommand(paths=["/Replicator"])``                    ``rep.graph.clear()`` (also releases the graph)
@@ -49,7 +49,7 @@ import graphsdg as rep
 from graphsdg.assets import get_assets_root_path
 from graphsdg.scenarios.palletizing import BinStacking
 from graphsdg.sim.bounds import create_bbox_cache
-from graphsdg.sim.queries import overlap_box
+from graphsdg.physics.queries import overlap_box
 from graphsdg.sim.timeline import TimelineEventType
 from graphsdg.sim.transforms import get_world_transform_matrix
 

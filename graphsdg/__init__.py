@@ -21,14 +21,14 @@ from graphsdg.render.gl_platform import select_gl_platform
 
 select_gl_platform()   # before anything imports mujoco
 
-from graphsdg import (annotators, backends, create, functional, orchestrator, rng, settings,  # noqa: E402
+from graphsdg import (annotators, backends, functional, orchestrator, rng, settings,  # noqa: E402
                       stage, writers)
 from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry  # noqa: E402
 from graphsdg.io import writers as _builtin_writers  # noqa: E402,F401  (registers BasicWriter)
 from graphsdg.io.backends import BackendDispatch  # noqa: E402
 from graphsdg.io.writer import Writer, WriterRegistry  # noqa: E402
 from graphsdg.rng import get_global_seed, set_global_seed  # noqa: E402
-from graphsdg.sim import timeline  # noqa: E402
+from graphsdg.physics import timeline  # noqa: E402
 
 
 def _import_node_library():
@@ -62,7 +62,8 @@ def _import_node_library():
 
 nodes = _import_node_library()
 
-from graphsdg import distribution, events, get, graph, modify, randomizer, trigger  # noqa: E402
+# the graph-API calls are made from the node types registered above
+from graphsdg import create, distribution, events, get, graph, modify, randomizer, trigger  # noqa: E402
 from graphsdg import events as utils  # noqa: E402  (rep.utils.send_og_event)
 from graphsdg.graph import ReplicatorItem, new_layer  # noqa: E402
 

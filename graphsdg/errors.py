@@ -25,6 +25,10 @@ class UnknownNameError(GraphSDGError, KeyError, ValueError):
         return str(self.args[0]) if self.args else ""
 
 
+class GraphBuildError(GraphSDGError, ValueError):
+    """A graph-API call that cannot be built as written."""
+
+
 class RenderProductDestroyedError(GraphSDGError, RuntimeError):
     """A render product used after ``destroy()``."""
 

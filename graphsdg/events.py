@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import warnings
 
-from graphsdg.graph.builder import current_graph
+from graphsdg.graph.current import current_graph
 
 
 def send_og_event(event_name: str) -> None:

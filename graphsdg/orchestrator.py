@@ -15,14 +15,21 @@ import time
 from fractions import Fraction
 from typing import Any, Callable
 
-from graphsdg import interrupts, profiling, settings
+from graphsdg import settings_store as settings
+from graphsdg.jobs import interrupts
+from graphsdg.benchmark import profiling
+from graphsdg import runtime as runtime_module
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.annotate.semantic_filter import SemanticFilter
+from graphsdg.graph import scheduler
 from graphsdg.io import run_state
+from graphsdg.io.location import open_location
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
-from graphsdg.progress import Progress
+from graphsdg.jobs import frame_plan
+from graphsdg.jobs.progress import Progress
 from graphsdg.render import motion_blur
+from graphsdg.render.attachments import attachments
 from graphsdg.render.camera import CameraView, camera_view
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import stage_context
@@ -100,7 +107,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     wants it running again calls ``timeline.play()``).
     ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
     Ctrl-C (or SIGTERM) during a step takes effect when the frame has been handed
-    to the writers (:mod:`graphsdg.interrupts`).
+    to the writers (:mod:`graphsdg.jobs.interrupts`).
 
     ``wait_for_render=False`` pipelines: the step returns once the frame is drawn
     and its pixels are copying off the GPU; its annotators and writers run at the
@@ -409,11 +416,6 @@ def _stop(status: str) -> None:
     _state.set(Status.STOPPED)
 
 
-def _graph_scheduler():
-    from graphsdg.graph import scheduler
-    return scheduler
-
-
 def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
     """Generate frames until ``num_frames`` were captured or every trigger reached its ``max_execs``.
 
@@ -425,21 +427,20 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
     if num_frames is not None and (isinstance(num_frames, bool) or not isinstance(num_frames, int)
                                    or num_frames < 0):
         raise ValueError(f"num_frames must be None or a non-negative integer, got {num_frames!r}")
-    sched = _graph_scheduler()
     if num_frames is None and settings.get("/graphsdg/run/numFrames") is not None:
         num_frames = int(settings.get("/graphsdg/run/numFrames"))   # graphsdg run --frames N
     if num_frames is None:
-        unlimited = sched.unlimited_triggers()
-        if sched.active_graph() is None or not any(t.counts_toward_completion for t in sched.active_graph().triggers):
+        unlimited = scheduler.unlimited_triggers()
+        graph = scheduler.active_graph()
+        if graph is None or not any(t.counts_toward_completion for t in graph.triggers):
             raise OrchestratorError("run() without num_frames needs a graph whose on_frame/on_time triggers set "
                                     "max_execs; pass num_frames=N")
         if unlimited:
             raise OrchestratorError(f"run() without num_frames would never stop: trigger(s) {unlimited} have no "
                                     f"max_execs; pass num_frames=N or set max_execs")
-    from graphsdg import frame_plan
     _state.plan = frame_plan.current()
     if _state.plan is not None:
-        num_frames = _planned_length(num_frames, sched)
+        num_frames = _planned_length(num_frames)
     if start_timeline:
         runtime().timeline.play()
     _state.remaining = num_frames
@@ -450,7 +451,6 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
 
 
 def _run_loop() -> None:
-    sched = _graph_scheduler()
     progress = Progress(_state.remaining, "run")
 
     def interrupted(signum: int) -> None:   # Ctrl-C / SIGTERM: end after the current frame
@@ -459,7 +459,7 @@ def _run_loop() -> None:
     with interrupts.deferred(on_signal=interrupted) as held:
         try:
             with progress:
-                paused = _frames(sched, progress)
+                paused = _frames(progress)
         except BaseException:
             _state.set(Status.STOPPED)
             raise
@@ -473,10 +473,10 @@ def _run_loop() -> None:
         log.info("run finished: %s", progress.summary())
 
 
-def _frames(sched, progress: Progress) -> bool:
+def _frames(progress: Progress) -> bool:
     """Capture until done, stopped or paused; returns whether it paused."""
     if _state.plan is not None:
-        _planned_frames(sched, progress)
+        _planned_frames(progress)
         return False
     while not _state.stop_requested:
         if _state.pause_requested:
@@ -484,7 +484,7 @@ def _frames(sched, progress: Progress) -> bool:
             return True
         if _state.remaining is not None and _state.remaining <= 0:
             break
-        if _state.remaining is None and sched.all_exhausted():
+        if _state.remaining is None and scheduler.all_exhausted():
             break
         step(pause_timeline=False)
         progress.advance()
@@ -494,11 +494,11 @@ def _frames(sched, progress: Progress) -> bool:
     return False
 
 
-def _planned_length(num_frames: int | None, sched) -> int:
+def _planned_length(num_frames: int | None) -> int:
     """The frame count of a sharded/resumed run: ``num_frames``, or what on_frame ``max_execs`` imply."""
     if num_frames is not None:
         return num_frames
-    graph = sched.active_graph()
+    graph = scheduler.active_graph()
     counted = [t for t in graph.triggers if t.counts_toward_completion] if graph is not None else []
     if not counted or any(not hasattr(t, "interval") or not t.max_execs for t in counted):
         raise OrchestratorError("a sharded or resumed run() needs num_frames (or graphsdg run --frames N) "
@@ -506,9 +506,8 @@ def _planned_length(num_frames: int | None, sched) -> int:
     return max((t.max_execs - 1) * t.interval + 1 for t in counted)
 
 
-def _planned_frames(sched, progress: Progress) -> None:
-    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.frame_plan`)."""
-    from graphsdg import frame_plan
+def _planned_frames(progress: Progress) -> None:
+    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.jobs.frame_plan`)."""
     plan, total = _state.plan, _state.remaining or 0
     writers = list(runtime().writers)
     for writer in writers:
@@ -518,12 +517,11 @@ def _planned_frames(sched, progress: Progress) -> None:
                 f"frame_index it receives (set frame_indexed = True on a writer that does; see docs/cli.md)")
         frame_plan.record_writer(writer)
     _state.frame_bases = {id(w): w.num_written or 0 for w in writers}
-    graph = sched.active_graph()
+    graph = scheduler.active_graph()
     start = graph.frame if graph is not None else 0
     frames = [f for f in range(total) if plan.owns(f)]
     if plan.resume:
         if not plan.sharded:   # shards share folders: the merge step removes their leftovers
-            from graphsdg.io.location import open_location
             get_write_queue().wait_until_done()   # writes already scheduled (a writer's first json) land first
             for writer in writers:
                 if getattr(writer.backend, "output_dir", None):    # temporary files, unfinished uploads
@@ -538,7 +536,7 @@ def _planned_frames(sched, progress: Progress) -> None:
             if _state.stop_requested:
                 break
             if f != following and graph is not None:
-                sched.seek(start + f)     # the frame's random values, as in one uninterrupted run
+                scheduler.seek(start + f)     # the frame's random values, as in one uninterrupted run
             _state.planned_frame = f
             step(pause_timeline=False)
             following = f + 1
@@ -548,7 +546,7 @@ def _planned_frames(sched, progress: Progress) -> None:
     finally:
         _state.planned_frame = None
     if graph is not None and following != total:
-        sched.seek(start + total, restore_state=False)   # where an uninterrupted run would have left it
+        scheduler.seek(start + total, restore_state=False)   # where an uninterrupted run would have left it
 
 
 def run_until_complete(num_frames: int | None = None, start_timeline: bool = False) -> None:
@@ -586,15 +584,14 @@ def preview() -> None:
     The stage shows what the next captured frame will randomize to (the
     scheduler's counters are not advanced) and MuJoCo is synced to it.
     """
-    sched = _graph_scheduler()
-    graph = sched.active_graph()
+    graph = scheduler.active_graph()
     if graph is not None:
-        snap = sched.snapshot(graph)
+        snap = scheduler.snapshot(graph)
         try:
-            sched.run_subgraphs(graph, [t for t in graph.triggers if not getattr(t, "exhausted", lambda: 0)()],
-                                graph.frame)
+            scheduler.run_subgraphs(graph, [t for t in graph.triggers if not getattr(t, "exhausted", lambda: 0)()],
+                                    graph.frame)
         finally:
-            sched.restore(graph, snap)
+            scheduler.restore(graph, snap)
     runtime().sim.sync_dirty_prims()
 
 
@@ -624,15 +621,12 @@ def reset_profile() -> None:
 
 def _flush_at_exit() -> None:
     """At interpreter exit: flush attached writers, finish every queued write, or say loudly what was lost."""
-    from graphsdg import runtime as runtime_module
     queue = current_write_queue()
-    rt = runtime_module._runtime          # never create a runtime (a GL context) just to exit
-    writers = list(rt.writers) if rt is not None else []
+    writers = list(attachments.writers)   # read from the registry: never create a runtime just to exit
     if queue is None and not writers:
         return
     try:
-        if rt is not None:
-            rt.complete_capture()   # a pipelined step's frame
+        attachments.complete_capture()   # a pipelined step's frame
         for writer in writers:
             writer.flush()
         queue = current_write_queue()

@@ -16,17 +16,19 @@ from pxr import Sdf, Usd
 
 from graphsdg.functional import create as FC
 from graphsdg.functional import modify as FM
-from graphsdg.graph.builder import flatten_prims
+from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
-from graphsdg.graph.node import ExecContext, Node, Port, is_random_value
+from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims, is_random_value
 from graphsdg.graph.registry import register_node
-from graphsdg.stage import semantics as semlib
 from graphsdg.stage.context import get_stage
 
 from .modify import POSE_PORTS, apply_pose, sample_port
 
-POSE = {"position": Port("vec3"), "rotation": Port("vec3"), "scale": Port("vec3|float"),
+# ports in the order of the calls' parameters (a node lists its values in this order)
+POSE = {"position": Port("vec3"), "scale": Port("vec3|float"), "rotation": Port("vec3"),
         "look_at": Port("vec3|prim"), "look_at_up_axis": Port("vec3")}
+SHAPE_POSE = {"position": POSE["position"], "scale": POSE["scale"], "pivot": Port("vec3"), "rotation": POSE["rotation"],
+              "look_at": POSE["look_at"], "look_at_up_axis": POSE["look_at_up_axis"]}
 COMMON = {"count": Port(int, 1), "parent": Port("prim")}
 LOOKS = REPLICATOR_ROOT + "/Looks"
 
@@ -48,6 +50,7 @@ class CreateNode(Node):
     """Base of create nodes: ``make(ctx, name, parent)`` makes one prim; setup makes ``count``."""
 
     family = "create"
+    call = Call(name_before="parent")
     outputs = {"prims": Port("prims")}
     default_name = "Prim"
     attribute_ports: dict[str, str] = {}   # port -> USD attribute re-sampled per execution
@@ -98,11 +101,13 @@ def _shape_node(shape: str) -> type[CreateNode]:
     make_fn: Callable[..., Usd.Prim] = getattr(FC, shape)
 
     class Shape(CreateNode):
-        __doc__ = f"``rep.create.{shape}``: unit {shape}s (count copies) with semantics, material, visibility."
+        __doc__ = (f"``count`` unit {shape}s at ``/Replicator/{shape.capitalize()}_Xform/"
+                   f"{shape.capitalize()}``; pose arguments may be distributions; ``as_mesh=True`` "
+                   f"makes each a ``UsdGeom.Mesh`` (Replicator's default; graphsdg's is an implicit prim).")
         type_name = f"create.{shape}"
         default_name = shape.capitalize()
-        inputs = {**POSE, **COMMON, "pivot": Port("vec3"), "semantics": Port(list), "material": Port("material"),
-                  "visible": Port(bool, True), "as_mesh": Port(bool, False)}
+        inputs = {**SHAPE_POSE, "semantics": Port(list), "material": Port("material"), "visible": Port(bool, True),
+                  "as_mesh": Port(bool, False), **COMMON}
 
         def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
             prim = make_fn(name=name, parent=parent, semantics=self.value_of("semantics"),
@@ -123,11 +128,11 @@ SHAPE_NODES = {s: _shape_node(s) for s in SHAPES}
 
 @register_node
 class CreateXform(CreateNode):
-    """``rep.create.xform``: empty transforms."""
+    """``count`` empty Xforms."""
 
     type_name = "create.xform"
     default_name = "Xform"
-    inputs = {**POSE, **COMMON, "semantics": Port(list), "visible": Port(bool, True)}
+    inputs = {**POSE, "semantics": Port(list), "visible": Port(bool, True), **COMMON}
 
     def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
         return FC.xform(name=name, parent=parent, semantics=self.value_of("semantics"),
@@ -140,17 +145,18 @@ LIGHT_TYPES = {"cylinder": FC.cylinder_light, "disk": FC.disk_light, "distant": 
 
 @register_node
 class CreateLight(CreateNode):
-    """``rep.create.light``: any UsdLux light; colour, intensity, exposure, temperature (K), dome texture.
+    """``count`` lights of ``light_type`` (cylinder, disk, distant, dome, rect, sphere; any case).
 
-    ``temperature`` switches on ``enableColorTemperature``; the renderer turns
-    Kelvin into RGB with :func:`graphsdg.sim.lights.kelvin_to_rgb` and multiplies
-    it with ``color``.
+    ``temperature`` is in Kelvin (colour temperature is switched on); ``texture``
+    is a dome light's image. Every argument may be a distribution.
     """
 
+    # the renderer turns Kelvin into RGB with graphsdg.sim.lights.kelvin_to_rgb and multiplies it with color;
+    # temperature's default is the int 6500, as Replicator's (plain values are part of the node's identity)
     type_name = "create.light"
-    inputs = {**POSE, **COMMON, "light_type": Port(str, "Distant"), "color": Port("rgb", (1.0, 1.0, 1.0)),
-              "intensity": Port(float, 1000.0), "exposure": Port(float), "temperature": Port(float, 6500.0),
-              "texture": Port(str)}
+    inputs = {**POSE, "light_type": Port(str, "Distant"), "color": Port("rgb", (1.0, 1.0, 1.0)),
+              "intensity": Port(float, 1000.0), "exposure": Port(float), "temperature": Port(float, 6500),
+              "texture": Port(str), **COMMON}
     attribute_ports = {"color": "inputs:color", "intensity": "inputs:intensity", "exposure": "inputs:exposure",
                        "temperature": "inputs:colorTemperature", "texture": "inputs:texture:file"}
 
@@ -192,14 +198,18 @@ class CreateLight(CreateNode):
 
 @register_node
 class CreateCamera(CreateNode):
-    """``rep.create.camera``: a pinhole camera (focal length and apertures in tenths of a stage unit)."""
+    """``count`` cameras. The near clip defaults to 0.01 (graphsdg stages are in metres; Replicator's 1.0
+    is one centimetre on its default stage). Fisheye parameters are accepted and unused (pinhole only)."""
 
+    # a pinhole camera; focal length and apertures in tenths of a stage unit
     type_name = "create.camera"
     default_name = "Camera"
-    inputs = {**POSE, **COMMON, "focal_length": Port(float, 24.0), "focus_distance": Port(float, 400.0),
-              "f_stop": Port(float, 0.0), "horizontal_aperture": Port(float, 20.955),
-              "horizontal_aperture_offset": Port(float, 0.0), "vertical_aperture_offset": Port(float, 0.0),
-              "clipping_range": Port("vec2", (0.01, 1000000.0)), "projection_type": Port(str, "pinhole")}
+    call = Call(ignored_keywords="fisheye")
+    inputs = {**{k: p for k, p in POSE.items() if k != "scale"}, "focal_length": Port(float, 24.0),
+              "focus_distance": Port(float, 400.0), "f_stop": Port(float, 0.0),
+              "horizontal_aperture": Port(float, 20.955), "horizontal_aperture_offset": Port(float, 0.0),
+              "vertical_aperture_offset": Port(float, 0.0), "clipping_range": Port("vec2", (0.01, 1000000.0)),
+              "projection_type": Port(str, "pinhole"), **COMMON}
     attribute_ports = {"focal_length": "focalLength", "focus_distance": "focusDistance", "f_stop": "fStop",
                        "horizontal_aperture": "horizontalAperture"}
 
@@ -221,10 +231,11 @@ UNRENDERED_INPUTS = ("roughness_texture", "metallic_texture", "emissive_texture"
 
 @register_node
 class CreateMaterialOmniPBR(CreateNode):
-    """``rep.create.material_omnipbr``: ``count`` OmniPBR-style materials under ``/Replicator/Looks``."""
+    """``count`` OmniPBR materials under ``/Replicator/Looks``; distribution inputs re-sampled per material."""
 
     type_name = "create.material_omnipbr"
     default_name = "OmniPBR"
+    call = Call()
     inputs = {"diffuse": Port("rgb"), "diffuse_texture": Port(str), "roughness": Port(float),
               "roughness_texture": Port(str), "metallic": Port(float), "metallic_texture": Port(str),
               "specular": Port(float), "emissive_color": Port("rgb"), "emissive_texture": Port(str),
@@ -250,7 +261,7 @@ class CreateMaterialOmniPBR(CreateNode):
                 inputs["emissive_color"] = (1.0, 1.0, 1.0)
             prim = FC.material(mdl="OmniPBR.mdl", name=self.user_name or "OmniPBR", parent=LOOKS, **inputs)
             if self.value_of("semantics"):
-                semlib.apply(prim, self.value_of("semantics"))
+                FM.semantics(prim, self.value_of("semantics"))
             mats.append(prim)
         self.output_values = {"prims": mats}
 
@@ -267,18 +278,24 @@ class CreateMaterialOmniPBR(CreateNode):
 
 @register_node
 class CreateGroup(Node):
-    """``rep.create.group``: the union of items' prims, so ``with group:`` edits all of them."""
+    """The union of ``items`` (items, prims or paths): ``with group:`` edits each of them."""
 
     type_name = "create.group"
     family = "create"
+    call = Call()
     inputs = {"items": Port(list, required=True), "semantics": Port(list)}
     outputs = {"prims": Port("prims")}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        items = values.get("items")
+        if not isinstance(items, (list, tuple)) or not items:
+            raise ValueError(f"group needs a non-empty list of items, got {items!r}")
+        super().__init__(name=name, **{**values, "items": list(items)})
 
     def setup(self, ctx: ExecContext) -> None:
         prims = flatten_prims(ctx.value("items"), "create.group items")
         if self.value_of("semantics"):
-            for prim in prims:
-                semlib.apply(prim, self.value_of("semantics"))
+            FM.semantics(prims, self.value_of("semantics"))
         self.output_values = {"prims": prims}
 
     def compute(self, ctx: ExecContext) -> dict:
@@ -287,10 +304,10 @@ class CreateGroup(Node):
 
 @register_node
 class CreateFromUsd(CreateNode):
-    """``rep.create.from_usd``: the USD file as a reference, ``count`` times."""
+    """``count`` references to the USD file ``usd``."""
 
     type_name = "create.from_usd"
-    inputs = {**POSE, **COMMON, "usd": Port(str, required=True), "semantics": Port(list)}
+    inputs = {"usd": Port(str, required=True), **POSE, "semantics": Port(list), **COMMON}
 
     @property
     def default_name(self) -> str:  # type: ignore[override]

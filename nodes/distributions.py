@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from graphsdg.graph.builder import ReplicatorItem, iter_refs
-from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.calls import Call
+from graphsdg.graph.node import ExecContext, Node, Port, ReplicatorItem, iter_refs
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
 from graphsdg.rng import stream
@@ -30,6 +30,18 @@ def _numeric(value: Any, what: str) -> np.ndarray:
     return arr
 
 
+def as_list(value: Any) -> Any:
+    """An iterable of values as a list (so tuples and generators are kept); a string, item or scalar as is."""
+    if isinstance(value, (str, ReplicatorItem)) or value is None or not hasattr(value, "__iter__"):
+        return value
+    return list(value)
+
+
+def _listed(values: dict[str, Any], *ports: str) -> dict[str, Any]:
+    """``values`` with the given ports' iterables made lists."""
+    return {k: as_list(v) if k in ports else v for k, v in values.items()}
+
+
 def _num_samples(value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise ValueError(f"num_samples must be a positive integer, got {value!r}")
@@ -40,6 +52,7 @@ class Distribution(Node):
     """Base of distribution nodes: ``draw(gen, n, ctx)`` makes ``n`` samples."""
 
     family = "distribution"
+    call = Call()
     outputs = {"samples": Port("samples")}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
@@ -78,7 +91,7 @@ def _resolved_pair(ctx: ExecContext, a: str, b: str, n: int) -> tuple[np.ndarray
 
 @register_node
 class Uniform(Distribution):
-    """``uniform(lower, upper)``: uniform in [lower, upper), element-wise."""
+    """Uniform in [lower, upper), element-wise for tuples."""
 
     type_name = "distribution.uniform"
     inputs = {"lower": Port("number|tuple", required=True), "upper": Port("number|tuple", required=True),
@@ -98,7 +111,7 @@ class Uniform(Distribution):
 
 @register_node
 class Normal(Distribution):
-    """``normal(mean, std)``: Gaussian, element-wise."""
+    """Gaussian with ``mean`` and standard deviation ``std`` (>= 0), element-wise."""
 
     type_name = "distribution.normal"
     inputs = {"mean": Port("number|tuple", required=True), "std": Port("number|tuple", required=True),
@@ -123,7 +136,7 @@ class Normal(Distribution):
 
 @register_node
 class LogUniform(Distribution):
-    """``log_uniform(lower, upper)``: ``exp(uniform(log lower, log upper))``, element-wise."""
+    """``exp(uniform(log(lower), log(upper)))`` (lower > 0)."""
 
     type_name = "distribution.log_uniform"
     inputs = {"lower": Port("number|tuple", required=True), "upper": Port("number|tuple", required=True),
@@ -160,11 +173,16 @@ def _expand(values: list) -> list:
 
 @register_node
 class Choice(Distribution):
-    """``choice(choices, weights=None, with_replacements=True)``: draws among ``choices``."""
+    """One of ``choices`` per sample, with probabilities ``weights`` (normalised) if given."""
 
     type_name = "distribution.choice"
     inputs = {"choices": Port(list, required=True), "weights": Port(list), "num_samples": Port(int, 1),
               "seed": Port(int, -1), "with_replacements": Port(bool, True)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        if values.get("weights") is not None:
+            values["weights"] = list(values["weights"])
+        super().__init__(name=name, **_listed(values, "choices"))
 
     def validate(self) -> None:
         choices, weights = self.value_of("choices"), self.value_of("weights")
@@ -200,15 +218,16 @@ class Choice(Distribution):
 
 @register_node
 class Sequence(Distribution):
-    """``sequence(items, ordered=True)``: steps through ``items``, one per execution (wrapping).
+    """The next of ``items`` on each execution, wrapping around (a fixed shuffle if ``ordered=False``)."""
 
-    With N targets an execution takes N consecutive items. ``ordered=False`` walks a
-    fixed random permutation; ``stride`` skips items.
-    """
-
+    # with N targets an execution takes N consecutive items; ``stride`` skips items
     type_name = "distribution.sequence"
+    call = Call(name_before="stride")
     inputs = {"items": Port(list, required=True), "ordered": Port(bool, True), "seed": Port(int, -1),
               "stride": Port(int)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **_listed(values, "items"))
 
     def validate(self) -> None:
         items = self.value_of("items")
@@ -236,14 +255,14 @@ class Sequence(Distribution):
 
 @register_node
 class Combine(Distribution):
-    """``combine(distributions)``: one sample is the concatenation of one sample of each part.
+    """Samples that concatenate one sample of each part (distributions or plain values)."""
 
-    Parts may be distributions or plain values: ``combine([uniform(0, 1), 2.0,
-    normal(0, 1)])`` draws vectors ``(u, 2.0, g)``.
-    """
-
+    # combine([uniform(0, 1), 2.0, normal(0, 1)]) draws vectors (u, 2.0, g)
     type_name = "distribution.combine"
     inputs = {"distributions": Port(list, required=True)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **_listed(values, "distributions"))
 
     def validate(self) -> None:
         parts = self.value_of("distributions")

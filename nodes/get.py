@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import logging
 
+from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.stage.prims import resolve_prims
@@ -13,10 +14,15 @@ log = logging.getLogger("graphsdg.graph")
 
 @register_node
 class GetPrims(Node):
-    """Prims matching path patterns, types and semantics; evaluated once unless ``cache_result=False``."""
+    """Prims whose path matches the regex ``path_pattern`` (or glob ``path_match``), of ``prim_types``,
+    labelled with any of ``semantics`` (``[("class", "box")]``), minus the exclusions.
+
+    Evaluated once (``cache_result=True``) or on every trigger execution.
+    """
 
     type_name = "get.prims"
     family = "get"
+    call = Call()
     inputs = {"path_pattern": Port(str), "path_match": Port(str), "path_pattern_exclusion": Port(str),
               "prim_types": Port(list), "prim_types_exclusion": Port(list), "semantics": Port(list),
               "semantics_exclusion": Port(list), "cache_result": Port(bool, True), "ignore_case": Port(bool, True)}
@@ -41,10 +47,11 @@ class GetPrims(Node):
 
 @register_node
 class PrimAtPath(Node):
-    """The prims at the given path(s); an unknown path raises."""
+    """The prim(s) at ``path`` (a path or a list of paths); unknown paths raise."""
 
     type_name = "get.prim_at_path"
     family = "get"
+    call = Call()
     inputs = {"path": Port("str|list", required=True)}
     outputs = {"prims": Port("prims")}
 

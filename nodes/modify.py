@@ -7,6 +7,8 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from graphsdg.functional import modify as F
+from graphsdg.functional.per_prim import per_prim_array
+from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
@@ -16,16 +18,15 @@ TARGET = {"input_prims": Port("prims", required=True)}
 POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
 
 
-def per_prim_rows(value: Any, n: int, width: int = 3) -> Any:
-    """Sampled values as ``(n, width)`` rows (scalars broadcast across the row); plain values unchanged."""
+def pose_rows(value: Any, n: int, what: str, uniform: bool = False) -> Any:
+    """A pose port's value (sampled or plain) as ``(n, 3)`` rows for ``functional.modify.pose``'s ``what``.
+
+    One number per prim fills that prim's row (a scalar distribution samples one
+    number per prim); a single number fills every row only where ``uniform`` (scale).
+    """
     if value is None:
         return None
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim == 1 and arr.shape[0] == n:
-        return np.repeat(arr[:, None], width, axis=1)
-    if arr.ndim == 2 and arr.shape[1] == 1:
-        return np.repeat(arr, width, axis=1)
-    return arr
+    return per_prim_array(value, n, what, uniform=uniform, uniform_per_prim=True)
 
 
 def look_at_points(value: Any, n: int) -> Any:
@@ -59,13 +60,13 @@ def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
     n = len(prims)
     if n == 0:
         return
-    position = per_prim_rows(sample_port(ctx, "position", n), n)
-    rotation = per_prim_rows(sample_port(ctx, "rotation", n), n)
+    position = pose_rows(sample_port(ctx, "position", n), n, "position_value")
+    rotation = pose_rows(sample_port(ctx, "rotation", n), n, "rotation_value")
     position = _with_components(ctx, prims, position, "position", n)
     rotation = _with_components(ctx, prims, rotation, "rotation", n)
-    scale = per_prim_rows(sample_port(ctx, "scale", n), n)
+    scale = pose_rows(sample_port(ctx, "scale", n), n, "scale_value", uniform=True)
     size = sample_port(ctx, "size", n)
-    pivot = per_prim_rows(sample_port(ctx, "pivot", n), n)
+    pivot = pose_rows(sample_port(ctx, "pivot", n), n, "pivot_value")
     look_at = look_at_points(sample_port(ctx, "look_at", n), n)
     up = ctx.value("look_at_up_axis") if ctx.given("look_at_up_axis") else None
     order = ctx.value("rotation_order") if "rotation_order" in ctx.node.inputs else "XYZ"
@@ -78,7 +79,7 @@ def _with_components(ctx: ExecContext, prims: list[Usd.Prim], full: Any, base: s
     ports = [f"{base}_{axis}" for axis in "xyz"]
     if not any(p in ctx.node.inputs and ctx.given(p) for p in ports):
         return full
-    from graphsdg.stage.xform import decompose, matrix_to_euler_xyz
+    from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
     rows = []
     for prim in prims:
         m = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()))
@@ -98,10 +99,11 @@ def any_random(ctx: ExecContext, ports: tuple[str, ...] | list[str]) -> bool:
 
 @register_node
 class Pose(Node):
-    """``modify.pose``: position, rotation (Euler degrees, ``rotation_order``), scale or size, pivot, look_at."""
+    """Set translation, Euler rotation (degrees), scale (or ``size``), pivot, or aim with ``look_at``."""
 
     type_name = "modify.pose"
     family = "modify"
+    call = Call()
     inputs = {**TARGET, "position": Port("vec3"), "position_x": Port(float), "position_y": Port(float),
               "position_z": Port(float), "rotation": Port("vec3"), "rotation_x": Port(float),
               "rotation_y": Port(float), "rotation_z": Port(float), "rotation_order": Port(str, "XYZ"),
@@ -129,10 +131,11 @@ class Pose(Node):
 
 @register_node
 class Attribute(Node):
-    """``modify.attribute``: set a USD attribute (created with ``attribute_type`` if missing)."""
+    """Set USD attribute ``name`` to ``value`` (creating it when ``attribute_type`` is given)."""
 
     type_name = "modify.attribute"
     family = "modify"
+    call = Call(named=False, renamed={"attribute": "name"}, required=("value",))
     inputs = {**TARGET, "attribute": Port(str, required=True), "value": Port(object), "attribute_type": Port(str)}
     outputs = {"prims": Port("prims")}
 
@@ -150,10 +153,11 @@ class Attribute(Node):
 
 @register_node
 class Semantics(Node):
-    """``modify.semantics``: add, replace or clear semantic labels."""
+    """Add, replace or clear semantic labels (``[("class", "box")]`` or ``{"class": "box"}``)."""
 
     type_name = "modify.semantics"
     family = "modify"
+    call = Call(params=("semantics", "input_prims", "mode"), named=False)
     inputs = {**TARGET, "semantics": Port(list), "mode": Port(str, "add")}
     outputs = {"prims": Port("prims")}
 
@@ -171,10 +175,11 @@ class Semantics(Node):
 
 @register_node
 class Visibility(Node):
-    """``modify.visibility``: show or hide; ``value=None`` draws a random bool per prim each execution."""
+    """Show or hide the prims; ``value=None`` picks a random visibility per prim each execution."""
 
     type_name = "modify.visibility"
     family = "modify"
+    call = Call()
     inputs = {**TARGET, "value": Port(bool)}
     outputs = {"prims": Port("prims")}
 
@@ -193,10 +198,12 @@ class Visibility(Node):
 
 @register_node
 class Material(Node):
-    """``modify.material``: bind a material (item, prim or path; a distribution picks one per prim)."""
+    """Bind material ``value`` (an item, prim or path)."""
 
+    # a distribution of materials picks one per prim each execution
     type_name = "modify.material"
     family = "modify"
+    call = Call()
     inputs = {**TARGET, "value": Port("material", required=True)}
     outputs = {"prims": Port("prims")}
 

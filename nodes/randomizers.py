@@ -10,26 +10,29 @@ from pxr import Sdf, Usd
 from graphsdg.functional import create as FC
 from graphsdg.functional import modify as FM
 from graphsdg.functional import randomizer as FR
-from graphsdg.graph.builder import flatten_prims
+from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
-from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
-from graphsdg.stage import semantics as semlib
 
 from .modify import TARGET, sample_port
 
 
 class Randomizer(Node):
+    """Base of randomizer nodes: each is the call ``rep.randomizer.<name>``."""
+
     family = "randomizer"
+    call = Call()
     outputs = {"prims": Port("prims")}
 
 
 @register_node
 class Color(Randomizer):
-    """``randomizer.color``: a material per prim with a diffuse colour from ``colors`` (one per prim)."""
+    """Give each prim its own material with a diffuse colour from ``colors`` (usually a distribution)."""
 
     type_name = "randomizer.color"
+    call = Call(named=False)
     inputs = {**TARGET, "colors": Port("rgb", required=True), "per_sub_mesh": Port(bool, False),
               "seed": Port(int)}
 
@@ -49,7 +52,7 @@ def _material_prims(value: Any, what: str) -> list[Usd.Prim]:
 
 @register_node
 class Materials(Randomizer):
-    """``randomizer.materials``: bind each prim a material drawn from ``materials``."""
+    """Bind each prim a material drawn from ``materials`` (a material_omnipbr item, prims or paths)."""
 
     type_name = "randomizer.materials"
     inputs = {**TARGET, "materials": Port("materials", required=True), "seed": Port(int),
@@ -64,9 +67,10 @@ class Materials(Randomizer):
 
 @register_node
 class Texture(Randomizer):
-    """``randomizer.texture``: a textured material per prim, file drawn from ``textures``; UV scale/rotation."""
+    """Give each prim a material textured with a file drawn from ``textures``; UV scale and rotation (degrees)."""
 
     type_name = "randomizer.texture"
+    call = Call(named=False)
     inputs = {**TARGET, "textures": Port(list, required=True), "texture_scale": Port("vec2"),
               "texture_rotate": Port(float), "per_sub_mesh": Port(bool, False), "project_uvw": Port(bool, False),
               "seed": Port(int)}
@@ -92,9 +96,10 @@ class Texture(Randomizer):
 
 @register_node
 class Rotation(Randomizer):
-    """``randomizer.rotation``: rotations uniform on SO(3) (within XYZ Euler limits)."""
+    """Rotate each prim uniformly on SO(3) (within XYZ Euler limits in degrees)."""
 
     type_name = "randomizer.rotation"
+    call = Call(named=False)
     inputs = {**TARGET, "min_angle": Port("vec3", (-180.0, -180.0, -180.0)),
               "max_angle": Port("vec3", (180.0, 180.0, 180.0)), "seed": Port(int)}
 
@@ -103,6 +108,9 @@ class Rotation(Randomizer):
         angles = FR.rotation(prims, ctx.value("min_angle"), ctx.value("max_angle"), rng=ctx.rng)
         ctx.record("rotation", angles)
         return {"prims": prims}
+
+
+UNBOUNDED = (None, None, None)   # a sampling corner that limits no axis (Replicator's min_samp / max_samp)
 
 
 def _functional_scatter(name: str):
@@ -119,12 +127,12 @@ def _opt_prims(ctx: ExecContext, port: str) -> list[Usd.Prim] | None:
 
 @register_node
 class Scatter2D(Randomizer):
-    """``randomizer.scatter_2d``: place prims on surface meshes (``functional.randomizer.scatter_2d``)."""
+    """Place the prims on ``surface_prims`` (``graphsdg.functional.randomizer.scatter_2d``)."""
 
     type_name = "randomizer.scatter_2d"
     inputs = {**TARGET, "surface_prims": Port("prims", required=True), "no_coll_prims": Port("prims"),
-              "min_samp": Port("vec3"), "max_samp": Port("vec3"), "seed": Port(int), "offset": Port(float, 0.0),
-              "check_for_collisions": Port(bool, False)}
+              "min_samp": Port("vec3", UNBOUNDED), "max_samp": Port("vec3", UNBOUNDED), "seed": Port(int),
+              "offset": Port(float, 0), "check_for_collisions": Port(bool, False)}
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
@@ -141,11 +149,12 @@ class Scatter2D(Randomizer):
 
 @register_node
 class Scatter3D(Randomizer):
-    """``randomizer.scatter_3d``: place prims inside volume meshes (``functional.randomizer.scatter_3d``)."""
+    """Place the prims inside ``volume_prims`` (``graphsdg.functional.randomizer.scatter_3d``)."""
 
     type_name = "randomizer.scatter_3d"
     inputs = {**TARGET, "volume_prims": Port("prims"), "no_coll_prims": Port("prims"),
-              "volume_excl_prims": Port("prims"), "min_samp": Port("vec3"), "max_samp": Port("vec3"),
+              "volume_excl_prims": Port("prims"), "min_samp": Port("vec3", UNBOUNDED),
+              "max_samp": Port("vec3", UNBOUNDED),
               "resolution_scaling": Port(float, 1.0), "voxel_size": Port(float, 0.0),
               "check_for_collisions": Port(bool, False), "prevent_vol_overlap": Port(bool, True),
               "viz_sampled_voxels": Port(bool, False), "seed": Port(int)}
@@ -182,14 +191,17 @@ def _translation(prim: Usd.Prim) -> list[float]:
 
 @register_node
 class Instantiate(Randomizer):
-    """``randomizer.instantiate``: ``size`` instances, each referencing an asset drawn from ``paths``."""
+    """``size`` instances under ``/Replicator``, each referencing a USD file drawn from ``paths``."""
 
     type_name = "randomizer.instantiate"
+    call = Call(name_before="use_cache")
     inputs = {"paths": Port(list, required=True), "size": Port(int, required=True), "weights": Port(list),
               "mode": Port(str, "scene_instance"), "with_replacements": Port(bool, True), "seed": Port(int),
               "use_cache": Port(bool, True), "semantics": Port(list)}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
+        if "paths" in values and not isinstance(values["paths"], str):
+            values["paths"] = list(values["paths"])
         super().__init__(name=name, **values)
         paths, size = self.value_of("paths"), self.value_of("size")
         if isinstance(paths, str) or not paths:
@@ -225,7 +237,6 @@ class Instantiate(Randomizer):
         chosen = [paths[int(i)] for i in idx]
         FM.reference(slots, chosen)
         if self.value_of("semantics"):
-            for prim in slots:
-                semlib.apply(prim, self.value_of("semantics"))
+            FM.semantics(slots, self.value_of("semantics"))
         ctx.record("paths", chosen)
         return {"prims": slots}

@@ -8,7 +8,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
+from graphsdg.graph.calls import Call
 from graphsdg.graph.node import Port, TriggerNode
 from graphsdg.graph.registry import register_node
 
@@ -21,9 +22,12 @@ def _positive_int(value: Any, what: str, minimum: int = 1) -> int:
 
 @register_node
 class OnFrame(TriggerNode):
-    """Fires on the trigger's frames 0, interval, 2*interval, ... until ``max_execs`` fires."""
+    """Fire on every ``interval``-th step (frames 0, interval, 2*interval, ...), at most ``max_execs`` times
+    (0: no limit; ``num_frames`` is its deprecated name)."""
 
     type_name = "trigger.on_frame"
+    call = Call(params=("interval", "num_frames", "name", "rt_subframes", "max_execs"), name_default="on_frame",
+                deprecated={"num_frames": "max_execs"})
     inputs = {"interval": Port(int, 1), "max_execs": Port(int, 0), "rt_subframes": Port(int, 1)}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
@@ -55,10 +59,12 @@ class OnFrame(TriggerNode):
 
 @register_node
 class OnTime(TriggerNode):
-    """Fires at simulated time 0, then every ``interval`` seconds of simulated time."""
+    """Fire at simulated time 0 and then every ``interval`` seconds of simulated time."""
 
     type_name = "trigger.on_time"
-    inputs = {"interval": Port(float, 1.0), "max_execs": Port(int, 0), "rt_subframes": Port(int, 32),
+    call = Call(params=("interval", "num", "name", "rt_subframes", "enable_capture_on_play", "reset_physics",
+                        "max_execs"), name_default="on_time", deprecated={"num": "max_execs"})
+    inputs = {"interval": Port(float, 1), "max_execs": Port(int, 0), "rt_subframes": Port(int, 32),
               "enable_capture_on_play": Port(bool, True), "reset_physics": Port(bool, True)}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
@@ -85,9 +91,13 @@ class OnTime(TriggerNode):
 
 @register_node
 class OnCustomEvent(TriggerNode):
-    """Fires on the step after ``rep.utils.send_og_event(event_name)``."""
+    """Fire on the step after ``rep.utils.send_og_event(event_name)``.
+
+    The trigger is named after the event (its key in ``trigger_outputs``).
+    """
 
     type_name = "trigger.on_custom_event"
+    call = Call(named=False, name_from="event_name")
     inputs = {"event_name": Port(str, required=True)}
     counts_toward_completion = False
 

@@ -45,7 +45,7 @@ class CommandFailed(Exception):
 
 def cli(*args: str) -> None:
     """Run ``graphsdg *args`` in-process; raise :class:`CommandFailed` unless it exits 0."""
-    from graphsdg.cli import main
+    from graphsdg.jobs.cli import main
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
         try:
@@ -428,7 +428,7 @@ def render_markdown(cases: list[Case] = CASES) -> str:
         "rows give the exit status and the error line (a `hint:` line follows it). graphsdg's own exception",
         "types live in `graphsdg.errors` (`PrimNotFoundError` is a `ValueError`, `InvalidPrimError` a `TypeError`,",
         "`UnknownNameError` a `KeyError` and a `ValueError`, `WriterError` a `RuntimeError`); `CompileError`",
-        "(`graphsdg.sim.compiler`), `GraphBuildError` (`graphsdg.graph`), `SemanticFilterError`",
+        "(`graphsdg.sim.compile_error`), `GraphBuildError` (`graphsdg.graph`), `SemanticFilterError`",
         "(`graphsdg.annotate.semantic_filter`), `ApproximationError` (`graphsdg.sim.colliders`) and",
         "`OrchestratorError` (`graphsdg.orchestrator`) are `ValueError`s or `RuntimeError`s too, so",
         "`except ValueError` catches the mistakes a script can correct.",

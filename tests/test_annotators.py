@@ -10,7 +10,7 @@ from graphsdg.errors import RenderProductDestroyedError, UnknownNameError
 from graphsdg.nodes.annotators import BBOX_2D_DTYPE, BBOX_3D_DTYPE, OCCLUSION_DTYPE
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
-from graphsdg.stage.xform import euler_to_matrix
+from graphsdg.maths.rotations import euler_to_matrix
 
 from conftest import cube_corners
 

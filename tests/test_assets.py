@@ -15,7 +15,7 @@ from graphsdg import settings
 from graphsdg.assets import (ASSETS_ROOT_ENV, ASSETS_ROOT_SETTING, builtin_pack_root, get_assets_root_path,
                              get_assets_root_path_async)
 from graphsdg.assets import catalog, geometry
-from graphsdg.sim import environment_map
+from graphsdg.imaging import environment_map
 from graphsdg.stage import materials as matlib
 
 ROOT = builtin_pack_root()

@@ -5,8 +5,8 @@ import math
 
 import pytest
 
-from graphsdg.benchmark import _steady_rate
-from graphsdg.cpu_share import cores_per_process, limit_image_threads
+from graphsdg.benchmark.throughput import _steady_rate
+from graphsdg.jobs.cpu_share import cores_per_process, limit_image_threads
 from graphsdg.io.write_queue import threads_per_process
 
 
@@ -62,7 +62,7 @@ def test_image_threads_set_opencvs_pool():
 
 
 def test_every_bench_option_is_described_in_its_help():
-    from graphsdg.cli import build_parser
+    from graphsdg.jobs.cli import build_parser
     commands = next(a for a in build_parser()._actions if isinstance(a, __import__("argparse")._SubParsersAction))
     bench = commands.choices["bench"]
     options = [a for a in bench._actions if a.option_strings and a.dest != "help"]
@@ -75,7 +75,7 @@ def test_every_bench_option_is_described_in_its_help():
 @pytest.mark.parametrize("bad", [["--asset-count", "0"], ["--num-frames", "-1"], ["--msaa", "-2"],
                                  ["--rt-subframes", "0"], ["--seconds", "0"], ["--backend", "rtx"]])
 def test_bench_refuses_bad_values_naming_them(bad, capsys):
-    from graphsdg.cli import build_parser
+    from graphsdg.jobs.cli import build_parser
     with pytest.raises(SystemExit):
         build_parser().parse_args(["bench", *bad])
     assert bad[1] in capsys.readouterr().err
@@ -89,7 +89,7 @@ def test_bench_refuses_bad_values_naming_them(bad, capsys):
     (5, 1.0, [1.0] * 10, 5),                 # ... unless fewer were asked for
 ])
 def test_timed_frames_fit_the_time_budget(frames, seconds, warmup_times, expected):
-    from graphsdg.benchmark import BenchConfig, timed_frames
+    from graphsdg.benchmark.throughput import BenchConfig, timed_frames
     assert timed_frames(BenchConfig(frames=frames, seconds=seconds), warmup_times) == expected
 
 

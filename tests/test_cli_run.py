@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from graphsdg.cli import main
+from graphsdg.jobs.cli import main
 
 SCRIPT = '''
 import sys

@@ -14,12 +14,12 @@ import pytest
 from PIL import Image
 
 import graphsdg as rep
-from graphsdg.cli import main
+from graphsdg.jobs.cli import main
 from graphsdg.dataset.formats import read_dataset
 from graphsdg.dataset.merge import merge_coco_documents, merge_shards
 from graphsdg.dataset.view import class_colour, write_view
-from graphsdg.frame_plan import FramePlan
-from graphsdg.job import JobSpec, run_job
+from graphsdg.jobs.frame_plan import FramePlan
+from graphsdg.jobs.job import JobSpec, run_job
 
 # A graph script with two writers (BasicWriter and COCO), two triggers (one every 3 frames) and
 # objects that leave the view now and then, so frames differ in classes and box counts.
@@ -128,7 +128,7 @@ def test_view_draws_boxes_of_every_format(kind, params, tmp_path):
 # ---- sharding on Ray -----------------------------------------------------------------
 def test_two_ray_workers_write_the_single_process_dataset(job_script, tmp_path):
     ray = pytest.importorskip("ray")
-    from graphsdg.scaleout import run_sharded
+    from graphsdg.jobs.scaleout import run_sharded
     single = JobSpec(job_script, seed=5, out=str(tmp_path / "single"), frames=7)
     run_job(single)
     rep.orchestrator.wait_until_complete()
@@ -186,7 +186,7 @@ def test_resume_after_sigkill_writes_the_uninterrupted_dataset(job_script, tmp_p
     run_job(JobSpec(job_script, seed=9, out=str(tmp_path / "full"), frames=frames))
     rep.orchestrator.wait_until_complete()
     cut = tmp_path / "cut"
-    cmd = [sys.executable, "-m", "graphsdg.cli", "run", job_script, "--seed", "9", "--frames", str(frames),
+    cmd = [sys.executable, "-m", "graphsdg.jobs.cli", "run", job_script, "--seed", "9", "--frames", str(frames),
            "--out", str(cut)]
     proc = subprocess.Popen(cmd, cwd=str(tmp_path), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + 120

@@ -15,7 +15,7 @@ from PIL import Image
 import pytest
 
 import graphsdg as rep
-from graphsdg.cli import main
+from graphsdg.jobs.cli import main
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError, CompatImportError
 

@@ -13,8 +13,8 @@ import graphsdg as rep
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError
 from graphsdg.runtime import runtime
-from graphsdg.sim.bodies import RigidBodyView
-from graphsdg.sim.compiler import CompileError
+from graphsdg.physics.bodies import RigidBodyView
+from graphsdg.sim.compile_error import CompileError
 
 
 @pytest.fixture

@@ -19,7 +19,7 @@ import numpy as np
 from PIL import Image
 
 import graphsdg as rep
-from graphsdg.cli import main
+from graphsdg.jobs.cli import main
 from graphsdg.sim import bounds
 
 from conftest import cube_corners, project_box
@@ -189,7 +189,7 @@ def test_workflow_01_boxes_settle_between_captures(tmp_path, monkeypatch, capsys
         assert mask(seg, labels, "pallet").sum() > 0 and mask(seg, labels, "cardbox").sum() > 0
     assert any("distractor" in classes(d / f"semantic_segmentation_labels_{i:04d}.json") for i in range(5))
     # the dropped boxes came to rest: none fell through the floor or the pallet, and some lie on the pallet
-    from graphsdg.sim.bodies import RigidBodyView
+    from graphsdg.physics.bodies import RigidBodyView
     boxes = [f"/SDG/Assets/Box_{i}" for i in range(10)]
     linear, _ = RigidBodyView(boxes).get_velocities()
     assert np.linalg.norm(linear, axis=1).max() < 0.5

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from graphsdg.cli import main, run_demo
+from graphsdg.jobs.cli import main, run_demo
 from graphsdg.dataset.validate import validate
 from graphsdg.dataset.view import write_view
 

@@ -9,7 +9,7 @@ import sys
 import pytest
 
 import graphsdg as rep
-from graphsdg.cli import run_demo
+from graphsdg.jobs.cli import run_demo
 from graphsdg.io.write_queue import reset_write_queue
 
 FRAMES, RESOLUTION, SEED = 3, (64, 48), 7
@@ -35,7 +35,7 @@ def test_demo_three_runs_give_identical_files(tmp_path):
     """Twice in this process, once in a fresh interpreter with another hash salt."""
     first = demo(str(tmp_path / "run1"))
     second = demo(str(tmp_path / "run2"))
-    code = ("import sys; from graphsdg.cli import run_demo; "
+    code = ("import sys; from graphsdg.jobs.cli import run_demo; "
             f"run_demo(sys.argv[1], {FRAMES}, {RESOLUTION}, {SEED})")
     env = dict(os.environ, PYTHONHASHSEED="12345")
     subprocess.run([sys.executable, "-c", code, str(tmp_path / "run3")], check=True, env=env, cwd=str(tmp_path),

@@ -5,39 +5,39 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
+from graphsdg.maths import rotations
 from graphsdg.runtime import runtime
 from graphsdg.sim import direct_writes, mesh_scaling
-from graphsdg.stage import xform
 
 
 def test_euler_quaternions_match_the_matrix_route():
     angles = np.random.default_rng(1).uniform(-720, 720, (300, 3))
     angles[:5] = [[0, 0, 0], [180, 0, 0], [0, 180, 0], [0, 0, 180], [90, 90, 90]]
-    quats = direct_writes.euler_xyz_to_quats(angles)
-    ref = direct_writes.matrices_to_quats(direct_writes.euler_xyz_to_matrices(angles))
+    quats = rotations.euler_xyz_to_quat(angles)
+    ref = rotations.matrix_to_quat_wxyz(rotations.euler_to_matrix(angles))
     assert np.all(quats[:, 0] >= 0) and np.allclose(np.linalg.norm(quats, axis=1), 1.0)
     for q, r, a in zip(quats, ref, angles):
         # the same rotation: q and r agree, or are opposite where w = 0 leaves the sign open
         assert np.allclose(q, r, atol=1e-12) or np.allclose(q, -r, atol=1e-12), a
-        assert np.allclose(xform.quat_wxyz_to_matrix(q), xform.euler_to_matrix(a, "XYZ"), atol=1e-12)
+        assert np.allclose(rotations.quat_wxyz_to_matrix(q), rotations.euler_to_matrix(a, "XYZ"), atol=1e-12)
 
 
 def test_quaternion_products_compose_rotations():
     rng = np.random.default_rng(2)
-    a = direct_writes.euler_xyz_to_quats(rng.uniform(0, 360, (20, 3)))
-    b = direct_writes.euler_xyz_to_quats(rng.uniform(0, 360, (20, 3)))
-    for p, qa, qb in zip(direct_writes.quat_products(a, b), a, b):
-        want = xform.quat_wxyz_to_matrix(qa) @ xform.quat_wxyz_to_matrix(qb)
-        assert np.allclose(xform.quat_wxyz_to_matrix(p), want, atol=1e-12)
+    a = rotations.euler_xyz_to_quat(rng.uniform(0, 360, (20, 3)))
+    b = rotations.euler_xyz_to_quat(rng.uniform(0, 360, (20, 3)))
+    for p, qa, qb in zip(rotations.quat_multiply(a, b), a, b):
+        want = rotations.quat_wxyz_to_matrix(qa) @ rotations.quat_wxyz_to_matrix(qb)
+        assert np.allclose(rotations.quat_wxyz_to_matrix(p), want, atol=1e-12)
 
 
 def test_decompose_keeps_rotation_scale_and_mirror():
-    r = xform.euler_to_matrix((30, -50, 110), "XYZ")
+    r = rotations.euler_to_matrix((30, -50, 110), "XYZ")
     for s in ([1, 1, 1], [0.5, 2, 3], [-1, 2, 2]):
         m = np.eye(4)
         m[:3, :3] = (r * np.array(s)).T       # row-vector convention: rows are the scaled axes
         m[3, :3] = (1, 2, 3)
-        t, rot, scale = xform.decompose(m)
+        t, rot, scale = rotations.decompose(m)
         assert np.allclose(t, (1, 2, 3))
         assert np.allclose(np.abs(scale), np.abs(s)) and np.isclose(np.prod(scale), np.prod(s))
         assert np.allclose(rot @ rot.T, np.eye(3), atol=1e-12) and np.isclose(np.linalg.det(rot), 1.0)
@@ -47,7 +47,7 @@ def test_decompose_keeps_rotation_scale_and_mirror():
 def test_decompose_drops_shear():
     m = np.eye(4)
     m[1, 0] = 0.3                             # y axis leans towards x
-    _, rot, _ = xform.decompose(m)
+    _, rot, _ = rotations.decompose(m)
     assert np.allclose(rot @ rot.T, np.eye(3), atol=1e-12) and np.isclose(np.linalg.det(rot), 1.0)
 
 

@@ -398,13 +398,12 @@ def test_write_to_fabric_matches_usd_authoring():
 
 def test_vectorized_quaternions_match_mujoco():
     import mujoco
-    from graphsdg.sim.direct_writes import euler_xyz_to_matrices, matrices_to_quats
-    from graphsdg.stage.xform import euler_to_matrix
+    from graphsdg.maths.rotations import euler_to_matrix, matrix_to_quat_wxyz
     angles = np.random.default_rng(0).uniform(-360, 360, (200, 3))
     angles[:4] = [[0, 0, 0], [180, 0, 0], [0, 180, 0], [0, 0, 180]]
-    mats = euler_xyz_to_matrices(angles)
+    mats = euler_to_matrix(angles)
     assert np.allclose(mats, [euler_to_matrix(a, "XYZ") for a in angles], atol=1e-12)
-    quats = matrices_to_quats(mats)
+    quats = matrix_to_quat_wxyz(mats)
     for m, q in zip(mats, quats):
         ref = np.empty(4)
         mujoco.mju_mat2Quat(ref, m.ravel())
@@ -412,7 +411,7 @@ def test_vectorized_quaternions_match_mujoco():
 
 
 def test_euler_convention_matches_usd_rotate_xyz():
-    from graphsdg.stage.xform import euler_to_matrix, matrix_to_euler_xyz
+    from graphsdg.maths.rotations import euler_to_matrix, matrix_to_euler_xyz
     cube = rep.functional.create.cube(rotation=(30, -50, 110))
     usd = np.array(UsdGeom.Xformable(cube).GetLocalTransformation())[:3, :3].T   # row-vector -> column
     assert np.allclose(usd, euler_to_matrix((30, -50, 110), "XYZ"), atol=1e-9)

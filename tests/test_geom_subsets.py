@@ -15,7 +15,8 @@ import graphsdg as rep
 from graphsdg import settings
 from graphsdg.compat import isaac
 from graphsdg.sim import geom_subsets
-from graphsdg.sim.compiler import HIDDEN_GROUP, compile_stage
+from graphsdg.sim.compiler import compile_stage
+from graphsdg.sim.visual import HIDDEN_GROUP
 from graphsdg.stage import get_stage
 from graphsdg.stage.shape_meshes import shape_mesh
 

@@ -200,7 +200,7 @@ def test_randomizer_materials_and_texture(tmp_path):
 
 
 def test_randomizer_rotation_is_uniform_on_so3():
-    from graphsdg.stage.xform import euler_to_matrix, quat_wxyz_to_matrix
+    from graphsdg.maths.rotations import euler_to_matrix, quat_wxyz_to_matrix
     n = 20000
     q = rep.functional.randomizer.uniform_quaternions(np.random.default_rng(1), n)
     z = np.array([quat_wxyz_to_matrix(v)[:, 2] for v in q])

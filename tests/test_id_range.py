@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg import benchmark
+from graphsdg.benchmark import throughput
 from graphsdg.render import rasterizer, readback
 
 SAMPLES = 4
@@ -142,9 +142,9 @@ def test_annotators_label_every_code_of_the_read_width(monkeypatch, count, size)
 
 def test_a_crowded_scene_reads_two_byte_codes_and_labels_only_its_objects():
     """1,000 assets of the bench scene at 64 px: every id in range, every box made of its own pixels."""
-    config = benchmark.BenchConfig(asset_count=200, resolution=(64, 64))
-    assets, _, rps = benchmark.build_scene(config)
-    benchmark._apply(benchmark.Randomization(config).draw(), assets, [])
+    config = throughput.BenchConfig(asset_count=200, resolution=(64, 64))
+    assets, _, rps = throughput.build_scene(config)
+    throughput._apply(throughput.Randomization(config).draw(), assets, [])
     anns = {n: rep.annotators.get(n) for n in ("instance_segmentation", "bounding_box_2d_tight")}
     for a in anns.values():
         a.attach(rps)
@@ -167,7 +167,7 @@ def test_a_crowded_scene_reads_two_byte_codes_and_labels_only_its_objects():
 
 def test_the_bench_loop_runs_crowded_scenes():
     """The hand-written loop at 300 assets (two-byte codes) reads its ids single-sample and finishes."""
-    config = benchmark.BenchConfig(frames=1, warmup=0, asset_count=60, resolution=(64, 64),
+    config = throughput.BenchConfig(frames=1, warmup=0, asset_count=60, resolution=(64, 64),
                                    annotators=("semantic_segmentation", "bounding_box_2d_tight"), skip_write=True)
-    result = benchmark.run_handwritten(config)
+    result = throughput.run_handwritten(config)
     assert result.frames == 1 and "baseline:boxes" in result.profile

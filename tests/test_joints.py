@@ -15,10 +15,10 @@ from pxr import Gf, Sdf, UsdGeom, UsdPhysics
 
 import graphsdg as rep
 from graphsdg.runtime import runtime
-from graphsdg.sim import queries
-from graphsdg.sim.articulations import ArticulationView, fixed_joint_enabled, set_fixed_joint_enabled
-from graphsdg.sim.bodies import RigidBodyView
-from graphsdg.sim.compiler import CompileError
+from graphsdg.physics import queries
+from graphsdg.physics.articulations import ArticulationView, fixed_joint_enabled, set_fixed_joint_enabled
+from graphsdg.physics.bodies import RigidBodyView
+from graphsdg.sim.compile_error import CompileError
 
 G = 9.81
 
@@ -269,7 +269,7 @@ def test_min_friction_combine_mode_makes_a_slippery_surface_win():
     assert v == pytest.approx(1.0 - 0.02 * G * 1.0, abs=0.02)
 
 
-@pytest.mark.parametrize("name", ["graphsdg.sim.joints", "graphsdg.sim.articulations", "graphsdg.scenarios.ur10",
+@pytest.mark.parametrize("name", ["graphsdg.sim.joints", "graphsdg.physics.articulations", "graphsdg.scenarios.ur10",
                                   "graphsdg.scenarios.palletizing"])
 def test_docstring_examples(name):
     import doctest

@@ -28,8 +28,8 @@ from graphsdg.runtime import runtime
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
 from graphsdg.scenarios.palletizing import BinStacking
-from graphsdg.sim.articulations import ArticulationView
-from graphsdg.sim.bodies import RigidBodyView
+from graphsdg.physics.articulations import ArticulationView
+from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.sim.bounds import create_bbox_cache
 from graphsdg.sim.timeline import TimelineEventType
 
@@ -68,7 +68,7 @@ def test_arm_kinematics_match_the_simulated_articulation():
     pos, quat = RigidBodyView([f"{cell.ROBOT}/{n}" for n in ur10.LINK_NAMES]).get_world_poses()
     for f, p, qu in zip(frames, pos, quat):
         assert p == pytest.approx(f.pos, abs=2e-6)
-        from graphsdg.stage.xform import quat_wxyz_to_matrix
+        from graphsdg.maths.rotations import quat_wxyz_to_matrix
         assert quat_wxyz_to_matrix(qu) == pytest.approx(f.rot, abs=2e-6)
     # the suction cup's face is the kinematics' tool centre point
     c = runtime().sim.compiled

@@ -11,9 +11,9 @@ import graphsdg as rep
 from graphsdg.render import pbr_scene as ps
 from graphsdg.render.camera import CameraView
 from graphsdg.runtime import runtime
-from graphsdg.sim import environment_map
+from graphsdg.imaging import environment_map
 from graphsdg.sim.lights import REFERENCE_IRRADIANCE
-from graphsdg.stage.xform import quat_wxyz_to_matrix
+from graphsdg.maths.rotations import quat_wxyz_to_matrix
 
 
 def _rotation(seed: int) -> np.ndarray:

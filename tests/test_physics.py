@@ -11,10 +11,12 @@ from pxr import Gf, UsdGeom, UsdPhysics
 
 import graphsdg as rep
 from graphsdg.runtime import runtime
-from graphsdg.sim import bounds, queries, transforms
-from graphsdg.sim.bodies import RigidBodyView
+from graphsdg.physics import queries
+from graphsdg.sim import bounds, transforms
+from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.sim.colliders import ApproximationError
-from graphsdg.sim.compiler import COLLISION_ONLY_GROUP, CompileError
+from graphsdg.sim.compile_error import CompileError
+from graphsdg.sim.visual import COLLISION_ONLY_GROUP
 from graphsdg.sim.timeline import TimelineEventType
 
 G = 9.81

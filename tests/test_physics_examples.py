@@ -14,8 +14,9 @@ from PIL import Image
 
 import graphsdg as rep
 from graphsdg.runtime import runtime
-from graphsdg.sim import bounds, queries
-from graphsdg.sim.bodies import RigidBodyView
+from graphsdg.physics import queries
+from graphsdg.sim import bounds
+from graphsdg.physics.bodies import RigidBodyView
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from pxr import Usd, UsdGeom
 
 import graphsdg as rep
+from graphsdg.maths import rotations
 from graphsdg.render.camera import camera_view
 from graphsdg.runtime import runtime
 from graphsdg.sim import direct_writes
@@ -136,20 +137,20 @@ def _same_quat(a, b, atol=1e-7):
 
 
 @FAST
-@given(angles, st.sampled_from(xform.ROTATION_ORDERS))
+@given(angles, st.sampled_from(rotations.ROTATION_ORDERS))
 def test_euler_matrices_are_rotations_and_xyz_round_trips(a, order):
-    r = xform.euler_to_matrix(a, order)
+    r = rotations.euler_to_matrix(a, order)
     assert _rotation_ok(r)
-    xyz = xform.euler_to_matrix(a, "XYZ")
-    assert np.allclose(xform.euler_to_matrix(xform.matrix_to_euler_xyz(xyz), "XYZ"), xyz, atol=1e-9)
+    xyz = rotations.euler_to_matrix(a, "XYZ")
+    assert np.allclose(rotations.euler_to_matrix(rotations.matrix_to_euler_xyz(xyz), "XYZ"), xyz, atol=1e-9)
 
 
 @FAST
 @given(quaternions())
 def test_quaternion_matrix_round_trip(q):
-    r = xform.quat_wxyz_to_matrix(q)
+    r = rotations.quat_wxyz_to_matrix(q)
     assert _rotation_ok(r)
-    back = xform.matrix_to_quat_wxyz(r)
+    back = rotations.matrix_to_quat_wxyz(r)
     assert back[0] >= 0 and _same_quat(back, q)
     mj = np.empty(4)
     mujoco.mju_mat2Quat(mj, r.ravel())
@@ -160,34 +161,34 @@ def test_quaternion_matrix_round_trip(q):
 @given(st.lists(angles, min_size=1, max_size=6))
 def test_vectorised_direct_write_rotations_match_the_stage_code(batch):
     a = np.array(batch)
-    mats = direct_writes.euler_xyz_to_matrices(a)
+    mats = rotations.euler_to_matrix(a)
     for ai, m in zip(a, mats):
-        assert np.allclose(m, xform.euler_to_matrix(ai, "XYZ"), atol=1e-12)
-    quats = direct_writes.matrices_to_quats(mats)
+        assert np.allclose(m, rotations.euler_to_matrix(ai, "XYZ"), atol=1e-12)
+    quats = rotations.matrix_to_quat_wxyz(mats)
     assert np.all(quats[:, 0] >= 0) and np.allclose(np.linalg.norm(quats, axis=1), 1)
     for q, m in zip(quats, mats):
-        assert _same_quat(q, xform.matrix_to_quat_wxyz(m))
+        assert _same_quat(q, rotations.matrix_to_quat_wxyz(m))
 
 
 @FAST
 @given(st.lists(quaternions(), min_size=1, max_size=5))
 def test_vectorised_quaternions_near_half_turns(qs):
     """Rotations close to 180 degrees (trace near -1) are where Shepperd's branches matter."""
-    mats = np.array([xform.quat_wxyz_to_matrix(q) for q in qs] +
-                    [xform.quat_wxyz_to_matrix((1e-9, q[1], q[2], q[3])) for q in qs if np.linalg.norm(q[1:]) > 1e-3])
-    for q, m in zip(direct_writes.matrices_to_quats(mats), mats):
-        assert np.allclose(xform.quat_wxyz_to_matrix(q), m, atol=1e-9)
+    mats = np.array([rotations.quat_wxyz_to_matrix(q) for q in qs] +
+                    [rotations.quat_wxyz_to_matrix((1e-9, q[1], q[2], q[3])) for q in qs if np.linalg.norm(q[1:]) > 1e-3])
+    for q, m in zip(rotations.matrix_to_quat_wxyz(mats), mats):
+        assert np.allclose(rotations.quat_wxyz_to_matrix(q), m, atol=1e-9)
 
 
 @FAST
 @given(st.tuples(finite, finite, finite), angles, st.tuples(st.floats(0.05, 20), st.floats(0.05, 20),
                                                              st.floats(0.05, 20)))
 def test_decompose_inverts_compose(t, a, s):
-    r = xform.euler_to_matrix(a, "XYZ")
+    r = rotations.euler_to_matrix(a, "XYZ")
     m = np.eye(4)
     m[:3, :3] = (r * np.asarray(s)).T          # row vectors: p_world = p_local @ M
     m[3, :3] = t
-    t2, r2, s2 = xform.decompose(m)
+    t2, r2, s2 = rotations.decompose(m)
     assert np.allclose(t2, t) and np.allclose(r2, r, atol=1e-9) and np.allclose(s2, s)
 
 
@@ -200,7 +201,7 @@ def test_authored_local_pose_composes_with_the_parent(pt, pa, ps, ct, ca_unused,
     child = rep.functional.create.cube(name="C", parent=parent)
     xform.set_local_pose(child, position=ct, rotation=tuple(rot), scale=cs)
     local = np.eye(4)
-    r = xform.quat_wxyz_to_matrix(rot) if len(rot) == 4 else xform.euler_to_matrix(rot, "XYZ")
+    r = rotations.quat_wxyz_to_matrix(rot) if len(rot) == 4 else rotations.euler_to_matrix(rot, "XYZ")
     local[:3, :3] = (r * cs).T
     local[3, :3] = ct
     expected = local @ xform.world_matrix(parent)
@@ -268,7 +269,7 @@ def _body_pose(sim, path):
 
 def _assert_poses_match_usd(sim, prims):
     for prim in prims:
-        t, r, _ = xform.decompose(xform.world_matrix(prim))
+        t, r, _ = rotations.decompose(xform.world_matrix(prim))
         pos, mat = _body_pose(sim, str(prim.GetPath()))
         assert np.allclose(pos, t, atol=1e-6), (prim.GetPath(), pos, t)
         assert np.allclose(mat, r, atol=1e-6), (prim.GetPath(), mat, r)

@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg.cli import main
+from graphsdg.jobs.cli import main
 from graphsdg.errors import WriterError
 from graphsdg.io import object_store
 from graphsdg.io.object_store import ObjectStoreError, S3MissingError
-from graphsdg.job import JobSpec, run_job
+from graphsdg.jobs.job import JobSpec, run_job
 
 pytest.importorskip("boto3")
 pytest.importorskip("moto.server")
@@ -364,7 +364,7 @@ def _node_ids(cluster) -> set[str]:
 
 def test_two_nodes_write_through_s3_the_single_process_disk_dataset(job_script, bucket, s3_server, cluster,
                                                                     tmp_path, capsys):
-    from graphsdg.scaleout import run_sharded
+    from graphsdg.jobs.scaleout import run_sharded
     run_job(JobSpec(job_script, seed=5, out=str(tmp_path / "single"), frames=7))
     rep.orchestrator.wait_until_complete()
     url = f"s3://{bucket}/job"

@@ -5,7 +5,7 @@ import subprocess
 import sys
 import textwrap
 
-from graphsdg.script_suite import run_folder, summary_line
+from graphsdg.jobs.script_suite import run_folder, summary_line
 
 PASSING = '''
 import os, sys
@@ -52,13 +52,13 @@ def test_verdicts_per_script_and_separate_working_folders(tmp_path):
 
 def test_command_line_prints_a_line_per_script_and_exits_1_on_a_failure(tmp_path):
     folder = _folder(tmp_path)
-    proc = subprocess.run([sys.executable, "-m", "graphsdg.cli", "run-folder", str(folder), "--compat", "isaac",
+    proc = subprocess.run([sys.executable, "-m", "graphsdg.jobs.cli", "run-folder", str(folder), "--compat", "isaac",
                            "--pattern", "[ac]_*.py", "--out", str(tmp_path / "o"), "--", "--test"],
                           capture_output=True, text=True, timeout=120)
     lines = proc.stdout.strip().splitlines()
     assert proc.returncode == 1
     assert lines[0].startswith("PASS  a_pass") and lines[1].startswith("FAIL  c_fail")
     assert lines[-1] == "1 passed, 1 failed"
-    missing = subprocess.run([sys.executable, "-m", "graphsdg.cli", "run-folder", str(tmp_path / "none")],
+    missing = subprocess.run([sys.executable, "-m", "graphsdg.jobs.cli", "run-folder", str(tmp_path / "none")],
                              capture_output=True, text=True, timeout=60)
     assert missing.returncode != 0 and "does not exist" in missing.stderr

@@ -12,7 +12,8 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 import graphsdg as rep
 from graphsdg.assets import skies
 from graphsdg.render.camera import camera_view
-from graphsdg.sim.compiler import CompileError, compile_stage
+from graphsdg.sim.compile_error import CompileError
+from graphsdg.sim.compiler import compile_stage
 from graphsdg.sim.texcoords import fan_triangles, mesh_texcoords
 from graphsdg.stage import shapes
 

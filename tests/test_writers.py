@@ -232,7 +232,7 @@ def test_coco_writer_flushes_on_stop(out_dir):
 
 # ---- PoseWriter ----------------------------------------------------------------------------
 def _quat_matrix(q):
-    from graphsdg.stage.xform import quat_wxyz_to_matrix
+    from graphsdg.maths.rotations import quat_wxyz_to_matrix
     return quat_wxyz_to_matrix(q)
 
 

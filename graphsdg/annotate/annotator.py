@@ -19,6 +19,7 @@ from typing import Any, Callable, Iterable
 import numpy as np
 
 from graphsdg.errors import closest, unknown_name
+from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
 
 ComputeFn = Callable[["FrameView", dict], dict]  # noqa: F821 (FrameView in annotate.frame)
@@ -197,14 +198,13 @@ class AnnotatorRegistry:
     @classmethod
     def detach(cls, annotator: "Annotator | str", render_products=None) -> None:
         """Detach ``annotator`` (an object, or the name of attached ones) from ``render_products`` (default all)."""
-        from graphsdg.runtime import runtime
         if isinstance(annotator, Annotator):
             annotator.detach(render_products)
             return
-        found = [a for a in runtime().annotators if a.name == annotator]
+        found = [a for a in attachments.annotators if a.name == annotator]
         if not found:
             raise ValueError(f"no attached annotator named {annotator!r}; attached: "
-                             f"{sorted({a.name for a in runtime().annotators})}")
+                             f"{sorted({a.name for a in attachments.annotators})}")
         for a in found:
             a.detach(render_products)
 
@@ -257,7 +257,6 @@ class Annotator:
 
     def attach(self, render_products: "RenderProduct | str | Iterable[RenderProduct | str]") -> "Annotator":
         """Attach to one render product or a list of them (objects or paths)."""
-        from graphsdg.runtime import runtime
         items = render_products if isinstance(render_products, (list, tuple)) else [render_products]
         if not items:
             raise ValueError(f"annotator {self.name!r}: attach() needs at least one render product")
@@ -265,13 +264,12 @@ class Annotator:
             rp = rp_registry.find(item)
             if rp not in self._render_products:
                 self._render_products.append(rp)
-        runtime().annotators.add(self)
+        attachments.annotators.add(self)
         return self
 
     def detach(self, render_products=None) -> None:
         """Detach from ``render_products`` (default: all)."""
-        from graphsdg.runtime import runtime
-        runtime().complete_capture()
+        attachments.complete_capture()
         if render_products is None:
             self._render_products.clear()
         else:
@@ -282,7 +280,7 @@ class Annotator:
         self._latest = {k: v for k, v in self._latest.items()
                         if any(rp.path == k for rp in self._render_products)}
         if not self._render_products:
-            runtime().annotators.discard(self)
+            attachments.annotators.discard(self)
 
     def compute_for(self, frame) -> dict:
         out = get_output(frame, self.spec, self.init_params)
@@ -298,8 +296,7 @@ class Annotator:
         if not self._render_products:
             raise RuntimeError(f"annotator {self.name!r} is not attached to a render product; call "
                                f"attach(render_product) and step first")
-        from graphsdg.runtime import runtime
-        runtime().complete_capture()   # a pipelined step's outputs are computed when first asked for
+        attachments.complete_capture()   # a pipelined step's outputs are computed when first asked for
         results = {}
         for rp in self._render_products:
             out = self._latest.get(rp.path)

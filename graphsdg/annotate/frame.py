@@ -29,8 +29,8 @@ from graphsdg.render.rasterizer import RenderOutputs
 from graphsdg.render.raycast import surface_normals
 from graphsdg.render.render_product import RenderProduct
 from graphsdg.sim import geom_subsets
-from graphsdg.sim.compiler import drawn_geom_mask
 from graphsdg.sim.scene import SimScene
+from graphsdg.sim.visual import drawn_geom_mask
 from graphsdg.stage import semantics as semlib
 
 

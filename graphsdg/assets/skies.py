@@ -9,7 +9,7 @@ The lat-long layout follows UsdLux (the OpenEXR convention): the top row is the
 pole (the stage's up axis, +Z here), longitude runs from +pi at the left edge to
 -pi at the right, longitude 0 looks along -Y of a Z-up stage and +pi/2 along +X.
 :func:`direction_grid` gives each pixel's world direction, and
-:mod:`graphsdg.sim.environment_map` uses the same convention to light scenes.
+:mod:`graphsdg.imaging.environment_map` uses the same convention to light scenes.
 
 Surfaces reflect the light that would reach them, and the emitters are scaled so
 the irradiance on an upward-facing surface is pi (that of a uniform sky of
@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 
 from graphsdg.assets.noise import fbm, hash01
-from graphsdg.sim.environment_map import latlong_directions
+from graphsdg.imaging.environment_map import latlong_directions
 
 RGB = tuple[float, float, float]
 

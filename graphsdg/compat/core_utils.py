@@ -21,13 +21,16 @@ import types
 from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom
+from pxr import Sdf, Usd, UsdGeom, UsdUtils
 
+from graphsdg.compat.kit import get_app
 from graphsdg.compat.modules import CompatModule
+from graphsdg.functional.create import add_reference
+from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.stage import context as stage_context
 from graphsdg.stage import semantics as semlib
-from graphsdg.stage.xform import (euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix,
-                                  set_local_pose)
+from graphsdg.maths.rotations import euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import set_local_pose
 
 
 # ---- isaacsim.core.utils.stage -------------------------------------------------------------------
@@ -38,7 +41,6 @@ def get_current_stage(fabric: bool = False) -> Usd.Stage:
 
 def get_current_stage_id() -> int:
     """The stage's id in USD's stage cache (inserted on first call)."""
-    from pxr import UsdUtils
     cache = UsdUtils.StageCache.Get()
     return cache.Insert(get_current_stage()).ToLongInt()
 
@@ -85,12 +87,10 @@ def is_stage_loading() -> bool:
 
 def update_stage() -> None:
     """One app update (Kit renders and steps the app here; graphsdg runs the orchestrator's update)."""
-    from graphsdg.compat.kit import get_app
     get_app().update()
 
 
 async def update_stage_async() -> None:
-    from graphsdg.compat.kit import get_app
     await get_app().next_update_async()
 
 
@@ -109,7 +109,6 @@ def clear_stage(predicate: Callable[[str], bool] | None = None) -> None:
 
 def add_reference_to_stage(usd_path: str, prim_path: str, prim_type: str = "Xform") -> Usd.Prim:
     """Reference ``usd_path`` at ``prim_path`` (defined as ``prim_type`` if it does not exist)."""
-    from graphsdg.functional.create import add_reference
     stage = get_current_stage()
     prim = stage.GetPrimAtPath(prim_path)
     created = not prim
@@ -202,13 +201,11 @@ def create_prim(prim_path: str, prim_type: str = "Xform", position: Sequence[flo
             raise ValueError(f"create_prim: {prim_type} prim {prim_path!r} has no attribute {name!r}")
         attr.Set(value)
     if usd_path is not None:
-        from graphsdg.functional.create import add_reference
         add_reference(prim, usd_path)
     if translation is not None or orientation is not None or scale is not None:
         rotation = None if orientation is None else tuple(float(v) for v in orientation)   # w, x, y, z
         set_local_pose(prim, position=translation, rotation=rotation, scale=scale)
     if position is not None:
-        from graphsdg.sim.transforms import set_world_pose
         set_world_pose(prim, position, None)
     if semantic_label is not None:
         semlib.apply(prim, {semantic_type: [semantic_label]}, mode="add")

@@ -42,93 +42,22 @@ Example:
 from __future__ import annotations
 
 import asyncio
-import enum
 import itertools
 import logging
 import types
 import weakref
 from typing import Any, Callable
 
+from graphsdg.compat import kit
+from graphsdg.compat.event_names import (APP_POST_UPDATE, APP_PRE_UPDATE, APP_UPDATE, TIMELINE_EVENT_NAMES,
+                                         StageRenderingEventType, stage_event_name, stage_rendering_event_name)
 from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.runtime import runtime
 from graphsdg.sim.timeline import TimelineEvent, TimelineEventType
 
 log = logging.getLogger("carb")
 
-# ---- event names ------------------------------------------------------------------
-# omni.timeline's global event names, by the timeline event they are sent for.
-TIMELINE_EVENT_NAMES: dict[TimelineEventType, tuple[str, str]] = {
-    TimelineEventType.PLAY: ("GLOBAL_EVENT_PLAY", "omni.timeline:play"),
-    TimelineEventType.PAUSE: ("GLOBAL_EVENT_PAUSE", "omni.timeline:pause"),
-    TimelineEventType.STOP: ("GLOBAL_EVENT_STOP", "omni.timeline:stop"),
-    TimelineEventType.CURRENT_TIME_TICKED: ("GLOBAL_EVENT_CURRENT_TIME_TICKED", "omni.timeline:current_time_ticked"),
-    TimelineEventType.CURRENT_TIME_TICKED_PERMANENT: ("GLOBAL_EVENT_CURRENT_TIME_TICKED_PERMANENT",
-                                                      "omni.timeline:current_time_ticked_permanent"),
-    TimelineEventType.LOOP_MODE_CHANGED: ("GLOBAL_EVENT_LOOP_MODE_CHANGED", "omni.timeline:loop_mode_changed"),
-    TimelineEventType.START_TIME_CHANGED: ("GLOBAL_EVENT_START_TIME_CHANGED", "omni.timeline:start_time_changed"),
-    TimelineEventType.END_TIME_CHANGED: ("GLOBAL_EVENT_END_TIME_CHANGED", "omni.timeline:end_time_changed"),
-    TimelineEventType.TIME_CODE_PER_SECOND_CHANGED: ("GLOBAL_EVENT_TIME_CODES_PER_SECOND_CHANGED",
-                                                     "omni.timeline:time_codes_per_second_changed"),
-    TimelineEventType.TICKS_PER_FRAME_CHANGED: ("GLOBAL_EVENT_TICKS_PER_FRAME_CHANGED",
-                                                "omni.timeline:ticks_per_frame_changed"),
-    TimelineEventType.PLAY_EVERY_FRAME_CHANGED: ("GLOBAL_EVENT_PLAY_EVERY_FRAME_CHANGED",
-                                                 "omni.timeline:play_every_frame_changed"),
-}
 
-# omni.kit.app's names (Kit's run-loop event names)
-APP_PRE_UPDATE = "preUpdate"
-APP_UPDATE = "update"
-APP_POST_UPDATE = "postUpdate"
-
-
-class StageRenderingEventType(enum.IntEnum):
-    """omni.usd.StageRenderingEventType (graphsdg sends NEW_FRAME)."""
-
-    NEW_FRAME = 0
-    HYDRA_ENGINE_FRAMES_COMPLETE = 1
-    HYDRA_ENGINE_FRAMES_ADDED = 2
-    RENDERER_RECORDING_COMPLETE = 3
-
-
-def stage_event_name(event: int) -> str:
-    """The dispatcher name of an ``omni.usd.StageEventType`` (``UsdContext.stage_event_name``)."""
-    from graphsdg.compat.kit import StageEventType
-    return f"omni.usd:stage_event:{_member(StageEventType, event, 'omni.usd.StageEventType').name.lower()}"
-
-
-def stage_event_type(name: str) -> enum.IntEnum:
-    """The ``omni.usd.StageEventType`` of a name :func:`stage_event_name` made."""
-    from graphsdg.compat.kit import StageEventType
-    for member in StageEventType:
-        if stage_event_name(member) == name:
-            return member
-    raise ValueError(f"{name!r} is not a stage event name; stage events: "
-                     f"{', '.join(stage_event_name(m) for m in StageEventType)}")
-
-
-def stage_rendering_event_name(event: int, immediate: bool = False) -> str:
-    """The dispatcher name of a ``StageRenderingEventType``; Kit sends an immediate and a deferred one."""
-    member = _member(StageRenderingEventType, event, "omni.usd.StageRenderingEventType")
-    return f"omni.usd:stage_rendering_event:{member.name.lower()}{':immediate' if immediate else ''}"
-
-
-def stage_rendering_event_type(name: str) -> StageRenderingEventType:
-    """The ``StageRenderingEventType`` of a name :func:`stage_rendering_event_name` made."""
-    for member in StageRenderingEventType:
-        if name in (stage_rendering_event_name(member), stage_rendering_event_name(member, True)):
-            return member
-    raise ValueError(f"{name!r} is not a stage rendering event name; known: "
-                     f"{', '.join(stage_rendering_event_name(m) for m in StageRenderingEventType)}")
-
-
-def _member(enum_type: type[enum.IntEnum], value: Any, what: str) -> enum.IntEnum:
-    try:
-        return enum_type(int(value))
-    except (TypeError, ValueError):
-        known = ", ".join(m.name for m in enum_type)
-        raise ValueError(f"{value!r} is not a {what}; known: {known}") from None
-
-
-# ---- events and observers --------------------------------------------------------
 class Event(CompatObject):
     """carb.eventdispatcher.Event: ``event_name`` and ``payload``; ``event["key"]`` is ``None`` when absent."""
 
@@ -340,9 +269,6 @@ class _KitEventSources:
         self._stage_subscription: Any = None
 
     def connect(self) -> None:
-        from graphsdg.compat import kit
-        from graphsdg.runtime import runtime
-
         rt = runtime()
         if self._timeline is not rt.timeline:   # a new runtime brings a new timeline
             self._timeline = rt.timeline

@@ -18,7 +18,8 @@ from typing import Any, Sequence
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdPhysics, UsdShade
 
-from graphsdg.compat.experimental_prims import Prim, flags, resolve_indices, rows, tokens, warn_once
+from graphsdg.compat.experimental_arguments import as_paths, flags, resolve_indices, rows, tokens, warn_once
+from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
 from graphsdg.stage import materials as matlib
@@ -78,7 +79,6 @@ def _existing_or_new(paths: Any, resolve_paths: bool = True) -> tuple[list[str],
     if resolve_paths:
         existent, nonexistent = Prim.resolve_paths(paths)
     else:
-        from graphsdg.compat.experimental_prims import as_paths
         stage = get_stage()
         given = as_paths(paths)
         existent = [p for p in given if stage.GetPrimAtPath(p)]

@@ -20,7 +20,9 @@ from typing import Any, Sequence
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, Vt
 
-from graphsdg.compat.experimental_prims import GeomPrim, Prim, XformPrim, resolve_indices, rows, tokens
+from graphsdg.compat.experimental_arguments import as_paths, resolve_indices, rows, tokens, warn_once
+from graphsdg.compat.experimental_prim_base import Prim
+from graphsdg.compat.experimental_prims import GeomPrim, XformPrim
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
 from graphsdg.stage.context import get_stage
@@ -34,7 +36,6 @@ def _wrap_or_define(paths: Any, resolve_paths: bool, schema: type, what: str) ->
     if resolve_paths:
         existent, nonexistent = Prim.resolve_paths(paths)
     else:
-        from graphsdg.compat.experimental_prims import as_paths
         given = as_paths(paths)
         existent = [p for p in given if stage.GetPrimAtPath(p)]
         nonexistent = [p for p in given if p not in existent]
@@ -399,7 +400,6 @@ class Mesh(XformPrim):
 
         graphsdg renders the control cage (no subdivision); a scheme other than ``none`` warns once.
         """
-        from graphsdg.compat.experimental_prims import warn_once
         for values, attr, allowed in (
                 (subdivision_schemes, "CreateSubdivisionSchemeAttr", ("catmullClark", "loop", "bilinear", "none")),
                 (interpolate_boundaries, "CreateInterpolateBoundaryAttr", ("none", "edgeOnly", "edgeAndCorner")),

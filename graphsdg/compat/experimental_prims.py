@@ -4,188 +4,31 @@ Each wrapper holds prims matched by path(s) (an exact path, or a regular
 expression per path segment, as Isaac's ``resolve_paths``) and reads or writes
 them in batches: inputs broadcast to ``(N, width)`` following NumPy's rules,
 ``indices`` selects a subset, and results are numpy arrays that also answer
-warp's ``.numpy()``. Poses go through :mod:`graphsdg.sim.transforms` (world) and
+warp's ``.numpy()`` (:mod:`graphsdg.compat.experimental_arguments`; the ``Prim`` base
+is :mod:`graphsdg.compat.experimental_prim_base`). Poses go through :mod:`graphsdg.sim.transforms` (world) and
 :func:`graphsdg.stage.xform.set_local_pose` (local); rigid bodies through
-:class:`graphsdg.sim.bodies.RigidBodyView`; collision and physics-material
+:class:`graphsdg.physics.bodies.RigidBodyView`; collision and physics-material
 properties are the ``UsdPhysics`` / ``physx*`` attributes the compiler reads.
 """
 from __future__ import annotations
 
-import re
-import warnings
 from typing import Any, Sequence
 
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 
-from graphsdg.compat.modules import CompatObject
+from graphsdg.compat.experimental_arguments import flags, resolve_indices, rows, tokens, warn_once
+from graphsdg.compat.experimental_materials import VisualMaterial, fetch_physics_material
+from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
+from graphsdg.physics.bodies import RigidBodyView
+from graphsdg.physics.world_pose import set_world_pose
+from graphsdg.sim.transforms import get_world_pose
 from graphsdg.stage.context import get_stage
-
-_REGEX_CHARS = re.compile(r"[\\^$.|?*+()\[\]{}]")
-_warned: set[str] = set()
-
-
-def warn_once(what: str, why: str) -> None:
-    """Warn once per process that ``what`` has no effect in graphsdg (``why``)."""
-    if what not in _warned:
-        _warned.add(what)
-        warnings.warn(f"{what} has no effect in graphsdg: {why}", UserWarning, stacklevel=3)
-
-
-# ---- batched arguments -------------------------------------------------------------------
-def rows(values: Any, count: int, width: int, name: str) -> np.ndarray:
-    """``values`` broadcast to ``(count, width)`` floats (NumPy rules, as Isaac); a ``ValueError`` names bad input."""
-    raw = values.numpy() if hasattr(values, "numpy") else values
-    try:
-        arr = np.asarray(raw, dtype=np.float64)
-        if arr.ndim <= 1 and width == 1:
-            arr = arr.reshape(-1, 1)
-        out = np.broadcast_to(arr, (count, width)).copy()
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} {values!r} cannot be broadcast to shape ({count}, {width}); expected "
-                         f"{'a number or ' if width == 1 else ''}{width} value(s) per prim or one row for all")
-    if not np.all(np.isfinite(out)):
-        raise ValueError(f"{name} {values!r} holds a value that is not finite")
-    return out
-
-
-def flags(values: Any, count: int, name: str) -> list[bool]:
-    """Booleans broadcast to ``count`` values."""
-    raw = values.numpy() if hasattr(values, "numpy") else values
-    arr = np.asarray(raw).reshape(-1)
-    if arr.size not in (1, count) or arr.dtype.kind not in "bui":
-        raise ValueError(f"{name} {values!r} must be one bool or {count} bools")
-    return [bool(v) for v in np.broadcast_to(arr, (count,))]
-
-
-def tokens(values: Any, count: int, name: str, allowed: Sequence[str]) -> list[str]:
-    """Strings broadcast to ``count`` values, each one of ``allowed``."""
-    items = [values] if isinstance(values, str) else list(values)
-    if len(items) not in (1, count):
-        raise ValueError(f"{name} {values!r} must be one value or {count} values")
-    items = items * count if len(items) == 1 else items
-    for item in items:
-        if item not in allowed:
-            raise ValueError(f"{name} {item!r} is not one of {list(allowed)}")
-    return [str(v) for v in items]
-
-
-def resolve_indices(indices: Any, count: int) -> list[int]:
-    """Prim indices to process (all when ``None``); out-of-range indices raise ``IndexError``."""
-    if indices is None:
-        return list(range(count))
-    raw = indices.numpy() if hasattr(indices, "numpy") else indices
-    out = [int(i) for i in np.atleast_1d(np.asarray(raw)).reshape(-1)]
-    bad = [i for i in out if not -count <= i < count]
-    if bad:
-        raise IndexError(f"indices {bad} out of range for {count} prims")
-    return [i % count for i in out]
-
-
-def as_paths(paths: Any) -> list[str]:
-    """One path, a list of paths (or prims) as strings; an empty list raises."""
-    if isinstance(paths, (str, Sdf.Path, Usd.Prim)):
-        paths = [paths]
-    out = [str(p.GetPath()) if isinstance(p, Usd.Prim) else str(p) for p in paths]
-    if not out:
-        raise ValueError("no prim paths given; expected a path or a non-empty list of paths")
-    return out
-
-
-def _match_segments(stage: Usd.Stage, pattern: str) -> list[str]:
-    """Prim paths whose every segment fully matches the pattern's segment (Isaac's regex path matching)."""
-    parts = [p for p in pattern.split("/") if p]
-    found = [stage.GetPseudoRoot()]
-    for part in parts:
-        regex = re.compile(part)
-        found = [child for prim in found for child in prim.GetChildren() if regex.fullmatch(child.GetName())]
-    return [str(p.GetPath()) for p in found]
-
-
-# ---- Prim ---------------------------------------------------------------------------------------
-class Prim(CompatObject):
-    """``isaacsim.core.experimental.prims.Prim``: the prims at ``paths`` (``paths``, ``prims``, ``valid``)."""
-
-    _compat_name = "isaacsim.core.experimental.prims.Prim"
-
-    def __init__(self, paths: str | Sequence[str], *, resolve_paths: bool = True) -> None:
-        if resolve_paths:
-            existent, nonexistent = self.resolve_paths(paths)
-            paths = existent or nonexistent
-        self._paths = as_paths(paths)
-        stage = get_stage()
-        self._prims = [stage.GetPrimAtPath(p) for p in self._paths]
-
-    @staticmethod
-    def resolve_paths(paths: str | Sequence[str], raise_on_mixed_paths: bool = True) -> tuple[list[str], list[str]]:
-        """(paths of existing prims, paths of no prim): exact paths first, else regex matches per segment."""
-        stage = get_stage()
-        existent: list[str] = []
-        nonexistent: list[str] = []
-        for path in as_paths(paths):
-            valid = Sdf.Path.IsValidPathString(path)
-            if valid and stage.GetPrimAtPath(path):
-                existent.append(path)
-                continue
-            if valid and _REGEX_CHARS.search(path) is None:
-                nonexistent.append(path)
-                continue
-            try:
-                matches = _match_segments(stage, path)
-            except re.error as exc:
-                raise ValueError(f"path {path!r} is neither a prim path nor a valid regular expression ({exc})")
-            if matches:
-                existent += [m for m in matches if m not in existent]
-            elif valid:
-                nonexistent.append(path)
-            else:
-                raise ValueError(f"path {path!r} matches no prim and is not a valid prim path")
-        if raise_on_mixed_paths and existent and nonexistent:
-            raise ValueError(f"paths mix existing prims ({existent[0]!r}) and missing ones ({nonexistent[0]!r}); "
-                             f"pass only existing prims or only new paths")
-        return existent, nonexistent
-
-    @staticmethod
-    def ensure_api(prims: Sequence[Usd.Prim], api: type, *args: Any, **kwargs: Any) -> list:
-        """Apply ``api`` (a USD API schema class) to each prim where missing; returns the schema objects."""
-        out = []
-        for prim in prims:
-            if hasattr(api, "Apply"):
-                out.append(api(prim, *args) if prim.HasAPI(api, *args) else api.Apply(prim, *args, **kwargs))
-            else:
-                out.append(api(prim, *args, **kwargs))
-        return out
-
-    @property
-    def paths(self) -> list[str]:
-        """The wrapped prims' paths."""
-        return list(self._paths)
-
-    @paths.setter
-    def paths(self, value: Sequence[str]) -> None:
-        self._paths = as_paths(value)
-        stage = get_stage()
-        self._prims = [stage.GetPrimAtPath(p) for p in self._paths]
-
-    @property
-    def prims(self) -> list[Usd.Prim]:
-        """The wrapped ``Usd.Prim`` objects."""
-        return list(self._prims)
-
-    @property
-    def valid(self) -> bool:
-        """Whether every wrapped prim still exists."""
-        return all(p and p.IsValid() for p in self._prims)
-
-    def __len__(self) -> int:
-        return len(self._paths)
-
-    def _check_valid(self) -> None:
-        gone = [path for path, prim in zip(self._paths, self._prims) if not (prim and prim.IsValid())]
-        if gone:
-            raise ValueError(f"{type(self).__name__}: the prim(s) {gone} no longer exist on the stage")
+from graphsdg.stage.xform import set_local_pose
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
 
 # ---- XformPrim ------------------------------------------------------------------------------------
@@ -228,7 +71,6 @@ class XformPrim(Prim):
     # ---- xform ops ---------------------------------------------------------------
     def reset_xform_op_properties(self) -> None:
         """Rewrite each prim's ops as ``translate``, ``orient``, ``scale`` (double), keeping its local transform."""
-        from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz
         for prim in self._prims:
             xf = UsdGeom.Xformable(prim)
             m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
@@ -252,13 +94,11 @@ class XformPrim(Prim):
     # ---- poses ----------------------------------------------------------------------
     def get_world_poses(self, indices: Any = None) -> tuple[WarpLikeArray, WarpLikeArray]:
         """(positions (k, 3), orientations (k, 4) w, x, y, z) in the world frame."""
-        from graphsdg.sim.transforms import get_world_pose
         poses = [get_world_pose(p) for p in self._selected(indices)]
         return _warp([p[0] for p in poses]), _warp([p[1] for p in poses])
 
     def set_world_poses(self, positions: Any = None, orientations: Any = None, indices: Any = None) -> None:
         """Move the prims to world positions and / or orientations (quaternions w, x, y, z)."""
-        from graphsdg.sim.transforms import set_world_pose
         paths = self._selected(indices)
         pos = None if positions is None else rows(positions, len(paths), 3, "positions")
         quat = None if orientations is None else _unit_quats(orientations, len(paths))
@@ -267,7 +107,6 @@ class XformPrim(Prim):
 
     def get_local_poses(self, indices: Any = None) -> tuple[WarpLikeArray, WarpLikeArray]:
         """(translations (k, 3), orientations (k, 4) w, x, y, z) relative to each prim's parent."""
-        from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz
         t_out, q_out = [], []
         for path in self._selected(indices):
             m = np.array(UsdGeom.Xformable(get_stage().GetPrimAtPath(path)).GetLocalTransformation(
@@ -279,7 +118,6 @@ class XformPrim(Prim):
 
     def set_local_poses(self, translations: Any = None, orientations: Any = None, indices: Any = None) -> None:
         """Set translations and / or orientations (w, x, y, z) relative to each prim's parent."""
-        from graphsdg.stage.xform import set_local_pose
         paths = self._selected(indices)
         t = None if translations is None else rows(translations, len(paths), 3, "translations")
         q = None if orientations is None else _unit_quats(orientations, len(paths))
@@ -289,7 +127,6 @@ class XformPrim(Prim):
 
     def get_local_scales(self, indices: Any = None) -> WarpLikeArray:
         """Scales (k, 3) of each prim's local transform."""
-        from graphsdg.stage.xform import decompose
         out = []
         for path in self._selected(indices):
             m = np.array(UsdGeom.Xformable(get_stage().GetPrimAtPath(path)).GetLocalTransformation(
@@ -299,7 +136,6 @@ class XformPrim(Prim):
 
     def set_local_scales(self, scales: Any = None, indices: Any = None) -> None:
         """Set each prim's local scale (k, 3)."""
-        from graphsdg.stage.xform import set_local_pose
         paths = self._selected(indices)
         if scales is None:
             return
@@ -358,7 +194,6 @@ class XformPrim(Prim):
 
     def get_applied_visual_materials(self, indices: Any = None) -> list:
         """The visual material wrapper bound to each prim (None where none)."""
-        from graphsdg.compat.experimental_materials import VisualMaterial
         out = []
         for path in self._selected(indices):
             material, _ = UsdShade.MaterialBindingAPI(get_stage().GetPrimAtPath(path)).ComputeBoundMaterial()
@@ -535,7 +370,6 @@ class GeomPrim(XformPrim):
 
     def get_applied_physics_materials(self, indices: Any = None) -> list:
         """The physics material wrapper bound to each prim (None where none)."""
-        from graphsdg.compat.experimental_materials import fetch_physics_material
         out = []
         for prim in self._selected_prims(indices):
             material, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial("physics")
@@ -555,7 +389,6 @@ class RigidPrim(XformPrim):
                  scales: Any = None, reset_xform_op_properties: bool = False) -> None:
         super().__init__(paths, resolve_paths=resolve_paths, translations=translations, scales=scales,
                          reset_xform_op_properties=reset_xform_op_properties)
-        from graphsdg.sim.bodies import RigidBodyView
         self._view = RigidBodyView(self.paths)
         if masses is not None or densities is not None:
             self._set_mass_api(masses, densities)

@@ -27,6 +27,7 @@ from typing import Iterable
 from pxr import Sdf, Usd, UsdSemantics
 
 from graphsdg.compat.modules import CompatModule
+from graphsdg.stage import get_stage
 
 _SCHEMA_PREFIX = "SemanticsLabelsAPI:"
 
@@ -34,7 +35,6 @@ _SCHEMA_PREFIX = "SemanticsLabelsAPI:"
 def _prim(prim: str | Sdf.Path | Usd.Prim, caller: str) -> Usd.Prim:
     """The prim at ``prim`` (a path on the current stage) or ``prim`` itself, checked valid."""
     if isinstance(prim, (str, Sdf.Path)):
-        from graphsdg.stage import get_stage
         found = get_stage().GetPrimAtPath(str(prim))
         if not found:
             raise ValueError(f"{caller}: no prim at {str(prim)!r} on the current stage")

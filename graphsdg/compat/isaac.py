@@ -12,13 +12,16 @@ modules raises :class:`~graphsdg.compat.modules.CompatError` naming what is ther
 """
 from __future__ import annotations
 
+import importlib
 import sys
 import types
 
-import importlib
-
+import graphsdg
+from graphsdg import assets, functional
 from graphsdg.compat import extensions, isaac_core, kit
 from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, ForwardingModule
+from graphsdg.sim import transforms
+from graphsdg.sim.timeline import TimelineEventType
 
 # Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
 # CompatModules named by their full Isaac name (:func:`_mount` links them under their parents), and may
@@ -36,15 +39,10 @@ _finder: CompatFinder | None = None
 
 
 def _assets():
-    from graphsdg import assets
     return assets
 
 
 def _modules() -> dict[str, types.ModuleType]:
-    import graphsdg
-    from graphsdg import functional
-    from graphsdg.sim import transforms
-
     rep = ForwardingModule("omni.replicator.core", graphsdg, BackendDispatch=graphsdg.BackendDispatch)
     rep_functional = ForwardingModule("omni.replicator.core.functional", functional)
     utils = CompatModule("omni.replicator.core.scripts.functional.utils",
@@ -55,7 +53,6 @@ def _modules() -> dict[str, types.ModuleType]:
     rep.scripts = scripts  # type: ignore[attr-defined]
     rep.functional = rep_functional  # type: ignore[attr-defined]
 
-    from graphsdg.sim.timeline import TimelineEventType
     timeline = CompatModule("omni.timeline", get_timeline_interface=kit.get_timeline_interface,
                             TimelineEventType=TimelineEventType)
     app = CompatModule("omni.kit.app", get_app=kit.get_app)

@@ -14,6 +14,8 @@ from graphsdg.compat.experimental_prims import RigidPrim, XformPrim  # noqa: F40
 from graphsdg.compat.modules import CompatObject
 from graphsdg.compat.warp_arrays import WarpLikeArray  # noqa: F401 - re-exported
 from graphsdg.compat.warp_arrays import as_warp_like as _warp  # noqa: F401 - re-exported
+from graphsdg.physics import queries
+from graphsdg.sim import bounds
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.context import get_stage
 
@@ -21,15 +23,13 @@ from graphsdg.stage.context import get_stage
 # ---- bounds -----------------------------------------------------------------------
 def create_bbox_cache(time: Usd.TimeCode = Usd.TimeCode.Default(), use_extents_hint: bool = True
                       ) -> UsdGeom.BBoxCache:
-    from graphsdg.sim.bounds import create_bbox_cache as make
-    return make(time, use_extents_hint)
+    return bounds.create_bbox_cache(time, use_extents_hint)
 
 
 def compute_aabb(*args: Any, bbox_cache: UsdGeom.BBoxCache | None = None, prim: Any = None,
                  include_children: bool = False) -> np.ndarray:
     """``compute_aabb(bbox_cache, prim, ...)`` (isaacsim.core.utils.bounds) or
     ``compute_aabb(prim, bbox_cache=..., include_children=...)`` (the experimental utils)."""
-    from graphsdg.sim.bounds import compute_aabb as aabb
     positional = list(args)
     if positional and isinstance(positional[0], UsdGeom.BBoxCache):
         bbox_cache = positional.pop(0)
@@ -39,17 +39,15 @@ def compute_aabb(*args: Any, bbox_cache: UsdGeom.BBoxCache | None = None, prim: 
         bbox_cache = positional.pop(0)
     if prim is None:
         raise TypeError("compute_aabb needs a prim")
-    return aabb(prim, bbox_cache, include_children=include_children)
+    return bounds.compute_aabb(prim, bbox_cache, include_children=include_children)
 
 
 def compute_combined_aabb(bbox_cache: UsdGeom.BBoxCache, prim_paths: Iterable[str]) -> np.ndarray:
-    from graphsdg.sim.bounds import compute_combined_aabb as combined
-    return combined(list(prim_paths), bbox_cache)
+    return bounds.compute_combined_aabb(list(prim_paths), bbox_cache)
 
 
 def compute_obb(bbox_cache: UsdGeom.BBoxCache, prim_path: str):
-    from graphsdg.sim.bounds import compute_obb as obb
-    return obb(prim_path, bbox_cache)
+    return bounds.compute_obb(prim_path, bbox_cache)
 
 
 # ---- stage and semantics utils ---------------------------------------------------------
@@ -82,21 +80,17 @@ class SceneQueryInterface(CompatObject):
 
     def overlap_box(self, half_extent: Any, position: Any, rotation: Any,
                     report_fn: Callable[[Any], bool] | None = None, any_hit: bool = False) -> int:
-        from graphsdg.sim.queries import overlap_box
-        return overlap_box(tuple(half_extent), tuple(position), tuple(rotation), report_fn, any_hit)
+        return queries.overlap_box(tuple(half_extent), tuple(position), tuple(rotation), report_fn, any_hit)
 
     def overlap_sphere(self, radius: float, position: Any, report_fn: Callable[[Any], bool] | None = None,
                        any_hit: bool = False) -> int:
-        from graphsdg.sim.queries import overlap_sphere
-        return overlap_sphere(radius, tuple(position), report_fn, any_hit)
+        return queries.overlap_sphere(radius, tuple(position), report_fn, any_hit)
 
     def raycast_closest(self, origin: Any, direction: Any, distance: float) -> dict:
-        from graphsdg.sim.queries import raycast_closest
-        return raycast_closest(tuple(origin), tuple(direction), distance)
+        return queries.raycast_closest(tuple(origin), tuple(direction), distance)
 
     def raycast_all(self, origin: Any, direction: Any, distance: float, report_fn: Callable | None = None):
-        from graphsdg.sim.queries import raycast_all
-        return raycast_all(tuple(origin), tuple(direction), distance, report_fn)
+        return queries.raycast_all(tuple(origin), tuple(direction), distance, report_fn)
 
 
 _scene_query = SceneQueryInterface()

@@ -2,7 +2,7 @@
 
 Each class is a thin adapter: an app update is :func:`graphsdg.orchestrator.update`,
 the timeline is the runtime's :class:`~graphsdg.sim.timeline.Timeline`, the USD
-context is :mod:`graphsdg.stage`, carb settings are :mod:`graphsdg.settings`.
+context is :mod:`graphsdg.stage`, carb settings are :mod:`graphsdg.settings_store`.
 
 App updates and asyncio follow Kit: every coroutine awaiting
 ``next_update_async()`` resumes after the same next update (two coroutines
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import asyncio
 import enum
+import inspect
 import logging
 import sys
 import unittest
@@ -24,10 +25,16 @@ from typing import Any, Callable
 
 from pxr import Gf, Sdf, Usd, UsdGeom
 
-from graphsdg import orchestrator, settings, stage
-from graphsdg.compat import extensions, viewport
+from graphsdg import orchestrator, stage
+from graphsdg import settings_store as settings
+from graphsdg.compat import event_names, extensions, viewport
+from graphsdg.compat.event_names import StageEventType
+from graphsdg.compat.kit_commands import COMMANDS
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
+from graphsdg.graph import clear as clear_graph
+from graphsdg.graph.graph import REPLICATOR_ROOT
 from graphsdg.runtime import runtime
+from graphsdg.sim import transforms
 
 log = logging.getLogger("carb")
 
@@ -344,18 +351,6 @@ def command_line_settings(argv: list[str]) -> dict[str, Any]:
 
 
 # ---- USD context ----------------------------------------------------------------
-class StageEventType(enum.IntEnum):
-    """omni.usd.StageEventType values graphsdg emits."""
-
-    SAVED = 0
-    SAVE_FAILED = 1
-    OPENING = 2
-    OPENED = 3
-    OPEN_FAILED = 4
-    CLOSING = 5
-    CLOSED = 6
-
-
 class StageState(enum.IntEnum):
     """omni.usd.StageState."""
 
@@ -442,23 +437,19 @@ class UsdContext(CompatObject):
     # Kit 107+ also sends these events by name through carb.eventdispatcher (graphsdg.compat.event_dispatch)
     def stage_event_name(self, event: "StageEventType") -> str:
         """The event-dispatcher name of a stage event."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_event_name(event)
+        return event_names.stage_event_name(event)
 
     def stage_event_type(self, event: str) -> "StageEventType":
         """The stage event a dispatcher name stands for."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_event_type(event)
+        return event_names.stage_event_type(event)
 
     def stage_rendering_event_name(self, event: int, immediate: bool = False) -> str:
         """The event-dispatcher name of a rendering event (``omni.usd.StageRenderingEventType``)."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_rendering_event_name(event, immediate)
+        return event_names.stage_rendering_event_name(event, immediate)
 
     def stage_rendering_event_type(self, event: str) -> int:
         """The rendering event a dispatcher name stands for."""
-        from graphsdg.compat import event_dispatch
-        return event_dispatch.stage_rendering_event_type(event)
+        return event_names.stage_rendering_event_type(event)
 
     def save_as_stage(self, url: str) -> bool:
         stage.save(url)
@@ -478,8 +469,7 @@ def get_context(name: str = "") -> UsdContext:
 
 def get_world_transform_matrix(prim: Usd.Prim, time_code: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
     """The prim's local-to-world matrix (row-vector, as Kit returns it)."""
-    from graphsdg.sim.transforms import get_world_transform_matrix as world
-    return world(prim, time_code)
+    return transforms.get_world_transform_matrix(prim, time_code)
 
 
 def get_local_transform_matrix(prim: Usd.Prim, time_code: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
@@ -491,9 +481,6 @@ def get_local_transform_matrix(prim: Usd.Prim, time_code: Usd.TimeCode = Usd.Tim
 def delete_prims(paths: list[str], destructive: bool = False) -> None:
     """``DeletePrimsCommand``: remove prims; deleting ``/Replicator`` (or a prim below it) also removes the
     node graph built there, as deleting Replicator's OmniGraph does in Kit."""
-    from graphsdg.graph import clear as clear_graph
-    from graphsdg.graph.graph import REPLICATOR_ROOT
-
     s = stage.get_stage()
     for path in paths:
         path = str(path)
@@ -508,8 +495,7 @@ _COMMANDS: dict[str, Callable[..., Any]] = {"DeletePrimsCommand": delete_prims}
 
 def execute(command: str, **kwargs: Any) -> tuple[bool, Any]:
     """omni.kit.commands.execute for the commands graphsdg maps; returns Kit's ``(success, result)``."""
-    from graphsdg.compat.kit_commands import COMMANDS   # Kit's prim-authoring commands
-    commands = {**_COMMANDS, **COMMANDS}
+    commands = {**_COMMANDS, **COMMANDS}   # Kit's prim-authoring commands and DeletePrims
     # Kit registers a command by its class name less "Command"; either spelling runs it
     fn = commands.get(command) or commands.get(command.removesuffix("Command")) or commands.get(command + "Command")
     if fn is None:
@@ -532,8 +518,6 @@ class _Deferred:
 def _asyncify_fixtures(cls: type) -> None:
     """Kit's tests write ``async def setUp``; unittest wants ``asyncSetUp``. Route one to the other, keeping
     ``await super().setUp()`` working."""
-    import inspect
-
     for name, async_name in (("setUp", "asyncSetUp"), ("tearDown", "asyncTearDown")):
         fn = cls.__dict__.get(name)
         if fn is None or not inspect.iscoroutinefunction(fn):
@@ -583,7 +567,7 @@ _asyncify_fixtures(AsyncTestCase)
 
 # ---- carb ------------------------------------------------------------------------
 class CarbSettings(CompatObject):
-    """carb.settings.ISettings over :mod:`graphsdg.settings`."""
+    """carb.settings.ISettings over :mod:`graphsdg.settings_store`."""
 
     _compat_name = "carb.settings.ISettings"
 

@@ -36,7 +36,9 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
 from graphsdg.stage import get_stage
+from graphsdg.stage.materials import define_mdl_material
 from graphsdg.stage.prims import unique_child_path
+from graphsdg.stage.shape_meshes import define_shape_mesh
 
 # Kit's mesh generator names -> graphsdg.stage.shape_meshes names
 MESH_PRIM_TYPES = {"Cone": "cone", "Cube": "cube", "Cylinder": "cylinder", "Disk": "disk", "Plane": "plane",
@@ -90,7 +92,6 @@ def create_mesh_prim_with_default_xform(prim_type: str, prim_path: str | None = 
     """``CreateMeshPrimWithDefaultXform``: a ``prim_type`` mesh at ``prim_path`` (default: a free ``/<prim_type>``)
     spanning ``2 * half_scale`` stage units (default 1 m), at ``object_origin`` (raised by its half height with
     ``above_ground``). Kit's tessellation sliders (``u_verts_scale`` ...) warn once: graphsdg's density is fixed."""
-    from graphsdg.stage.shape_meshes import define_shape_mesh
 
     if prim_type not in MESH_PRIM_TYPES:
         raise ValueError(f"CreateMeshPrimWithDefaultXform: unknown prim_type {prim_type!r}; "
@@ -134,7 +135,6 @@ def create_mdl_material_prim(mtl_url: str, mtl_name: str, mtl_path: str, select_
     if not isinstance(mtl_name, str) or not mtl_name:
         raise ValueError(f"CreateMdlMaterialPrim: mtl_name must name the material in {mtl_url}, got {mtl_name!r}")
     _selection("CreateMdlMaterialPrim", select_new_prim)
-    from graphsdg.stage.materials import define_mdl_material
     define_mdl_material(get_stage(), mtl_path, mtl_url, mtl_name)
 
 

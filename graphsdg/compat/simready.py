@@ -38,7 +38,11 @@ from typing import Any, Callable, Iterable, Sequence
 
 from pxr import Gf, Sdf, Usd, UsdGeom
 
+from graphsdg.assets import get_assets_root_path
+from graphsdg.compat.extensions import get_extension_manager
 from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.functional import create
+from graphsdg.stage import get_stage, semantics
 
 EXPLORER = "omni.simready.explorer"
 TOGGLE_WINDOW = "toggle_window"
@@ -165,7 +169,6 @@ def _check_words(search_words: Iterable[str] | None) -> list[str]:
 
 
 def _catalog() -> Catalog:
-    from graphsdg.assets import get_assets_root_path
     root = get_assets_root_path()
     if root is None:
         raise FileNotFoundError("no asset root (get_assets_root_path() is None): the SimReady catalogue cannot "
@@ -190,7 +193,6 @@ def add_asset_to_stage(url: str, parent_path: Sdf.Path | str = Sdf.Path.emptyPat
 
     Raises ``ValueError`` naming a variant set or variant the asset does not offer.
     """
-    from graphsdg.functional import create
     parent = str(parent_path) if str(parent_path) else None
     name = os.path.splitext(os.path.basename(os.fspath(url)))[0]
     if payload:
@@ -309,7 +311,6 @@ class ActionRegistry(CompatObject):
 
     def execute_action(self, extension_id: str, action_id: str, *args: Any, **kwargs: Any) -> Any:
         """Run an action. Raises ``KeyError`` naming an action that is not registered, or whose extension is off."""
-        from graphsdg.compat.extensions import get_extension_manager
         action = self._actions.get((extension_id, action_id))
         if action is None:
             known = ", ".join(f"{e}/{a}" for e, a in sorted(self._actions)) or "none"
@@ -366,7 +367,6 @@ def upgrade_prim_semantics_to_labels(prim: Usd.Prim | str, include_descendants: 
     ``semanticData`` a label in it. The old API and its attributes are removed (blocked where a referenced
     layer authors them). Returns how many ``SemanticsAPI`` instances were upgraded.
     """
-    from graphsdg.stage import get_stage, semantics
     if isinstance(prim, (str, Sdf.Path)):
         path = str(prim)
         prim = get_stage().GetPrimAtPath(path)

@@ -44,11 +44,17 @@ import warnings
 import weakref
 from typing import Any, Callable
 
-from pxr import Usd, UsdPhysics
+from pxr import Tf, Usd, UsdPhysics
 
+from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.functional.physics import create_physics_scene
+from graphsdg.runtime import runtime
 from graphsdg.sim import physics_steps
+from graphsdg.physics.timeline import get_timeline_interface
 from graphsdg.sim.timeline import TimelineEventType
+from graphsdg.stage import get_stage
+from graphsdg.stage.context import stage_context
 
 log = logging.getLogger("carb")
 
@@ -151,8 +157,6 @@ class _Deletions:
     """Calls ``callback(path)`` for prims removed from the current stage (USD ObjectsChanged resyncs)."""
 
     def __init__(self, callback: Callable[[str], Any]) -> None:
-        from pxr import Tf
-        from graphsdg.stage import get_stage
         self._stage = get_stage()
         self._callback = callback
         self._listener = Tf.Notice.Register(Usd.Notice.ObjectsChanged, self._on_changed, self._stage)
@@ -193,8 +197,6 @@ class SimulationManager:
         if cls._started:
             return
         cls._started = True
-        from graphsdg.sim.timeline import get_timeline_interface
-        from graphsdg.stage.context import stage_context
         timeline = get_timeline_interface()
         cls._timeline_subscriptions = [timeline.subscribe(cls._on_play, TimelineEventType.PLAY),
                                        timeline.subscribe(cls._on_stop, TimelineEventType.STOP)]
@@ -208,7 +210,6 @@ class SimulationManager:
         """Unhook what :meth:`_start` hooked (compat mode uninstalled: plain graphsdg runs untouched)."""
         if not cls._started:
             return
-        from graphsdg.stage.context import stage_context
         cls._reset()
         for subscription in cls._timeline_subscriptions:
             subscription.unsubscribe()
@@ -255,12 +256,10 @@ class SimulationManager:
 
     @staticmethod
     def _dispatch(event: SimulationEvent | IsaacEvents) -> None:
-        from graphsdg.compat.event_dispatch import get_eventdispatcher
         get_eventdispatcher().dispatch_event(event.value, payload={})
 
     @staticmethod
     def _simulation():
-        from graphsdg.runtime import runtime
         return runtime().sim
 
     @classmethod
@@ -338,7 +337,6 @@ class SimulationManager:
     @classmethod
     def is_paused(cls) -> bool:
         """Whether the timeline is paused (neither playing nor stopped)."""
-        from graphsdg.sim.timeline import get_timeline_interface
         timeline = get_timeline_interface()
         return not timeline.is_playing() and not timeline.is_stopped()
 
@@ -370,8 +368,6 @@ class SimulationManager:
 
         Authors ``physxScene:timeStepsPerSecond = round(1 / dt)`` as Isaac's PhysX scene does.
         """
-        from graphsdg.functional.physics import create_physics_scene
-        from graphsdg.sim.timeline import get_timeline_interface
         if get_timeline_interface().is_playing():
             raise RuntimeError("The physics dt cannot be set while the simulation is running/playing")
         if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= 1.0:
@@ -461,12 +457,10 @@ class SimulationManager:
             handle = physics_steps.subscribe(pre, order, on_step)
             cls._callbacks[uid] = _Ended(lambda: physics_steps.unsubscribe(handle))
         elif event in _DISPATCHED_EVENTS:
-            from graphsdg.compat.event_dispatch import get_eventdispatcher
             guard = get_eventdispatcher().observe_event(order=order, event_name=event.value, on_event=call,
                                                         observer_name=f"SimulationManager.{event.name}.{uid}")
             cls._callbacks[uid] = _Ended(guard.reset)
         elif event in _TIMELINE_EVENTS:
-            from graphsdg.sim.timeline import get_timeline_interface
             subscription = get_timeline_interface().subscribe(call, _TIMELINE_EVENTS[event])
             cls._callbacks[uid] = _Ended(subscription.unsubscribe)
         else:   # prim deletion
@@ -528,8 +522,6 @@ class _Ended:
 
 def _physics_scenes(create: bool = False) -> list[str]:
     """Paths of the stage's physics scenes, in stage order (``/PhysicsScene`` is made when ``create`` and none)."""
-    from graphsdg.functional.physics import create_physics_scene
-    from graphsdg.stage import get_stage
     paths = [str(p.GetPath()) for p in get_stage().Traverse() if p.IsA(UsdPhysics.Scene)]
     if not paths and create:
         # Isaac's SimulationManager makes a PhysX scene here; PhysxSceneAPI's rate defaults to 60 steps per
@@ -541,7 +533,6 @@ def _physics_scenes(create: bool = False) -> list[str]:
 
 
 def _scene_prim(path: str) -> Usd.Prim:
-    from graphsdg.stage import get_stage
     prim = get_stage().GetPrimAtPath(str(path))
     if not prim or not prim.IsA(UsdPhysics.Scene):
         raise ValueError(f"physics scene {path!r} is not a UsdPhysics.Scene prim on the stage; scenes: "

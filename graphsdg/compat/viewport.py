@@ -29,6 +29,7 @@ from typing import Any
 
 from pxr import Gf, Sdf, Usd, UsdGeom
 
+from graphsdg import create
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.xform import set_local_pose
@@ -109,8 +110,7 @@ class ViewportAPI(CompatObject):
     def render_product_path(self) -> str:
         """A render product of the viewport's camera at its resolution (made on first use)."""
         if self._render_product is None:
-            import graphsdg
-            self._render_product = graphsdg.create.render_product(self._camera_path, self._resolution,
+            self._render_product = create.render_product(self._camera_path, self._resolution,
                                                                   name="Viewport")
         return self._render_product.path
 

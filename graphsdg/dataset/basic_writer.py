@@ -21,19 +21,14 @@ from functools import cached_property
 import numpy as np
 from PIL import Image
 
+from graphsdg.io.basic_writer_layout import FLAGS, json_companions
 from graphsdg.io.location import Location, open_location
 
-# file stem -> the companion files BasicWriter writes with it
-COMPANIONS = {
-    "bounding_box_2d_tight": ("_labels", "_prim_paths"),
-    "bounding_box_2d_loose": ("_labels", "_prim_paths"),
-    "bounding_box_3d": ("_labels", "_prim_paths"),
-    "semantic_segmentation": ("_labels",),
-    "instance_segmentation": ("_mapping", "_semantics_mapping"),
-    "instance_id_segmentation": ("_mapping",),
-}
+# file stem -> the JSON companion files BasicWriter writes with it (from the writer's layout table)
+COMPANIONS = {stem: suffixes for stem in sorted({stem for _, stem in FLAGS.values()})
+              if (suffixes := json_companions(stem))}
 _MAIN = re.compile(r"^(?P<stem>[a-z0-9_]+?)_(?P<frame>(?:\d+_)*\d+)\.(?P<ext>png|jpg|jpeg|npy|json)$")
-_COMPANION_SUFFIXES = ("_labels", "_prim_paths", "_semantics_mapping", "_mapping")
+_COMPANION_SUFFIXES = tuple(sorted({suffix for suffixes in COMPANIONS.values() for suffix in suffixes}))
 
 
 def _parse(name: str) -> tuple[str, str, str] | None:

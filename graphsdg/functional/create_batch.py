@@ -1,6 +1,7 @@
 """``rep.functional.create_batch``: create ``count`` prims in one call.
 
-Per-prim arguments take an ``(N, 3)`` array (one row per prim) or one value for all.
+Per-prim arguments take an ``(N, 3)`` array (one row per prim) or one value for all
+(:mod:`graphsdg.functional.per_prim`).
 
 Example:
     >>> import graphsdg as rep, numpy as np
@@ -16,39 +17,7 @@ from typing import Any
 import numpy as np
 
 from graphsdg.functional import create
-
-
-def per_prim_array(value: Any, count: int, what: str, width: int = 3) -> np.ndarray:
-    """``value`` as a (count, width) float array: its rows, or one shared value repeated.
-
-    ``width`` is the width expected of rows (3, or 4 for quaternions); a shared
-    value may be 3 or 4 wide, and a scale may also be one number, or one number
-    per prim (uniform scales, as the seed's Workflow 1 passes them).
-    """
-    if value is None:
-        raise ValueError(f"{what} is None; expected one {width}-vector or an (N, {width}) array")
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim == 2:
-        if arr.shape[0] != count:
-            raise ValueError(f"{what} has {arr.shape[0]} rows but count/prims is {count}")
-        return arr
-    is_scale = what.startswith("scale")
-    if arr.ndim == 0 and is_scale:
-        return np.full((count, 3), float(arr))
-    if arr.ndim == 1 and is_scale and arr.shape[0] == count:
-        return np.repeat(arr[:, None], 3, axis=1)
-    if arr.ndim == 1 and arr.shape[0] in (3, 4):
-        return np.broadcast_to(arr, (count, arr.shape[0]))
-    raise ValueError(f"{what} must be one {width}-vector or an (N, {width}) array, got shape {arr.shape}")
-
-
-def per_prim(value: Any, count: int, what: str, width: int = 3) -> list:
-    """Split ``value`` into ``count`` per-prim values (rows of :func:`per_prim_array`); ``None`` for each
-    prim when ``value`` is None."""
-    if value is None:
-        return [None] * count
-    rows = per_prim_array(value, count, what, width)
-    return [rows[0]] * count if rows.strides[0] == 0 else list(rows)   # a shared value: one array, not N views
+from graphsdg.functional.per_prim import per_prim
 
 
 def _batch(shape: str):
@@ -59,7 +28,7 @@ def _batch(shape: str):
             raise ValueError(f"count must be a positive integer, got {count!r}")
         positions = per_prim(position, count, "position")
         rotations = per_prim(rotation, count, "rotation")
-        scales = per_prim(scale, count, "scale")
+        scales = per_prim(scale, count, "scale", uniform=True, uniform_per_prim=True)
         targets = per_prim(look_at, count, "look_at")
         fn = getattr(create, shape)
         return [fn(position=positions[i], rotation=rotations[i], scale=scales[i], look_at=targets[i],

@@ -18,19 +18,21 @@ from typing import Any
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.errors import closest
-from graphsdg.functional.create_batch import per_prim, per_prim_array
+from graphsdg.functional.per_prim import per_prim, per_prim_array
+from graphsdg.runtime import runtime
+from graphsdg.sim import direct_writes
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.prims import resolve_prim, resolve_prims
-from graphsdg.stage.xform import set_local_pose
+from graphsdg.stage.xform import set_local_pose, world_matrix
+from graphsdg.maths.rotations import decompose
 
 
 def _look_at_point(value: Any) -> Any:
     """A look-at target given as a prim (or prim path) becomes its world position."""
     if isinstance(value, Usd.Prim) or (isinstance(value, str) and value.startswith("/")):
-        from graphsdg.stage.xform import world_matrix
         return world_matrix(resolve_prim(value))[3, :3]
     return value
 
@@ -54,18 +56,18 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
     n = len(targets)
     if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
             and _write_to_fabric():
-        from graphsdg.runtime import runtime
-        from graphsdg.sim import direct_writes
-        arrays = [None if v is None else per_prim_array(v, n, name, width=np.shape(v)[-1] if np.ndim(v) else 3)
-                  for v, name in ((position_value, "position_value"), (rotation_value, "rotation_value"),
-                                  (scale_value, "scale_value"))]
+        arrays = [None if v is None else per_prim_array(v, n, name, width=width, uniform=uniform,
+                                                         uniform_per_prim=uniform)
+                  for v, name, width, uniform in ((position_value, "position_value", 3, False),
+                                                  (rotation_value, "rotation_value", _pose_width(rotation_value),
+                                                   False),
+                                                  (scale_value, "scale_value", 3, True))]
         if direct_writes.write_poses(runtime().sim, targets, *arrays):
             return
     positions = per_prim(position_value, n, "position_value")
-    rotations = per_prim(rotation_value, n, "rotation_value", width=4 if np.ndim(rotation_value) and
-                         np.shape(rotation_value)[-1] == 4 else 3)
-    scales = per_prim(scale_value, n, "scale_value")
-    sizes = per_prim(size_value, n, "scale_value (size)")
+    rotations = per_prim(rotation_value, n, "rotation_value", width=_pose_width(rotation_value))
+    scales = per_prim(scale_value, n, "scale_value", uniform=True, uniform_per_prim=True)
+    sizes = per_prim(size_value, n, "scale_value (size)", uniform=True, uniform_per_prim=True)
     pivots = per_prim(pivot_value, n, "pivot_value")
     looks = per_prim(look_at_value, n, "look_at_value")
     for i, prim in enumerate(targets):
@@ -74,6 +76,11 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
                        look_at_up_axis=look_at_up_axis, rotation_order=rotation_order)
         if pivots[i] is not None:
             _apply_pivot(prim, np.asarray(pivots[i], dtype=np.float64), positions[i])
+
+
+def _pose_width(value: Any) -> int:
+    """4 for quaternions (rows of 4 numbers), else 3."""
+    return 4 if np.ndim(value) and np.shape(value)[-1] == 4 else 3
 
 
 def size_to_scale(prim: Usd.Prim, size: Any) -> np.ndarray:
@@ -91,7 +98,6 @@ def size_to_scale(prim: Usd.Prim, size: Any) -> np.ndarray:
 
 
 def _apply_pivot(prim: Usd.Prim, pivot: np.ndarray, position: Any) -> None:
-    from graphsdg.stage.xform import decompose
     xf = UsdGeom.Xformable(prim)
     m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
     t, r, s = decompose(m)
@@ -202,8 +208,6 @@ def display_color(prims: Any, value: Any) -> None:
     targets = resolve_prims(prims)
     colors = per_prim_array(value, len(targets), "display color")
     if _write_to_fabric():
-        from graphsdg.runtime import runtime
-        from graphsdg.sim import direct_writes
         if direct_writes.write_colors(runtime().sim, targets, colors[:, :3]):
             return
     for prim, c in zip(targets, colors):

@@ -22,11 +22,13 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from graphsdg.functional import modify
+from graphsdg.functional.per_prim import per_prim
 from graphsdg.rng import ReplicatorRNG, as_generator
-from graphsdg.sim import bounds, placement, transforms
+from graphsdg.sim import bounds, placement
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.prims import resolve_prims, sanitize_name
-from graphsdg.stage.xform import matrix_to_euler_xyz, quat_wxyz_to_matrix, set_local_pose, world_matrix
+from graphsdg.maths.rotations import matrix_to_euler_xyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import set_local_pose, world_matrix
 
 LOOKS = "/Replicator/Looks"
 
@@ -122,8 +124,8 @@ def texture(prims: Any, textures: Sequence[str], texture_scale: Any = None, text
         raise FileNotFoundError(f"texture file(s) not found: {missing}")
     targets = resolve_prims(prims)
     picks = as_generator(rng, "texture").integers(0, len(files), size=len(targets))
-    scales = _per_prim_rows(texture_scale, len(targets), 2, "texture_scale")
-    rotates = _per_prim_rows(texture_rotate, len(targets), 1, "texture_rotate")
+    scales = per_prim(texture_scale, len(targets), "texture_scale", width=2, uniform=True)
+    rotates = per_prim(texture_rotate, len(targets), "texture_rotate", width=1, uniform=True, uniform_per_prim=True)
     chosen = []
     for i, prim in enumerate(targets):
         mat = _own_material(prim, "Texture", looks)
@@ -132,21 +134,6 @@ def texture(prims: Any, textures: Sequence[str], texture_scale: Any = None, text
                           texture_rotate=None if rotates[i] is None else float(rotates[i][0]))
         chosen.append(files[int(picks[i])])
     return chosen
-
-
-def _per_prim_rows(value: Any, n: int, width: int, what: str) -> list:
-    if value is None:
-        return [None] * n
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim == 0:
-        return [np.full(width, float(arr))] * n
-    if arr.ndim == 1 and arr.shape[0] == width:
-        return [arr] * n
-    if arr.ndim == 1 and width == 1 and arr.shape[0] == n:
-        return [np.array([v]) for v in arr]
-    if arr.ndim == 2 and arr.shape[0] == n and arr.shape[1] in (1, width):
-        return [np.broadcast_to(row, (width,)) for row in arr]
-    raise ValueError(f"{what} must be one value, one {width}-vector or one per prim ({n}), got shape {arr.shape}")
 
 
 def uniform_quaternions(gen: np.random.Generator, n: int) -> np.ndarray:
@@ -192,7 +179,7 @@ def _bounds_offsets(targets: list) -> np.ndarray:
     cache = bounds.create_bbox_cache()
     out = np.zeros((len(targets), 6))
     for i, prim in enumerate(targets):
-        origin = transforms.get_world_position(prim)
+        origin = world_matrix(prim)[3, :3]   # targets are resolved prims
         try:
             box = bounds.compute_aabb(prim, cache)
         except ValueError:

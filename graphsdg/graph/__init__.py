@@ -1,9 +1,11 @@
 """The node graph: Replicator's declarative graph API rebuilt on networkx.
 
-* :mod:`~graphsdg.graph.node`: :class:`Node`, typed :class:`Port` s, :class:`TriggerNode`;
+* :mod:`~graphsdg.graph.node`: :class:`Node`, typed :class:`Port` s, :class:`TriggerNode`, the
+  :class:`ReplicatorItem` s that reference a node's output, and describing / resolving those references;
 * :mod:`~graphsdg.graph.registry`: :class:`NodeRegistry` of node types (the library lives in ``nodes/``);
 * :mod:`~graphsdg.graph.graph`: the ``networkx.DiGraph`` of data dependencies, order and stable ids;
-* :mod:`~graphsdg.graph.builder`: items, ``with`` scopes, ``new_layer``;
+* :mod:`~graphsdg.graph.builder`: adding nodes; :mod:`~graphsdg.graph.scopes`: the open ``with`` blocks;
+* :mod:`~graphsdg.graph.current`: the current graph, its lifetime and ``new_layer``;
 * :mod:`~graphsdg.graph.scheduler`: per-step trigger firing, execution, provenance, seek;
 * :mod:`~graphsdg.graph.export`, :mod:`~graphsdg.graph.drawing` and :mod:`~graphsdg.graph.dry_run`: seeing the graph.
 
@@ -16,14 +18,14 @@ Example:
     'on_frame'
     >>> rep.graph.clear()
 """
+from graphsdg.errors import GraphBuildError
 from graphsdg.graph import scheduler
-from graphsdg.graph.builder import (GraphBuildError, ReplicatorItem, current_graph, new_layer,
-                                    remove_prim_specs)
+from graphsdg.graph.current import current_graph, new_layer, remove_prim_specs
 from graphsdg.graph.drawing import draw, layout
 from graphsdg.graph.dry_run import DryRunReport, dry_run
 from graphsdg.graph.export import describe, to_dict, to_dot, to_json, to_networkx
 from graphsdg.graph.graph import REPLICATOR_ROOT, Graph
-from graphsdg.graph.node import ExecContext, Node, Port, TriggerNode
+from graphsdg.graph.node import ExecContext, Node, Port, ReplicatorItem, TriggerNode
 from graphsdg.graph.registry import NodeRegistry, register_node
 from graphsdg.graph.scheduler import clear, seek
 

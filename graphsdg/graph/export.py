@@ -16,8 +16,8 @@ from typing import Any
 
 import networkx as nx
 
-from graphsdg.graph.builder import current_graph
-from graphsdg.graph.graph import Graph, node_summary
+from graphsdg.graph.current import current_graph
+from graphsdg.graph.graph import Graph, effective_triggers, node_summary
 
 
 def _graph(graph: Graph | None) -> Graph | None:
@@ -83,7 +83,6 @@ def describe(graph: Graph | None = None) -> str:
     n_trig = len(g.triggers)
     lines = [f"graph: {len(order)} node{'s' if len(order) != 1 else ''}, {n_trig} trigger{'s' if n_trig != 1 else ''}, "
              f"{len(data_edges)} edge{'s' if len(data_edges) != 1 else ''}"]
-    from graphsdg.graph.graph import effective_triggers
     groups: dict[str, list] = {t.name: [] for t in g.triggers}
     groups["(runs once, at build)"] = []
     for n in order:

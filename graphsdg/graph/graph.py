@@ -18,7 +18,8 @@ from typing import Any, Iterable, Iterator
 import networkx as nx
 from pxr import Sdf, Usd
 
-from graphsdg.graph.node import Node
+from graphsdg.errors import unknown_name
+from graphsdg.graph.node import Node, describe_value
 from graphsdg.rng import stable_key
 
 REPLICATOR_ROOT = "/Replicator"
@@ -94,7 +95,6 @@ class Graph:
     def node(self, name: str) -> Node:
         """The node called ``name``."""
         if name not in self.dag:
-            from graphsdg.errors import unknown_name
             raise unknown_name("graph node", name, self.dag.nodes)
         return self.dag.nodes[name]["node"]
 
@@ -163,7 +163,6 @@ def effective_triggers(node: Node) -> list[Node]:
 
 
 def _plain_inputs(node: Node) -> str:
-    from graphsdg.graph.builder import describe_value
     return repr(sorted((k, describe_value(v, keys_only=True)) for k, v in node.values.items()
                        if v is not None and not k.startswith("_")))
 

@@ -1,9 +1,12 @@
-"""The node model: typed ports, the :class:`Node` base class and its execution context.
+"""The node model: typed ports, the :class:`Node` base class, the items that reference a node's output, and the
+execution context a node computes in.
 
 A node type declares its ``inputs`` and ``outputs`` as :class:`Port` s and
 implements :meth:`Node.compute`. An input holds either a plain value or a
-reference to another node's output (an :class:`~graphsdg.graph.builder.ReplicatorItem`);
-references become the data edges of the graph.
+reference to another node's output (a :class:`ReplicatorItem`, what every graph-API
+call returns); references become the data edges of the graph. Nodes and items refer
+to each other (an input holds items, an item wraps a node), so both live here, with
+the functions that find, resolve and describe the references inside input values.
 
 Example:
     >>> from graphsdg.graph import Node, Port, NodeRegistry
@@ -19,14 +22,18 @@ Example:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Iterator
 
 import numpy as np
-from pxr import Usd
+from pxr import Sdf, Usd
 
 from graphsdg import rng as rnglib
+from graphsdg.errors import GraphBuildError
+from graphsdg.graph.samples import Samples
+from graphsdg.graph.scopes import scopes
+from graphsdg.stage.prims import resolve_prim
 
-if TYPE_CHECKING:  # pragma: no cover
+if TYPE_CHECKING:  # type names only: the graph module imports this one
     from graphsdg.graph.graph import Graph
 
 FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer")
@@ -95,11 +102,62 @@ class Node:
 
     def summary(self) -> dict[str, Any]:
         """The node's plain inputs, for describe() and exports."""
-        from graphsdg.graph.builder import describe_value
         return {k: describe_value(v) for k, v in self.values.items() if v is not None}
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name or self.type_name}>"
+
+
+class ReplicatorItem:
+    """What every graph-API call returns: a handle on one node's output (``rep.ReplicatorItem``).
+
+    Use it as an argument of other calls (a data edge), as ``with item:`` (the
+    implicit target of modify/randomizer calls), or read it with
+    :meth:`get_output_prims`.
+    """
+
+    def __init__(self, node: Node, output: str | None = None) -> None:
+        self.node = node
+        self.output = output or next(iter(node.outputs), "")
+
+    @property
+    def name(self) -> str:
+        return self.node.name
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, ReplicatorItem) and other.node is self.node
+
+    def __hash__(self) -> int:
+        return id(self.node)
+
+    def __repr__(self) -> str:
+        return f"ReplicatorItem({self.node.name!r}, {self.node.type_name})"
+
+    def __enter__(self) -> "ReplicatorItem":
+        if self.node.family == "trigger":
+            scopes.enter_trigger(self.node)
+        else:
+            scopes.targets.append(self)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.node.family == "trigger":
+            scopes.exit_trigger(self.node)
+        else:
+            scopes.targets.pop()
+
+    def get_output(self, port: str | None = None) -> Any:
+        """The node's current value of output ``port`` (its main output by default)."""
+        port = port or self.output
+        if port not in self.node.outputs:
+            raise KeyError(f"{self.node.type_name} has no output {port!r}; outputs: {sorted(self.node.outputs)}")
+        return self.node.output_values.get(port)
+
+    def get_output_prims(self) -> dict[str, list[Usd.Prim]]:
+        """``{"prims": [Usd.Prim, ...]}`` of a create / get / group item."""
+        if "prims" not in self.node.outputs:
+            raise TypeError(f"{self.node.name!r} ({self.node.type_name}) outputs no prims")
+        return {"prims": list(self.node.output_values.get("prims") or [])}
 
 
 class ExecContext:
@@ -125,7 +183,6 @@ class ExecContext:
 
     def value(self, port: str) -> Any:
         """The input ``port`` with upstream references replaced by their current outputs."""
-        from graphsdg.graph.builder import resolve_refs
         return resolve_refs(self.node.value_of(port))
 
     def given(self, port: str) -> bool:
@@ -133,12 +190,10 @@ class ExecContext:
 
     def prims(self, port: str = "input_prims") -> list[Usd.Prim]:
         """The prims an input names (items, prims, paths, or lists of them), flattened."""
-        from graphsdg.graph.builder import flatten_prims
         return flatten_prims(self.value(port), f"{self.node.type_name}.{port}")
 
     def sample(self, port: str, n: int) -> Any:
         """``n`` samples for ``port`` if it holds a distribution, else the plain value (or None)."""
-        from graphsdg.graph.samples import Samples
         value = self.value(port)
         if isinstance(value, Samples):
             return value.take(n)
@@ -206,3 +261,82 @@ class TriggerNode(Node):
     def seek(self, frame: int) -> None:
         """Set the state it would have entering ``frame`` (only for frame-determined triggers)."""
         raise NotImplementedError(f"{self.type_name} cannot seek: it depends on events or simulated time")
+
+
+# ---- references inside input values ------------------------------------------
+def iter_refs(value: Any) -> Iterator[ReplicatorItem]:
+    """Every item (or bare Node) referenced inside ``value`` (lists, tuples and dicts are searched)."""
+    if isinstance(value, ReplicatorItem):
+        yield value
+    elif isinstance(value, Node):
+        yield ReplicatorItem(value)
+    elif isinstance(value, (list, tuple)):
+        for v in value:
+            yield from iter_refs(v)
+    elif isinstance(value, dict):
+        for v in value.values():
+            yield from iter_refs(v)
+
+
+def resolve_refs(value: Any) -> Any:
+    """``value`` with every item replaced by its node's current output."""
+    if isinstance(value, Node):
+        value = ReplicatorItem(value)
+    if isinstance(value, ReplicatorItem):
+        out = value.node.output_values.get(value.output)
+        if out is None and value.output not in value.node.output_values:
+            raise GraphBuildError(f"{value.node.name!r} ({value.node.type_name}) has not produced "
+                                  f"{value.output!r} yet; is it gated by a trigger that has not fired?")
+        return out
+    if isinstance(value, list):
+        return [resolve_refs(v) for v in value]
+    if isinstance(value, tuple):
+        return tuple(resolve_refs(v) for v in value)
+    if isinstance(value, dict):
+        return {k: resolve_refs(v) for k, v in value.items()}
+    return value
+
+
+def flatten_prims(value: Any, what: str) -> list[Usd.Prim]:
+    """Prims, paths, prim lists and resolved item outputs, flattened into ``Usd.Prim`` s."""
+    out: list[Usd.Prim] = []
+
+    def visit(v: Any) -> None:
+        if v is None:
+            return
+        if isinstance(v, (list, tuple)):
+            for x in v:
+                visit(x)
+            return
+        if isinstance(v, (Usd.Prim, str, Sdf.Path)) or hasattr(v, "GetPrim"):
+            out.append(resolve_prim(v))
+            return
+        raise TypeError(f"{what}: expected prims, prim paths or graph items, got {type(v).__name__}: {v!r}")
+
+    visit(value)
+    return out
+
+
+def describe_value(value: Any, keys_only: bool = False) -> Any:
+    """A JSON-ready description of an input value (items by node name, prims by path)."""
+    if isinstance(value, Node):
+        value = ReplicatorItem(value)
+    if isinstance(value, ReplicatorItem):
+        return "<ref>" if keys_only else f"<{value.node.name}>"
+    if isinstance(value, Usd.Prim):
+        return str(value.GetPath())
+    if isinstance(value, Sdf.Path):
+        return str(value)
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [describe_value(v, keys_only) for v in value]
+    if isinstance(value, dict):
+        return {str(k): describe_value(v, keys_only) for k, v in value.items()}
+    if callable(value):
+        return getattr(value, "__qualname__", repr(value))
+    if isinstance(value, (str, int, float, bool)) or value is None:
+        return value
+    return repr(value)

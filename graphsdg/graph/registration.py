@@ -14,8 +14,8 @@ import functools
 from types import ModuleType
 from typing import Any, Callable
 
-from graphsdg.graph.builder import GraphBuildError, ReplicatorItem
-from graphsdg.graph.node import Node
+from graphsdg.errors import GraphBuildError
+from graphsdg.graph.node import Node, ReplicatorItem
 
 
 def as_item(value: Any) -> Any:

@@ -19,12 +19,14 @@ import contextlib
 import copy
 from typing import Any, Iterable
 
+import numpy as np
 from pxr import Sdf, Usd
 
-from graphsdg import profiling
-from graphsdg.graph.builder import ReplicatorItem, current_graph, edit_context, release_graph
+from graphsdg.benchmark import profiling
+from graphsdg.graph.current import current_graph, edit_context, release_graph
 from graphsdg.graph.graph import Graph, effective_triggers
-from graphsdg.graph.node import ExecContext, Node, TriggerNode
+from graphsdg.graph.node import ExecContext, Node, ReplicatorItem, TriggerNode
+from graphsdg.runtime import runtime
 
 
 def active_graph() -> Graph | None:
@@ -96,7 +98,6 @@ def run_subgraphs(graph: Graph, fired: Iterable[Node], frame: int, dry: bool = F
 
 def graph_step() -> dict[str, Any] | None:
     """The orchestrator hook: one step of the current graph."""
-    from graphsdg.runtime import runtime
     graph = active_graph()
     if graph is None:
         return None
@@ -134,7 +135,6 @@ def unlimited_triggers() -> list[str]:
 # ---- provenance ------------------------------------------------------------
 def jsonable(value: Any) -> Any:
     """Plain JSON types for a sampled value (arrays -> lists, prims -> paths)."""
-    import numpy as np
     if isinstance(value, np.ndarray):
         return jsonable(value.tolist())
     if isinstance(value, np.generic):
@@ -238,7 +238,6 @@ def clear() -> None:
 
 def install() -> None:
     """Register :func:`graph_step` as an orchestrator graph hook (once)."""
-    from graphsdg.runtime import runtime
     hooks = runtime().graph_hooks
     if graph_step not in hooks:
         hooks.append(graph_step)

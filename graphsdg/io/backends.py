@@ -18,7 +18,8 @@ import uuid
 from typing import Any, Callable
 
 
-from graphsdg import frame_plan, settings
+from graphsdg import settings_store as settings
+from graphsdg.jobs import frame_plan
 from graphsdg.errors import unknown_name
 from graphsdg.io import encode, object_store
 from graphsdg.io.object_store import S3Url, is_s3_url

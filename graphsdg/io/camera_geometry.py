@@ -25,7 +25,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from graphsdg.stage.xform import decompose
+from graphsdg.maths.rotations import decompose
 
 USD_TO_OPENCV = np.diag([1.0, -1.0, -1.0])
 

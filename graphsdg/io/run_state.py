@@ -49,8 +49,9 @@ import time
 import weakref
 from typing import Any, Iterator
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.io.location import open_location
+from graphsdg.render.attachments import attachments
 
 FILE_NAME = "graphsdg_run.json"
 FORMAT = "graphsdg.run_state"
@@ -191,9 +192,8 @@ class FrameLedger:
                 (not self.aggregate or self.flushed_upto >= self.last_begun)
 
     def writer_gone(self) -> bool:
-        from graphsdg.runtime import _runtime
         writer = self.writer_ref()
-        return writer is None or _runtime is None or writer not in _runtime.writers
+        return writer is None or writer not in attachments.writers
 
 
 _ledgers: dict[tuple[int, str], FrameLedger] = {}

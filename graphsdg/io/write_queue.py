@@ -37,8 +37,9 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from graphsdg import profiling, settings
-from graphsdg.cpu_share import cores_per_process
+from graphsdg import settings_store as settings
+from graphsdg.benchmark import profiling
+from graphsdg.jobs.cpu_share import cores_per_process
 from graphsdg.errors import WriterError
 
 log = logging.getLogger("graphsdg.io")

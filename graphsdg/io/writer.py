@@ -31,6 +31,7 @@ from graphsdg import rng
 from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry, shape_output
 from graphsdg.errors import closest, unknown_name
 from graphsdg.io.io_functions import write_json
+from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
 
 DATA_STRUCTURES = ("legacy", "annotator", "renderProduct")
@@ -106,7 +107,6 @@ class Writer:
     def attach(self, render_products: "RenderProduct | str | Iterable[RenderProduct | str]",
                trigger: Any = ON_FRAME) -> None:
         """Attach to render products; frames are written when ``trigger`` fires (every step by default)."""
-        from graphsdg.runtime import runtime
         if render_products is None or (isinstance(render_products, (list, tuple)) and not render_products):
             raise ValueError(f"{type(self).__name__}.attach() needs at least one render product, got "
                              f"{render_products!r}")
@@ -128,7 +128,7 @@ class Writer:
         self._manual_requests = 0
         for a in annotators:
             a.attach(rps)
-        runtime().writers.add(self)
+        attachments.writers.add(self)
 
     def attach_async(self, render_products, trigger: Any = ON_FRAME):
         async def _attach():
@@ -137,14 +137,13 @@ class Writer:
 
     def detach(self) -> None:
         """Stop receiving frames (aggregate files are flushed first); the writer's annotators detach."""
-        from graphsdg.runtime import runtime
-        if self in runtime().writers:
-            runtime().complete_capture()   # the frame a pipelined step left pending is this writer's too
+        if self in attachments.writers:
+            attachments.complete_capture()   # the frame a pipelined step left pending is this writer's too
             self.flush()
         for a in self._annotator_objects():
             a.detach(self.render_products) if self.render_products else None
         self._render_products = []
-        runtime().writers.discard(self)
+        attachments.writers.discard(self)
 
     def schedule_write(self) -> None:
         """With ``attach(..., trigger=None)``: write the next captured frame."""
@@ -282,8 +281,7 @@ class WriterRegistry:
 
     @classmethod
     def get_attached_writers(cls) -> list[Writer]:
-        from graphsdg.runtime import runtime
-        return list(runtime().writers)
+        return list(attachments.writers)
 
     @classmethod
     def detach_all(cls) -> None:

@@ -32,7 +32,7 @@ import sys
 from dataclasses import dataclass
 from typing import Callable, Protocol, runtime_checkable
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 
 log = logging.getLogger("graphsdg.render")
 

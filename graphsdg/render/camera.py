@@ -18,7 +18,8 @@ import numpy as np
 from pxr import Usd, UsdGeom
 
 from graphsdg.errors import InvalidPrimError
-from graphsdg.stage.xform import decompose, world_matrix
+from graphsdg.maths.rotations import decompose
+from graphsdg.stage.xform import world_matrix
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,8 @@ from typing import Iterator
 import mujoco
 import numpy as np
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
+from graphsdg.maths.rotations import quat_slerp
 from graphsdg.render.camera import CameraView
 from graphsdg.sim import physics_steps
 
@@ -76,28 +77,12 @@ class _State:
     mocap_quat: np.ndarray
 
 
-def _slerp(a: np.ndarray, b: np.ndarray, u: float) -> np.ndarray:
-    """Quaternions (..., 4) a -> b at fraction u, the short way."""
-    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
-    b = b / np.linalg.norm(b, axis=-1, keepdims=True)
-    dot = np.sum(a * b, axis=-1, keepdims=True)
-    b = np.where(dot < 0, -b, b)
-    dot = np.abs(dot)
-    theta = np.arccos(np.clip(dot, -1.0, 1.0))
-    small = theta < 1e-8
-    s = np.sin(np.where(small, 1.0, theta))
-    wa = np.where(small, 1.0 - u, np.sin((1.0 - u) * theta) / s)
-    wb = np.where(small, u, np.sin(u * theta) / s)
-    q = wa * a + wb * b
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
-
-
 def _rotation_slerp(ra: np.ndarray, rb: np.ndarray, u: float) -> np.ndarray:
     qa, qb = np.zeros(4), np.zeros(4)
     mujoco.mju_mat2Quat(qa, np.ascontiguousarray(ra, dtype=np.float64).ravel())
     mujoco.mju_mat2Quat(qb, np.ascontiguousarray(rb, dtype=np.float64).ravel())
     out = np.zeros(9)
-    mujoco.mju_quat2Mat(out, _slerp(qa, qb, u))
+    mujoco.mju_quat2Mat(out, quat_slerp(qa, qb, u))
     return out.reshape(3, 3)
 
 
@@ -144,9 +129,9 @@ class MotionRecord:
     def _mix(self, a: _State, b: _State, u: float, t: float) -> _State:
         qpos = a.qpos + u * (b.qpos - a.qpos)
         for sl in self._quat_slices:
-            qpos[sl] = _slerp(a.qpos[sl], b.qpos[sl], u)
+            qpos[sl] = quat_slerp(a.qpos[sl], b.qpos[sl], u)
         mocap_pos = a.mocap_pos + u * (b.mocap_pos - a.mocap_pos)
-        mocap_quat = _slerp(a.mocap_quat, b.mocap_quat, u) if len(a.mocap_quat) else a.mocap_quat.copy()
+        mocap_quat = quat_slerp(a.mocap_quat, b.mocap_quat, u) if len(a.mocap_quat) else a.mocap_quat.copy()
         return _State(t, qpos, mocap_pos, mocap_quat)
 
 

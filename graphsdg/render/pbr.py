@@ -41,15 +41,20 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from pxr import UsdShade
+from pxr import Usd, UsdGeom, UsdShade
 
-from graphsdg import profiling, settings
+from graphsdg import settings_store as settings
+from graphsdg.benchmark import profiling
+from graphsdg.imaging import environment_map
 from graphsdg.render import mesh_folds, pbr_scene
 from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend
 from graphsdg.render.camera import CameraView
-from graphsdg.render.rasterizer import PASSES, RenderOutputs
-from graphsdg.sim.compiler import PBR_CAMERA, UNDRAWN_GROUPS, drawn_geom_mask
+from graphsdg.maths.rotations import decompose
+from graphsdg.render.rasterizer import PASSES, Rasterizer, RenderOutputs
+from graphsdg.sim import lights as lightmap
 from graphsdg.sim.scene import SimScene
+from graphsdg.sim.visual import PBR_CAMERA, UNDRAWN_GROUPS, drawn_geom_mask
+from graphsdg.stage.xform import world_matrix
 
 ENABLED_GROUPS = tuple(g for g in range(mujoco.mjNGROUP) if g not in UNDRAWN_GROUPS)
 
@@ -172,11 +177,6 @@ class PbrRenderer:
 
     def _environment(self, sim: SimScene) -> tuple[np.ndarray | None, float]:
         """The stage's dome lights as one environment map in nits, and its yaw (0 when resampled)."""
-        from pxr import Usd, UsdGeom
-
-        from graphsdg.sim import environment_map
-        from graphsdg.sim import lights as lightmap
-        from graphsdg.stage.xform import decompose, world_matrix
         stage = sim.stage
         domes = [p for p in stage.Traverse() if p.GetTypeName() == "DomeLight"
                  and UsdGeom.Imageable(p).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible]
@@ -383,7 +383,6 @@ class PbrRenderer:
 
     def _classic(self):
         if self._isolated is None:
-            from graphsdg.render.rasterizer import Rasterizer
             self._isolated = Rasterizer()
         return self._isolated
 

@@ -243,7 +243,7 @@ def renderer_directions(width: int, height: int) -> np.ndarray:
 
 
 def usd_latlong_lookup(radiance: np.ndarray, directions: np.ndarray) -> np.ndarray:
-    """Bilinear lookup of a UsdLux lat-long map (``graphsdg.sim.environment_map`` convention: top row up,
+    """Bilinear lookup of a UsdLux lat-long map (``graphsdg.imaging.environment_map`` convention: top row up,
     longitude 0 along -Y of a Z-up frame) at map-frame unit ``directions`` (..., 3)."""
     import cv2
     d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)

@@ -39,7 +39,7 @@ import cv2
 import mujoco
 import numpy as np
 
-from graphsdg import profiling
+from graphsdg.benchmark import profiling
 from graphsdg.render import gl_direct, sky
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer
@@ -47,9 +47,9 @@ from graphsdg.render.lookup import lookup
 from graphsdg.render.motion_blur import MotionSamples
 from graphsdg.render.readback import PixelReads, code_bits
 from graphsdg.render.scene_geoms import geom_array
-from graphsdg.sim.compiler import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 from graphsdg.sim.mesh_scaling import MeshMaps
 from graphsdg.sim.scene import SimScene
+from graphsdg.sim.visual import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 
 PASSES = ("color", "hdr", "depth", "segmentation")
 Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)

@@ -21,8 +21,8 @@ import mujoco
 import numpy as np
 
 from graphsdg.render.camera import CameraView
-from graphsdg.sim.compiler import UNDRAWN_GROUPS
 from graphsdg.sim.scene import SimScene
+from graphsdg.sim.visual import UNDRAWN_GROUPS
 
 SILHOUETTE_GROWTH = 1.05
 _CURVED = {int(mujoco.mjtGeom.mjGEOM_SPHERE), int(mujoco.mjtGeom.mjGEOM_ELLIPSOID),

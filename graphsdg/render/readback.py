@@ -34,7 +34,7 @@ import numpy as np
 from OpenGL import GL
 from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no client-array wrapping: a PBO offset
 
-from graphsdg import profiling
+from graphsdg.benchmark import profiling
 from graphsdg.render import gl_direct as gld
 from graphsdg.render.polling import wait_until
 

@@ -16,7 +16,7 @@ and no infinite plane, and the renderer keeps MuJoCo's skybox otherwise.
 Example (inside a current GL context, after ``mjr_render`` without the skybox flag)::
 
     sky = uniform_sky(model)          # (r, g, b) in [0, 1], or None for a textured sky
-    if sky is not None and fill_is_exact(model, drawn_geom_mask(model)):   # graphsdg.sim.compiler
+    if sky is not None and fill_is_exact(model, drawn_geom_mask(model)):   # graphsdg.sim.visual
         fill_background(512, 512, sky)
 """
 from __future__ import annotations

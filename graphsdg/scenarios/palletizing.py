@@ -41,7 +41,7 @@ from typing import Callable
 
 import numpy as np
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
 from graphsdg.scenarios.palletizing_controller import Event, PalletizingController

@@ -28,10 +28,9 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdPhysics, UsdShade
 
 from graphsdg.assets import catalog, geometry
 from graphsdg.assets.authoring import define_mesh, define_textured_material
-from graphsdg.sim.joints import rotation_about
+from graphsdg.maths.rotations import matrix_to_quat_wxyz, rotation_about
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics
-from graphsdg.stage.xform import matrix_to_quat_wxyz
 
 CELL = "/World/Ur10Table"
 BINS = f"{CELL}/bins"

@@ -15,7 +15,7 @@ whether or not anything pauses the timeline in between:
   commanded tool pose into joint position and velocity targets for the drives.
   The suction cup grips on contact: when the cup touches the bin, the bin's
   pre-authored fixed joint is switched on holding the current relative pose
-  (:func:`graphsdg.sim.articulations.set_fixed_joint_enabled`). Upright bins go
+  (:func:`graphsdg.physics.articulations.set_fixed_joint_enabled`). Upright bins go
   straight to their slot on the pallet; upside-down bins are turned over on the
   flip helper first: laid on their side, re-gripped from above and stood up,
   re-gripped from the top.
@@ -28,11 +28,11 @@ from typing import Iterator
 
 import numpy as np
 
+from graphsdg.maths.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, rotation_about
 from graphsdg.scenarios.palletizing_cell import CellLayout
 from graphsdg.scenarios.ur10 import HOME, Ur10Kinematics
-from graphsdg.sim.articulations import ArticulationView, set_fixed_joint_enabled
-from graphsdg.sim.joints import Frame, rotation_about
-from graphsdg.stage.xform import matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.physics.articulations import ArticulationView, set_fixed_joint_enabled
+from graphsdg.sim.joints import Frame
 
 Z = np.array([0.0, 0.0, 1.0])
 SPEED = 1.0                 # m/s, peak tool speed of swings and long descents

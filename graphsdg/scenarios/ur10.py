@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
-from graphsdg.sim.joints import Frame, rotation_about
-from graphsdg.stage.xform import matrix_to_quat_wxyz
+from graphsdg.maths.rotations import matrix_to_quat_wxyz, matrix_to_rotation_vector, rotation_about
+from graphsdg.sim.joints import Frame
 
 JOINT_NAMES = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
                "wrist_3_joint")
@@ -183,17 +183,7 @@ class Ur10Kinematics:
 
 def rotation_error(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     """Axis-angle vector (world frame) that turns ``current`` into ``target``."""
-    r = target @ current.T
-    cos = max(-1.0, min(1.0, (np.trace(r) - 1.0) / 2.0))
-    angle = math.acos(cos)
-    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    if angle < 1e-9:
-        return 0.5 * v
-    if math.pi - angle < 1e-6:
-        # 180 degrees: the axis is the eigenvector of r with eigenvalue 1
-        w, vecs = np.linalg.eigh((r + r.T) / 2)
-        return vecs[:, int(np.argmax(w))] * angle
-    return v * (angle / (2.0 * math.sin(angle)))
+    return matrix_to_rotation_vector(target @ current.T)
 
 
 # ---- USD authoring ----------------------------------------------------------------

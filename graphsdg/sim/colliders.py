@@ -1,8 +1,15 @@
-"""Collision shapes of meshes under ``UsdPhysics.MeshCollisionAPI`` approximations.
+"""Colliders: which gprims collide, their friction, and the shapes MuJoCo collides them as.
+
+A gprim collides when it or an ancestor has an enabled ``UsdPhysics.CollisionAPI``;
+the ``UsdPhysics.MaterialAPI`` material bound with the ``physics`` purpose sets its
+friction (PhysX's 0.5 when none). A static or kinematic ``Plane`` collider is an
+infinite plane, as in PhysX; other shapes that collide as something other than
+their drawn geom get proxy shapes in :data:`~graphsdg.sim.visual.COLLISION_ONLY_GROUP`
+(never drawn).
 
 MuJoCo collides a mesh geom through its convex hull. PhysX offers more
-approximations; each maps to MuJoCo shapes as follows (vertices are in the
-mesh's own frame, scale applied):
+``UsdPhysics.MeshCollisionAPI`` approximations; each maps to MuJoCo shapes as
+follows (vertices are in the mesh's own frame, scale applied):
 
 ==========================  ===============================================================
 ``convexHull``              the mesh's convex hull (MuJoCo's own mesh collision)
@@ -18,6 +25,8 @@ mesh's own frame, scale applied):
 
 Example:
     >>> import numpy as np
+
+from graphsdg.errors import closest
     >>> v = np.array([[0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]], dtype=float)
     >>> center, half = bounding_cube(v)
     >>> center.tolist(), half.tolist()
@@ -27,13 +36,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
+from pxr import Usd, UsdPhysics, UsdShade
+
+from graphsdg.sim.compile_error import CompileError
+from graphsdg.sim.visual import COLLISION_ONLY_GROUP
+from graphsdg.maths.rotations import matrix_to_quat_wxyz
+
+from graphsdg.errors import closest
 
 APPROXIMATIONS = ("none", "convexHull", "convexDecomposition", "boundingCube", "boundingSphere",
                   "meshSimplification", "sdf", "sphereFill")
 EXACT_APPROXIMATIONS = ("none", "meshSimplification", "sdf", "sphereFill")
 MAX_PRISM_TRIANGLES = 4096        # beyond this a non-convex part falls back to its hull
 FLAT_TOLERANCE = 1e-6             # relative thickness under which a part is flat
+DEFAULT_FRICTION = 0.5            # PhysX's default material (static = dynamic = 0.5)
 
 
 class ApproximationError(ValueError):
@@ -44,7 +62,6 @@ def check_approximation(name: object, where: str = "") -> str:
     """Return ``name`` if it is a known approximation token, else raise :class:`ApproximationError`."""
     if isinstance(name, str) and name in APPROXIMATIONS:
         return name
-    from graphsdg.errors import closest
     hint = closest(str(name), APPROXIMATIONS)
     at = f" on {where}" if where else ""
     raise ApproximationError(f"unknown collider approximation {name!r}{at}{hint}; "
@@ -184,3 +201,87 @@ def collision_pieces(verts: np.ndarray, tris: np.ndarray, approximation: str, dy
         else:
             pieces.append(Piece("hull", vertices=part_verts))
     return pieces
+
+
+def collides(prim: Usd.Prim) -> bool:
+    """Whether ``prim`` collides: the nearest ``CollisionAPI`` at or above it is enabled."""
+    p = prim
+    while p and not p.IsPseudoRoot():
+        if p.HasAPI(UsdPhysics.CollisionAPI):
+            enabled = UsdPhysics.CollisionAPI(p).GetCollisionEnabledAttr().Get()
+            return enabled is None or bool(enabled)
+        p = p.GetParent()
+    return False
+
+
+def approximation(prim: Usd.Prim) -> str:
+    """The ``physics:approximation`` of a mesh collider (``none`` when unset)."""
+    attr = UsdPhysics.MeshCollisionAPI(prim).GetApproximationAttr() if prim.HasAPI(
+        UsdPhysics.MeshCollisionAPI) else prim.GetAttribute("physics:approximation")
+    value = attr.Get() if attr and attr.IsValid() else None
+    if value is None:
+        return "none"
+    try:
+        return check_approximation(str(value), f"{prim.GetPath()} (physics:approximation)")
+    except ApproximationError as exc:
+        raise CompileError(str(exc)) from None
+
+
+def friction(prim: Usd.Prim) -> tuple[float, int]:
+    """(dynamic friction, contact priority) of the physics material bound to ``prim``.
+
+    PhysX's 0.5 when none. MuJoCo takes the larger friction of two touching geoms
+    unless one has a higher priority; a material whose
+    ``physxMaterial:frictionCombineMode`` is ``min`` or ``multiply`` (PhysX: the
+    smaller value wins) gets priority 1, so a slippery surface stays slippery.
+    """
+    binding = UsdShade.MaterialBindingAPI(prim)
+    material, _ = binding.ComputeBoundMaterial("physics")
+    if material and material.GetPrim().HasAPI(UsdPhysics.MaterialAPI):
+        mat = material.GetPrim()
+        combine = mat.GetAttribute("physxMaterial:frictionCombineMode")
+        priority = 1 if combine and str(combine.Get()) in ("min", "multiply") else 0
+        api = UsdPhysics.MaterialAPI(mat)
+        for attr in (api.GetDynamicFrictionAttr(), api.GetStaticFrictionAttr()):
+            v = attr.Get() if attr else None
+            if v is not None:
+                return max(float(v), 0.0), priority
+        return DEFAULT_FRICTION, priority
+    return DEFAULT_FRICTION, 0
+
+
+def collision_shapes(spec: mujoco.MjSpec, prim: Usd.Prim, body, geom, mesh_data, t: np.ndarray, r: np.ndarray,
+                     dynamic: bool, static: bool) -> list:
+    """The geoms that collide for ``prim``: its own geom, or proxies in :data:`COLLISION_ONLY_GROUP`."""
+    type_name = prim.GetTypeName()
+    if type_name == "Plane" and not dynamic:
+        # PhysX collides a UsdGeom.Plane as an infinite plane; so does MuJoCo's plane geom.
+        size = np.array(geom.size, dtype=np.float64)
+        plane = body.add_geom(name=f"{prim.GetPath()}#plane", type=mujoco.mjtGeom.mjGEOM_PLANE,
+                              size=[max(size[0], 1e-3), max(size[1], 1e-3), 1.0], pos=list(geom.pos),
+                              quat=list(geom.quat), group=COLLISION_ONLY_GROUP)
+        return [plane]
+    if type_name != "Mesh":
+        return [geom]
+    verts, tris = mesh_data[:2]
+    pieces = collision_pieces(verts, tris, approximation(prim), dynamic)
+    if len(pieces) == 1 and pieces[0].kind == "hull" and len(pieces[0].vertices) == len(np.unique(tris)):
+        return [geom]      # the mesh itself is the hull MuJoCo collides with
+    made = []
+    q = matrix_to_quat_wxyz(r).tolist()
+    for i, piece in enumerate(pieces):
+        name = f"{prim.GetPath()}#collider{i}"
+        if piece.kind == "box":
+            made.append(body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX, size=piece.half.tolist(),
+                                      pos=(r @ piece.center + t).tolist(), quat=q,
+                                      group=COLLISION_ONLY_GROUP))
+        elif piece.kind == "sphere":
+            made.append(body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_SPHERE,
+                                      size=[piece.radius, 0, 0], pos=(r @ piece.center + t).tolist(),
+                                      group=COLLISION_ONLY_GROUP))
+        else:
+            mesh = spec.add_mesh(name=f"mesh:{name}", uservert=(piece.vertices @ r.T + t).ravel().tolist())
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+            made.append(body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"mesh:{name}",
+                                      group=COLLISION_ONLY_GROUP))
+    return made

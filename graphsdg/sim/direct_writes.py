@@ -18,88 +18,11 @@ import mujoco
 import numpy as np
 from pxr import Usd
 
-from graphsdg.sim.compiler import primitive_size
+from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
-from graphsdg.stage.xform import decompose, world_matrix
-
-
-def euler_xyz_to_matrices(angles_deg: np.ndarray) -> np.ndarray:
-    """(N, 3) Euler XYZ degrees -> (N, 3, 3) column-vector rotations (R = Rz Ry Rx)."""
-    a = np.radians(np.asarray(angles_deg, dtype=np.float64))
-    cx, cy, cz = np.cos(a).T
-    sx, sy, sz = np.sin(a).T
-    r = np.empty((len(a), 3, 3))
-    r[:, 0, 0] = cy * cz
-    r[:, 0, 1] = sx * sy * cz - cx * sz
-    r[:, 0, 2] = cx * sy * cz + sx * sz
-    r[:, 1, 0] = cy * sz
-    r[:, 1, 1] = sx * sy * sz + cx * cz
-    r[:, 1, 2] = cx * sy * sz - sx * cz
-    r[:, 2, 0] = -sy
-    r[:, 2, 1] = sx * cy
-    r[:, 2, 2] = cx * cy
-    return r
-
-
-def matrices_to_quats(r: np.ndarray) -> np.ndarray:
-    """(N, 3, 3) rotations -> (N, 4) unit quaternions (w, x, y, z), w >= 0 (Shepperd's method)."""
-    r = np.asarray(r, dtype=np.float64)
-    m00, m11, m22 = r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]
-    q = np.empty((len(r), 4))
-    # Take the largest of w, x, y, z from the diagonal for stability, then the rest from off-diagonals.
-    cands = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], 1)
-    k = np.argmax(cands, axis=1)
-    s = np.sqrt(np.maximum(cands[np.arange(len(r)), k], 1e-300)) * 2
-    d = lambda i, j: r[:, i, j]  # noqa: E731
-    sel = [k == 0, k == 1, k == 2, k == 3]
-    q[sel[0]] = np.stack([s / 4, (d(2, 1) - d(1, 2)) / s, (d(0, 2) - d(2, 0)) / s, (d(1, 0) - d(0, 1)) / s], 1)[sel[0]]
-    q[sel[1]] = np.stack([(d(2, 1) - d(1, 2)) / s, s / 4, (d(0, 1) + d(1, 0)) / s, (d(0, 2) + d(2, 0)) / s], 1)[sel[1]]
-    q[sel[2]] = np.stack([(d(0, 2) - d(2, 0)) / s, (d(0, 1) + d(1, 0)) / s, s / 4, (d(1, 2) + d(2, 1)) / s], 1)[sel[2]]
-    q[sel[3]] = np.stack([(d(1, 0) - d(0, 1)) / s, (d(0, 2) + d(2, 0)) / s, (d(1, 2) + d(2, 1)) / s, s / 4], 1)[sel[3]]
-    return _canonical(q)
-
-
-def euler_xyz_to_quats(angles_deg: np.ndarray) -> np.ndarray:
-    """(N, 3) Euler XYZ degrees -> (N, 4) unit quaternions (w, x, y, z) of R = Rz Ry Rx, w >= 0.
-
-    The product qz qy qx of the three axis rotations, written out: the same
-    rotations as :func:`euler_xyz_to_matrices` without building the matrices.
-    """
-    half = np.radians(np.asarray(angles_deg, dtype=np.float64)) * 0.5
-    cx, cy, cz = np.cos(half).T
-    sx, sy, sz = np.sin(half).T
-    q = np.empty((len(half), 4))
-    czcy, szsy, czsy, szcy = cz * cy, sz * sy, cz * sy, sz * cy
-    q[:, 0] = czcy * cx + szsy * sx
-    q[:, 1] = czcy * sx - szsy * cx
-    q[:, 2] = czsy * cx + szcy * sx
-    q[:, 3] = szcy * cx - czsy * sx
-    return _canonical(q)
-
-
-def quat_products(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise Hamilton products ``a[i] * b[i]`` of (N, 4) quaternions (w, x, y, z): rotation b, then a."""
-    aw, ax, ay, az = a.T
-    bw, bx, by, bz = b.T
-    return np.stack([aw * bw - ax * bx - ay * by - az * bz,
-                     aw * bx + ax * bw + ay * bz - az * by,
-                     aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw], axis=1)
-
-
-def _canonical(q: np.ndarray) -> np.ndarray:
-    """Quaternions normalised, with w >= 0 (one of the two for each rotation), in place."""
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    q[q[:, 0] < 0] *= -1
-    return q
-
-
-def _unit_quats(q: np.ndarray) -> np.ndarray:
-    """(N, 4) quaternions as given (any length, not all zero) -> unit, w >= 0."""
-    norms = np.linalg.norm(q, axis=1)
-    if np.any(norms < 1e-12):
-        raise ValueError(f"rotation quaternions must not be zero, got {q[norms < 1e-12][0].tolist()}")
-    return _canonical(np.array(q, dtype=np.float64))
+from graphsdg.maths.rotations import canonical_quat, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
+    quat_multiply, unit_quat
+from graphsdg.stage.xform import world_matrix
 
 
 class DirectTargets:
@@ -116,11 +39,9 @@ class DirectTargets:
         self.geom_ids = np.array([b.geom_id for b in self.bindings])
         self.mocap_ids = np.array([b.mocap_id for b in self.bindings])
         parents = [p.GetParent() for p in prims]
-        mats = [world_matrix(p) if p and not p.IsPseudoRoot() else np.eye(4) for p in parents]
-        self.parent_t = np.array([m[3, :3] for m in mats])
-        self.parent_r = np.array([decompose(m)[1] for m in mats])
-        self.parent_q = matrices_to_quats(self.parent_r)
-        self.parent_s = np.array([decompose(m)[2] for m in mats])
+        mats = np.array([world_matrix(p) if p and not p.IsPseudoRoot() else np.eye(4) for p in parents])
+        self.parent_t, self.parent_r, self.parent_s = decompose(mats.reshape(-1, 4, 4))
+        self.parent_q = matrix_to_quat_wxyz(self.parent_r)
         # most batches sit under an untransformed parent: their local poses are world poses
         self.parent_is_identity = bool(np.allclose(self.parent_t, 0.0, atol=0.0) and
                                        np.allclose(self.parent_r, np.eye(3), atol=0.0) and
@@ -231,9 +152,9 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
             t.parent_t + np.einsum("nij,nj->ni", t.parent_r, local * t.parent_s)
     if rotations is not None:
         rot = np.asarray(rotations, dtype=np.float64)
-        local_q = _unit_quats(rot.reshape(n, 4)) if rot.shape[-1] == 4 else euler_xyz_to_quats(rot.reshape(n, 3))
+        local_q = unit_quat(rot.reshape(n, 4)) if rot.shape[-1] == 4 else euler_xyz_to_quat(rot.reshape(n, 3))
         d.mocap_quat[t.mocap_ids] = local_q if t.parent_is_identity else \
-            _canonical(quat_products(t.parent_q, local_q))
+            canonical_quat(quat_multiply(t.parent_q, local_q))
     if scales is not None:
         current = t.current_scales()
         _write_mesh_scales(sim, t, world_scale, current)
@@ -300,4 +221,4 @@ def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> tuple[np.ndarray
     return box | sphere | tube, sizes
 
 
-__all__ = ["write_poses", "write_colors", "euler_xyz_to_matrices", "euler_xyz_to_quats", "quat_products"]
+__all__ = ["write_poses", "write_colors"]

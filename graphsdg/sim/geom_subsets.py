@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.sim.mesh_normals import MeshNormals
 from graphsdg.sim.texcoords import fan_triangles
 from graphsdg.stage import materials as matlib
@@ -145,14 +145,14 @@ class PartGeom:
     label_path: str
 
 
-def add_part_geoms(builder, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris: np.ndarray,
+def add_part_geoms(materials, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris: np.ndarray,
                    normals: MeshNormals | None, r: np.ndarray, t: np.ndarray,
                    material_rgba: tuple[float, ...]) -> list[PartGeom]:
     """Add a drawn geom per :func:`face_parts` of ``mesh`` (if it has any) beside its own ``geom``.
 
-    ``builder`` is the compiler's builder: its ``spec``, ``material(prim)``
-    (registers the prim's bound material, returns its name) and
-    ``mesh_uvs(prim, material)`` are used. ``verts`` / ``tris`` are the mesh's
+    ``materials`` is the compile's :class:`graphsdg.sim.materials.SpecMaterials`: its
+    ``spec``, ``material(prim)`` (registers the prim's bound material, returns its
+    name) and ``mesh_uvs(prim, material)`` are used. ``verts`` / ``tris`` are the mesh's
     scaled vertices and triangles (``normals`` its authored normals, if any),
     ``r`` / ``t`` its pose in ``body``'s frame;
     a part showing a material gets ``material_rgba`` (the geom colour that lets
@@ -169,11 +169,11 @@ def add_part_geoms(builder, mesh: Usd.Prim, body, geom, verts: np.ndarray, tris:
         part_tris = tris[part.triangles]
         used, local = np.unique(part_tris, return_inverse=True)   # MuJoCo meshes hold only the points they use
         name = f"{path}#part{i}"
-        mj_mesh = builder.spec.add_mesh(name=f"mesh:{name}", uservert=(verts[used] @ r.T + t).ravel().tolist(),
+        mj_mesh = materials.spec.add_mesh(name=f"mesh:{name}", uservert=(verts[used] @ r.T + t).ravel().tolist(),
                                         userface=local.reshape(-1, 3).ravel().tolist())
         mj_mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
-        material = builder.material(part.material_prim)
-        uvs = builder.mesh_uvs(mesh, material)
+        material = materials.material(part.material_prim)
+        uvs = materials.mesh_uvs(mesh, material)
         if uvs is not None and len(uvs.face_texcoord) == len(tris):
             mj_mesh.usertexcoord = uvs.texcoord.ravel().tolist()
             mj_mesh.userfacetexcoord = uvs.face_texcoord[part.triangles].ravel().tolist()

@@ -29,8 +29,13 @@ reads the stage's joints and decides, for every rigid body, where it hangs:
   excludes contacts between all of that articulation's links (MuJoCo always
   skips parent-child contacts, as PhysX skips jointed pairs).
 
+:func:`add_link_body` and :func:`add_joint_elements` add the plan to a compile's
+``MjSpec``, :func:`bind_joints` finds its joints in the compiled model, and
+:func:`sync_drive` writes a drive's edited targets into it live.
+
 Example:
     >>> import numpy as np
+    >>> from graphsdg.maths.rotations import rotation_about
     >>> f = Frame(np.array([0.0, 0.0, 1.0]), rotation_about(2, np.pi / 2))
     >>> np.round((f @ f.inverse()).pos, 9).tolist()
     [0.0, 0.0, 0.0]
@@ -40,11 +45,16 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from typing import Callable
 
+import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom, UsdPhysics
 
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, world_matrix
+from graphsdg.sim.compiled_scene import CompiledScene, JointBinding
+from graphsdg.sim.needs_recompile import NeedsRecompile
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 
 JOINT_KINDS = {"PhysicsRevoluteJoint": "revolute", "PhysicsPrismaticJoint": "prismatic",
                "PhysicsFixedJoint": "fixed", "PhysicsSphericalJoint": "spherical"}
@@ -73,16 +83,6 @@ class Frame:
     def of_prim(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -> "Frame":
         t, r, _ = decompose(world_matrix(prim, cache))
         return Frame(t, r)
-
-
-def rotation_about(axis: int, angle: float) -> np.ndarray:
-    """Column-vector rotation by ``angle`` radians about coordinate axis ``axis`` (0, 1, 2)."""
-    c, s = math.cos(angle), math.sin(angle)
-    if axis == 0:
-        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-    if axis == 1:
-        return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 @dataclass
@@ -365,3 +365,103 @@ def measured_position(link: TreeLink, parent_world: Frame, child_world: Frame) -
         rc = link.child_frame.rot
         return matrix_to_quat_wxyz(rc @ rel.rot @ rc.T)
     return np.zeros(0)
+
+
+def add_link_body(parent, link: TreeLink):
+    """The MuJoCo body of a tree link, added under ``parent`` (its parent's MjSpec body) at the joint's zero
+    pose, with its joint."""
+    rest = link.rest_pose()
+    body = parent.add_body(name=link.body, pos=rest.pos.tolist(), quat=matrix_to_quat_wxyz(rest.rot).tolist())
+    j = link.joint
+    kinds = {"revolute": mujoco.mjtJoint.mjJNT_HINGE, "prismatic": mujoco.mjtJoint.mjJNT_SLIDE,
+             "spherical": mujoco.mjtJoint.mjJNT_BALL}
+    if j.kind in kinds:
+        joint = body.add_joint(name=j.path, type=kinds[j.kind], pos=link.child_frame.pos.tolist(),
+                               axis=link.axis_in_child().tolist(), armature=j.armature)
+        if j.lower is not None:
+            joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+            joint.range = [j.lower, j.upper]
+        else:
+            joint.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+    return body
+
+
+def add_joint_elements(spec: mujoco.MjSpec, jp: JointPlan, body_for: Callable[[str], object]) -> None:
+    """Tree bodies without geometry, drive actuators, weld constraints and self-collision filters.
+
+    ``body_for(path)`` is the MjSpec body of rigid body ``path`` (made on first use).
+    """
+    for body in list(jp.links):
+        body_for(body)
+    for path in jp.order:
+        link = next(lk for lk in jp.links.values() if lk.joint.path == path)
+        drive = link.joint.drive
+        if drive is None or link.joint.kind not in ("revolute", "prismatic"):
+            continue
+        act = spec.add_actuator(name=path, target=path, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        act.gainprm[0] = drive.stiffness
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.biasprm[:3] = [drive.damping * drive.target_velocity, -drive.stiffness, -drive.damping]
+        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        if np.isfinite(drive.max_force):
+            act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            act.forcerange = [-drive.max_force, drive.max_force]
+        else:
+            act.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
+    for weld in jp.welds:
+        for body in (weld.body0, weld.body1):
+            if body != WORLD:
+                body_for(body)
+        rel = weld.frame0 @ weld.frame1.inverse()      # body1 in body0's frame when the joint holds
+        data = np.zeros(mujoco.mjNEQDATA)
+        data[3:6] = rel.pos
+        data[6:10] = matrix_to_quat_wxyz(rel.rot)
+        data[10] = 1.0                                  # torque scale
+        spec.add_equality(name=weld.path, type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,
+                          name1=weld.body0 or "world", name2=weld.body1 or "world",
+                          active=weld.enabled, data=data.tolist())
+    for bodies in jp.no_self_collision:
+        for i, a in enumerate(bodies):
+            for b in bodies[i + 1:]:
+                spec.add_exclude(bodyname1=a, bodyname2=b)
+
+
+def bind_joints(scene: CompiledScene, jp: JointPlan, stage: Usd.Stage, cache: UsdGeom.XformCache) -> None:
+    """Joint bindings of the compiled ``scene``; tree joints start at the value the links' authored poses show."""
+    model, data = scene.model, scene.data
+    for link in jp.links.values():
+        j = link.joint
+        b = JointBinding(path=j.path, kind=j.kind, body0=j.body0, body1=j.body1,
+                         articulation=jp.articulation.get(link.body, ""), reversed=link.reversed)
+        b.joint_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.path)
+        if b.joint_id >= 0:
+            b.qpos_adr, b.dof_adr = int(model.jnt_qposadr[b.joint_id]), int(model.jnt_dofadr[b.joint_id])
+            parent = Frame(np.zeros(3), np.eye(3)) if link.parent == WORLD else \
+                Frame.of_prim(stage.GetPrimAtPath(link.parent), cache)
+            child = Frame.of_prim(stage.GetPrimAtPath(link.body), cache)
+            value = measured_position(link, parent, child)
+            data.qpos[b.qpos_adr:b.qpos_adr + len(value)] = value
+        b.actuator_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, j.path)
+        if b.actuator_id >= 0:
+            data.ctrl[b.actuator_id] = j.drive.target_position
+        scene.joints[j.path] = b
+    for weld in jp.welds:
+        b = JointBinding(path=weld.path, kind=weld.kind, body0=weld.body0, body1=weld.body1)
+        b.eq_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, weld.path)
+        scene.joints[weld.path] = b
+
+
+def sync_drive(c: CompiledScene, stage: Usd.Stage, path: str, names: set[str], rigid_root) -> None:
+    """A drive's target edited on the stage: a write into ``ctrl`` / the actuator's bias."""
+    j = c.joints[path]
+    if not all(n.startswith("drive:") and n.endswith(("targetPosition", "targetVelocity")) for n in names):
+        raise NeedsRecompile     # stiffness, damping, limits...: rebuild the actuator
+    if j.actuator_id < 0:
+        raise NeedsRecompile     # a drive that did not exist at compile time
+    prim = stage.GetPrimAtPath(path)
+    drive = read_joint(prim, rigid_root).drive
+    if drive is None:
+        raise NeedsRecompile
+    c.data.ctrl[j.actuator_id] = drive.target_position
+    c.model.actuator_biasprm[j.actuator_id, 0] = drive.damping * drive.target_velocity

@@ -19,7 +19,7 @@ from typing import Iterator
 import mujoco
 import numpy as np
 
-from graphsdg.stage.xform import quat_wxyz_to_matrix
+from graphsdg.maths.rotations import quat_wxyz_to_matrix
 
 
 def rescale_mesh_geoms(model: mujoco.MjModel, geom_ids: np.ndarray, old_scales: np.ndarray,

@@ -18,6 +18,8 @@ from collections import OrderedDict
 import cv2
 import numpy as np
 
+from graphsdg.imaging.environment_map import tonemap
+
 MAX_EDGE = 4096          # larger images are downsampled (memory, and GL upload time on CPU renderers)
 _CACHE_SIZE = 64
 
@@ -47,8 +49,8 @@ def _to_rgb8(img: np.ndarray, path: str) -> np.ndarray:
     if img.dtype == np.uint16:
         return np.ascontiguousarray((img >> 8).astype(np.uint8))
     if np.issubdtype(img.dtype, np.floating):
-        from graphsdg.sim.environment_map import tonemap   # HDR/EXR used as a colour map
-        return tonemap(np.nan_to_num(img.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0))
+        return tonemap(   # HDR/EXR used as a colour map
+            np.nan_to_num(img.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0))
     raise TextureFileError(f"texture file {path!r} has unsupported pixel type {img.dtype}")
 
 

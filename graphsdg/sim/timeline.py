@@ -1,6 +1,9 @@
 """The timeline: play / pause / stop, simulated time, and timeline events.
 
-Mirrors ``omni.timeline``. The timeline runs at ``time_codes_per_second``
+Mirrors ``omni.timeline``; the process's timeline is the runtime's
+(:func:`graphsdg.physics.timeline.get_timeline_interface`, ``rep.timeline``): the
+runtime hands it the stage's simulation as a callable, so this module never
+reaches back into the runtime. The timeline runs at ``time_codes_per_second``
 (the stage's, 60 by default); while it plays, each app update
 (:func:`graphsdg.orchestrator.update`, the equivalent of Isaac's
 ``simulation_app.update()``) advances it one frame, ``1 / time_codes_per_second``
@@ -46,7 +49,7 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 
 if TYPE_CHECKING:
     from graphsdg.sim.scene import SimScene
@@ -364,9 +367,3 @@ def _seconds(value: Any, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ValueError(f"{what} must be a finite number of seconds, got {value!r}")
     return float(value)
-
-
-def get_timeline_interface() -> Timeline:
-    """The process's timeline (``omni.timeline.get_timeline_interface()``)."""
-    from graphsdg.runtime import runtime
-    return runtime().timeline

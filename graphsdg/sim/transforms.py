@@ -3,7 +3,9 @@
 The stage is current: simulated rigid-body poses are authored on it after every
 physics step, so these functions see where bodies are now. They mirror
 ``omni.usd.get_world_transform_matrix`` and Replicator's
-``scripts.functional.utils.get_world_position``.
+``scripts.functional.utils.get_world_position``. Setting a world pose is
+:func:`graphsdg.physics.world_pose.set_world_pose`, which authors the local pose
+:func:`local_pose_for_world` computes.
 
 Example:
     >>> import graphsdg as rep
@@ -19,8 +21,10 @@ from __future__ import annotations
 import numpy as np
 from pxr import Gf, Usd, UsdGeom
 
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.prims import PrimLike, resolve_prim
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graphsdg.stage.xform import world_matrix
 
 
 def get_world_transform_matrix(prim: PrimLike, time: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
@@ -42,10 +46,10 @@ def get_world_pose(prim: PrimLike) -> tuple[np.ndarray, np.ndarray]:
     return t, matrix_to_quat_wxyz(r)
 
 
-def set_world_pose(prim: PrimLike, position=None, orientation=None) -> None:
-    """Place the prim so its world position is ``position`` (3,) and its world rotation the quaternion
-    ``orientation`` (w, x, y, z); either may be ``None`` (kept). The world scale is kept; the local pose
-    authored is the one that yields this world pose under the prim's parent.
+def local_pose_for_world(prim: PrimLike, position=None, orientation=None) -> tuple[np.ndarray, np.ndarray]:
+    """The local (translation (3,), quaternion (w, x, y, z)) that puts the prim at world position
+    ``position`` (3,) with world rotation ``orientation`` (w, x, y, z) under its parent; either may be
+    ``None`` (kept). The world scale is kept. :func:`graphsdg.physics.world_pose.set_world_pose` authors it.
 
     Example:
         >>> import graphsdg as rep
@@ -53,13 +57,10 @@ def set_world_pose(prim: PrimLike, position=None, orientation=None) -> None:
         >>> _ = rep.stage.new_stage()
         >>> world = rep.functional.create.xform(name="World", position=(1, 0, 0))
         >>> cube = rep.functional.create.cube(parent=world)
-        >>> transforms.set_world_pose(cube, position=(0, 0, 3))
-        >>> transforms.get_world_position(cube).tolist()
-        [0.0, 0.0, 3.0]
+        >>> t, q = transforms.local_pose_for_world(cube, position=(0, 0, 3))
+        >>> t.tolist(), q.tolist()
+        ([-1.0, 0.0, 3.0], [1.0, 0.0, 0.0, 0.0])
     """
-    from graphsdg.functional import modify
-    from graphsdg.stage.xform import quat_wxyz_to_matrix
-
     p = resolve_prim(prim)
     parent = p.GetParent()
     parent_m = world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
@@ -71,7 +72,7 @@ def set_world_pose(prim: PrimLike, position=None, orientation=None) -> None:
         r = quat_wxyz_to_matrix(np.asarray(orientation, dtype=np.float64).reshape(4))
         world[:3, :3] = (r * scale).T   # row-vector layout: rows are the scaled local axes
     t, r, _ = decompose(world @ np.linalg.inv(parent_m))
-    modify.pose(p, position_value=t, rotation_value=matrix_to_quat_wxyz(r))
+    return t, matrix_to_quat_wxyz(r)
 
 
 def get_world_scale(prim: PrimLike) -> np.ndarray:

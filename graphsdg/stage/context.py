@@ -15,6 +15,7 @@ from typing import Callable
 
 from pxr import Sdf, Usd, UsdGeom
 
+from graphsdg.assets.root import builtin_pack_root
 from graphsdg.errors import usd_error_text
 from graphsdg.stage.changes import ChangeTracker
 
@@ -115,7 +116,6 @@ def save(path: str | os.PathLike | None = None) -> str:
         layer = stage.GetRootLayer()
         if layer.anonymous:
             raise ValueError("the stage is in memory only; pass save(path='scene.usda')")
-        from graphsdg.assets.root import builtin_pack_root
         pack = os.path.realpath(builtin_pack_root())
         if os.path.realpath(layer.realPath).startswith(pack + os.sep):
             raise PermissionError(f"{layer.realPath} belongs to graphsdg's built-in asset pack; "

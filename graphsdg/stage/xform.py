@@ -2,120 +2,28 @@
 
 Conventions (the USD ones): matrices are row-vector 4x4 (``p_world = p_local @ M``,
 translation in the last row); Euler angles are degrees, ``rotateXYZ`` applies X,
-then Y, then Z; cameras and lights look down their local -Z with +Y up.
+then Y, then Z; cameras and lights look down their local -Z with +Y up. The
+rotation maths itself (Euler angles, quaternions, decomposition) is
+:mod:`graphsdg.maths.rotations`.
 """
 from __future__ import annotations
 
-import math
 from typing import Sequence
 
 import numpy as np
 from pxr import Gf, Usd, UsdGeom
 
 from graphsdg.errors import describe
+from graphsdg.maths.rotations import (ROTATION_ORDERS, decompose, look_at_matrix, matrix_to_euler_xyz,
+                                      matrix_to_quat_wxyz)
 
-ROTATION_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 _ROTATE_OPS = {
     "XYZ": UsdGeom.XformOp.TypeRotateXYZ, "XZY": UsdGeom.XformOp.TypeRotateXZY,
     "YXZ": UsdGeom.XformOp.TypeRotateYXZ, "YZX": UsdGeom.XformOp.TypeRotateYZX,
     "ZXY": UsdGeom.XformOp.TypeRotateZXY, "ZYX": UsdGeom.XformOp.TypeRotateZYX,
 }
 _OP_ORDER_BY_TYPE = {v: k for k, v in _ROTATE_OPS.items()}
-
-
-def _axis_matrix(axis: str, deg: float) -> np.ndarray:
-    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
-    if axis == "X":
-        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-    if axis == "Y":
-        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
-def euler_to_matrix(angles_deg: Sequence[float], order: str = "XYZ") -> np.ndarray:
-    """Column-vector rotation matrix of USD's ``rotate<order>`` op (first axis applied first)."""
-    order = order.upper()
-    if order not in ROTATION_ORDERS:
-        raise ValueError(f"rotation_order must be one of {ROTATION_ORDERS}, got {order!r}")
-    angles = dict(zip("XYZ", [float(a) for a in angles_deg]))
-    r = np.eye(3)
-    for axis in order:
-        r = _axis_matrix(axis, angles[axis]) @ r
-    return r
-
-
-def matrix_to_euler_xyz(r: np.ndarray) -> tuple[float, float, float]:
-    """Inverse of :func:`euler_to_matrix` for order XYZ (R = Rz @ Ry @ Rx), degrees."""
-    sy = -float(np.clip(r[2, 0], -1.0, 1.0))
-    b = math.asin(sy)
-    if abs(sy) < 1 - 1e-9:
-        a = math.atan2(r[2, 1], r[2, 2])
-        c = math.atan2(r[1, 0], r[0, 0])
-    else:  # gimbal lock: fold everything into X
-        a = math.atan2(-r[1, 2], r[1, 1])
-        c = 0.0
-    return (math.degrees(a), math.degrees(b), math.degrees(c))
-
-
-def quat_wxyz_to_matrix(q: Sequence[float]) -> np.ndarray:
-    w, x, y, z = (float(v) for v in q)
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    if n == 0:
-        raise ValueError("quaternion must be non-zero")
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
-def matrix_to_quat_wxyz(r: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a column-vector rotation matrix, w >= 0."""
-    m = np.asarray(r, dtype=np.float64)
-    t = np.trace(m)
-    if t > 0:
-        s = math.sqrt(t + 1.0) * 2
-        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
-        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
-        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
-    else:
-        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
-        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
-    q = np.array(q)
-    q /= np.linalg.norm(q)
-    return -q if q[0] < 0 else q
-
-
-def look_at_matrix(eye: Sequence[float], target: Sequence[float],
-                   up: Sequence[float] = (0.0, 0.0, 1.0)) -> np.ndarray:
-    """Rotation whose local -Z points from ``eye`` to ``target`` and local +Y leans to ``up``."""
-    # Plain float arithmetic: numpy's per-call overhead on 3-vectors was most of a camera's pose edit.
-    ex, ey, ez = (float(v) for v in eye)
-    tx, ty, tz = (float(v) for v in target)
-    fx, fy, fz = tx - ex, ty - ey, tz - ez
-    length = math.sqrt(fx * fx + fy * fy + fz * fz)
-    if length < 1e-12:
-        raise ValueError(f"look_at target {tuple(target)} coincides with the position {tuple(eye)}")
-    z = (-fx / length, -fy / length, -fz / length)
-    x = _cross(tuple(float(v) for v in up), z)
-    if math.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2) < 1e-9:  # looking along the up axis: any perpendicular up
-        x = _cross((0.0, 1.0, 0.0) if abs(z[1]) < 0.9 else (1.0, 0.0, 0.0), z)
-    n = math.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
-    x = (x[0] / n, x[1] / n, x[2] / n)
-    y = _cross(z, x)
-    return np.array([x, y, z], dtype=np.float64).T
-
-
 _IDENTITY3 = np.eye(3)
-
-
-def _cross(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def up_axis_vector(stage: Usd.Stage) -> tuple[float, float, float]:
@@ -130,29 +38,6 @@ def world_matrix(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -> np.
         m = UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(Usd.TimeCode.Default()) \
             if prim.IsA(UsdGeom.Xformable) else Gf.Matrix4d(1.0)
     return np.array(m, dtype=np.float64)
-
-
-def decompose(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Split a row-vector 4x4 into (translation, column-vector rotation 3x3, per-axis scale).
-
-    Shear is dropped (the rotation is orthonormalised).
-    """
-    m = np.asarray(m, dtype=np.float64)
-    rows = m[:3, :3].tolist()
-    scale = [max(math.sqrt(x * x + y * y + z * z), 1e-12) for x, y, z in rows]
-    u = [[v / s for v in row] for row, s in zip(rows, scale)]   # unit rows: the rotation's columns
-    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = u
-    if a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0) < 0:
-        scale[0] = -scale[0]
-        u[0] = [-a0, -a1, -a2]
-        a0, a1, a2 = u[0]
-    r = np.array(u).T
-    # rows already orthogonal (no shear, the usual case): r is a rotation up to rounding, no SVD needed
-    if max(abs(a0 * b0 + a1 * b1 + a2 * b2), abs(a0 * c0 + a1 * c1 + a2 * c2),
-           abs(b0 * c0 + b1 * c1 + b2 * c2)) > 1e-12:
-        left, _, right = np.linalg.svd(r)
-        r = left @ right
-    return m[3, :3].copy(), r, np.array(scale)
 
 
 UNITS_RESOLVE_SUFFIX = ":unitsResolve"

@@ -7,7 +7,8 @@ Per frame ``n`` (zero-padded to ``frame_padding``) and per enabled flag:
 each file goes to ``<rp_name>/<annotator>/`` (or ``<annotator>/<rp_name>_`` with
 ``use_common_output_dir=True``). With ``provenance=True`` it also writes
 ``provenance_{n}.json``: the values the graph sampled, by node name, with the
-frame each was drawn on and the ``trigger_outputs``.
+frame each was drawn on and the ``trigger_outputs``. Which files each annotator
+writes is the layout table of :mod:`graphsdg.io.basic_writer_layout`.
 
 Example:
     >>> import graphsdg as rep, tempfile
@@ -18,36 +19,18 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
 from graphsdg.io.backends import BaseBackend
+from graphsdg.io.basic_writer_layout import FLAGS, IMAGE, LayoutFile, files_of
 from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
 
-# flag -> (annotator name BasicWriter requests, file stem)
-_FLAGS = {
-    "rgb": ("rgb", "rgb"),
-    "bounding_box_2d_tight": ("bounding_box_2d_tight_fast", "bounding_box_2d_tight"),
-    "bounding_box_2d_loose": ("bounding_box_2d_loose_fast", "bounding_box_2d_loose"),
-    "semantic_segmentation": ("semantic_segmentation", "semantic_segmentation"),
-    "instance_id_segmentation": ("instance_id_segmentation_fast", "instance_id_segmentation"),
-    "instance_segmentation": ("instance_segmentation_fast", "instance_segmentation"),
-    "distance_to_camera": ("distance_to_camera", "distance_to_camera"),
-    "distance_to_image_plane": ("distance_to_image_plane", "distance_to_image_plane"),
-    "bounding_box_3d": ("bounding_box_3d_fast", "bounding_box_3d"),
-    "occlusion": ("occlusion", "occlusion"),
-    "normals": ("normals", "normals"),
-    "motion_vectors": ("motion_vectors", "motion_vectors"),
-    "camera_params": ("camera_params", "camera_params"),
-    "pointcloud": ("pointcloud", "pointcloud"),
-    "skeleton_data": ("skeleton_data", "skeleton"),
-}
 _SEMANTIC = {"bounding_box_2d_tight", "bounding_box_2d_loose", "semantic_segmentation", "instance_segmentation",
              "bounding_box_3d", "occlusion", "pointcloud"}
 IMAGE_FORMATS = ("png", "jpg", "jpeg")
+_WRITE_BY_EXT = {"png": iof.write_image, "jpg": iof.write_image, "npy": iof.write_np, "json": iof.write_json}
 
 
 class BasicWriter(Writer):
@@ -95,7 +78,7 @@ class BasicWriter(Writer):
         self._colorize = {"semantic_segmentation": colorize_semantic_segmentation,
                           "instance_id_segmentation": colorize_instance_id_segmentation,
                           "instance_segmentation": colorize_instance_segmentation}
-        self._colorize_depth = colorize_depth
+        self._options = {"colorize_depth"} if colorize_depth else set()   # the layout's optional files
         self._provenance = bool(provenance)
         flags = {"rgb": rgb, "bounding_box_2d_tight": bounding_box_2d_tight,
                  "bounding_box_2d_loose": bounding_box_2d_loose, "semantic_segmentation": semantic_segmentation,
@@ -109,7 +92,7 @@ class BasicWriter(Writer):
         for flag, enabled in flags.items():
             if not enabled:
                 continue
-            anno_name, stem = _FLAGS[flag]
+            anno_name, stem = FLAGS[flag]
             spec = AnnotatorRegistry.resolve(anno_name)   # clear error if not available
             params: dict[str, Any] = {}
             if flag in _SEMANTIC and "semanticFilter" in spec.defaults:
@@ -155,18 +138,12 @@ class BasicWriter(Writer):
                                   path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
         self._frame_id += 1
 
-    def _files_of(self, stem: str) -> list[str]:
-        """The ``suffix.ext`` of every file :meth:`_write_one` writes for ``stem``."""
-        files = {"rgb": [f".{self._image_ext}"], "semantic_segmentation": [".png", "_labels.json"],
-                 "instance_id_segmentation": [".png", "_mapping.json"], "camera_params": [".json"],
-                 "instance_segmentation": [".png", "_mapping.json", "_semantics_mapping.json"],
-                 "normals": [".png"], "skeleton": [".json"],
-                 "pointcloud": [".npy", "_rgb.npy", "_normals.npy", "_semantic.npy", "_instance.npy"]}
-        if stem.startswith("bounding_box"):
-            return [".npy", "_labels.json", "_prim_paths.json"]
-        if stem.startswith("distance_to"):
-            return [".npy", ".png"] if self._colorize_depth else [".npy"]
-        return files.get(stem, [".npy"])
+    def _files_of(self, stem: str) -> tuple[LayoutFile, ...]:
+        """The files :meth:`_write_one` writes for ``stem`` (BasicWriter's layout table)."""
+        return files_of(stem, self._options)
+
+    def _ext(self, file: LayoutFile) -> str:
+        return self._image_ext if file.ext == IMAGE else file.ext
 
     def expected_files(self, frame_index: int) -> list[str]:
         """The files (relative to the output folder) this writer writes for frame ``frame_index``."""
@@ -176,9 +153,8 @@ class BasicWriter(Writer):
         for anno in self._annotator_objects():
             stem = self._stems.get(anno.name, anno.name[:-5] if anno.name.endswith("_fast") else anno.name)
             for rp_name in rps:
-                for tail in self._files_of(stem):
-                    suffix, ext = tail.rsplit(".", 1)
-                    out.append(f"{self._path(stem, rp_name, multi, suffix, frame_index)}.{ext}")
+                for file in self._files_of(stem):
+                    out.append(f"{self._path(stem, rp_name, multi, file.suffix, frame_index)}.{self._ext(file)}")
         if self._provenance:
             out.append(f"provenance_{self._sequence}{frame_index:0{self._padding}d}.json")
         return out
@@ -188,44 +164,10 @@ class BasicWriter(Writer):
         return all(self.backend.exists(f) for f in self.expected_files(frame_index))
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
-        b = self.backend
-        path = lambda suffix="": self._path(stem, rp_name, multi, suffix)  # noqa: E731
-        arr = payload.get("data")
-        if stem == "rgb":
-            b.schedule(iof.write_image, data=arr, path=f"{path()}.{self._image_ext}")
-        elif stem.startswith("bounding_box"):
-            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
-            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_labels')}.json")
-            b.schedule(iof.write_json, data=list(payload["primPaths"]), path=f"{path('_prim_paths')}.json")
-        elif stem == "semantic_segmentation":
-            b.schedule(iof.write_image, data=arr, path=f"{path()}.png")
-            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_labels')}.json")
-        elif stem == "instance_id_segmentation":
-            b.schedule(iof.write_image, data=arr, path=f"{path()}.png")
-            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_mapping')}.json")
-        elif stem == "instance_segmentation":
-            b.schedule(iof.write_image, data=arr, path=f"{path()}.png")
-            b.schedule(iof.write_json, data=payload["idToLabels"], path=f"{path('_mapping')}.json")
-            b.schedule(iof.write_json, data=payload["idToSemantics"], path=f"{path('_semantics_mapping')}.json")
-        elif stem.startswith("distance_to"):
-            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
-            if self._colorize_depth:
-                b.schedule(iof.write_image, data=colorize_depth(arr), path=f"{path()}.png")
-        elif stem == "camera_params":
-            b.schedule(iof.write_json, data=payload, path=f"{path()}.json")
-        elif stem == "normals":
-            b.schedule(iof.write_image, data=colorize_normals(arr), path=f"{path()}.png")
-        elif stem == "pointcloud":
-            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
-            b.schedule(iof.write_np, data=np.asarray(payload["pointRgb"]).reshape(-1, 4), path=f"{path('_rgb')}.npy")
-            b.schedule(iof.write_np, data=np.asarray(payload["pointNormals"]).reshape(-1, 4),
-                       path=f"{path('_normals')}.npy")
-            b.schedule(iof.write_np, data=payload["pointSemantic"], path=f"{path('_semantic')}.npy")
-            b.schedule(iof.write_np, data=payload["pointInstance"], path=f"{path('_instance')}.npy")
-        elif stem == "skeleton":
-            b.schedule(iof.write_json, data=skeleton_json(payload), path=f"{path()}.json")
-        else:
-            b.schedule(iof.write_np, data=arr, path=f"{path()}.npy")
+        for file in self._files_of(stem):
+            ext = self._ext(file)
+            self.backend.schedule(_WRITE_BY_EXT[ext], data=file.content(payload),
+                                  path=f"{self._path(stem, rp_name, multi, file.suffix)}.{ext}")
 
 
 def sequence_prefix(trigger_outputs: dict) -> str:
@@ -238,47 +180,3 @@ def sequence_prefix(trigger_outputs: dict) -> str:
         if "on_time" in name:
             seq = f"{count}_{seq}"
     return seq
-
-
-def skeleton_json(payload: dict) -> dict:
-    """Replicator's ``skeleton_{n}.json``: ``{"skeleton_<i>": {snake_case fields}}`` split per skeleton."""
-    out = {}
-    sizes = np.asarray(payload["skeletonParentsSizes"], dtype=np.int64)
-    starts = np.concatenate([[0], np.cumsum(sizes)])
-    per_joint = {"skeleton_parents": "skeletonParents", "rest_global_translations": "restGlobalTranslations",
-                 "rest_local_translations": "restLocalTranslations", "rest_local_rotations": "restLocalRotations",
-                 "global_translations": "globalTranslations", "local_rotations": "localRotations",
-                 "translations_2d": "translations2d", "skeleton_joints": "skeletonJoints",
-                 "joint_occlusions": "jointOcclusions"}
-    for i in range(int(payload["numSkeletons"])):
-        lo, hi = int(starts[i]), int(starts[i + 1])
-        entry = {"skel_name": payload["skelName"][i], "skel_path": payload["skelPath"][i],
-                 "asset_path": payload["assetPath"][i], "animation_variant": payload["animationVariant"][i]}
-        for key, src in per_joint.items():
-            entry[key] = np.asarray(payload[src][lo:hi]).tolist() if key != "skeleton_joints" \
-                else list(payload[src][lo:hi])
-        entry["occlusion_types"] = payload["occlusionTypes"][i]
-        entry["in_view"] = bool(payload["inView"][i])
-        out[f"skeleton_{i}"] = entry
-    return out
-
-
-def colorize_depth(depth: np.ndarray) -> np.ndarray:
-    """Depth as an 8-bit grey PNG (near bright, far dark; background black), log-scaled."""
-    d = np.asarray(depth, dtype=np.float64)
-    finite = np.isfinite(d) & (d > 0)
-    out = np.zeros(d.shape, dtype=np.uint8)
-    if finite.any():
-        logd = np.log(d[finite])
-        lo, hi = logd.min(), logd.max()
-        scale = (hi - lo) or 1.0
-        out[finite] = (255 - (logd - lo) / scale * 215).astype(np.uint8)
-    return out
-
-
-def colorize_normals(normals: np.ndarray) -> np.ndarray:
-    """World normals (H, W, 4) to an RGBA image ((n + 1) / 2 * 255)."""
-    n = np.asarray(normals, dtype=np.float32)
-    rgb = np.clip((n[..., :3] + 1.0) * 0.5 * 255.0, 0, 255).astype(np.uint8)
-    alpha = np.where(np.any(n[..., :3] != 0, axis=-1), 255, 0).astype(np.uint8)
-    return np.dstack([rgb, alpha])

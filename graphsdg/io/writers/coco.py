@@ -41,7 +41,8 @@ from typing import Any, Sequence
 import cv2
 import numpy as np
 
-from graphsdg import frame_plan, rng
+from graphsdg import rng
+from graphsdg.jobs import frame_plan
 from graphsdg.annotate.ids import color_of
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof

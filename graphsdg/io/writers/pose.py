@@ -49,7 +49,7 @@ from graphsdg.io.camera_geometry import CUBOID_KEYPOINTS, PinholeCamera, box_cor
 from graphsdg.io.labels import class_name
 from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
 FORMATS = ("dope", "centerpose")
 # Cuboid edges by keypoint index (1..8 = corners): Isaac's front (x_min), back (x_max) and connecting edges.

@@ -16,7 +16,8 @@ import runpy
 import sys
 from typing import Iterator, Sequence
 
-from graphsdg import orchestrator, rng, settings
+from graphsdg import orchestrator, rng
+from graphsdg import settings_store as settings
 from graphsdg.io.location import normalize
 
 # the orchestrator's entry points that capture frames (build_script turns them into a stop)

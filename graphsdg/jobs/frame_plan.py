@@ -15,7 +15,8 @@ The plan lives in settings, so ``graphsdg run`` sets it before the script runs:
 * ``/graphsdg/run/resume`` (default False).
 
 Example:
-    >>> from graphsdg import frame_plan, settings
+    >>> from graphsdg import settings
+    >>> from graphsdg.jobs import frame_plan
     >>> settings.set("/graphsdg/run/shardIndex", 1); settings.set("/graphsdg/run/shardCount", 3)
     >>> [f for f in range(8) if frame_plan.current().owns(f)]
     [1, 4, 7]
@@ -28,7 +29,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 
-from graphsdg import settings
+from graphsdg import settings_store as settings
 from graphsdg.io.object_store import is_s3_url
 
 SHARD_FOLDER = ".graphsdg-shards"   # per-shard aggregate files, inside a writer's output folder

@@ -14,7 +14,7 @@ with OpenCV on a thread pool of the same size. Both run in one process, one
 after the other, and the report gives their ratio.
 
 Example:
-    >>> from graphsdg.benchmark import BenchConfig, run_graphsdg
+    >>> from graphsdg.benchmark.throughput import BenchConfig, run_graphsdg
     >>> result = run_graphsdg(BenchConfig(frames=2, warmup=1, asset_count=1, resolution=(64, 48),
     ...                                   skip_write=True))
     >>> result.frames
@@ -201,13 +201,13 @@ def _apply(draw: dict[str, np.ndarray], assets, cams) -> None:
 def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     """Time graphsdg on the benchmark scene; ``before_timing()`` runs after the warm-up (a barrier, say)."""
     import graphsdg as rep
-    from graphsdg import profiling
+    from graphsdg.benchmark import profiling
     from graphsdg.io.write_queue import reset_write_queue
 
     rep.settings.set("/omni/replicator/backend/writeThreads", _write_threads(config))
     reset_write_queue()
     if config.image_threads is not None:
-        from graphsdg.cpu_share import limit_image_threads
+        from graphsdg.jobs.cpu_share import limit_image_threads
         limit_image_threads(config.image_threads)
     assets, cams, rps = build_scene(config)
     flags = {ANNOTATOR_FLAGS[a]: True for a in config.annotators}
@@ -269,7 +269,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     import mujoco
 
     import graphsdg as rep  # noqa: F401  (EGL selection)
-    from graphsdg import profiling
+    from graphsdg.benchmark import profiling
     from graphsdg.runtime import runtime
 
     assets, cams, rps = build_scene(config)
@@ -446,7 +446,7 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     """
     import multiprocessing
 
-    from graphsdg.cpu_share import cores_per_process
+    from graphsdg.jobs.cpu_share import cores_per_process
     from graphsdg.io.write_queue import threads_per_process
     ctx = multiprocessing.get_context("spawn")
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores

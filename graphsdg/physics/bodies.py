@@ -7,7 +7,7 @@ world frame, angular in rad/s.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.sim.bodies import RigidBodyView
+    >>> from graphsdg.physics.bodies import RigidBodyView
     >>> _ = rep.stage.new_stage()
     >>> cube = rep.functional.create.cube(position=(0, 0, 2))
     >>> rep.functional.physics.apply_rigid_body(cube)
@@ -24,10 +24,12 @@ from typing import Iterable, Sequence
 import numpy as np
 from pxr import Sdf, Usd, UsdPhysics
 
-from graphsdg.sim.compiler import rigid_root
+from graphsdg.runtime import runtime
+from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import PrimLike
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
+from graphsdg.stage.xform import world_matrix
 
 
 def _rigid_paths(stage: Usd.Stage) -> list[str]:
@@ -84,7 +86,6 @@ class RigidBodyView:
 
     @staticmethod
     def _sim():
-        from graphsdg.runtime import runtime
         sim = runtime().sim
         sim.sync_dirty_prims()
         return sim

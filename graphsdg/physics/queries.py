@@ -14,7 +14,7 @@ Quaternions follow PhysX here: ``(x, y, z, w)``.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.sim import queries
+    >>> from graphsdg.physics import queries
     >>> _ = rep.stage.new_stage()
     >>> cube = rep.functional.create.cube(position=(0, 0, 0.5), name="Crate")
     >>> rep.functional.physics.apply_collider(cube)
@@ -32,7 +32,10 @@ from typing import Any, Callable, Sequence
 import mujoco
 import numpy as np
 
-from graphsdg.sim.compiler import CompiledScene, rigid_root
+from graphsdg.maths.rotations import quat_wxyz_to_matrix
+from graphsdg.runtime import runtime
+from graphsdg.sim.compiled_scene import CompiledScene
+from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.prims import PrimLike, resolve_prim
 
 NO_PROTO = 0xFFFFFFFF
@@ -101,16 +104,10 @@ def _rotation_xyzw(rotation: Any) -> np.ndarray:
     norm = np.linalg.norm(q)
     if norm < 1e-12:
         raise ValueError(f"rotation quaternion (x, y, z, w) must be non-zero, got {rotation!r}")
-    x, y, z, w = q / norm
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return quat_wxyz_to_matrix(q[[3, 0, 1, 2]])
 
 
 def _scene() -> CompiledScene:
-    from graphsdg.runtime import runtime
     sim = runtime().sim
     sim.sync_dirty_prims()
     return sim.ensure_compiled()

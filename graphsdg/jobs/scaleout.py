@@ -27,13 +27,13 @@ import tempfile
 import time
 from dataclasses import replace
 
-from graphsdg.cpu_share import cores_per_process
+from graphsdg.jobs.cpu_share import cores_per_process
 from graphsdg.io import object_store
 from graphsdg.io.location import normalize
 from graphsdg.io.write_queue import threads_per_process
-from graphsdg.job import JobSpec, run_job
+from graphsdg.jobs.job import JobSpec, run_job
 
-log = logging.getLogger("graphsdg.scaleout")
+log = logging.getLogger("graphsdg.jobs.scaleout")
 RAY_HINT = "pip install 'graphsdg[ray]'"
 SHARD_COLUMNS = ("shard", "frames", "seconds", "node", "pid", "gpu_ids", "egl_device", "write_threads",
                  "image_threads")   # per-shard summary
@@ -75,9 +75,9 @@ class ShardWorker:
         """Run shard ``index`` of ``count``; ``write_threads`` is the default writer pool size here
         (the script may still set ``/omni/replicator/backend/writeThreads`` itself), ``image_threads``
         OpenCV's pool size (None: its default)."""
-        from graphsdg import settings
-        from graphsdg.cpu_share import limit_image_threads
-        from graphsdg.frame_plan import FramePlan
+        from graphsdg import settings_store as settings
+        from graphsdg.jobs.cpu_share import limit_image_threads
+        from graphsdg.jobs.frame_plan import FramePlan
         from graphsdg.io.write_queue import THREADS_KEY, get_write_queue
         if write_threads is not None:
             settings.set(THREADS_KEY, write_threads)

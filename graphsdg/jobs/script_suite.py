@@ -64,7 +64,7 @@ def run_script_in_process(script: Path, workdir: Path, compat: str | None, scrip
                           timeout: float, extra: Sequence[str] = ()) -> ScriptResult:
     """Run ``script`` with ``graphsdg run`` in a new process whose working folder is ``workdir``."""
     workdir.mkdir(parents=True, exist_ok=True)
-    command = [sys.executable, "-m", "graphsdg.cli", "run", str(script.resolve()), *extra]
+    command = [sys.executable, "-m", "graphsdg.jobs.cli", "run", str(script.resolve()), *extra]
     if compat:
         command += ["--compat", compat]
     command += ["--", *script_args]

@@ -14,8 +14,9 @@ import os
 import time
 from dataclasses import asdict, dataclass, field
 
-from graphsdg import frame_plan, orchestrator
-from graphsdg.frame_plan import FramePlan
+from graphsdg import orchestrator
+from graphsdg.jobs import frame_plan
+from graphsdg.jobs.frame_plan import FramePlan
 from graphsdg.io import backends
 from graphsdg.io.location import open_location
 
@@ -73,7 +74,7 @@ def check_job_file(job: JobSpec) -> None:
 
 def run_job(job: JobSpec, plan: FramePlan | None = None) -> dict:
     """Run ``job`` in this process (shard ``plan`` of it, if given); return its summary."""
-    from graphsdg.script_runner import run_script
+    from graphsdg.jobs.script_runner import run_script
 
     plan = plan or FramePlan(resume=job.resume)
     for key, value in job.env.items():

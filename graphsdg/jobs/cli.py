@@ -56,13 +56,13 @@ def run_bench(args: argparse.Namespace) -> None:
     """``graphsdg bench``: print (and optionally record) the benchmark table."""
     import platform
 
-    from graphsdg import benchmark
+    from graphsdg.benchmark import throughput
 
-    annotators = tuple(benchmark.ANNOTATOR_FLAGS) if args.annotators == ["all"] else tuple(args.annotators)
-    unknown = [a for a in annotators if a not in benchmark.ANNOTATOR_FLAGS]
+    annotators = tuple(throughput.ANNOTATOR_FLAGS) if args.annotators == ["all"] else tuple(args.annotators)
+    unknown = [a for a in annotators if a not in throughput.ANNOTATOR_FLAGS]
     if unknown:
-        raise ValueError(f"unknown benchmark annotator(s) {unknown}; known: {sorted(benchmark.ANNOTATOR_FLAGS)}")
-    config = benchmark.BenchConfig(
+        raise ValueError(f"unknown benchmark annotator(s) {unknown}; known: {sorted(throughput.ANNOTATOR_FLAGS)}")
+    config = throughput.BenchConfig(
         frames=args.num_frames, warmup=args.warmup, num_cameras=args.num_cameras, resolution=tuple(args.resolution),
         asset_count=args.asset_count, annotators=annotators, skip_write=args.skip_write,
         rt_subframes=args.rt_subframes, wait_for_render=args.wait_for_render,
@@ -84,22 +84,22 @@ def run_bench(args: argparse.Namespace) -> None:
     machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}, render backend: " \
               f"{_render_backend(args.backend)}"
     if args.processes:
-        row = benchmark.run_processes(config, args.processes)
-        table = benchmark.format_table([row])
+        row = throughput.run_processes(config, args.processes)
+        table = throughput.format_table([row])
     else:
-        rows = [benchmark.run_graphsdg(config)]
+        rows = [throughput.run_graphsdg(config)]
         if not args.no_baseline:
-            rows.append(benchmark.run_handwritten(config))
+            rows.append(throughput.run_handwritten(config))
         summaries = [r.summary() for r in rows]
         if len(rows) == 2:
             ratio = rows[0].fps / rows[1].fps if rows[1].fps else float("nan")
             for s in summaries:
                 s["ratio to hand-written"] = round(ratio, 2) if s["run"] == "graphsdg" else 1.0
-        table = benchmark.format_table(summaries)
+        table = throughput.format_table(summaries)
         if args.profile:
             prof = rows[0].profile
             frame_ms = 1000.0 / rows[0].fps if rows[0].fps else 0.0
-            table += "\n\n" + benchmark.format_table(
+            table += "\n\n" + throughput.format_table(
                 [{"phase": k, "ms/frame": round(v / rows[0].frames * 1000, 2),
                   "share of frame": "(worker threads)" if k == "encode+write" else
                   f"{v / rows[0].frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
@@ -107,7 +107,7 @@ def run_bench(args: argparse.Namespace) -> None:
             table += f"\n\ngraphsdg frame time {frame_ms:.2f} ms"
             if len(rows) == 2 and rows[1].profile:
                 base_ms = 1000.0 / rows[1].fps if rows[1].fps else 0.0
-                table += "\n\n" + benchmark.format_table(
+                table += "\n\n" + throughput.format_table(
                     [{"hand-written phase": k, "ms/frame": round(v / rows[1].frames * 1000, 2)}
                      for k, v in sorted(rows[1].profile.items(), key=lambda kv: -kv[1])])
                 table += f"\n\nhand-written frame time {base_ms:.2f} ms"
@@ -121,7 +121,7 @@ def run_bench(args: argparse.Namespace) -> None:
 def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
     """``graphsdg graph``: build the script's graph (no render, no write); print it, write DOT and PNG."""
     from graphsdg import graph as graphs
-    from graphsdg.script_runner import build_script
+    from graphsdg.jobs.script_runner import build_script
 
     stopped_at = build_script(args.script, script_args, compat=args.compat, seed=args.seed)
     g = graphs.current_graph(create=False)
@@ -176,14 +176,14 @@ def _render_backend(requested: str | None) -> str:
 
 def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
     """``graphsdg run``: the script in this process, or sharded over Ray workers; then the summary."""
-    from graphsdg.job import JobSpec, check_job_file, format_summary, run_job
+    from graphsdg.jobs.job import JobSpec, check_job_file, format_summary, run_job
 
     if not os.path.isfile(args.script):
         raise FileNotFoundError(f"script {args.script!r} does not exist")
     job = JobSpec(script=args.script, args=tuple(script_args), compat=args.compat, seed=args.seed, out=args.out,
                   frames=args.frames, resume=args.resume, resolution_scale=args.resolution_scale)
     if args.workers is not None:
-        from graphsdg.scaleout import import_ray, run_sharded
+        from graphsdg.jobs.scaleout import import_ray, run_sharded
         import_ray()                      # says how to get Ray before anything runs
         check_job_file(job)
         summary = run_sharded(job, args.workers, address=args.address, gpus_per_worker=args.gpus_per_worker)
@@ -198,7 +198,7 @@ def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
 
 def run_folder_command(args: argparse.Namespace, script_args: list[str]) -> int:
     """``graphsdg run-folder``: a verdict line per script, then the totals; 1 if any failed."""
-    from graphsdg.script_suite import run_folder, summary_line
+    from graphsdg.jobs.script_suite import run_folder, summary_line
     extra = [] if args.resolution_scale is None else ["--resolution-scale", str(args.resolution_scale)]
     results = run_folder(args.folder, args.compat, script_args, args.out, args.timeout, args.pattern, extra,
                          report=lambda r: print(r.line(), flush=True))
@@ -208,9 +208,9 @@ def run_folder_command(args: argparse.Namespace, script_args: list[str]) -> int:
 
 def _hint(exc: BaseException) -> str:
     """The hint line printed under a one-line error."""
-    from graphsdg.job import JobMismatchError
+    from graphsdg.jobs.job import JobMismatchError
     from graphsdg.io.object_store import ObjectStoreError, S3MissingError
-    from graphsdg.scaleout import RayMissingError, ShardFailedError
+    from graphsdg.jobs.scaleout import RayMissingError, ShardFailedError
     if isinstance(exc, RayMissingError):
         return "install Ray with: pip install 'graphsdg[ray]'"
     if isinstance(exc, S3MissingError):

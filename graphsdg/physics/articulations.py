@@ -38,13 +38,15 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, UsdPhysics
 
+from graphsdg.runtime import runtime
 from graphsdg.sim import joints as jointmap
-from graphsdg.sim.compiler import JointBinding, rigid_root
-from graphsdg.stage.xform import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix, world_matrix
+from graphsdg.sim.compiled_scene import JointBinding
+from graphsdg.sim.rigid_bodies import rigid_root
+from graphsdg.stage.xform import world_matrix
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 
 
 def _sim():
-    from graphsdg.runtime import runtime
     return runtime().sim
 
 

@@ -1,0 +1,6 @@
+"""The error a compile raises when the stage holds something that cannot become a MuJoCo model."""
+from __future__ import annotations
+
+
+class CompileError(ValueError):
+    """The stage holds something that cannot become a MuJoCo model."""
