@@ -1,8 +1,11 @@
 """The PBR backend on Warp's CPU device at tiny sizes: same layout, ids and depth as the classic path.
 
-Skipped where the gpu extra is absent (CI's Python 3.11). The first run compiles Warp kernels (about a minute
+Skipped where the gpu extra is absent (CI's Python 3.11). ``GRAPHSDG_PBR_TEST_DEVICE=cuda:0`` runs them on a
+GPU instead (the device machine's check of the CUDA path). The first run compiles Warp kernels (about a minute
 on a laptop-class CPU, cached afterwards in Warp's kernel cache)."""
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import pytest
@@ -15,11 +18,12 @@ from graphsdg.render.pbr import PbrRenderer, id_codes  # noqa: E402
 from graphsdg.runtime import runtime  # noqa: E402
 
 W, H = 32, 24
+DEVICE = os.environ.get("GRAPHSDG_PBR_TEST_DEVICE", "cpu")
 
 
 @pytest.fixture(scope="module")
 def renderer():
-    r = PbrRenderer(device="cpu")
+    r = PbrRenderer(device=DEVICE)
     yield r
     r.close()
 
@@ -122,7 +126,7 @@ def test_pbr_motion_blur_smears_by_the_projected_travel():
 
     def capture(speed: float):
         rep.stage.new_stage()
-        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": "cpu",
+        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
                            "/omni/replicator/captureMotionBlur": True, "/rtx/post/motionblur/numSamples": 8,
                            "/rtx/post/motionblur/maxBlurDiameterFraction": 1.0}.items():
             settings.set(key, value)

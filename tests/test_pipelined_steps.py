@@ -104,12 +104,12 @@ def test_pixel_reads_wait_for_their_fence_by_polling(monkeypatch):
     """A map first polls the read's fence (never a blocking driver wait), sleeping between polls."""
     from OpenGL import GL
 
-    from graphsdg.render import readback
+    from graphsdg.render import polling, readback
     statuses = iter([GL.GL_TIMEOUT_EXPIRED, GL.GL_TIMEOUT_EXPIRED, GL.GL_TIMEOUT_EXPIRED, GL.GL_CONDITION_SATISFIED])
     calls, sleeps = [], []
     monkeypatch.setattr(readback.gld, "glClientWaitSync",      # the poll keeps the interpreter lock (gl_direct)
                         lambda fence, flags, timeout: calls.append((flags, timeout)) or next(statuses), raising=False)
-    monkeypatch.setattr(readback.time, "sleep", sleeps.append)
+    monkeypatch.setattr(polling.time, "sleep", sleeps.append)
     readback.wait_for_fence(object())
     assert [t for _, t in calls] == [0, 0, 0, 0]                         # never a blocking wait
     assert calls[0][0] == GL.GL_SYNC_FLUSH_COMMANDS_BIT and all(f == 0 for f, _ in calls[1:])
