@@ -282,6 +282,7 @@ def test_maps_compile_as_mujoco_texture_roles_only_where_pbr_draws(tmp_path, mon
                                                                         role.mjTEXROLE_ORM)}
 
     monkeypatch.setattr(backend, "pbr_in_use", False)     # a PbrRenderer made earlier in this process sets it
+    rep.settings.set("/graphsdg/render/backend", "classic")   # auto would pick pbr on a GPU machine
     model, ids = compiled_roles()
     assert ids[role.mjTEXROLE_RGB] >= 0 and ids[role.mjTEXROLE_NORMAL] == -1 and ids[role.mjTEXROLE_ORM] == -1
     monkeypatch.setattr(backend, "pbr_in_use", True)
