@@ -18,14 +18,18 @@ TARGET = {"input_prims": Port("prims", required=True)}
 POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
 
 
-def pose_rows(value: Any, n: int, what: str, uniform: bool = False) -> Any:
-    """A pose port's value (sampled or plain) as ``(n, 3)`` rows for ``functional.modify.pose``'s ``what``.
+def pose_rows(ctx: ExecContext, port: str, n: int, what: str, uniform: bool = False) -> Any:
+    """Pose port ``port`` (sampled or plain) as ``(n, 3)`` rows for ``functional.modify.pose``'s ``what``.
 
-    One number per prim fills that prim's row (a scalar distribution samples one
-    number per prim); a single number fills every row only where ``uniform`` (scale).
+    A scalar distribution draws one number per prim, which fills that prim's row; a
+    plain vector is one value for every prim, also when there are as many prims as
+    it has numbers; a single number fills every row only where ``uniform`` (scale).
     """
+    value, sampled = _port_value(ctx, port, n)
     if value is None:
         return None
+    if sampled and np.ndim(value) == 1:
+        value = np.asarray(value, dtype=np.float64)[:, None]     # one number per prim, never a shared row
     return per_prim_array(value, n, what, uniform=uniform, uniform_per_prim=True)
 
 
@@ -45,14 +49,19 @@ def look_at_points(value: Any, n: int) -> Any:
 
 def sample_port(ctx: ExecContext, port: str, n: int) -> Any:
     """``n`` samples of ``port`` (recorded as provenance) or its plain value."""
+    return _port_value(ctx, port, n)[0]
+
+
+def _port_value(ctx: ExecContext, port: str, n: int) -> tuple[Any, bool]:
+    """:func:`sample_port`'s value and whether it was drawn from a distribution."""
     if not ctx.given(port):
-        return None
+        return None, False
     value = ctx.value(port)
     if isinstance(value, Samples):
         drawn = value.take(n)
         ctx.record(port, drawn)
-        return drawn
-    return value
+        return drawn, True
+    return value, False
 
 
 def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
@@ -60,13 +69,13 @@ def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
     n = len(prims)
     if n == 0:
         return
-    position = pose_rows(sample_port(ctx, "position", n), n, "position_value")
-    rotation = pose_rows(sample_port(ctx, "rotation", n), n, "rotation_value")
+    position = pose_rows(ctx, "position", n, "position_value")
+    rotation = pose_rows(ctx, "rotation", n, "rotation_value")
     position = _with_components(ctx, prims, position, "position", n)
     rotation = _with_components(ctx, prims, rotation, "rotation", n)
-    scale = pose_rows(sample_port(ctx, "scale", n), n, "scale_value", uniform=True)
+    scale = pose_rows(ctx, "scale", n, "scale_value", uniform=True)
     size = sample_port(ctx, "size", n)
-    pivot = pose_rows(sample_port(ctx, "pivot", n), n, "pivot_value")
+    pivot = pose_rows(ctx, "pivot", n, "pivot_value")
     look_at = look_at_points(sample_port(ctx, "look_at", n), n)
     up = ctx.value("look_at_up_axis") if ctx.given("look_at_up_axis") else None
     order = ctx.value("rotation_order") if "rotation_order" in ctx.node.inputs else "XYZ"

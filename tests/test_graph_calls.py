@@ -233,3 +233,29 @@ def test_docstring_examples(name):
     import importlib
     rep.stage.new_stage()
     assert doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS).failed == 0
+
+
+def test_a_vector_is_one_value_for_as_many_prims_as_it_has_numbers():
+    """Replicator's rule: position=(1, 2, 3) or scale=(1, 2, 3) on three prims gives each prim that vector, while
+    a scalar distribution still draws one number per prim (three prims: three uniform scales)."""
+    from pxr import UsdGeom
+
+    from graphsdg.stage.context import get_stage
+
+    def ops(prim):
+        return {op.GetOpName(): tuple(op.Get()) for op in UsdGeom.Xformable(prim).GetOrderedXformOps()}
+
+    assert per_prim_array((1, 2, 3), 3, "scale", uniform=True, uniform_per_prim=True).tolist() == [[1, 2, 3]] * 3
+    rep.create.cube(count=3, position=(1, 2, 3), scale=(1, 2, 3))
+    rep.orchestrator.step()
+    cubes = [p for p in get_stage().Traverse() if p.GetTypeName() == "Cube"]
+    assert len(cubes) == 3
+    for cube in cubes:
+        assert ops(cube)["xformOp:translate"] == (1.0, 2.0, 3.0) and ops(cube)["xformOp:scale"] == (1.0, 2.0, 3.0)
+    with rep.trigger.on_frame():
+        rep.modify.pose(input_prims=cubes, scale=rep.distribution.uniform(0.5, 2.0))
+    rep.orchestrator.step()
+    scales = [ops(c)["xformOp:scale"] for c in cubes]
+    assert all(s[0] == s[1] == s[2] for s in scales) and len(set(scales)) == 3
+    rep.functional.modify.pose(cubes, scale_value=(1, 2, 3))
+    assert all(ops(c)["xformOp:scale"] == (1.0, 2.0, 3.0) for c in cubes)

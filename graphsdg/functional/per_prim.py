@@ -24,7 +24,10 @@ def per_prim_array(value: Any, count: int, what: str, width: int = 3, uniform: b
     A shared row is ``width`` numbers (3 or 4 for pose vectors: a 4-vector is a
     quaternion). ``uniform`` lets one number fill every row (a uniform scale);
     ``uniform_per_prim`` lets ``count`` numbers (flat, or one column) fill one row
-    each, and that reading wins when ``count`` equals the row width. Rows of pose
+    each. A flat vector as long as a row is one shared row even when ``count``
+    equals its length (``scale=(1, 2, 3)`` on three prims scales each by (1, 2, 3),
+    as Replicator reads it); per-prim numbers that could be mistaken for a row come
+    as one column (what the graph's scalar distributions draw). Rows of pose
     vectors are not checked for width here (``set_local_pose`` says which value is
     wrong).
     """
@@ -40,10 +43,10 @@ def per_prim_array(value: Any, count: int, what: str, width: int = 3, uniform: b
             return arr
     if arr.ndim == 0 and uniform:
         return np.full((count, width), float(arr))
-    if arr.ndim == 1 and uniform_per_prim and arr.shape[0] == count:
-        return np.repeat(arr[:, None], width, axis=1)
     if arr.ndim == 1 and arr.shape[0] in ((3, 4) if width in (3, 4) else (width,)):
         return np.broadcast_to(arr, (count, arr.shape[0]))
+    if arr.ndim == 1 and uniform_per_prim and arr.shape[0] == count:
+        return np.repeat(arr[:, None], width, axis=1)
     raise ValueError(f"{what} must be one {width}-vector or an (N, {width}) array, got shape {arr.shape}")
 
 
