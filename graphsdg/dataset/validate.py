@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from graphsdg.dataset.basic_writer import BasicWriterDataset, Frame
+from graphsdg.io import run_state
 
 
 @dataclass
@@ -121,7 +122,6 @@ def _check_content(ds: BasicWriterDataset, f: Frame, seen: dict[str, str], out: 
 
 def _unfinished_run(root: str) -> list[Violation]:
     """A run-state file means the run that wrote the folder did not finish (docs/reproducibility.md)."""
-    from graphsdg.io import run_state
     try:
         doc = run_state.read(root)
     except ValueError as exc:

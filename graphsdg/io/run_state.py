@@ -52,6 +52,10 @@ from typing import Any, Iterator
 from graphsdg import settings_store as settings
 from graphsdg.io.location import open_location
 from graphsdg.render.attachments import attachments
+from graphsdg.rng import get_global_seed
+from graphsdg.io.write_queue import get_write_queue
+from graphsdg.errors import unknown_name
+from graphsdg.io.writer import Writer
 
 FILE_NAME = "graphsdg_run.json"
 FORMAT = "graphsdg.run_state"
@@ -98,8 +102,6 @@ class FrameLedger:
     """One writer's frames in one output folder: handed to ``write()``, on disk, complete."""
 
     def __init__(self, writer: Any, output_dir: str) -> None:
-        from graphsdg.io.writer import Writer
-        from graphsdg.rng import get_global_seed
         self.writer_ref = weakref.ref(writer)
         self.name = type(writer).__name__
         self.output_dir = output_dir
@@ -251,7 +253,6 @@ def frame(writer: Any, step: int, frame_index: int | None = None) -> Iterator[No
     if ledger is None:
         yield
         return
-    from graphsdg.io.write_queue import get_write_queue
     first = ledger.status != "writing" or ledger.begun == 0
     number = ledger.begin(step, frame_index)
     if first:     # the file exists whenever frames are in flight, so a killed run always leaves one
@@ -412,7 +413,6 @@ def complete_frames(output_dir: str | os.PathLike, writer: str | None = None) ->
                              f"pass writer=")
         writer = next(iter(writers))
     if writer not in writers:
-        from graphsdg.errors import unknown_name
         raise unknown_name("writer entry", writer, writers)
     return [f for first, last in writers[writer]["complete"] for f in range(first, last + 1)]
 

@@ -19,6 +19,7 @@ from graphsdg.jobs import frame_plan
 from graphsdg.jobs.frame_plan import FramePlan
 from graphsdg.io import backends
 from graphsdg.io.location import open_location
+from graphsdg.jobs.script_runner import run_script
 
 JOB_FILE = ".graphsdg-job.json"
 
@@ -74,7 +75,6 @@ def check_job_file(job: JobSpec) -> None:
 
 def run_job(job: JobSpec, plan: FramePlan | None = None) -> dict:
     """Run ``job`` in this process (shard ``plan`` of it, if given); return its summary."""
-    from graphsdg.jobs.script_runner import run_script
 
     plan = plan or FramePlan(resume=job.resume)
     for key, value in job.env.items():

@@ -42,6 +42,7 @@ from graphsdg.io.backends import BaseBackend, writes_discarded
 from graphsdg.io.write_queue import get_write_queue
 from graphsdg.io.writer import ON_FRAME, Writer
 from graphsdg.io.writers import arguments
+from graphsdg.stage import get_stage
 
 MODALITIES = ("rgb", "shaded_seg", "segmentation", "depth", "edges")
 ON_TIME = "on_time"
@@ -147,7 +148,6 @@ class CosmosWriter(Writer):
             if ON_TIME in trigger_name and int(count) > self._clip:
                 self.next_clip()
         if self._fps is None:
-            from graphsdg.stage import get_stage
             stage = get_stage()
             self._fps = float(stage.GetTimeCodesPerSecond())
             # shading light from straight above, whichever axis is up
