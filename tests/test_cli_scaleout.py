@@ -73,9 +73,11 @@ def job_script(tmp_path):
 
 
 # ---- graphsdg graph ------------------------------------------------------------------
-def test_graph_command_builds_without_rendering_or_writing(job_script, tmp_path, capsys):
+def test_graph_command_builds_without_rendering_or_writing(job_script, tmp_path, capsys, monkeypatch):
     out = tmp_path / "graph"
+    monkeypatch.chdir(tmp_path)              # the job's writers have relative output folders
     assert main(["graph", job_script, "--out", str(out), "--seed", "3"]) == 0
+    rep.orchestrator.wait_until_complete()   # nothing the writers held is written afterwards either
     text = capsys.readouterr()
     assert "trigger on_frame " in text.out and "trigger on_frame_01 " in text.out
     assert "stopped at orchestrator.run()" in text.err

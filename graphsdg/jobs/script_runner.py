@@ -19,6 +19,8 @@ from typing import Iterator, Sequence
 from graphsdg import orchestrator, rng
 from graphsdg import settings_store as settings
 from graphsdg.io.location import normalize
+from graphsdg.io.write_queue import get_write_queue
+from graphsdg.render.attachments import attachments
 
 # the orchestrator's entry points that capture frames (build_script turns them into a stop)
 CAPTURE_CALLS = ("step", "step_async", "run", "run_async", "run_until_complete", "run_until_complete_async",
@@ -107,6 +109,7 @@ def capture_stopped() -> Iterator[None]:
 
     discard = settings.get("/graphsdg/io/discardWrites", False)
     settings.set("/graphsdg/io/discardWrites", True)
+    attached_before = set(map(id, attachments.writers))
     for name in CAPTURE_CALLS:
         setattr(orchestrator, name, stopper(name))
     try:
@@ -114,6 +117,11 @@ def capture_stopped() -> Iterator[None]:
     finally:
         for name, fn in saved.items():
             setattr(orchestrator, name, fn)
+        # the stopped script's writers flush what they hold (aggregate files) while writes are still dropped;
+        # left attached, they would write it at exit, into the working folder
+        for writer in [w for w in attachments.writers if id(w) not in attached_before]:
+            writer.detach()
+        get_write_queue().wait_until_done()
         settings.set("/graphsdg/io/discardWrites", discard)
 
 
