@@ -16,7 +16,7 @@ from pxr import Usd
 from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
 from graphsdg.render.attachments import OrderedSet, attachments
-from graphsdg.render.backend import RenderBackend, resolve_backend
+from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
 from graphsdg.render.rasterizer import Rasterizer
 from graphsdg.sim.scene import SimScene
 from graphsdg.sim.timeline import Timeline
@@ -83,7 +83,7 @@ class Runtime:
         stage = self.stage
         if self._sim is None or self._sim_stage is not stage:
             assert stage_context.tracker is not None
-            self._sim = SimScene(stage, stage_context.tracker)
+            self._sim = SimScene(stage, stage_context.tracker, pbr_draws=pbr_draws)
             self._sim_stage = stage
             self.timeline.set_time_codes_per_second(stage.GetTimeCodesPerSecond() or 60.0)
         return self._sim

@@ -36,6 +36,7 @@ attribute edits straight into the model.
 """
 from __future__ import annotations
 
+import time
 import warnings
 
 import mujoco
@@ -65,16 +66,10 @@ PROBE_BOX = "graphsdg:probe_box"          # collision-free shapes posed by scene
 PROBE_SPHERE = "graphsdg:probe_sphere"
 
 
-def _pbr_draws() -> bool:
-    """Whether the pbr backend draws in this process (its camera and texture maps are compiled in)."""
-    from graphsdg.render.backend import pbr_draws   # render/ sits above sim/: asked at compile time only
-    return pbr_draws()
-
-
 class _Builder:
     """One compile: walks the stage and fills an MjSpec, each schema through its module's part."""
 
-    def __init__(self, stage: Usd.Stage, offscreen: tuple[int, int]) -> None:
+    def __init__(self, stage: Usd.Stage, offscreen: tuple[int, int], pbr: bool) -> None:
         self.stage = stage
         self.spec = mujoco.MjSpec()
         self.cache = UsdGeom.XformCache(Usd.TimeCode.Default())
@@ -82,7 +77,7 @@ class _Builder:
         self.geom_records: list[tuple[str, object, str | None, np.ndarray, str | None, bool]] = []
         self.mass_records: list[tuple] = []
         self.collider_records: list[tuple] = []
-        self.pbr_maps = _pbr_draws()                   # materials carry normal / ORM / ... maps for the pbr backend
+        self.pbr_maps = pbr                            # materials carry normal / ORM / ... maps for the pbr backend
         self.materials = SpecMaterials(self.spec, self.pbr_maps)
         self.lights = lightmap.SpecLights(self.spec, stage, self.cache)
         self.bodies = SpecBodies(self.spec, stage, self.cache)
@@ -278,11 +273,13 @@ class _Builder:
         return scene
 
 
-def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480)) -> CompiledScene:
+def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480), pbr: bool = False) -> CompiledScene:
     """Compile ``stage`` into a :class:`CompiledScene` (model, data and prim maps).
 
     ``offscreen`` is the size of MuJoCo's offscreen framebuffer (the largest
-    render product).
+    render product). ``pbr``: the pbr backend draws this model, so it gets that
+    backend's camera and its materials their normal / ORM / ... maps (the classic
+    model stays without them).
 
     Example:
         >>> from graphsdg import stage
@@ -291,9 +288,7 @@ def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480)) -> 
         >>> compile_stage(s).model.ngeom
         1
     """
-    import time
-
     start = time.perf_counter()
-    scene = _Builder(stage, offscreen).build()
+    scene = _Builder(stage, offscreen, pbr).build()
     scene.compile_seconds = time.perf_counter() - start
     return scene

@@ -59,9 +59,12 @@ _model_versions = itertools.count()
 class SimScene:
     """MuJoCo model and data of one stage, kept in step with it."""
 
-    def __init__(self, stage: Usd.Stage, tracker: ChangeTracker) -> None:
+    def __init__(self, stage: Usd.Stage, tracker: ChangeTracker,
+                 pbr_draws: Callable[[], bool] = lambda: False) -> None:
         self.stage = stage
         self.tracker = tracker
+        # asked at each compile: whether the pbr backend draws this process's models (render/ knows; sim/ is below)
+        self.pbr_draws = pbr_draws
         self.compiled: CompiledScene | None = None
         self.offscreen = (64, 64)
         # changes on every recompile (renderers rebuild contexts); drawn from one process-wide counter so
@@ -137,7 +140,7 @@ class SimScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
         start = time.perf_counter()
-        new = compile_stage(self.stage, self.offscreen)
+        new = compile_stage(self.stage, self.offscreen, pbr=self.pbr_draws())
         if old is not None and keep_state:
             carry_state(old, new)
             mujoco.mj_forward(new.model, new.data)
