@@ -22,10 +22,9 @@ from typing import Any, Callable, Mapping
 
 from graphsdg.errors import GraphBuildError
 from graphsdg.graph.builder import add_node, targets_value
-from graphsdg.graph.node import ReplicatorItem
-from graphsdg.graph.scopes import current_trigger
-from graphsdg.graph.node import Node, Port
+from graphsdg.graph.node import Node, Port, ReplicatorItem
 from graphsdg.graph.registry import NodeRegistry
+from graphsdg.graph.scopes import current_trigger
 
 TARGET = "input_prims"   # the port a modifier edits; its call falls back on the enclosing ``with item:``
 
