@@ -125,8 +125,9 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         if address:
             ray.init(address=address, log_to_driver=True)
         else:
-            ray.init(num_cpus=num_cpus or max(workers, os.cpu_count() or 1), include_dashboard=False,
-                     log_to_driver=True)
+            # address="local": a new cluster of this process's own, never one another run left on the machine
+            ray.init(address="local", num_cpus=num_cpus or max(workers, os.cpu_count() or 1),
+                     include_dashboard=False, log_to_driver=True)
     try:
         gpus = float(ray.cluster_resources().get("GPU", 0))
         per_worker = gpus_per_worker if gpus_per_worker is not None else (min(1.0, gpus / workers) if gpus else 0)
