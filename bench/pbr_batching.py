@@ -26,6 +26,7 @@ import numpy as np
 
 import graphsdg as rep
 from graphsdg.benchmark import throughput
+from graphsdg.maths.rotations import look_at_matrix
 from graphsdg.render.pbr import ENABLED_GROUPS
 from graphsdg.runtime import runtime
 from graphsdg.sim.visual import PBR_CAMERA
@@ -45,18 +46,10 @@ def random_states(model: mujoco.MjModel, data: mujoco.MjData, count: int, rng: n
         xmat.append(data.geom_xmat.reshape(-1, 3, 3).astype(np.float32))
         eye = rng.uniform(5, 10, 3)
         cam_pos.append(eye.astype(np.float32))
-        cam_mat.append(look_at(eye, np.zeros(3)).astype(np.float32))
+        cam_mat.append(look_at_matrix(eye, (0.0, 0.0, 0.0)).astype(np.float32))
     data.mocap_pos[:], data.mocap_quat[:] = saved_pos, saved_quat
     mujoco.mj_kinematics(model, data)
     return np.stack(xpos), np.stack(xmat), np.stack(cam_pos), np.stack(cam_mat)
-
-
-def look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """A MuJoCo camera frame (columns x, y, z; the camera looks down -z, y up) at ``eye`` facing ``target``."""
-    z = (eye - target) / np.linalg.norm(eye - target)
-    x = np.cross((0.0, 0.0, 1.0), z)
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z], axis=1)
 
 
 class Views:

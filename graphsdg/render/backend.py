@@ -101,8 +101,7 @@ def requested_backend() -> BackendRequest:
 def pbr_device() -> str:
     """The Warp device the pbr backend renders on (``/graphsdg/render/pbrDevice``)."""
     device = str(settings.get(DEVICE_KEY, "cuda:0") or "cuda:0")
-    if device != "cpu" and not (device == "cuda" or (device.startswith("cuda:") and device[5:].isdigit())):
-        raise ValueError(f"setting {DEVICE_KEY} must be 'cuda', 'cuda:N' or 'cpu', got {device!r}")
+    settings.VALIDATORS[DEVICE_KEY](DEVICE_KEY, device)   # a default edited by hand lands here unchecked
     return device
 
 
