@@ -30,6 +30,7 @@ from graphsdg.jobs import frame_plan
 from graphsdg.jobs.progress import Progress
 from graphsdg.render import motion_blur
 from graphsdg.render.attachments import attachments
+from graphsdg.render.backend import RenderRequest
 from graphsdg.render.camera import CameraView, camera_view
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import stage_context
@@ -220,8 +221,8 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
     defer = defer and _state.plan is None and all(a.spec.pixels_only for _, anns in products.values() for a in anns)
     capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame, rt.sim.data.time,
                        list(rt.writers))
-    for path, (rp, annotators) in products.items():
-        capture.frames.append((path, _render(rt, rp, annotators, subframes, defer), annotators))
+    for path, (rp, annotators), frame in zip(products, products.values(), _render(rt, products, subframes, defer)):
+        capture.frames.append((path, frame, annotators))
     if products:
         for observer in list(rt.render_observers):
             observer(list(products))
@@ -231,26 +232,36 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
         capture.finish()
 
 
-def _render(rt, rp, annotators: list[Annotator], subframes: int, defer: bool) -> FrameView:
+def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int, defer: bool) -> list[FrameView]:
+    """Render every product's passes in one call to the backend (which may draw several in one launch)."""
     t = time.perf_counter()
     sim, stage = rt.sim, rt.stage
-    sim.require_offscreen(rp.width, rp.height)
-    with profiling.timed("render:camera"):
-        view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
-    passes: set[str] = set()
-    for a in annotators:
-        passes |= a.spec.passes
-    motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
-    render = rt.renderer.render(sim, view, passes, subframes, defer=defer, motion=motion) if passes else None
-    t = _timed("render", t)
-    frame = FrameView(rp, view, render, sim, stage, rt.labels, _state.frame_index, sim.data.time,
-                      attached=frozenset(a.spec.name for a in annotators))
-    if defer:   # the labels as of this capture, before the script edits the stage for the next
+    views: list[CameraView] = []
+    requests: list[RenderRequest | None] = []
+    for rp, annotators in products.values():
+        sim.require_offscreen(rp.width, rp.height)
+        with profiling.timed("render:camera"):
+            view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
+        passes: set[str] = set()
         for a in annotators:
-            if "segmentation" in a.spec.passes:
-                frame.instance_map(SemanticFilter.from_params(a.init_params))
+            passes |= a.spec.passes
+        motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
+        views.append(view)
+        requests.append(RenderRequest(view, passes, subframes, defer, motion) if passes else None)
+    drawn = [r for r in requests if r is not None]
+    outputs = iter(rt.renderer.render_batch(sim, drawn) if drawn else [])
+    t = _timed("render", t)
+    frames = []
+    for (rp, annotators), view, request in zip(products.values(), views, requests):
+        frame = FrameView(rp, view, next(outputs) if request is not None else None, sim, stage, rt.labels,
+                          _state.frame_index, sim.data.time, attached=frozenset(a.spec.name for a in annotators))
+        if defer:   # the labels as of this capture, before the script edits the stage for the next
+            for a in annotators:
+                if "segmentation" in a.spec.passes:
+                    frame.instance_map(SemanticFilter.from_params(a.init_params))
+        frames.append(frame)
     _timed("annotate:frame", t)
-    return frame
+    return frames
 
 
 class _Capture:

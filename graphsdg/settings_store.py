@@ -70,6 +70,10 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                          "where it can run, else classic; said once in the log)"),
     "/graphsdg/render/pbrDevice": ("cuda:0", "the Warp device the pbr backend renders on: cuda:N, or cpu (Warp's "
                                              "CPU device: slow, for checks on machines without a GPU)"),
+    "/graphsdg/render/pbrBatchPixels": (1 << 20, "the pbr backend draws a step's render products in one launch "
+                                                 "while their pixels add up to at most this many (one camera "
+                                                 "each; bench/pbr_products.py measured where it pays); 0: one "
+                                                 "launch per product"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
     "/app/player/timelineSubsampleRate": (1, "timeline ticks per frame: each app update's frame is split into this "
@@ -162,6 +166,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/maxResolution": _integer(1),
     "/graphsdg/render/backend": _choice("classic", "pbr", "auto"),
     "/graphsdg/render/pbrDevice": _warp_device,
+    "/graphsdg/render/pbrBatchPixels": _integer(0),
     "/rtx/pathtracing/spp": _integer(1),
     "/rtx/pathtracing/optixDenoiser/enabled": _boolean,
     "/omni/replicator/captureMotionBlur": _boolean,

@@ -116,6 +116,37 @@ def test_pbr_follows_rescaled_meshes_sizes_and_camera_intrinsics(renderer):
     assert renderer.stats["contexts"] == contexts, "no new render context for per-frame changes"
 
 
+def test_pbr_draws_a_steps_products_in_one_launch_each_at_its_own_size(renderer):
+    """render_batch: two products of different sizes and cameras as two cameras of one launch; each product's
+    ids and depth are the classic path's, and a product alone (its own launch) gives the same labels."""
+    from graphsdg import settings
+    from graphsdg.render.backend import RenderRequest
+    cube, ball, cam = _scene()
+    side = rep.functional.create.camera(position=(0.5, 4.0, 1.5), look_at=(0.3, 0, 0.4))
+    sim = runtime().sim
+    views = [camera_view(cam, W, H), camera_view(side, 20, 16)]
+    sim.require_offscreen(W, H)
+    passes = {"color", "depth", "segmentation"}
+    launches = renderer.stats["color"]
+    outs = renderer.render_batch(sim, [RenderRequest(v, passes) for v in views])
+    assert renderer.stats["color"] == launches + 1, "both products in one launch"
+    assert sim.pbr_cameras >= 2
+    for view, out in zip(views, outs):
+        classic = runtime().rasterizer.render(sim, view, {"depth", "segmentation"})
+        assert out.color.shape == (view.height, view.width, 4)
+        assert (out.geom_ids != classic.geom_ids).sum() <= 1
+        hit = np.isfinite(out.depth) & np.isfinite(classic.depth)
+        assert np.median(np.abs(out.depth[hit] - classic.depth[hit]) / classic.depth[hit]) < 1e-3
+        alone = renderer.render(sim, view, passes)
+        assert np.array_equal(alone.geom_ids, out.geom_ids) and np.array_equal(alone.depth, out.depth)
+        assert np.abs(alone.color.astype(int) - out.color.astype(int)).mean() < 2.0
+    assert len({out.geom_ids.tobytes() for out in outs}) == 2, "each camera saw its own view"
+    settings.set("/graphsdg/render/pbrBatchPixels", 0)     # one launch per product
+    launches = renderer.stats["color"]
+    renderer.render_batch(sim, [RenderRequest(v, passes) for v in views])
+    assert renderer.stats["color"] == launches + 2
+
+
 def test_pbr_motion_blur_smears_by_the_projected_travel():
     """Through the orchestrator with /graphsdg/render/backend = pbr on Warp's CPU device: a box moving during
     the shutter smears by its analytic image travel (as the classic path's test asserts), labels stay crisp."""

@@ -98,27 +98,45 @@ def test_backend_settings_have_effect_and_refuse_nonsense():
 
 
 def test_captures_render_through_the_chosen_backend(monkeypatch):
-    """The orchestrator asks the runtime's backend, not the rasteriser, for pixels."""
+    """The orchestrator asks the runtime's backend, not the rasteriser, for pixels: a step's render products in
+    one batch (the pbr backend draws them in one launch), each with its own size and passes."""
     rep.functional.create.dome_light(intensity=600)
     rep.functional.create.cube()
     cam = rep.functional.create.camera(position=(0, -4, 0), look_at=(0, 0, 0))
     rgb = rep.annotators.get("rgb")
     rgb.attach(rep.create.render_product(cam, (32, 24)))
+    depth = rep.annotators.get("distance_to_image_plane")
+    depth.attach(rep.create.render_product(cam, (16, 12)))
     calls = []
 
     class Recording:
         def render(self, sim, view, passes, subframes=1, defer=False, motion=None):
-            calls.append((view.width, view.height, set(passes), subframes))
-            return runtime().rasterizer.render(sim, view, passes, subframes, defer=defer, motion=motion)
+            raise AssertionError("a step renders its products through render_batch")
+
+        def render_batch(self, sim, requests):
+            calls.append([(r.view.width, r.view.height, set(r.passes), r.subframes) for r in requests])
+            return runtime().rasterizer.render_batch(sim, requests)
 
         def close(self):
             pass
 
     monkeypatch.setattr(type(runtime()), "renderer", property(lambda self: Recording()))
     rep.orchestrator.step(delta_time=0)
-    assert calls == [(32, 24, {"color"}, 1)]
+    assert calls == [[(32, 24, {"color"}, 1), (16, 12, {"depth"}, 1)]]
     assert rgb.get_data().shape == (24, 32, 4) and np.asarray(rgb.get_data())[..., 3].min() == 255
+    assert np.asarray(depth.get_data()).shape == (12, 16) and np.isfinite(depth.get_data()).any()
 
+
+def test_launch_groups_pack_products_up_to_the_pixel_limit():
+    quarter = 512 * 512
+    assert backend.launch_groups([quarter] * 4, limit=1 << 20) == [[0, 1, 2, 3]]
+    assert backend.launch_groups([quarter] * 5, limit=1 << 20) == [[0, 1, 2, 3], [4]]
+    assert backend.launch_groups([1920 * 1080, 64 * 64, 64 * 64], limit=1 << 20) == [[0], [1, 2]]
+    assert backend.launch_groups([10, 10, 10], limit=0) == [[0], [1], [2]]
+    settings.set(backend.BATCH_PIXELS_KEY, 25)
+    assert backend.launch_groups([10, 10, 10]) == [[0, 1], [2]]
+    with pytest.raises(ValueError, match="pbrBatchPixels"):
+        settings.set(backend.BATCH_PIXELS_KEY, -1)
 
 
 def test_gpu_extra_pins_the_measured_versions_for_python_312_only():

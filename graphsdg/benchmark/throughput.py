@@ -71,6 +71,7 @@ class BenchConfig:
     render_backend: str | None = None    # /graphsdg/render/backend (classic, pbr, auto); None: the setting as it is
     render_mode: str | None = None       # /rtx/rendermode (RaytracedLighting, PathTracing); None: the setting as it is
     path_spp: int | None = None          # /rtx/pathtracing/spp of the path tier; None: the setting as it is
+    pbr_batch_pixels: int | None = None  # /graphsdg/render/pbrBatchPixels (0: a launch per product); None: as set
     seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
 
 
@@ -169,6 +170,8 @@ def build_scene(config: BenchConfig):
         rep.settings.set("/rtx/rendermode", config.render_mode)
     if config.path_spp is not None:
         rep.settings.set("/rtx/pathtracing/spp", int(config.path_spp))
+    if config.pbr_batch_pixels is not None:
+        rep.settings.set("/graphsdg/render/pbrBatchPixels", int(config.pbr_batch_pixels))
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)

@@ -68,14 +68,15 @@ def run_bench(args: argparse.Namespace) -> None:
         rt_subframes=args.rt_subframes, wait_for_render=args.wait_for_render,
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
         msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds,
-        render_mode=args.rendermode, path_spp=args.spp)
+        render_mode=args.rendermode, path_spp=args.spp, pbr_batch_pixels=args.pbr_batch_pixels)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
                        f", {args.write_threads} write threads" if args.write_threads is not None else
                        "" if args.processes else f", {_default_write_threads()} write threads",
                        ", wait_for_render" if args.wait_for_render else "",
                        f", {args.rendermode}" if args.rendermode else "",
-                       f", {args.spp} path samples" if args.spp else ""])
+                       f", {args.spp} path samples" if args.spp else "",
+                       f", pbr batch pixels {args.pbr_batch_pixels}" if args.pbr_batch_pixels is not None else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
     settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
@@ -332,6 +333,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--spp", type=_positive,
                        help="path-traced samples per pixel of one launch, /rtx/pathtracing/spp (default: the larger of "
                             "the settings spp and totalSpp)")
+    bench.add_argument("--pbr-batch-pixels", type=_non_negative, metavar="N",
+                       help="on pbr, draw a step's render products in one launch while their pixels add up to at "
+                            "most N, 0 for a launch per product: /graphsdg/render/pbrBatchPixels (default: the "
+                            "setting, 1048576)")
     bench.add_argument("--processes", type=_non_negative, default=0,
                        help="run this many graphsdg processes at once and report their aggregate frames/s "
                             "(no hand-written loop); 0 runs one process with the loop (default: 0)")

@@ -2,7 +2,9 @@
 
 Render products, annotators and writers only see :class:`RenderBackend`: a
 ``render(sim, view, passes, subframes, defer, motion)`` that returns
-:class:`~graphsdg.render.rasterizer.RenderOutputs` in one layout (uint8 RGBA
+:class:`~graphsdg.render.rasterizer.RenderOutputs`, and ``render_batch(sim, requests)``
+for a step's render products at once (:class:`RenderRequest`; the pbr backend draws
+several in one launch, the classic one draw by draw), in one layout (uint8 RGBA
 colour, linear float ``hdr``, planar-z depth with ``inf`` background, int32 geom
 ids with -1 background). Two backends implement it:
 
@@ -23,6 +25,8 @@ The choice comes from settings (:func:`requested_backend`):
 * ``/rtx/rendermode``: ``RaytracedLighting`` (Isaac's default) -> the real-time tier;
   ``PathTracing`` -> the path tier with ``max(/rtx/pathtracing/spp, /rtx/pathtracing/totalSpp)``
   samples per pixel per launch and ``/rtx/pathtracing/optixDenoiser/enabled`` as the denoiser.
+* ``/graphsdg/render/pbrBatchPixels``: the pbr backend draws a step's render products in one
+  launch while their pixels add up to at most this many (:func:`launch_groups`).
 """
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ import importlib.util
 import logging
 import sys
 from dataclasses import dataclass
-from typing import Callable, Protocol, runtime_checkable
+from typing import Any, Callable, Protocol, runtime_checkable
 
 from graphsdg import settings_store as settings
 
@@ -42,6 +46,7 @@ BACKEND_KEY = "/graphsdg/render/backend"
 DEVICE_KEY = "/graphsdg/render/pbrDevice"
 BACKENDS = ("classic", "pbr", "auto")
 DENOISER_KEY = "/rtx/pathtracing/optixDenoiser/enabled"
+BATCH_PIXELS_KEY = "/graphsdg/render/pbrBatchPixels"
 #: the ``graphsdg[gpu]`` extra: import name -> distribution pinned in pyproject.toml
 PBR_MODULES = {"warp": "warp-lang==1.19.0", "mujoco_warp": "mujoco-warp==3.17.0",
                "mujoco_warp_pbr": "mujoco-warp-pbr==0.2.0"}
@@ -53,6 +58,22 @@ class PbrUnavailableError(RuntimeError):
     """The PBR backend was asked for on a machine that cannot run it (the message says what is missing)."""
 
 
+@dataclass
+class RenderRequest:
+    """One render product's render of a step: the arguments of :meth:`RenderBackend.render`.
+
+    ``view``: the product's :class:`~graphsdg.render.camera.CameraView`; ``passes``: ``color``, ``hdr``,
+    ``depth``, ``segmentation``; ``subframes``: renders accumulated; ``defer``: leave the pixels copying;
+    ``motion``: motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`) or None.
+    """
+
+    view: Any
+    passes: set[str]
+    subframes: int = 1
+    defer: bool = False
+    motion: Any = None
+
+
 @runtime_checkable
 class RenderBackend(Protocol):
     """What render products' captures call; both backends return the same :class:`RenderOutputs` layout."""
@@ -60,6 +81,10 @@ class RenderBackend(Protocol):
     def render(self, sim, view, passes: set[str], subframes: int = 1, defer: bool = False,
                motion=None):   # -> graphsdg.render.rasterizer.RenderOutputs
         """Render ``passes`` (``color``, ``hdr``, ``depth``, ``segmentation``) of ``view`` of ``sim`` now."""
+        ...
+
+    def render_batch(self, sim, requests: list[RenderRequest]) -> list:
+        """Render every request of one step (one :class:`RenderOutputs` each, in order)."""
         ...
 
     def close(self) -> None:
@@ -96,6 +121,30 @@ def requested_backend() -> BackendRequest:
         samples = min(samples, cap)
     return BackendRequest(backend=backend, tier="path" if path else "realtime", path_samples=samples,
                           denoise=bool(settings.get(DENOISER_KEY, True)))
+
+
+def launch_groups(pixels: list[int], limit: int | None = None) -> list[list[int]]:
+    """Indices of a step's render products, grouped for the pbr backend's launches: consecutive products
+    while their pixel counts add up to at most ``limit`` (default: ``/graphsdg/render/pbrBatchPixels``); a
+    product larger than the limit, or a limit of 0, gets a launch of its own.
+
+    Example:
+        >>> launch_groups([512 * 512] * 4, limit=1 << 20)
+        [[0, 1, 2, 3]]
+        >>> launch_groups([512 * 512] * 3, limit=600_000)
+        [[0, 1], [2]]
+    """
+    limit = int(settings.get(BATCH_PIXELS_KEY, 1 << 20)) if limit is None else int(limit)
+    groups: list[list[int]] = []
+    total = 0
+    for i, n in enumerate(pixels):
+        if groups and total + n <= limit:
+            groups[-1].append(i)
+            total += n
+        else:
+            groups.append([i])
+            total = n
+    return groups
 
 
 def pbr_device() -> str:
@@ -186,5 +235,5 @@ def resolve_backend(request: BackendRequest | None = None,
     return chosen
 
 
-__all__ = ["BACKENDS", "BackendRequest", "PbrUnavailableError", "RenderBackend", "pbr_device", "pbr_missing",
-           "requested_backend", "resolve_backend"]
+__all__ = ["BACKENDS", "BackendRequest", "PbrUnavailableError", "RenderBackend", "RenderRequest", "launch_groups",
+           "pbr_device", "pbr_missing", "requested_backend", "resolve_backend"]

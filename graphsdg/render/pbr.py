@@ -14,11 +14,16 @@ the classic layout, so annotators and writers do not know which backend drew.
   their rescale folded into the geom frame (no BVH refit), meshes deformed otherwise get
   their BVHs refit (:mod:`graphsdg.render.pbr_meshes`).
   A new model, resolution, or a geom shown or hidden builds a new render context.
-* **Same camera.** The model carries one camera (``graphsdg:pbr_camera``, added by
-  the compiler where this backend draws); each render poses it at the USD camera
-  and renders per-pixel rays (:func:`graphsdg.render.pbr_scene.camera_rays`), so
-  aperture fit, offsets and clipping are the classic path's exactly; new
-  intrinsics give new rays without recompiling.
+* **Same camera.** The model carries cameras for this backend (``graphsdg:pbr_camera``,
+  ``graphsdg:pbr_camera_1``, ...: added by the compiler where this backend draws, one per
+  render product drawn in one launch); each render poses them at the USD cameras and
+  renders per-pixel rays (:func:`graphsdg.render.pbr_scene.camera_rays`), so aperture
+  fit, offsets and clipping are the classic path's exactly; new intrinsics give new
+  rays without recompiling.
+* **Products in one launch.** :meth:`PbrRenderer.render_batch` draws a step's render
+  products as the cameras of one launch while their pixels add up to at most
+  ``/graphsdg/render/pbrBatchPixels`` (:func:`graphsdg.render.backend.launch_groups`;
+  ``bench/pbr_products.py`` measured where it pays), each at its own resolution.
 * **Labels from the same rays.** Depth (planar z, ``inf`` background) and geom ids
   (-1 background) come from the colour render's primary rays, converted to the
   classic layout on the GPU (:mod:`graphsdg.render.pbr_outputs`).
@@ -47,13 +52,13 @@ from graphsdg import settings_store as settings
 from graphsdg.benchmark import profiling
 from graphsdg.imaging import environment_map
 from graphsdg.render import mesh_folds, pbr_scene
-from graphsdg.render.backend import PbrUnavailableError, pbr_missing, requested_backend
+from graphsdg.render.backend import PbrUnavailableError, RenderRequest, launch_groups, pbr_missing, requested_backend
 from graphsdg.render.camera import CameraView
 from graphsdg.maths.rotations import decompose
 from graphsdg.render.rasterizer import PASSES, Rasterizer, RenderOutputs
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim.scene import SimScene
-from graphsdg.sim.visual import PBR_CAMERA, UNDRAWN_GROUPS, drawn_geom_mask
+from graphsdg.sim.visual import UNDRAWN_GROUPS, drawn_geom_mask, pbr_camera_name
 from graphsdg.stage.xform import world_matrix
 
 ENABLED_GROUPS = tuple(g for g in range(mujoco.mjNGROUP) if g not in UNDRAWN_GROUPS)
@@ -61,19 +66,21 @@ ENABLED_GROUPS = tuple(g for g in range(mujoco.mjNGROUP) if g not in UNDRAWN_GRO
 
 @dataclass
 class _Context:
-    """One render context: a model's geometry at one resolution and tier."""
+    """One render context: a model's geometry, with one camera per render product it draws in one launch, at
+    those products' resolutions and one tier."""
 
     key: tuple
     model: Any          # mujoco_warp Model
     data: Any           # mujoco_warp Data (nworld 1)
     rc: Any             # mujoco_warp_pbr PbrRenderContext
-    camera: int         # the PBR camera's id
-    rgb: Any            # wp.array (1, H, W) vec3 (path-tier accumulation)
+    cameras: list[int]  # the PBR cameras' ids, one per render product (the renderer's camera order)
     env_yaw: float
-    layout: Any         # pbr_outputs.ClassicLayout: device-side conversion and host buffers
-    rays_key: tuple     # the camera intrinsics the rays were made from
+    layouts: list       # pbr_outputs.ClassicLayout per camera: device-side conversion and host buffers
+    rays_keys: list     # per camera: the intrinsics its rays were made from
     meshes: "_MeshState"     # how the device's mesh BVHs relate to the model's current vertices
+    uploads: Any        # pbr_uploads.PinnedUploads: the per-frame copies' page-locked buffers
     uploaded: dict = field(default_factory=dict)   # field name -> host copy last uploaded
+    rgb: dict = field(default_factory=dict)        # camera index -> wp.array (1, H, W) vec3 (colour accumulation)
 
 
 @dataclass
@@ -95,6 +102,8 @@ class _MeshState:
 class PbrRenderer:
     """Renders :class:`SimScene` views with mujoco-warp-pbr (see the module docstring)."""
 
+    MAX_CONTEXTS = 4    # live render contexts (device memory): a step's batch, plus products drawn alone
+
     def __init__(self, device: str | None = None) -> None:
         lacks = pbr_missing()
         if lacks and device != "cpu":
@@ -103,65 +112,72 @@ class PbrRenderer:
         import mujoco_warp_pbr as mjpbr
         import warp as wp
 
-        from graphsdg.render import backend, pbr_meshes, pbr_outputs
+        from graphsdg.render import backend, pbr_meshes, pbr_outputs, pbr_uploads
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
-        self._outputs, self._meshes = pbr_outputs, pbr_meshes
+        self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
-        self._renders: dict[str, int] = {}       # per camera path: the seed of its next path-traced launch
+        self._renders: dict[tuple, int] = {}     # per launch's camera paths: the seed of its next launch
         self._isolated = None                    # classic rasteriser for render_isolated footprints
-        self.stats: dict[str, int] = {"color": 0, "contexts": 0}
+        self.stats: dict[str, int] = {"color": 0, "contexts": 0, "products": 0}
 
     # ---- contexts ------------------------------------------------------
-    def _key(self, sim: SimScene, view: CameraView, subframes: int) -> tuple:
+    def _key(self, sim: SimScene, views: list[CameraView], subframes: int) -> tuple:
         request = requested_backend()
         model = sim.model
         drawn = drawn_geom_mask(model)
         per_axis = math.ceil(math.sqrt(subframes)) if request.tier == "realtime" else 1
-        return (id(model), sim.model_version, view.width, view.height, request.tier, request.path_samples,
-                request.denoise, per_axis, drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)))
+        sizes = tuple((v.width, v.height) for v in views)
+        return (id(model), sim.model_version, sizes, request.tier, request.path_samples, request.denoise, per_axis,
+                drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)))
 
-    def _context(self, sim: SimScene, view: CameraView, subframes: int) -> _Context:
-        if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, PBR_CAMERA) < 0:
-            sim.recompile(keep_state=True)   # compiled while the classic backend drew: add the PBR camera
-        key = self._key(sim, view, subframes)
-        ctx = self._contexts.get(key)
-        if ctx is not None:
-            return ctx
-        self._contexts.clear()      # one live context (device memory); products at several sizes rebuild
-        with profiling.timed("render:pbr_context"):
-            ctx = self._build(sim, view, key)
-        self._contexts[key] = ctx
-        self.stats["contexts"] += 1
+    def _context(self, sim: SimScene, views: list[CameraView], subframes: int) -> _Context:
+        sim.require_pbr_cameras(len(views))
+        if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, pbr_camera_name(len(views) - 1)) < 0:
+            sim.recompile(keep_state=True)   # compiled while the classic backend drew: add the PBR cameras
+        key = self._key(sim, views, subframes)
+        ctx = self._contexts.pop(key, None)
+        if ctx is None:
+            for stale in [k for k in self._contexts if k[:2] != key[:2]]:   # built for another model
+                del self._contexts[stale]
+            while len(self._contexts) >= self.MAX_CONTEXTS:   # the least recently used goes
+                del self._contexts[next(iter(self._contexts))]
+            with profiling.timed("render:pbr_context"):
+                ctx = self._build(sim, views, key)
+            self.stats["contexts"] += 1
+        self._contexts[key] = ctx    # (re)inserted last: the most recently used
         return ctx
 
-    def _build(self, sim: SimScene, view: CameraView, key: tuple) -> _Context:
+    def _build(self, sim: SimScene, views: list[CameraView], key: tuple) -> _Context:
         wp, mjw, mjpbr = self._wp, self._mjw, self._mjpbr
         model = sim.model
-        camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, PBR_CAMERA)
+        cameras = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, pbr_camera_name(i)) for i in range(len(views))]
         request = requested_backend()
         exposure_setting = float(settings.get("/graphsdg/render/exposure", 1.0))
         env, yaw = self._environment(sim)
         path = request.tier == "path"
-        cam_active = [i == camera for i in range(model.ncam)]
+        cam_active = [i in cameras for i in range(model.ncam)]
         with wp.ScopedDevice(self._device):
             m = mjw.put_model(model)
             d = mjw.put_data(model, sim.data, nworld=1)
             rc = mjpbr.create_render_context(
-                model, nworld=1, cam_res=[(view.width, view.height)], render_rgb=True, render_depth=True,
+                model, nworld=1, cam_res=[(v.width, v.height) for v in views], render_rgb=True, render_depth=True,
                 render_seg=True, enabled_geom_groups=ENABLED_GROUPS, cam_active=cam_active,
                 light_model=mjpbr.LightModel.PHYSICAL, tone_mapper=mjpbr.ToneMapper.CLAMP,
-                ev100=pbr_scene.ev100(exposure_setting), samples_per_pixel=key[7],
+                ev100=pbr_scene.ev100(exposure_setting), samples_per_pixel=key[6],
                 envmap=env, envmap_intensity=1.0 if env is not None else None, envmap_rotation=math.degrees(yaw),
                 use_skybox=env is None, mesh_bvh_frame="mujoco",
                 tier=mjpbr.Tier.PATH if path else mjpbr.Tier.REALTIME, path_samples=request.path_samples,
-                denoise=path and request.denoise, camera_rays=pbr_scene.camera_rays(view)[None])
-            rgb = wp.zeros((1, view.height, view.width), dtype=wp.vec3)
-        layout = self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
-                                             view.far, self._device)
-        return _Context(key=key, model=m, data=d, rc=rc, camera=camera, rgb=rgb, env_yaw=yaw, layout=layout,
-                        rays_key=_rays_key(view), meshes=self._mesh_state(sim, rc))
+                denoise=path and request.denoise, camera_rays=[pbr_scene.camera_rays(v) for v in views])
+        layouts = [self._layout(v) for v in views]
+        return _Context(key=key, model=m, data=d, rc=rc, cameras=cameras, env_yaw=yaw, layouts=layouts,
+                        rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(sim, rc),
+                        uploads=self._uploads.PinnedUploads(self._device))
+
+    def _layout(self, view: CameraView):
+        return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
+                                           view.far, self._device)
 
     def _mesh_state(self, sim: SimScene, rc) -> _MeshState:
         """The context was built from the model's current vertices: every mesh's BVH is up to date."""
@@ -197,41 +213,81 @@ class PbrRenderer:
             total = env if total is None else total + env
         return total, yaw
 
-    # ---- one render ----------------------------------------------------
+    # ---- renders -------------------------------------------------------
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
                defer: bool = False, motion=None) -> RenderOutputs:
         """Render ``passes`` of ``view``: colour, depth and ids from the same rays (see the module docstring)."""
-        unknown = set(passes) - set(PASSES)
-        if unknown:
-            raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
-        if subframes < 1:
-            raise ValueError(f"subframes must be >= 1, got {subframes}")
-        wp = self._wp
-        ctx = self._context(sim, view, subframes)
+        return self._render_launch(sim, [RenderRequest(view, passes, subframes, defer, motion)])[0]
+
+    def render_batch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
+        """Render a step's products: those one launch can draw together (no motion blur, one launch of samples,
+        :func:`~graphsdg.render.backend.launch_groups`'s pixel limit) as cameras of one launch, the rest alone.
+        A product's pixels do not depend on which products share its launch, except the soft-shadow and path
+        samples' seed (each launch's own, deterministic)."""
+        outputs: list[RenderOutputs | None] = [None] * len(requests)
+        together = [i for i, r in enumerate(requests) if self._one_launch(r) and r.subframes == requests[0].subframes]
+        for group in launch_groups([requests[i].view.width * requests[i].view.height for i in together]):
+            chosen = [together[j] for j in group]
+            for i, out in zip(chosen, self._render_launch(sim, [requests[i] for i in chosen])):
+                outputs[i] = out
+        for i, r in enumerate(requests):
+            if outputs[i] is None:
+                outputs[i] = self._render_launch(sim, [r])[0]
+        return outputs
+
+    def _one_launch(self, request: RenderRequest) -> bool:
+        """Whether ``request`` is drawn by one launch (no motion blur, no path samples beyond one launch's)."""
+        tier = requested_backend()
+        return request.motion is None and (tier.tier == "realtime" or request.subframes <= max(1, tier.path_samples))
+
+    def _render_launch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
+        """Render ``requests`` (several only when each takes one launch: :meth:`_one_launch`) as the cameras of
+        one render context."""
+        for r in requests:
+            unknown = set(r.passes) - set(PASSES)
+            if unknown:
+                raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
+            if r.subframes < 1:
+                raise ValueError(f"subframes must be >= 1, got {r.subframes}")
+        views = [r.view for r in requests]
+        wp, first = self._wp, requests[0]
+        ctx = self._context(sim, views, first.subframes)
+        seeds = tuple(v.path for v in views)
         with wp.ScopedDevice(self._device):
             with profiling.timed("render:pbr_upload"):
-                self._upload_state(sim, view, ctx)
+                self._upload_state(sim, views, ctx)
             path = requested_backend().tier == "path"
-            launches = max(1, math.ceil(subframes / max(1, ctx.rc.path_samples))) if path else 1
-            acc = self._motion_blur(sim, ctx, motion, launches) if motion is not None else None
+            launches = max(1, math.ceil(first.subframes / max(1, ctx.rc.path_samples))) if path else 1
+            acc = self._motion_blur(sim, ctx, first.motion, launches) if first.motion is not None else None
             if acc is not None:
-                self._upload_state(sim, view, ctx)     # labels from the capture's own instant
+                self._upload_state(sim, views, ctx)     # labels from the capture's own instant
                 launches = 1
             with profiling.timed("render:pbr"):
                 for _ in range(launches):
-                    seed = self._renders.get(view.path, 0)
-                    self._renders[view.path] = seed + 1
-                    self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
-                    self.stats["color"] += 1
-                    if motion is None and launches > 1:   # several path launches: average their display colours
+                    self._launch(ctx, seeds)
+                    if first.motion is None and launches > 1:   # several path launches: average their colours
                         acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
-                if acc is not None and motion is None:
+                if acc is not None and first.motion is None:
                     acc = acc / launches
-                ctx.layout.convert(ctx.rc.base, 0)
+                for index, layout in enumerate(ctx.layouts):
+                    layout.convert(ctx.rc.base, index)
             with profiling.timed("readback:pbr"):
-                want_ids = "segmentation" in passes or "depth" in passes
-                host = ctx.layout.read(colour=acc is None and bool({"color", "hdr"} & passes),
-                                       depth="depth" in passes, ids=want_ids)
+                hosts = self._outputs.read_all([
+                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes,
+                     bool({"segmentation", "depth"} & r.passes)) for layout, r in zip(ctx.layouts, requests)])
+        self.stats["products"] += len(requests)
+        return [self._outputs_of(sim, r, host, acc) for r, host in zip(requests, hosts)]
+
+    def _launch(self, ctx: _Context, seeds: tuple) -> None:
+        """One launch of every camera of ``ctx``, with the next seed of this set of products."""
+        seed = self._renders.get(seeds, 0)
+        self._renders[seeds] = seed + 1
+        self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
+        self.stats["color"] += 1
+
+    def _outputs_of(self, sim: SimScene, request: RenderRequest, host, acc: np.ndarray | None) -> RenderOutputs:
+        """One product's :class:`RenderOutputs` from its host arrays (``acc``: an averaged colour, if any)."""
+        view, passes = request.view, request.passes
         out = RenderOutputs()
         if acc is not None:
             colour = np.clip(acc, 0.0, 1.0).astype(np.float32)
@@ -253,10 +309,14 @@ class PbrRenderer:
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
         return out
 
-    def _colour(self, ctx: _Context) -> np.ndarray:
-        """The last launch's display colour, (H, W, 3) float in [0, 1]."""
-        self._mjpbr.get_rgb(ctx.rc, 0, ctx.rgb)
-        return ctx.rgb.numpy()[0]
+    def _colour(self, ctx: _Context, index: int = 0) -> np.ndarray:
+        """The last launch's display colour of camera ``index``, (H, W, 3) float in [0, 1]."""
+        rgb = ctx.rgb.get(index)
+        if rgb is None:
+            h, w = ctx.layouts[index].shape
+            rgb = ctx.rgb[index] = self._wp.zeros((1, h, w), dtype=self._wp.vec3, device=self._device)
+        self._mjpbr.get_rgb(ctx.rc, index, rgb)
+        return rgb.numpy()[0]
 
     def _motion_blur(self, sim: SimScene, ctx: _Context, motion, launches: int) -> np.ndarray:
         """Mean display colour of renders at the motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`):
@@ -265,37 +325,37 @@ class PbrRenderer:
         with profiling.timed("render:pbr_motion"):
             for i in range(motion.count):
                 posed, seen = motion.pose(i)
-                self._upload_state(sim, seen, ctx, data=posed)
+                self._upload_state(sim, [seen], ctx, data=posed)
                 for _ in range(launches):
-                    seed = self._renders.get(seen.path, 0)
-                    self._renders[seen.path] = seed + 1
-                    self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
-                    self.stats["color"] += 1
+                    self._launch(ctx, (seen.path,))
                     acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
         return acc / (motion.count * launches)
 
-    def _upload_state(self, sim: SimScene, view: CameraView, ctx: _Context, data=None) -> None:
+    def _upload_state(self, sim: SimScene, views: list[CameraView], ctx: _Context, data=None) -> None:
         """The simulation's poses and randomized model fields into the renderer (no recompile).
 
         Poses change every frame and always go up; model fields that randomizers may write (colours,
-        material bindings, sizes, light colours) go up only when they differ from the last upload."""
-        model, m, d, rc = sim.model, ctx.model, ctx.data, ctx.rc
+        material bindings, sizes, light colours) go up only when they differ from the last upload. Every copy
+        goes through :class:`~graphsdg.render.pbr_uploads.PinnedUploads`."""
+        model, m, d, rc, uploads = sim.model, ctx.model, ctx.data, ctx.rc, ctx.uploads
         data = sim.data if data is None else data
-        d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
-        xmat = self._traced_frames(sim, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3))
-        d.geom_xmat.assign(np.asarray(xmat, dtype=np.float32)[None])
+        uploads.begin()
+        uploads.put("geom_xpos", d.geom_xpos, data.geom_xpos)
+        uploads.put("geom_xmat", d.geom_xmat,
+                    self._traced_frames(sim, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3)))
         if model.nlight:
-            d.light_xpos.assign(np.asarray(data.light_xpos, dtype=np.float32)[None])
-            d.light_xdir.assign(np.asarray(data.light_xdir, dtype=np.float32)[None])
+            uploads.put("light_xpos", d.light_xpos, data.light_xpos)
+            uploads.put("light_xdir", d.light_xdir, data.light_xdir)
         if model.nflex:     # deformables: their vertices as physics left them (refit_bvh refits the flex BVHs)
-            d.flexvert_xpos.assign(np.asarray(data.flexvert_xpos, dtype=np.float32)[None])
-        self._pose_camera(view, ctx)
+            uploads.put("flexvert_xpos", d.flexvert_xpos, data.flexvert_xpos)
+        self._pose_cameras(views, ctx)
         changed = self._upload_changed(ctx, [
-            (m.geom_rgba, "geom_rgba", model.geom_rgba, np.float32),
-            (m.geom_matid, "geom_matid", model.geom_matid, np.int32),
-            (m.geom_size, "geom_size", model.geom_size, np.float32),
-            (m.mat_rgba, "mat_rgba", model.mat_rgba if model.nmat else None, np.float32),
-            (m.light_diffuse, "light_diffuse", model.light_diffuse if model.nlight else None, np.float32)])
+            (m.geom_rgba, "geom_rgba", model.geom_rgba),
+            (m.geom_matid, "geom_matid", model.geom_matid),
+            (m.geom_size, "geom_size", model.geom_size),
+            (m.mat_rgba, "mat_rgba", model.mat_rgba if model.nmat else None),
+            (m.light_diffuse, "light_diffuse", model.light_diffuse if model.nlight else None)])
+        uploads.end()
         if changed & {"geom_matid", "light_diffuse"} or "surfaces" not in ctx.uploaded:
             exposure = float(settings.get("/graphsdg/render/exposure", 1.0))
             world = pbr_scene.world_arrays(model, self._surfaces(sim), exposure)
@@ -336,36 +396,37 @@ class PbrRenderer:
 
     @staticmethod
     def _upload_changed(ctx: _Context, fields: list) -> set[str]:
-        """Assign each ``(device array, name, host array, dtype)`` whose host array differs from its last upload;
-        returns the names assigned."""
+        """Upload each ``(device array, name, host array)`` whose host array differs from its last upload;
+        returns the names uploaded."""
         changed = set()
-        for device_array, name, host, dtype in fields:
+        for device_array, name, host in fields:
             if host is None:
                 continue
             last = ctx.uploaded.get(name)
             if last is not None and np.array_equal(last, host):
                 continue
-            copy = np.array(host, dtype=dtype)
-            device_array.assign(copy[None])
+            copy = np.array(host)
+            ctx.uploads.put(name, device_array, copy)
             ctx.uploaded[name] = copy
             changed.add(name)
         return changed
 
-    def _pose_camera(self, view: CameraView, ctx: _Context) -> None:
-        """Place the PBR camera at the USD camera; new intrinsics (focal length, apertures, clipping) give new
-        rays, copied to the renderer without recompiling."""
-        position, xmat = pbr_scene.camera_pose(view)
-        cam_xpos = np.zeros((1, ctx.model.ncam, 3), dtype=np.float32)
-        cam_xmat = np.tile(np.eye(3, dtype=np.float32), (1, ctx.model.ncam, 1, 1))
-        cam_xpos[0, ctx.camera], cam_xmat[0, ctx.camera] = position, xmat
-        ctx.data.cam_xpos.assign(cam_xpos)
-        ctx.data.cam_xmat.assign(cam_xmat)
-        key = _rays_key(view)
-        if key != ctx.rays_key:
-            self._mjpbr.set_camera_rays(ctx.rc, pbr_scene.camera_rays(view)[None])
-            ctx.layout = self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
-                                                     view.far, self._device)
-            ctx.rays_key = key
+    def _pose_cameras(self, views: list[CameraView], ctx: _Context) -> None:
+        """Place each PBR camera at its product's USD camera; new intrinsics (focal length, apertures,
+        clipping) give new rays, copied to the renderer without recompiling."""
+        ncam = ctx.model.ncam
+        cam_xpos = np.zeros((ncam, 3), dtype=np.float32)
+        cam_xmat = np.tile(np.eye(3, dtype=np.float32), (ncam, 1, 1))
+        for camera, view in zip(ctx.cameras, views):
+            cam_xpos[camera], cam_xmat[camera] = pbr_scene.camera_pose(view)
+        ctx.uploads.put("cam_xpos", ctx.data.cam_xpos, cam_xpos)
+        ctx.uploads.put("cam_xmat", ctx.data.cam_xmat, cam_xmat)
+        keys = [_rays_key(v) for v in views]
+        if keys != ctx.rays_keys:
+            self._mjpbr.set_camera_rays(ctx.rc, [pbr_scene.camera_rays(v) for v in views])
+            ctx.layouts = [layout if key == old else self._layout(view)
+                           for layout, key, old, view in zip(ctx.layouts, keys, ctx.rays_keys, views)]
+            ctx.rays_keys = keys
 
     def _surfaces(self, sim: SimScene) -> dict[int, pbr_scene.SurfaceFields]:
         compiled = sim.ensure_compiled()

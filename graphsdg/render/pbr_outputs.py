@@ -5,8 +5,9 @@ The renderer leaves one camera's pixels in three device buffers: colour packed a
 ``(object id, object type)`` pairs. Annotators want RGBA bytes, planar depth with
 ``inf`` on misses and past the far plane, and int32 geom ids with -1 for background
 (:class:`~graphsdg.render.rasterizer.RenderOutputs`). One kernel converts all three
-where the pixels already are, then each asked-for array comes back in one copy into
-page-locked host memory: about a third of the bytes the renderer's own float
+where the pixels already are (one launch per camera of a batched render), then each
+asked-for array comes back in one copy into page-locked host memory, all cameras' copies
+behind one wait: about a third of the bytes the renderer's own float
 ``get_rgb`` readback moves, and no per-pixel numpy work on the CPU.
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
@@ -69,6 +70,7 @@ class ClassicLayout:
         self.host_depth = wp.empty(n, dtype=wp.float32, device="cpu", pinned=pinned)
         self.host_ids = wp.empty(n, dtype=wp.int32, device="cpu", pinned=pinned)
         self._adrs: dict[tuple, int] = {}
+        self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
 
     def convert(self, base, camera: int) -> None:
         """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0)."""
@@ -86,21 +88,37 @@ class ClassicLayout:
         return self._adrs[key]
 
     def read(self, colour: bool, depth: bool, ids: bool) -> HostFrame:
-        """Copy the asked-for arrays to the host (one device copy each, into page-locked memory, then into
-        arrays of their own: annotators and writer threads keep them past the next render)."""
-        h, w = self.shape
-        wanted = [(colour, self.rgba, self.host_rgba), (depth, self.depth, self.host_depth),
-                  (ids, self.ids, self.host_ids)]
-        for want, src, dst in wanted:
+        """Copy the asked-for arrays to the host (:func:`read_all` of this layout alone)."""
+        return read_all([(self, colour, depth, ids)])[0]
+
+    def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
+        """Queue one device copy of each asked-for array into its page-locked host buffer."""
+        self._wanted = (colour, depth, ids)
+        for want, src, dst in zip(self._wanted, (self.rgba, self.depth, self.ids),
+                                  (self.host_rgba, self.host_depth, self.host_ids)):
             if want:
                 wp.copy(dst, src)
-        if wp.get_device(self.device).is_cuda:   # CPU copies are done when wp.copy returns
-            done = wp.record_event()
-            wait_until(lambda: done.is_complete)   # not wp.synchronize_device: CUDA's wait spins a core
-        own = [np.array(dst.numpy()) if want else None for want, _, dst in wanted]
+
+    def take(self) -> HostFrame:
+        """The queued copies (done) as arrays of their own: annotators and writer threads keep them past the
+        next render."""
+        h, w = self.shape
+        own = [np.array(dst.numpy()) if want else None
+               for want, dst in zip(self._wanted, (self.host_rgba, self.host_depth, self.host_ids))]
         return HostFrame(rgba=None if own[0] is None else own[0].view(np.uint8).reshape(h, w, 4),
                          depth=None if own[1] is None else own[1].reshape(h, w),
                          geom_ids=None if own[2] is None else own[2].reshape(h, w))
 
 
-__all__ = ["ClassicLayout", "HostFrame"]
+def read_all(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> list[HostFrame]:
+    """Each ``(layout, colour, depth, ids)``'s asked-for arrays on the host: every copy queued, then one wait
+    for all of them (polled: ``wp.synchronize_device`` would spin a core in CUDA's wait)."""
+    for layout, colour, depth, ids in reads:
+        layout.queue_read(colour, depth, ids)
+    if reads and wp.get_device(reads[0][0].device).is_cuda:   # CPU copies are done when wp.copy returns
+        done = wp.record_event()
+        wait_until(lambda: done.is_complete)
+    return [layout.take() for layout, *_ in reads]
+
+
+__all__ = ["ClassicLayout", "HostFrame", "read_all"]

@@ -41,6 +41,7 @@ import numpy as np
 
 from graphsdg.benchmark import profiling
 from graphsdg.render import gl_direct, sky
+from graphsdg.render.backend import RenderRequest
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
@@ -323,6 +324,10 @@ class Rasterizer:
             if current is not None:
                 undo = uploaded_inverse.get(mid)
                 g.mat[:] = g.mat @ (current if undo is None else current @ undo)
+
+    def render_batch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
+        """:meth:`render` of each request in turn (the rasteriser draws one camera per pass)."""
+        return [self.render(sim, r.view, r.passes, r.subframes, defer=r.defer, motion=r.motion) for r in requests]
 
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
                defer: bool = False, motion: MotionSamples | None = None) -> RenderOutputs:

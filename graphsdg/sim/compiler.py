@@ -56,7 +56,7 @@ from graphsdg.sim.mesh_normals import mesh_normals
 from graphsdg.sim.mujoco_warnings import route_warnings
 from graphsdg.sim.physics_scene import configure_physics
 from graphsdg.sim.rigid_bodies import SpecBodies, in_body_frame, is_kinematic, rigid_root
-from graphsdg.sim.visual import HIDDEN_GROUP, add_pbr_camera, configure_visual
+from graphsdg.sim.visual import HIDDEN_GROUP, add_pbr_cameras, configure_visual
 from graphsdg.stage.xform import world_matrix
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
@@ -69,7 +69,7 @@ PROBE_SPHERE = "graphsdg:probe_sphere"
 class _Builder:
     """One compile: walks the stage and fills an MjSpec, each schema through its module's part."""
 
-    def __init__(self, stage: Usd.Stage, offscreen: tuple[int, int], pbr: bool) -> None:
+    def __init__(self, stage: Usd.Stage, offscreen: tuple[int, int], pbr: bool, pbr_cameras: int = 1) -> None:
         self.stage = stage
         self.spec = mujoco.MjSpec()
         self.cache = UsdGeom.XformCache(Usd.TimeCode.Default())
@@ -78,6 +78,7 @@ class _Builder:
         self.mass_records: list[tuple] = []
         self.collider_records: list[tuple] = []
         self.pbr_maps = pbr                            # materials carry normal / ORM / ... maps for the pbr backend
+        self.pbr_cameras = pbr_cameras
         self.materials = SpecMaterials(self.spec, self.pbr_maps)
         self.lights = lightmap.SpecLights(self.spec, stage, self.cache)
         self.bodies = SpecBodies(self.spec, stage, self.cache)
@@ -207,7 +208,7 @@ class _Builder:
         self.flex_plans = deformables.add_to_spec(self.spec, prims, self.cache)
         self.lights.finish()
         if self.pbr_maps:     # only where the pbr backend draws, so the classic model is unchanged
-            add_pbr_camera(self.spec)
+            add_pbr_cameras(self.spec, self.pbr_cameras)
         assign_masses(self.mass_records, self.bodies.body_mass)
         try:   # physxCollision offsets -> margins; authored PhysX attributes with no effect warn once
             physx_attributes.tune_colliders(self.stage, self.collider_records)
@@ -273,13 +274,15 @@ class _Builder:
         return scene
 
 
-def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480), pbr: bool = False) -> CompiledScene:
+def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480), pbr: bool = False,
+                  pbr_cameras: int = 1) -> CompiledScene:
     """Compile ``stage`` into a :class:`CompiledScene` (model, data and prim maps).
 
     ``offscreen`` is the size of MuJoCo's offscreen framebuffer (the largest
     render product). ``pbr``: the pbr backend draws this model, so it gets that
-    backend's camera and its materials their normal / ORM / ... maps (the classic
-    model stays without them).
+    backend's cameras (``pbr_cameras``: how many render products it draws in one
+    launch) and its materials their normal / ORM / ... maps (the classic model
+    stays without them).
 
     Example:
         >>> from graphsdg import stage
@@ -289,6 +292,6 @@ def compile_stage(stage: Usd.Stage, offscreen: tuple[int, int] = (640, 480), pbr
         1
     """
     start = time.perf_counter()
-    scene = _Builder(stage, offscreen, pbr).build()
+    scene = _Builder(stage, offscreen, pbr, pbr_cameras).build()
     scene.compile_seconds = time.perf_counter() - start
     return scene

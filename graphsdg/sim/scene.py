@@ -67,6 +67,7 @@ class SimScene:
         self.pbr_draws = pbr_draws
         self.compiled: CompiledScene | None = None
         self.offscreen = (64, 64)
+        self.pbr_cameras = 1                # cameras compiled for the pbr backend (render products per launch)
         # changes on every recompile (renderers rebuild contexts); drawn from one process-wide counter so
         # that (id(sim), model_version) keys stay unique when a freed scene's id is reused by a new one
         self.model_version = next(_model_versions)
@@ -113,6 +114,14 @@ class SimScene:
                 self.compiled.model.vis.global_.offheight = h
                 self.model_version = next(_model_versions)
 
+    def require_pbr_cameras(self, count: int) -> None:
+        """Compile at least ``count`` cameras for the pbr backend, to draw that many render products in one
+        launch (recompiles, keeping the state, if they grow and the model has them too few)."""
+        if count > self.pbr_cameras:
+            self.pbr_cameras = count
+            if self.compiled is not None:
+                self.recompile(keep_state=True)
+
     def rescale_mesh(self, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> None:
         """Rescale visual mesh geom ``geom_id`` in place and record the map for renderers."""
         self.rescale_meshes(np.array([geom_id]), np.array([old_scale]), np.array([new_scale]))
@@ -140,7 +149,7 @@ class SimScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
         start = time.perf_counter()
-        new = compile_stage(self.stage, self.offscreen, pbr=self.pbr_draws())
+        new = compile_stage(self.stage, self.offscreen, pbr=self.pbr_draws(), pbr_cameras=self.pbr_cameras)
         if old is not None and keep_state:
             carry_state(old, new)
             mujoco.mj_forward(new.model, new.data)

@@ -21,6 +21,12 @@ UNDRAWN_GROUPS = (COLLISION_ONLY_GROUP, HIDDEN_GROUP)
 PBR_CAMERA = "graphsdg:pbr_camera"   # the camera the PBR backend renders from (render products' poses)
 
 
+def pbr_camera_name(index: int) -> str:
+    """The name of the PBR backend's camera ``index`` (0: :data:`PBR_CAMERA`; one per render product it draws
+    in one launch)."""
+    return PBR_CAMERA if index == 0 else f"{PBR_CAMERA}_{index}"
+
+
 def drawn_geom_mask(model: mujoco.MjModel) -> np.ndarray:
     """Which geoms renders draw: those in MuJoCo's groups 0-5 other than :data:`UNDRAWN_GROUPS`."""
     group = model.geom_group
@@ -56,10 +62,13 @@ def configure_visual(spec: mujoco.MjSpec, offscreen: tuple[int, int]) -> None:
     vis.map.zfar = 8.0
 
 
-def add_pbr_camera(spec: mujoco.MjSpec) -> None:
-    """One MuJoCo camera for the PBR backend to pose at each render product's USD camera (its rays are
-    per pixel, so no field of view is needed)."""
-    spec.worldbody.add_camera(name=PBR_CAMERA)
+def add_pbr_cameras(spec: mujoco.MjSpec, count: int = 1) -> None:
+    """``count`` MuJoCo cameras for the PBR backend to pose at render products' USD cameras, one per product
+    drawn in the same launch (their rays are per pixel, so no field of view is needed)."""
+    if count < 1:
+        raise ValueError(f"the pbr backend needs at least one camera, got count={count}")
+    for index in range(count):
+        spec.worldbody.add_camera(name=pbr_camera_name(index))
 
 
 def sync_visibility(model: mujoco.MjModel, prim: Usd.Prim, g: GeomBinding) -> None:
