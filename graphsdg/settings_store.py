@@ -70,7 +70,7 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                          "where it can run, else classic; said once in the log)"),
     "/graphsdg/render/pbrDevice": ("cuda:0", "the Warp device the pbr backend renders on: cuda:N, or cpu (Warp's "
                                              "CPU device: slow, for checks on machines without a GPU)"),
-    "/graphsdg/render/pbrBatchPixels": (1 << 20, "the pbr backend draws a step's render products in one launch "
+    "/graphsdg/render/pbrBatchPixels": (1 << 21, "the pbr backend draws a step's render products in one launch "
                                                  "while their pixels add up to at most this many (one camera "
                                                  "each; bench/pbr_products.py measured where it pays); 0: one "
                                                  "launch per product"),

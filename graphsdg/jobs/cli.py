@@ -336,7 +336,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--pbr-batch-pixels", type=_non_negative, metavar="N",
                        help="on pbr, draw a step's render products in one launch while their pixels add up to at "
                             "most N, 0 for a launch per product: /graphsdg/render/pbrBatchPixels (default: the "
-                            "setting, 1048576)")
+                            "setting, 2097152: eight 512x512 products)")
     bench.add_argument("--processes", type=_non_negative, default=0,
                        help="run this many graphsdg processes at once and report their aggregate frames/s "
                             "(no hand-written loop); 0 runs one process with the loop (default: 0)")
