@@ -15,6 +15,7 @@ from pxr import Usd
 
 from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
+from graphsdg.render import render_product
 from graphsdg.render.attachments import OrderedSet, attachments
 from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
 from graphsdg.render.rasterizer import Rasterizer
@@ -83,7 +84,8 @@ class Runtime:
         stage = self.stage
         if self._sim is None or self._sim_stage is not stage:
             assert stage_context.tracker is not None
-            self._sim = SimScene(stage, stage_context.tracker, pbr_draws=pbr_draws)
+            self._sim = SimScene(stage, stage_context.tracker, pbr_draws=pbr_draws,
+                                 render_products=lambda: len(render_product.registry))
             self._sim_stage = stage
             self.timeline.set_time_codes_per_second(stage.GetTimeCodesPerSecond() or 60.0)
         return self._sim

@@ -482,3 +482,25 @@ def test_a_pile_of_boxes_is_deterministic():
         return np.concatenate(RigidBodyView(cubes).get_world_poses(), axis=1)
 
     assert np.array_equal(pile(), pile())
+
+
+def test_a_scene_without_degrees_of_freedom_advances_to_the_state_mj_step_gives():
+    """No rigid bodies (nv = 0): advancing moves the clock step by step without mj_step's forward pass, to the
+    same time and poses as stepping with mj_step, and physics callbacks still run once a step."""
+    import mujoco
+    for name, z in (("A", 0.5), ("B", 1.2)):
+        rep.functional.physics.apply_collider(rep.functional.create.cube(position=(0, 0, z), name=name))
+    s = sim()
+    m, d = s.model, s.data
+    assert m.nv == 0
+    reference = mujoco.MjData(m)
+    mujoco.mj_copyData(reference, m, d)
+    calls = []
+    s.add_physics_callback("count", lambda step: calls.append(step))
+    s.advance(DT)
+    for _ in range(2):
+        mujoco.mj_step(m, reference)
+    mujoco.mj_forward(m, reference)
+    assert calls == [H, H]
+    assert d.time == reference.time == pytest.approx(DT)
+    np.testing.assert_array_equal(d.geom_xpos, reference.geom_xpos)

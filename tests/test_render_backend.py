@@ -151,3 +151,30 @@ def test_gpu_extra_pins_the_measured_versions_for_python_312_only():
     assert all('python_version >= "3.12"' in req for req in gpu)
     assert not any("warp" in dep for dep in project["dependencies"])          # the core install is unchanged
     assert not any("warp" in dep for dep in project["optional-dependencies"]["dev"])   # and so is CI's
+
+
+def test_models_compiled_for_pbr_carry_a_camera_per_render_product(monkeypatch):
+    """Where pbr draws, each compile gives every render product a PBR camera (a step's products then go in one
+    launch without recompiling mid-step); more products than cameras later recompile once, keeping the state."""
+    import mujoco
+
+    from graphsdg.sim.visual import pbr_camera_name
+    monkeypatch.setattr(backend, "pbr_in_use", True)
+    rep.functional.create.cube()
+    cam = rep.functional.create.camera(position=(0, -4, 0), look_at=(0, 0, 0))
+    for size in ((32, 24), (16, 12), (8, 8)):
+        rep.create.render_product(cam, size)
+    sim = runtime().sim
+    model = sim.model
+
+    def names(m):
+        return {mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(m.ncam)}
+
+    assert {pbr_camera_name(i) for i in range(3)} <= names(model) and pbr_camera_name(3) not in names(model)
+    compiles = sim.stats["compiles"]
+    sim.require_pbr_cameras(2)
+    assert sim.stats["compiles"] == compiles and sim.model is model
+    sim.data.time = 1.25
+    sim.require_pbr_cameras(5)
+    assert sim.stats["compiles"] == compiles + 1 and pbr_camera_name(4) in names(sim.model)
+    assert sim.data.time == 1.25

@@ -60,11 +60,15 @@ class SimScene:
     """MuJoCo model and data of one stage, kept in step with it."""
 
     def __init__(self, stage: Usd.Stage, tracker: ChangeTracker,
-                 pbr_draws: Callable[[], bool] = lambda: False) -> None:
+                 pbr_draws: Callable[[], bool] = lambda: False,
+                 render_products: Callable[[], int] = lambda: 1) -> None:
         self.stage = stage
         self.tracker = tracker
         # asked at each compile: whether the pbr backend draws this process's models (render/ knows; sim/ is below)
         self.pbr_draws = pbr_draws
+        # asked at each compile: how many render products there are, so that a model compiled for the pbr backend
+        # has a camera for each when it draws them in one launch (no recompile in the middle of a step)
+        self.render_products = render_products
         self.compiled: CompiledScene | None = None
         self.offscreen = (64, 64)
         self.pbr_cameras = 1                # cameras compiled for the pbr backend (render products per launch)
@@ -116,7 +120,8 @@ class SimScene:
 
     def require_pbr_cameras(self, count: int) -> None:
         """Compile at least ``count`` cameras for the pbr backend, to draw that many render products in one
-        launch (recompiles, keeping the state, if they grow and the model has them too few)."""
+        launch (recompiles, keeping the state, if they grow and the model has them too few: only when products
+        were created after the compile, since each compile gives every render product one)."""
         if count > self.pbr_cameras:
             self.pbr_cameras = count
             if self.compiled is not None:
@@ -149,7 +154,10 @@ class SimScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
         start = time.perf_counter()
-        new = compile_stage(self.stage, self.offscreen, pbr=self.pbr_draws(), pbr_cameras=self.pbr_cameras)
+        pbr = self.pbr_draws()
+        if pbr:
+            self.pbr_cameras = max(self.pbr_cameras, int(self.render_products()))
+        new = compile_stage(self.stage, self.offscreen, pbr=pbr, pbr_cameras=self.pbr_cameras)
         if old is not None and keep_state:
             carry_state(old, new)
             mujoco.mj_forward(new.model, new.data)
@@ -333,7 +341,12 @@ class SimScene:
                                    "physics callbacks may write simulation state (joint targets, constraints) "
                                    "but not edit the stage's structure")
             physics_steps.notify(True, float(m.opt.timestep))
-            mujoco.mj_step(m, d)
+            if m.nv == 0 and m.na == 0 and m.nplugin == 0:
+                # nothing to integrate: a step only moves the clock (mj_Euler's own addition), and its forward
+                # pass would be recomputed by the mj_forward below (the SDG scenes without rigid bodies)
+                d.time += m.opt.timestep
+            else:
+                mujoco.mj_step(m, d)
             physics_steps.notify(False, float(m.opt.timestep))
             steps += 1
         # mj_step leaves positions-derived quantities one step behind; renders,
