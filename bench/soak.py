@@ -132,6 +132,8 @@ def soak_pipelined(out: str, frames: int, every: int, resolution: tuple[int, int
         if n % every == 0:
             gc.collect()
             samples.append((n, rss_mb(), n / (time.perf_counter() - t0), rep.orchestrator.get_write_queue().pending()))
+            print(f"frame {n}: RSS {samples[-1][1]:.1f} MB, {samples[-1][2]:.1f} frames/s", file=sys.stderr,
+                  flush=True)   # a run cut short still shows its samples
     rep.orchestrator.wait_until_complete()
     writer.detach()
     return samples
