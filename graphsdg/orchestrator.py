@@ -221,7 +221,7 @@ def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], proven
     defer = defer and _state.plan is None and all(a.spec.pixels_only for _, anns in products.values() for a in anns)
     capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame, rt.sim.data.time,
                        list(rt.writers))
-    for path, (rp, annotators), frame in zip(products, products.values(), _render(rt, products, subframes, defer)):
+    for (path, (_, annotators)), frame in zip(products.items(), _render(rt, products, subframes, defer)):
         capture.frames.append((path, frame, annotators))
     if products:
         for observer in list(rt.render_observers):

@@ -46,10 +46,9 @@ BACKEND_KEY = "/graphsdg/render/backend"
 DEVICE_KEY = "/graphsdg/render/pbrDevice"
 BACKENDS = ("classic", "pbr", "auto")
 DENOISER_KEY = "/rtx/pathtracing/optixDenoiser/enabled"
+#: its default (the settings store's) is eight 512x512 products: the most pixels bench/pbr_products.py measured one
+#: launch to be faster for (H100: 1.1-1.4x from two 512x512 to sixteen 128x128 products, docs/rendering.md)
 BATCH_PIXELS_KEY = "/graphsdg/render/pbrBatchPixels"
-#: eight 512x512 products: the most pixels bench/pbr_products.py measured one launch to be faster for (H100; 1.1-1.4x
-#: from two 512x512 to sixteen 128x128 products, docs/rendering.md)
-DEFAULT_BATCH_PIXELS = 1 << 21
 #: the ``graphsdg[gpu]`` extra: import name -> distribution pinned in pyproject.toml
 PBR_MODULES = {"warp": "warp-lang==1.19.0", "mujoco_warp": "mujoco-warp==3.17.0",
                "mujoco_warp_pbr": "mujoco-warp-pbr==0.2.0"}
@@ -137,7 +136,7 @@ def launch_groups(pixels: list[int], limit: int | None = None) -> list[list[int]
         >>> launch_groups([512 * 512] * 3, limit=600_000)
         [[0, 1], [2]]
     """
-    limit = int(settings.get(BATCH_PIXELS_KEY, DEFAULT_BATCH_PIXELS)) if limit is None else int(limit)
+    limit = int(settings.get(BATCH_PIXELS_KEY)) if limit is None else int(limit)
     groups: list[list[int]] = []
     total = 0
     for i, n in enumerate(pixels):
