@@ -52,7 +52,8 @@ from graphsdg import settings_store as settings
 from graphsdg.benchmark import profiling
 from graphsdg.imaging import environment_map
 from graphsdg.render import mesh_folds, pbr_scene
-from graphsdg.render.backend import PbrUnavailableError, RenderRequest, launch_groups, pbr_missing, requested_backend
+from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderRequest, launch_groups, pbr_missing,
+                                     requested_backend)
 from graphsdg.render.camera import CameraView
 from graphsdg.maths.rotations import decompose
 from graphsdg.render.rasterizer import PASSES, Rasterizer, RenderOutputs
@@ -225,7 +226,9 @@ class PbrRenderer:
         A product's pixels do not depend on which products share its launch, except the soft-shadow and path
         samples' seed (each launch's own, deterministic)."""
         outputs: list[RenderOutputs | None] = [None] * len(requests)
-        together = [i for i, r in enumerate(requests) if self._one_launch(r) and r.subframes == requests[0].subframes]
+        tier = requested_backend()
+        together = [i for i, r in enumerate(requests)
+                    if self._one_launch(r, tier) and r.subframes == requests[0].subframes]
         for group in launch_groups([requests[i].view.width * requests[i].view.height for i in together]):
             chosen = [together[j] for j in group]
             for i, out in zip(chosen, self._render_launch(sim, [requests[i] for i in chosen])):
@@ -235,9 +238,10 @@ class PbrRenderer:
                 outputs[i] = self._render_launch(sim, [r])[0]
         return outputs
 
-    def _one_launch(self, request: RenderRequest) -> bool:
-        """Whether ``request`` is drawn by one launch (no motion blur, no path samples beyond one launch's)."""
-        tier = requested_backend()
+    @staticmethod
+    def _one_launch(request: RenderRequest, tier: BackendRequest) -> bool:
+        """Whether ``request`` is drawn by one launch under ``tier`` (a :class:`BackendRequest`): no motion blur,
+        no path samples beyond one launch's."""
         return request.motion is None and (tier.tier == "realtime" or request.subframes <= max(1, tier.path_samples))
 
     def _render_launch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:

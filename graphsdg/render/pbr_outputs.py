@@ -87,10 +87,6 @@ class ClassicLayout:
             self._adrs[key] = int(getattr(base, f"{kind}_adr").numpy()[camera])
         return self._adrs[key]
 
-    def read(self, colour: bool, depth: bool, ids: bool) -> HostFrame:
-        """Copy the asked-for arrays to the host (:func:`read_all` of this layout alone)."""
-        return read_all([(self, colour, depth, ids)])[0]
-
     def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
         """Queue one device copy of each asked-for array into its page-locked host buffer."""
         self._wanted = (colour, depth, ids)
