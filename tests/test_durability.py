@@ -171,38 +171,19 @@ def test_disk_full_leaves_only_whole_files(out_dir, monkeypatch):
     """A disk that fills up mid-dataset: every file under a final name is whole, no temp file, a clear error."""
     import errno
     import graphsdg.io.backends as backends
-    real_open = open
+    real_write_all = backends._write_all
     budget = {"bytes": None}
 
-    class QuotaFile:
-        def __init__(self, f):
-            self.f = f
+    def quota_write_all(fd, data):
+        if budget["bytes"] is None:
+            return real_write_all(fd, data)
+        room = max(0, budget["bytes"])
+        real_write_all(fd, data[:room])                   # what fits really reaches the disk
+        budget["bytes"] -= len(data)
+        if len(data) > room:
+            raise OSError(errno.ENOSPC, "No space left on device")
 
-        def write(self, data):
-            if budget["bytes"] is not None:
-                room = max(0, budget["bytes"])
-                self.f.write(data[:room])                 # what fits really reaches the disk
-                budget["bytes"] -= len(data)
-                if len(data) > room:
-                    raise OSError(errno.ENOSPC, "No space left on device")
-            else:
-                self.f.write(data)
-            return len(data)
-
-        def fileno(self):
-            return self.f.fileno()
-
-        def flush(self):
-            self.f.flush()
-
-        def __enter__(self):
-            return self
-
-        def __exit__(self, *exc):
-            self.f.close()
-
-    monkeypatch.setattr(backends, "open", lambda p, m="r", *a, **k: QuotaFile(real_open(p, m, *a, **k))
-                        if "w" in m else real_open(p, m, *a, **k), raising=False)
+    monkeypatch.setattr(backends, "_write_all", quota_write_all)
     cube, cam, rp = unit_cube_scene(resolution=(64, 48))
     writer = rep.writers.get("BasicWriter")
     writer.initialize(output_dir=out_dir, rgb=True, bounding_box_2d_tight=True, semantic_segmentation=True)

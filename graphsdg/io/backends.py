@@ -245,11 +245,21 @@ _process_token = (-1, "")
 
 def _temp_token() -> str:
     """A name part no other write (thread, process, or host sharing the folder) uses at the same time:
-    a random token per process (made again after a fork) and a serial number."""
+    a random token per process (made again in a forked child) and a serial number."""
     global _process_token
-    if _process_token[0] != os.getpid():
+    if not _process_token[1]:
         _process_token = (os.getpid(), uuid.uuid4().hex[:10])
     return f"{_process_token[1]}{next(_temp_serial)}"
+
+
+def _forget_process_token() -> None:
+    global _process_token
+    _process_token = (-1, "")
+
+
+# a forked child must not reuse its parent's temporary names (asking os.getpid() per file instead was a
+# system call per file)
+os.register_at_fork(after_in_child=_forget_process_token)
 
 
 def files_written() -> int:
@@ -317,6 +327,18 @@ def write_file_atomic(full_path: str, data: bytes) -> None:
     _write_atomic(full_path, data, count=True)
 
 
+# os.open + os.write instead of open(): a buffered file object also makes fstat, ioctl and lseek calls, and
+# each system call hands the interpreter lock to another thread and back (a frame of small images writes
+# seven files; the render thread waits for the lock each time the writer takes it)
+_CREATE_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_CLOEXEC", 0)
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
 def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
     """:func:`write_file_atomic`; ``count=False`` leaves the totals alone (bookkeeping files: the run state)."""
     if writes_discarded():
@@ -329,15 +351,16 @@ def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
     durable = bool(settings.get("/graphsdg/io/fsync", False))
     try:
         try:
-            f = open(tmp, "wb")
+            fd = os.open(tmp, _CREATE_FLAGS, 0o666)
         except FileNotFoundError:   # the folder was removed since: make it again
             os.makedirs(directory, exist_ok=True)
-            f = open(tmp, "wb")
-        with f:
-            f.write(data)
+            fd = os.open(tmp, _CREATE_FLAGS, 0o666)
+        try:
+            _write_all(fd, data)
             if durable:
-                f.flush()
-                os.fsync(f.fileno())
+                os.fsync(fd)
+        finally:
+            os.close(fd)
         os.replace(tmp, full_path)
         if durable:
             _fsync_dir(directory)
