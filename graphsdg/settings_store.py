@@ -179,6 +179,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
 }
 
 _values: dict[str, Any] = {}
+_MISSING = object()
 _warned: set[str] = set()
 _lock = threading.Lock()
 
@@ -214,6 +215,12 @@ def set(key: str, value: Any) -> None:  # noqa: A001 - mirrors carb's API name
 
 def get(key: str, default: Any = None) -> Any:
     """Return the value of ``key``: what was set, else graphsdg's default, else ``default``."""
+    if type(key) is str:
+        # A frame reads settings ~50 times: a key spelt as stored (stored keys are normalized) needs neither
+        # normalizing nor the lock (one dict read is atomic)
+        value = _values.get(key, _MISSING)
+        if value is not _MISSING:
+            return value
     k = normalize_key(key)
     with _lock:
         if k in _values:

@@ -34,6 +34,7 @@ Example:
 """
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 from typing import Iterable, Mapping, Sequence
@@ -161,7 +162,13 @@ class SemanticFilter:
         """Parse ``predicate``; raise :class:`SemanticFilterError` naming the problem and its position."""
         if not isinstance(predicate, str):
             raise SemanticFilterError(f"semanticFilter must be a string such as 'class:*', got {predicate!r}")
-        return _Parser(predicate).parse()
+        return _parsed(predicate)
+
+
+@functools.lru_cache(maxsize=256)
+def _parsed(predicate: str) -> SemanticFilter:
+    """Parsed filters are immutable, and annotators ask for theirs every frame: each text is parsed once."""
+    return _Parser(predicate).parse()
 
 
 _TOKEN_CHARS = set(":;,|&!")
