@@ -285,6 +285,11 @@ class _Capture:
             if frame.outputs is not None:
                 frame.outputs.finish()   # a pass no annotator read still holds a pixel buffer: hand it back
         reference_time = Fraction(self.sim_time).limit_denominator(1_000_000)
+        with get_write_queue().batch():   # the frame's files wake the writer threads once
+            self._write(rt, outputs, reference_time)
+        _timed("write", t)
+
+    def _write(self, rt, outputs: dict, reference_time: Fraction) -> None:
         for writer in self.writers:
             if writer not in rt.writers or not writer.wants_frame(self.fired):
                 continue
@@ -295,7 +300,6 @@ class _Capture:
                                         (reference_time.numerator, reference_time.denominator), extra=extra or None)
             with run_state.frame(writer, self.stage_step, data.get("frame_index")):   # for graphsdg_run.json
                 writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
-        _timed("write", t)
 
 
 async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float | None = None,

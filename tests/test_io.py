@@ -135,6 +135,45 @@ def test_full_queue_throttles_the_producer():
     q.shutdown()
 
 
+def test_a_batch_wakes_the_workers_once_when_it_ends():
+    import threading
+    import time
+
+    from graphsdg.io.write_queue import WriteQueue
+
+    q = WriteQueue(num_threads=2, max_size=100)
+    ran: list[int] = []
+    q.schedule(ran.append, -1)
+    q.wait_until_done()                       # both workers now wait for work
+    with q.batch():
+        for i in range(5):
+            q.schedule(ran.append, i)
+        with q.batch():                       # nested: still held until the outer block ends
+            q.schedule(ran.append, 5)
+        time.sleep(0.1)
+        assert ran == [-1]                    # no idle worker was woken inside the block
+        assert q.pending() == 6
+    q.wait_until_done()
+    assert sorted(ran) == [-1, 0, 1, 2, 3, 4, 5]
+    # inside a block, a full queue, wait_until_done and shutdown wake the workers first (no deadlock)
+    small = WriteQueue(num_threads=1, max_size=2)
+    done = threading.Event()
+
+    def produce():
+        with small.batch():
+            for i in range(6):
+                small.schedule(ran.append, 10 + i)
+            small.wait_until_done()
+            small.schedule(ran.append, 16)
+            small.shutdown()
+        done.set()
+
+    threading.Thread(target=produce, daemon=True).start()
+    assert done.wait(10), "a batch on a full queue deadlocked"
+    assert sorted(ran)[-7:] == list(range(10, 17))
+    q.shutdown()
+
+
 @pytest.mark.parametrize("threads", [1, 3])
 def test_bytes_do_not_depend_on_writer_threads(tmp_path, threads):
     from test_foundation import _capture

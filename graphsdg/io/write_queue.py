@@ -194,6 +194,7 @@ class WriteQueue:
                 inline = False
                 # A task that schedules a follow-up must not wait for room it occupies itself.
                 if self._full(nbytes) and threading.current_thread() not in self._threads:
+                    self._wake_deferred()          # the room can only come from tasks a worker was told about
                     now = time.perf_counter()
                     if now - self._last_throttle_log >= _THROTTLE_LOG_EVERY_S:
                         self._last_throttle_log = now
@@ -209,7 +210,10 @@ class WriteQueue:
                 group.pending += 1
             if not inline:
                 self._items.append(item)
-                self._has_work.notify()        # one idle worker takes it
+                if getattr(self._local, "deferred", None) is not None:
+                    self._local.deferred += 1      # inside batch(): woken when the block ends
+                else:
+                    self._has_work.notify()    # one idle worker takes it
         if inline:
             self._run(item)
 
@@ -237,6 +241,33 @@ class WriteQueue:
             if finished:
                 group.on_done(not group.failed)
 
+    @contextlib.contextmanager
+    def batch(self) -> Iterator[None]:
+        """Schedule the block's tasks with one wake-up of the workers, when it ends.
+
+        A frame's files are several tasks; waking an idle worker for each made it take the interpreter
+        lock from the scheduling thread once per task (docs/performance.md, small images). Inside the block
+        a full queue, :meth:`wait_until_done` and :meth:`shutdown` still wake the workers first. Nested
+        blocks wake at the end of the outermost.
+        """
+        if getattr(self._local, "deferred", None) is not None:
+            yield
+            return
+        self._local.deferred = 0
+        try:
+            yield
+        finally:
+            self._wake_deferred()
+            self._local.deferred = None
+
+    def _wake_deferred(self) -> None:
+        """Wake a worker for each task this thread scheduled inside :meth:`batch` so far."""
+        count = getattr(self._local, "deferred", None)
+        if count:
+            with self._cond:
+                self._has_work.notify(count)
+            self._local.deferred = 0
+
     def configure(self, num_threads: int, max_size: int, max_bytes: int) -> None:
         """Apply new limits to the live queue (extra workers exit once idle)."""
         with self._cond:
@@ -260,6 +291,7 @@ class WriteQueue:
 
     def wait_until_done(self) -> None:
         """Block until every scheduled task ran, then raise the first failure if any."""
+        self._wake_deferred()
         with self._cond:
             while self._unfinished:
                 self._cond.wait()
@@ -276,6 +308,7 @@ class WriteQueue:
 
     def shutdown(self) -> None:
         """Finish every task, then stop the workers."""
+        self._wake_deferred()
         with self._cond:
             while self._unfinished:
                 self._cond.wait()
