@@ -199,8 +199,13 @@ def _shutter_views(rt) -> dict[str, CameraView]:
     motion blur is off."""
     if motion_blur.shutter() is None:
         return {}
-    return {path: camera_view(rp.camera_prim(rt.stage), rp.width, rp.height)
-            for path, (rp, _) in _active_products(rt).items()}
+    return {path: _camera_view(rt, rp) for path, (rp, _) in _active_products(rt).items()}
+
+
+def _camera_view(rt, rp) -> CameraView:
+    """A render product's camera now (its pose written with write-to-fabric, when it was)."""
+    prim = rp.camera_prim(rt.stage)
+    return camera_view(prim, rp.width, rp.height, world=rt.sim.camera_poses.world(str(prim.GetPath())))
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
@@ -241,7 +246,7 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
     for rp, annotators in products.values():
         sim.require_offscreen(rp.width, rp.height)
         with profiling.timed("render:camera"):
-            view = camera_view(rp.camera_prim(stage), rp.width, rp.height)
+            view = _camera_view(rt, rp)
         passes: set[str] = set()
         for a in annotators:
             passes |= a.spec.passes

@@ -201,3 +201,95 @@ def test_a_batch_checked_valid_is_checked_again_after_a_removal():
     prim_lookup.resolve_prims(others)
     rep.stage.new_stage()                                                      # its prims expire with it
     assert not prim_lookup._checked.holds(others)
+
+
+def _camera_rig(fabric: bool):
+    """A camera under a translated, rotated and scaled xform, a cube to look at, a 64x48 depth product."""
+    rep.stage.new_stage()
+    rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", fabric)
+    rig = rep.functional.create.xform(name="Rig", position=(1, -2, 0.5), rotation=(20, 40, -70), scale=2.0)
+    cam = rep.functional.create.camera(position=(3, 3, 3), look_at=(0, 0, 0), parent=rig, name="Cam")
+    cube = rep.functional.create.cube(name="Box", position=(0.5, 0, 0))
+    rp = rep.create.render_product(cam, (64, 48))
+    depth = rep.annotators.get("distance_to_image_plane")
+    depth.attach(rp)
+    return cam, cube, rp, depth
+
+
+CAMERA_POSES = [
+    dict(position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0), look_at_up_axis=(0.0, 0.0, 1.0)),
+    dict(rotation_value=(10.0, 20.0, 30.0)),
+    dict(position_value=(2.0, 2.0, 5.0)),                              # keeps the rotation
+    dict(rotation_value=tuple(np.array([0.9, 0.1, -0.3, 0.2]) / np.linalg.norm([0.9, 0.1, -0.3, 0.2]))),
+    dict(look_at_value="/Box"),                                        # aim at a prim, keeping the position
+]
+
+
+def test_cameras_posed_with_write_to_fabric_match_authored_poses():
+    """Camera poses written beside the stage give the view and the depth image the stage's authoring gives;
+    the stage keeps its authored pose."""
+    from graphsdg.orchestrator import _camera_view
+
+    def run(fabric: bool):
+        cam, cube, rp, depth = _camera_rig(fabric)
+        authored = tuple(cam.GetAttribute("xformOp:translate").Get())
+        views, images = [], []
+        for kwargs in CAMERA_POSES:
+            rep.functional.modify.pose(cam, **kwargs)
+            rep.orchestrator.step()
+            view = _camera_view(runtime(), rp)
+            views.append((view.position, view.rotation))
+            images.append(depth.get_data())
+        assert (tuple(cam.GetAttribute("xformOp:translate").Get()) == authored) == fabric
+        assert (runtime().sim.camera_poses.world(str(cam.GetPath())) is not None) == fabric
+        return views, images
+
+    stage_views, stage_images = run(False)
+    fabric_views, fabric_images = run(True)
+    for (t_usd, r_usd), (t_fab, r_fab) in zip(stage_views, fabric_views):
+        np.testing.assert_allclose(t_fab, t_usd, atol=1e-9)
+        np.testing.assert_allclose(r_fab, r_usd, atol=1e-9)
+    for usd, fab in zip(stage_images, fabric_images):
+        assert np.array_equal(np.isfinite(usd), np.isfinite(fab))
+        np.testing.assert_allclose(fab[np.isfinite(fab)], usd[np.isfinite(usd)], rtol=1e-5)
+    assert sum(bool(np.isfinite(usd).any()) for usd in stage_images) >= 3     # the box is in view
+    assert len({(round(float(t[0]), 6), round(float(r[0, 0]), 6)) for t, r in stage_views}) == len(CAMERA_POSES)
+
+
+def test_a_later_stage_edit_of_a_fabric_posed_camera_wins():
+    """Authoring the camera's (or its parent's) transform after a fabric pose makes the stage's pose count
+    again; a fabric pose after a stage edit is kept (the edit is synced first)."""
+    from graphsdg.orchestrator import _camera_view
+    from graphsdg.stage.xform import set_local_pose, world_matrix
+
+    cam, cube, rp, depth = _camera_rig(True)
+    poses, path = runtime().sim.camera_poses, str(cam.GetPath())
+    rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
+    fabric_t = _camera_view(runtime(), rp).position
+    set_local_pose(cam, position=(0.0, 0.0, 6.0), look_at=(0.0, 0.0, 0.0))    # authored on the stage
+    rep.orchestrator.step()
+    assert poses.world(path) is None
+    np.testing.assert_allclose(_camera_view(runtime(), rp).position, world_matrix(cam)[3, :3], atol=1e-12)
+    assert not np.allclose(_camera_view(runtime(), rp).position, fabric_t)
+    set_local_pose(cam, position=(0.0, 0.0, 7.0))                              # authored, not synced yet
+    rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
+    rep.orchestrator.step()
+    np.testing.assert_allclose(_camera_view(runtime(), rp).position, fabric_t, atol=1e-12)
+    set_local_pose(cam.GetParent(), position=(0.0, 0.0, 1.0))                  # the parent moves on the stage
+    rep.orchestrator.step()
+    assert poses.world(path) is None
+    cam.GetAttribute("focalLength").Set(35.0)                                  # not a pose: kept
+    rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0))
+    rep.orchestrator.step()
+    assert poses.world(path) is not None
+
+
+def test_cameras_with_other_op_stacks_are_authored():
+    """A camera whose op stack is not translate / rotate / scale (here a pivot op) keeps the stage route."""
+    from pxr import UsdGeom
+
+    cam, cube, rp, depth = _camera_rig(True)
+    UsdGeom.Xformable(cam).AddTranslateOp(UsdGeom.XformOp.PrecisionDouble, "pivot")
+    rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
+    assert runtime().sim.camera_poses.world(str(cam.GetPath())) is None
+    assert tuple(cam.GetAttribute("xformOp:translate").Get()) == (4.0, 1.0, 2.0)

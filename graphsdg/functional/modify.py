@@ -26,7 +26,7 @@ from graphsdg.sim import direct_writes
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.prims import resolve_prim, resolve_prims
-from graphsdg.stage.xform import set_local_pose, world_matrix
+from graphsdg.stage.xform import as_vec3, set_local_pose, up_axis_vector, world_matrix
 from graphsdg.maths.rotations import decompose
 
 
@@ -54,6 +54,12 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
     targets = resolve_prims(prims)
     look_at_value = _look_at_point(look_at_value)
     n = len(targets)
+    if rotation_value is not None and look_at_value is not None:
+        raise ValueError("rotation and look_at are exclusive; pass one of them")
+    if scale_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
+            and _write_to_fabric() and _pose_cameras(targets, position_value, rotation_value, look_at_value,
+                                                     look_at_up_axis):
+        return
     if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
             and _write_to_fabric():
         arrays = [None if v is None else per_prim_array(v, n, name, width=width, uniform=uniform,
@@ -76,6 +82,26 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
                        look_at_up_axis=look_at_up_axis, rotation_order=rotation_order)
         if pivots[i] is not None:
             _apply_pivot(prim, np.asarray(pivots[i], dtype=np.float64), positions[i])
+
+
+def _pose_cameras(targets: list, position_value: Any, rotation_value: Any, look_at_value: Any,
+                  look_at_up_axis: Any) -> bool:
+    """Write-to-fabric for cameras (:mod:`graphsdg.sim.camera_poses`); False when the prims are not all
+    cameras with graphsdg's op stack."""
+    if not targets or not all(p.IsA(UsdGeom.Camera) for p in targets):
+        return False
+    n = len(targets)
+    positions = None if position_value is None else per_prim_array(position_value, n, "position_value")
+    rotations = None if rotation_value is None else \
+        per_prim_array(rotation_value, n, "rotation_value", width=_pose_width(rotation_value))
+    if (positions is not None and (positions.shape[1] != 3 or not np.isfinite(positions).all())) or \
+            (rotations is not None and (rotations.shape[1] not in (3, 4) or not np.isfinite(rotations).all())):
+        return False    # the stage path raises, naming the bad value
+    looks = None if look_at_value is None else \
+        [as_vec3(v, "look_at") for v in per_prim(look_at_value, n, "look_at_value")]
+    up = as_vec3(look_at_up_axis, "look_at_up_axis") if look_at_up_axis is not None else \
+        up_axis_vector(targets[0].GetStage())
+    return direct_writes.write_camera_poses(runtime().sim, targets, positions, rotations, looks, up)
 
 
 def _pose_width(value: Any) -> int:

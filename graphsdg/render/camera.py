@@ -189,13 +189,15 @@ def _attr(prim: Usd.Prim, name: str, default):
     return default if v is None else v
 
 
-def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCache | None = None) -> CameraView:
-    """Read a ``UsdGeom.Camera`` prim at a resolution."""
+def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCache | None = None,
+                world: np.ndarray | None = None) -> CameraView:
+    """Read a ``UsdGeom.Camera`` prim at a resolution; ``world``: its world transform when it is not the
+    stage's (a camera posed with write-to-fabric, :mod:`graphsdg.sim.camera_poses`)."""
     if not prim or not prim.IsA(UsdGeom.Camera):
         raise InvalidPrimError(f"{prim.GetPath() if prim else prim} is a {prim.GetTypeName() if prim else 'missing'} "
                                f"prim, not a Camera; render products need a UsdGeom.Camera")
     cam = UsdGeom.Camera(prim)
-    t, r, _ = decompose(world_matrix(prim, cache))
+    t, r, _ = decompose(world if world is not None else world_matrix(prim, cache))
     focal = float(cam.GetFocalLengthAttr().Get())
     h_ap = float(cam.GetHorizontalApertureAttr().Get())
     if focal <= 0 or h_ap <= 0:

@@ -16,8 +16,9 @@ from typing import Sequence
 
 import mujoco
 import numpy as np
-from pxr import Usd
+from pxr import Usd, UsdGeom
 
+from graphsdg.sim.camera_poses import parent_world, posed_world
 from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
 from graphsdg.maths.rotations import canonical_quat, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
@@ -165,6 +166,32 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
             m.geom_rbound[gids] = np.linalg.norm(_half_extents(t, rows, sizes[rows]), axis=1)
             current[rows] = world_scale[rows]   # every binding's scale (its row of this array)
     mujoco.mj_kinematics(m, d)
+    return True
+
+
+def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray | None,
+                       rotations: np.ndarray | None, looks: Sequence | None, up: Sequence[float]) -> bool:
+    """Pose cameras without authoring the stage (:mod:`graphsdg.sim.camera_poses`); ``False`` (nothing
+    written) unless every prim is a camera with the canonical op stack.
+
+    ``positions`` / ``rotations``: (N, 3) or (N, 4) local values or None; ``looks``: a world point per
+    camera or None; ``up``: the up axis of the aim.
+    """
+    if not prims or not all(p.IsA(UsdGeom.Camera) for p in prims):
+        return False
+    sim.sync_dirty_prims()   # edits authored before this write must not undo it at the next sync
+    poses = sim.camera_poses
+    if not all(poses.is_canonical(p) for p in prims):
+        return False
+    for i, prim in enumerate(prims):
+        path = str(prim.GetPath())
+        parent = parent_world(prim)
+        current = poses.world(path)
+        local = current @ np.linalg.inv(parent) if current is not None else \
+            np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
+        poses.set(path, posed_world(local, parent, None if positions is None else positions[i],
+                                    None if rotations is None else rotations[i],
+                                    None if looks is None else looks[i], up))
     return True
 
 

@@ -37,6 +37,7 @@ from pxr import Sdf, Usd, UsdGeom
 from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
+from graphsdg.sim.camera_poses import CameraPoses
 from graphsdg.sim.compiled_scene import BodyBinding, CompiledScene
 from graphsdg.sim.compiler import compile_stage
 from graphsdg.sim.edit_aspects import ALL_ASPECTS, INHERITED_ASPECTS, edit_aspects
@@ -88,6 +89,7 @@ class SimScene:
         # that draws its copy through the maps must take new vertices only for these
         self.mesh_reshapes = np.zeros(0, dtype=np.int64)
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
+        self.camera_poses = CameraPoses()   # cameras posed with write-to-fabric
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
         self._physics_callbacks: dict[str, Callable[[float], None]] = {}
@@ -183,6 +185,8 @@ class SimScene:
     def sync_dirty_prims(self) -> None:
         """Bring MuJoCo up to date with every stage edit since the last sync."""
         changes = self.tracker.drain()
+        if changes:
+            self.camera_poses.forget_edited(changes)
         if self.compiled is None:
             self.recompile()
             return

@@ -1,0 +1,126 @@
+"""Camera poses written with write-to-fabric: kept beside the stage, read by every render.
+
+With ``/exts/omni.replicator.core/enableWriteToFabric`` on, ``rep.functional.modify.pose`` on cameras lands
+here instead of authoring ``xformOp``s: the camera's new world transform is stored by path and the renders
+(:func:`graphsdg.render.camera.camera_view`) use it. As for the geoms of :mod:`graphsdg.sim.direct_writes`
+(and Replicator's Fabric), the stage keeps its authored pose, so readers of USD transforms see that one.
+Authoring the camera's (or an ancestor's) transform on the stage afterwards makes the stage's pose count
+again, as a USD edit reaches Fabric.
+
+Only cameras whose op stack is graphsdg's canonical one (translate, one rotation, scale; what
+``rep.functional.create.camera`` authors) are posed here; others are authored as before.
+
+Example:
+    >>> import numpy as np
+    >>> poses = CameraPoses()
+    >>> poses.set("/World/Camera", np.eye(4))
+    >>> poses.world("/World/Camera").shape
+    (4, 4)
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+from pxr import Usd, UsdGeom
+
+from graphsdg.maths.rotations import decompose, euler_to_matrix, look_at_matrix, quat_wxyz_to_matrix, \
+    unit_quat
+from graphsdg.stage.changes import ChangeSet
+from graphsdg.stage.xform import world_matrix
+
+_ROTATIONS = (UsdGeom.XformOp.TypeRotateXYZ, UsdGeom.XformOp.TypeOrient)
+
+
+class CameraPoses:
+    """World transforms (row-vector 4x4) of cameras posed with write-to-fabric, by prim path."""
+
+    def __init__(self) -> None:
+        self._world: dict[str, np.ndarray] = {}
+        self._canonical: dict[str, bool] = {}     # whether a camera's op stack is the canonical one
+
+    def world(self, path: str) -> np.ndarray | None:
+        """The camera's world transform if it was posed here since its stage pose last changed, else None."""
+        return self._world.get(path)
+
+    def set(self, path: str, matrix: np.ndarray) -> None:
+        self._world[path] = matrix
+
+    def forget_edited(self, changes: ChangeSet) -> None:
+        """Drop the poses of cameras whose transform the stage changed: an edit of the camera's or an
+        ancestor's ``xformOp``s, or a structural change at or above it."""
+        if not self._world and not self._canonical:
+            return
+        touched = [str(p) for p in changes.structural]
+        touched += [str(p) for p, names in changes.edited.items()
+                    if "*" in names or any(n.startswith("xformOp") for n in names)]
+        for root in touched:
+            below = root.rstrip("/") + "/"
+            for table in (self._world, self._canonical):
+                for path in [k for k in table if k == root or k.startswith(below)]:
+                    del table[path]
+
+    def is_canonical(self, prim: Usd.Prim) -> bool:
+        """Whether ``prim``'s op stack is at most a translate, one ``rotateXYZ`` or ``orient``, and a scale, in
+        that order, with no reset of the parent's transform (cached until the prim's transform is edited)."""
+        path = str(prim.GetPath())
+        known = self._canonical.get(path)
+        if known is None:
+            known = self._canonical[path] = _canonical_stack(UsdGeom.Xformable(prim))
+        return known
+
+
+def _canonical_stack(xf: UsdGeom.Xformable) -> bool:
+    if xf.GetResetXformStack():
+        return False
+    order = (UsdGeom.XformOp.TypeTranslate, _ROTATIONS, UsdGeom.XformOp.TypeScale)
+    slot = 0
+    for op in xf.GetOrderedXformOps():
+        kind = op.GetOpType()
+        if op.IsInverseOp() or len(op.GetOpName().split(":")) > 2:   # suffixed ops: pivots, unitsResolve
+            return False
+        while slot < 3 and not (kind in order[slot] if isinstance(order[slot], tuple) else kind == order[slot]):
+            slot += 1
+        if slot == 3:
+            return False
+        slot += 1
+    return True
+
+
+def compose(t: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """The row-vector 4x4 of translation ``t``, rotation ``r`` and per-axis scale ``s`` (inverse of
+    :func:`graphsdg.maths.rotations.decompose`)."""
+    m = np.eye(4)
+    m[:3, :3] = s[:, None] * r.T
+    m[3, :3] = t
+    return m
+
+
+def posed_world(current_local: np.ndarray, parent: np.ndarray, position: Sequence[float] | None,
+                rotation: Sequence[float] | None, look_at: Sequence[float] | None,
+                up: Sequence[float]) -> np.ndarray:
+    """A camera's new world transform: its local pose ``current_local`` with a new ``position`` (local),
+    ``rotation`` (Euler XYZ degrees or a (w, x, y, z) quaternion, local) or aim at the world point
+    ``look_at``, under the parent's world transform ``parent``; as :func:`graphsdg.stage.xform.set_local_pose`
+    authors it."""
+    t, r, s = decompose(current_local)
+    if position is not None:
+        t = np.asarray(position, dtype=np.float64)
+    if look_at is not None:
+        eye = np.append(t, 1.0) @ parent
+        r_world = look_at_matrix(eye[:3], look_at, up)
+        _, r_parent, _ = decompose(parent)
+        r = r_world if np.array_equal(r_parent, np.eye(3)) else r_parent.T @ r_world
+    elif rotation is not None:
+        rot = np.asarray(rotation, dtype=np.float64)
+        r = quat_wxyz_to_matrix(unit_quat(rot)) if rot.shape == (4,) else euler_to_matrix(rot, "XYZ")
+    return compose(t, r, s) @ parent
+
+
+def parent_world(prim: Usd.Prim) -> np.ndarray:
+    """The world transform of ``prim``'s parent (identity at the root)."""
+    parent = prim.GetParent()
+    return world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
+
+
+__all__ = ["CameraPoses", "compose", "parent_world", "posed_world"]
