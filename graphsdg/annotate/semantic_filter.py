@@ -98,9 +98,10 @@ class SemanticFilter:
 
     conjuncts: tuple[tuple[Clause, ...], ...]
 
-    @property
+    @functools.cached_property
     def text(self) -> str:
-        """The normalized predicate (also the cache key of the instance maps it selects)."""
+        """The normalized predicate (also the cache key of the instance maps it selects: asked several times
+        per frame, built once per filter)."""
         return "; ".join(", ".join(str(c) for c in conj) for conj in self.conjuncts)
 
     @property
