@@ -31,7 +31,7 @@ from graphsdg.jobs.progress import Progress
 from graphsdg.render import motion_blur
 from graphsdg.render.attachments import attachments
 from graphsdg.render.backend import RenderRequest
-from graphsdg.render.camera import CameraView, camera_view
+from graphsdg.render.camera import CameraView, camera_view, read_lens
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import stage_context
 
@@ -203,9 +203,11 @@ def _shutter_views(rt) -> dict[str, CameraView]:
 
 
 def _camera_view(rt, rp) -> CameraView:
-    """A render product's camera now (its pose written with write-to-fabric, when it was)."""
+    """A render product's camera now (its pose written with write-to-fabric, when it was; its lens as last
+    read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
-    return camera_view(prim, rp.width, rp.height, world=rt.sim.camera_poses.world(str(prim.GetPath())))
+    lens = rt.sim.prim_reads.get(str(prim.GetPath()), "lens", lambda: read_lens(prim))
+    return camera_view(prim, rp.width, rp.height, world=rt.sim.camera_poses.world(prim), lens=lens)
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:

@@ -180,6 +180,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
 
 _values: dict[str, Any] = {}
 _MISSING = object()
+_generation = 0   # bumped by every set and reset (readers cache what they derive from settings)
 _warned: set[str] = set()
 _lock = threading.Lock()
 
@@ -200,8 +201,10 @@ def set(key: str, value: Any) -> None:  # noqa: A001 - mirrors carb's API name
     check = VALIDATORS.get(k)
     if check is not None:
         check(k, value)
+    global _generation
     with _lock:
         _values[k] = value
+        _generation += 1
         unknown = k not in KNOWN_KEYS and k not in _warned
         if unknown:
             _warned.add(k)
@@ -232,9 +235,23 @@ def get(key: str, default: Any = None) -> Any:
 
 def reset() -> None:
     """Forget every value that was set (defaults apply again) and which keys were already warned about."""
+    global _generation
     with _lock:
         _values.clear()
         _warned.clear()
+        _generation += 1
+
+
+def generation() -> int:
+    """A number that changes whenever a setting is set or the settings are reset: what a hot path derived
+    from settings stays valid while it is the same.
+
+    Example:
+        >>> g = generation(); set("/omni/replicator/backend/writeThreads", 2); generation() != g
+        True
+        >>> reset()
+    """
+    return _generation
 
 
 # carb-style aliases so `settings.get_settings().set(...)` reads naturally.

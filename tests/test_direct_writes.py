@@ -241,7 +241,7 @@ def test_cameras_posed_with_write_to_fabric_match_authored_poses():
             views.append((view.position, view.rotation))
             images.append(depth.get_data())
         assert (tuple(cam.GetAttribute("xformOp:translate").Get()) == authored) == fabric
-        assert (runtime().sim.camera_poses.world(str(cam.GetPath())) is not None) == fabric
+        assert (runtime().sim.camera_poses.local(str(cam.GetPath())) is not None) == fabric
         return views, images
 
     stage_views, stage_images = run(False)
@@ -257,8 +257,9 @@ def test_cameras_posed_with_write_to_fabric_match_authored_poses():
 
 
 def test_a_later_stage_edit_of_a_fabric_posed_camera_wins():
-    """Authoring the camera's (or its parent's) transform after a fabric pose makes the stage's pose count
-    again; a fabric pose after a stage edit is kept (the edit is synced first)."""
+    """Authoring the camera's transform after a fabric pose makes the stage's pose count again; a fabric pose
+    after a stage edit is kept (the edit is synced first); a parent moved on the stage carries the fabric-posed
+    camera along."""
     from graphsdg.orchestrator import _camera_view
     from graphsdg.stage.xform import set_local_pose, world_matrix
 
@@ -268,20 +269,23 @@ def test_a_later_stage_edit_of_a_fabric_posed_camera_wins():
     fabric_t = _camera_view(runtime(), rp).position
     set_local_pose(cam, position=(0.0, 0.0, 6.0), look_at=(0.0, 0.0, 0.0))    # authored on the stage
     rep.orchestrator.step()
-    assert poses.world(path) is None
+    assert poses.local(path) is None
     np.testing.assert_allclose(_camera_view(runtime(), rp).position, world_matrix(cam)[3, :3], atol=1e-12)
     assert not np.allclose(_camera_view(runtime(), rp).position, fabric_t)
     set_local_pose(cam, position=(0.0, 0.0, 7.0))                              # authored, not synced yet
     rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
     rep.orchestrator.step()
     np.testing.assert_allclose(_camera_view(runtime(), rp).position, fabric_t, atol=1e-12)
+    local = poses.local(path).copy()
     set_local_pose(cam.GetParent(), position=(0.0, 0.0, 1.0))                  # the parent moves on the stage
     rep.orchestrator.step()
-    assert poses.world(path) is None
+    np.testing.assert_array_equal(poses.local(path), local)
+    moved = (local @ world_matrix(cam.GetParent()))[3, :3]
+    np.testing.assert_allclose(_camera_view(runtime(), rp).position, moved, atol=1e-12)
+    assert not np.allclose(moved, fabric_t)
     cam.GetAttribute("focalLength").Set(35.0)                                  # not a pose: kept
-    rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0))
     rep.orchestrator.step()
-    assert poses.world(path) is not None
+    assert poses.local(path) is not None
 
 
 def test_cameras_with_other_op_stacks_are_authored():
@@ -291,5 +295,5 @@ def test_cameras_with_other_op_stacks_are_authored():
     cam, cube, rp, depth = _camera_rig(True)
     UsdGeom.Xformable(cam).AddTranslateOp(UsdGeom.XformOp.PrecisionDouble, "pivot")
     rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
-    assert runtime().sim.camera_poses.world(str(cam.GetPath())) is None
+    assert runtime().sim.camera_poses.local(str(cam.GetPath())) is None
     assert tuple(cam.GetAttribute("xformOp:translate").Get()) == (4.0, 1.0, 2.0)

@@ -360,10 +360,19 @@ def default_threads(cores: int | None = None) -> int:
     return min(DEFAULT_THREADS, max(1, cores // 4))
 
 
+_configured_at: tuple[int, tuple[int, int, int]] = (-1, (0, 0, 0))
+
+
 def _configured() -> tuple[int, int, int]:
-    return (_positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS)),
-            _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
-            _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30)))
+    """(threads, queue size, queue bytes) from the settings; read again only when a setting changed (a frame
+    asks for the queue ~10 times)."""
+    global _configured_at
+    generation = settings.generation()
+    if _configured_at[0] != generation:
+        _configured_at = (generation, (_positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS)),
+                                       _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
+                                       _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30))))
+    return _configured_at[1]
 
 
 def get_write_queue() -> WriteQueue:

@@ -189,15 +189,28 @@ def _attr(prim: Usd.Prim, name: str, default):
     return default if v is None else v
 
 
-def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCache | None = None,
-                world: np.ndarray | None = None) -> CameraView:
-    """Read a ``UsdGeom.Camera`` prim at a resolution; ``world``: its world transform when it is not the
-    stage's (a camera posed with write-to-fabric, :mod:`graphsdg.sim.camera_poses`)."""
+@dataclass(frozen=True)
+class CameraLens:
+    """What a camera prim says about its projection: a :class:`CameraView` but for pose and resolution."""
+
+    focal_length: float
+    horizontal_aperture: float
+    horizontal_aperture_offset: float
+    vertical_aperture_offset: float
+    near: float
+    far: float
+    projection: str
+    focus_distance: float
+    f_stop: float
+
+
+def read_lens(prim: Usd.Prim) -> CameraLens:
+    """Read a ``UsdGeom.Camera`` prim's lens attributes (checked: positive focal length and aperture,
+    0 < near < far)."""
     if not prim or not prim.IsA(UsdGeom.Camera):
         raise InvalidPrimError(f"{prim.GetPath() if prim else prim} is a {prim.GetTypeName() if prim else 'missing'} "
                                f"prim, not a Camera; render products need a UsdGeom.Camera")
     cam = UsdGeom.Camera(prim)
-    t, r, _ = decompose(world if world is not None else world_matrix(prim, cache))
     focal = float(cam.GetFocalLengthAttr().Get())
     h_ap = float(cam.GetHorizontalApertureAttr().Get())
     if focal <= 0 or h_ap <= 0:
@@ -207,13 +220,27 @@ def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCac
     near, far = float(clipping[0]), float(clipping[1])
     if not 0 < near < far:
         raise ValueError(f"camera {prim.GetPath()} clipping range ({near}, {far}) must satisfy 0 < near < far")
-    proj = str(cam.GetProjectionAttr().Get())
-    stage = prim.GetStage()
+    return CameraLens(focal_length=focal, horizontal_aperture=h_ap,
+                      horizontal_aperture_offset=float(_attr(prim, "horizontalApertureOffset", 0.0)),
+                      vertical_aperture_offset=float(_attr(prim, "verticalApertureOffset", 0.0)),
+                      near=near, far=far, projection=str(cam.GetProjectionAttr().Get()),
+                      focus_distance=float(_attr(prim, "focusDistance", 400.0)),
+                      f_stop=float(_attr(prim, "fStop", 0.0)))
+
+
+def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCache | None = None,
+                world: np.ndarray | None = None, lens: CameraLens | None = None) -> CameraView:
+    """Read a ``UsdGeom.Camera`` prim at a resolution. ``world``: its world transform when it is not the
+    stage's (a camera posed with write-to-fabric, :mod:`graphsdg.sim.camera_poses`); ``lens``: its
+    :func:`read_lens`, when the caller keeps it."""
+    if lens is None:
+        lens = read_lens(prim)
+    t, r, _ = decompose(world if world is not None else world_matrix(prim, cache))
     return CameraView(
-        path=str(prim.GetPath()), position=t, rotation=r, focal_length=focal, horizontal_aperture=h_ap,
-        vertical_aperture=h_ap * height / width,
-        horizontal_aperture_offset=float(_attr(prim, "horizontalApertureOffset", 0.0)),
-        vertical_aperture_offset=float(_attr(prim, "verticalApertureOffset", 0.0)),
-        near=near, far=far, width=int(width), height=int(height), projection=proj,
-        focus_distance=float(_attr(prim, "focusDistance", 400.0)), f_stop=float(_attr(prim, "fStop", 0.0)),
-        meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(stage) or 1.0))
+        path=str(prim.GetPath()), position=t, rotation=r, focal_length=lens.focal_length,
+        horizontal_aperture=lens.horizontal_aperture,
+        vertical_aperture=lens.horizontal_aperture * height / width,
+        horizontal_aperture_offset=lens.horizontal_aperture_offset,
+        vertical_aperture_offset=lens.vertical_aperture_offset, near=lens.near, far=lens.far, width=int(width),
+        height=int(height), projection=lens.projection, focus_distance=lens.focus_distance, f_stop=lens.f_stop,
+        meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(prim.GetStage()) or 1.0))

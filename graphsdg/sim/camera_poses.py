@@ -1,11 +1,12 @@
 """Camera poses written with write-to-fabric: kept beside the stage, read by every render.
 
 With ``/exts/omni.replicator.core/enableWriteToFabric`` on, ``rep.functional.modify.pose`` on cameras lands
-here instead of authoring ``xformOp``s: the camera's new world transform is stored by path and the renders
-(:func:`graphsdg.render.camera.camera_view`) use it. As for the geoms of :mod:`graphsdg.sim.direct_writes`
-(and Replicator's Fabric), the stage keeps its authored pose, so readers of USD transforms see that one.
-Authoring the camera's (or an ancestor's) transform on the stage afterwards makes the stage's pose count
-again, as a USD edit reaches Fabric.
+here instead of authoring ``xformOp``s: the camera's new local transform is stored by path, and renders
+(:func:`graphsdg.render.camera.camera_view`) compose it with the parent's current world transform (a parent
+that moves, on the stage or with physics, carries the camera along). As for the geoms of
+:mod:`graphsdg.sim.direct_writes` (and Replicator's Fabric), the stage keeps its authored pose, so readers of
+USD transforms see that one. Authoring the camera's own transform on the stage afterwards makes the stage's
+pose count again, as a USD edit reaches Fabric.
 
 Only cameras whose op stack is graphsdg's canonical one (translate, one rotation, scale; what
 ``rep.functional.create.camera`` authors) are posed here; others are authored as before.
@@ -13,8 +14,8 @@ Only cameras whose op stack is graphsdg's canonical one (translate, one rotation
 Example:
     >>> import numpy as np
     >>> poses = CameraPoses()
-    >>> poses.set("/World/Camera", np.eye(4))
-    >>> poses.world("/World/Camera").shape
+    >>> poses.set_local("/World/Camera", np.eye(4))
+    >>> poses.local("/World/Camera").shape
     (4, 4)
 """
 from __future__ import annotations
@@ -33,32 +34,39 @@ _ROTATIONS = (UsdGeom.XformOp.TypeRotateXYZ, UsdGeom.XformOp.TypeOrient)
 
 
 class CameraPoses:
-    """World transforms (row-vector 4x4) of cameras posed with write-to-fabric, by prim path."""
+    """Local transforms (row-vector 4x4) of cameras posed with write-to-fabric, by prim path."""
 
     def __init__(self) -> None:
-        self._world: dict[str, np.ndarray] = {}
+        self._local: dict[str, np.ndarray] = {}
         self._canonical: dict[str, bool] = {}     # whether a camera's op stack is the canonical one
 
-    def world(self, path: str) -> np.ndarray | None:
-        """The camera's world transform if it was posed here since its stage pose last changed, else None."""
-        return self._world.get(path)
+    def local(self, path: str) -> np.ndarray | None:
+        """The camera's local transform if it was posed here since its stage pose last changed, else None."""
+        return self._local.get(path)
 
-    def set(self, path: str, matrix: np.ndarray) -> None:
-        self._world[path] = matrix
+    def world(self, prim: Usd.Prim) -> np.ndarray | None:
+        """The camera's world transform: its local one from here under its parent's current world transform;
+        None when it was not posed here."""
+        local = self._local.get(str(prim.GetPath()))
+        return None if local is None else local @ parent_world(prim)
+
+    def set_local(self, path: str, matrix: np.ndarray) -> None:
+        self._local[path] = matrix
 
     def forget_edited(self, changes: ChangeSet) -> None:
-        """Drop the poses of cameras whose transform the stage changed: an edit of the camera's or an
-        ancestor's ``xformOp``s, or a structural change at or above it."""
-        if not self._world and not self._canonical:
+        """Drop the poses of cameras whose own ``xformOp``s the stage changed, or that a structural change at
+        or above them may have replaced."""
+        if not self._local and not self._canonical:
             return
-        touched = [str(p) for p in changes.structural]
-        touched += [str(p) for p, names in changes.edited.items()
-                    if "*" in names or any(n.startswith("xformOp") for n in names)]
-        for root in touched:
+        for root in map(str, changes.structural):
             below = root.rstrip("/") + "/"
-            for table in (self._world, self._canonical):
+            for table in (self._local, self._canonical):
                 for path in [k for k in table if k == root or k.startswith(below)]:
                     del table[path]
+        for path, names in changes.edited.items():
+            if "*" in names or any(n.startswith("xformOp") for n in names):
+                self._local.pop(str(path), None)
+                self._canonical.pop(str(path), None)
 
     def is_canonical(self, prim: Usd.Prim) -> bool:
         """Whether ``prim``'s op stack is at most a translate, one ``rotateXYZ`` or ``orient``, and a scale, in
@@ -96,14 +104,13 @@ def compose(t: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.ndarray:
     return m
 
 
-def posed_world(current_local: np.ndarray, parent: np.ndarray, position: Sequence[float] | None,
+def posed_local(current: np.ndarray, parent: np.ndarray, position: Sequence[float] | None,
                 rotation: Sequence[float] | None, look_at: Sequence[float] | None,
                 up: Sequence[float]) -> np.ndarray:
-    """A camera's new world transform: its local pose ``current_local`` with a new ``position`` (local),
-    ``rotation`` (Euler XYZ degrees or a (w, x, y, z) quaternion, local) or aim at the world point
-    ``look_at``, under the parent's world transform ``parent``; as :func:`graphsdg.stage.xform.set_local_pose`
-    authors it."""
-    t, r, s = decompose(current_local)
+    """A camera's new local transform: ``current`` with a new ``position`` (local), ``rotation`` (Euler XYZ
+    degrees or a (w, x, y, z) quaternion, local) or aim at the world point ``look_at``, under the parent's
+    world transform ``parent``; as :func:`graphsdg.stage.xform.set_local_pose` authors it."""
+    t, r, s = decompose(current)
     if position is not None:
         t = np.asarray(position, dtype=np.float64)
     if look_at is not None:
@@ -114,7 +121,7 @@ def posed_world(current_local: np.ndarray, parent: np.ndarray, position: Sequenc
     elif rotation is not None:
         rot = np.asarray(rotation, dtype=np.float64)
         r = quat_wxyz_to_matrix(unit_quat(rot)) if rot.shape == (4,) else euler_to_matrix(rot, "XYZ")
-    return compose(t, r, s) @ parent
+    return compose(t, r, s)
 
 
 def parent_world(prim: Usd.Prim) -> np.ndarray:
@@ -123,4 +130,4 @@ def parent_world(prim: Usd.Prim) -> np.ndarray:
     return world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
 
 
-__all__ = ["CameraPoses", "compose", "parent_world", "posed_world"]
+__all__ = ["CameraPoses", "compose", "parent_world", "posed_local"]

@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg.sim.camera_poses import parent_world, posed_world
+from graphsdg.sim.camera_poses import parent_world, posed_local
 from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
 from graphsdg.maths.rotations import canonical_quat, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
@@ -185,13 +185,13 @@ def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.n
         return False
     for i, prim in enumerate(prims):
         path = str(prim.GetPath())
-        parent = parent_world(prim)
-        current = poses.world(path)
-        local = current @ np.linalg.inv(parent) if current is not None else \
-            np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
-        poses.set(path, posed_world(local, parent, None if positions is None else positions[i],
-                                    None if rotations is None else rotations[i],
-                                    None if looks is None else looks[i], up))
+        current = poses.local(path)
+        if current is None:
+            current = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
+                               dtype=np.float64)
+        poses.set_local(path, posed_local(current, parent_world(prim), None if positions is None else positions[i],
+                                          None if rotations is None else rotations[i],
+                                          None if looks is None else looks[i], up))
     return True
 
 

@@ -50,6 +50,7 @@ from graphsdg.sim.pose_write_back import PoseWriter, set_world_pose_sdf
 from graphsdg.sim.rigid_bodies import VELOCITY_ATTRIBUTES, authored_velocity, rigid_root, sync_body_pose
 from graphsdg.sim.state_carry import carry_state
 from graphsdg.sim.visual import sync_visibility
+from graphsdg.stage.read_cache import PrimReadCache
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import world_matrix
 from graphsdg.maths.rotations import decompose, quat_wxyz_to_matrix
@@ -90,6 +91,7 @@ class SimScene:
         self.mesh_reshapes = np.zeros(0, dtype=np.int64)
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self.camera_poses = CameraPoses()   # cameras posed with write-to-fabric
+        self.prim_reads = PrimReadCache()   # values read from prims until the stage edits them
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
         self._physics_callbacks: dict[str, Callable[[float], None]] = {}
@@ -187,6 +189,7 @@ class SimScene:
         changes = self.tracker.drain()
         if changes:
             self.camera_poses.forget_edited(changes)
+            self.prim_reads.forget(changes)
         if self.compiled is None:
             self.recompile()
             return
