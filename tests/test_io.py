@@ -144,7 +144,11 @@ def test_a_batch_wakes_the_workers_once_when_it_ends():
     q = WriteQueue(num_threads=2, max_size=100)
     ran: list[int] = []
     q.schedule(ran.append, -1)
-    q.wait_until_done()                       # both workers now wait for work
+    q.wait_until_done()
+    deadline = time.monotonic() + 10          # a worker that just finished a task may not be waiting yet
+    while len(q._has_work._waiters) < 2 and time.monotonic() < deadline:   # CPython's Condition keeps its waiters
+        time.sleep(0.01)
+    assert len(q._has_work._waiters) == 2     # both workers now wait for work
     with q.batch():
         for i in range(5):
             q.schedule(ran.append, i)
