@@ -240,21 +240,21 @@ _counter_lock = threading.Lock()
 _written = {"files": 0, "bytes": 0}
 _folders_made: set[str] = set()
 _temp_serial = itertools.count()
-_process_token = (-1, "")
+_process_token = ""
 
 
 def _temp_token() -> str:
     """A name part no other write (thread, process, or host sharing the folder) uses at the same time:
     a random token per process (made again in a forked child) and a serial number."""
     global _process_token
-    if not _process_token[1]:
-        _process_token = (os.getpid(), uuid.uuid4().hex[:10])
-    return f"{_process_token[1]}{next(_temp_serial)}"
+    if not _process_token:
+        _process_token = uuid.uuid4().hex[:10]
+    return f"{_process_token}{next(_temp_serial)}"
 
 
 def _forget_process_token() -> None:
     global _process_token
-    _process_token = (-1, "")
+    _process_token = ""
 
 
 # a forked child must not reuse its parent's temporary names (asking os.getpid() per file instead was a
