@@ -42,7 +42,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/graphsdg/io/runState": (True, "keep graphsdg_run.json (which frames are complete on disk) in each writer's "
                               "output folder"),
     "/exts/omni.replicator.core/enableWriteToFabric": (
-        False, "write randomized poses and colours straight into MuJoCo (stage not authored)"),
+        False, "write randomized poses and colours straight into MuJoCo, camera poses beside the stage (stage not "
+               "authored)"),
     "/graphsdg/run/numFrames": (None, "frames for orchestrator.run() calls without num_frames (graphsdg run --frames)"),
     "/graphsdg/run/shardIndex": (0, "this process's shard of a sharded run (graphsdg run --workers)"),
     "/graphsdg/run/shardCount": (1, "shards of a sharded run: shard i captures frames i, i+K, ..."),
