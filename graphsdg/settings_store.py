@@ -32,7 +32,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/captureOnPlay": (True, "capture every timeline tick while playing"),
     "/omni/replicator/RTSubframes": (1, "default number of accumulated subframes per capture"),
     "/omni/replicator/globalSeed": (None, "global seed of every distribution and ReplicatorRNG"),
-    "/omni/replicator/backend/writeThreads": (4, "writer worker threads of the I/O pool"),
+    "/omni/replicator/backend/writeThreads": (4, "writer worker threads of the I/O pool, at most (they start as "
+                                                   "the backlog needs them)"),
     "/omni/replicator/backend/queueSize": (1000, "queued writes before the producer is throttled"),
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
     "/graphsdg/io/queueMaxBytes": (1 << 30, "bytes of image/array data queued writes may hold before the producer "

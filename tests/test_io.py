@@ -146,9 +146,9 @@ def test_a_batch_wakes_the_workers_once_when_it_ends():
     q.schedule(ran.append, -1)
     q.wait_until_done()
     deadline = time.monotonic() + 10          # a worker that just finished a task may not be waiting yet
-    while len(q._has_work._waiters) < 2 and time.monotonic() < deadline:   # CPython's Condition keeps its waiters
-        time.sleep(0.01)
-    assert len(q._has_work._waiters) == 2     # both workers now wait for work
+    while len(q._has_work._waiters) < len(q._threads) and time.monotonic() < deadline:   # CPython's Condition
+        time.sleep(0.01)                                                                 # keeps its waiters
+    assert len(q._has_work._waiters) == len(q._threads) >= 1     # every worker now waits for work
     with q.batch():
         for i in range(5):
             q.schedule(ran.append, i)
@@ -261,3 +261,33 @@ def test_a_forked_child_names_its_temporary_files_apart():
     os.close(read)
     os.waitpid(pid, 0)
     assert child[:10] != parent[:10] and backends._temp_token()[:10] == parent[:10]
+
+
+def test_writer_threads_start_as_the_backlog_needs_them():
+    """One worker while it keeps up; more, up to the setting, once tasks wait; fewer configured retire."""
+    import threading
+    import time
+
+    from graphsdg.io.write_queue import BACKLOG_PER_WORKER, WriteQueue
+
+    q = WriteQueue(num_threads=4, max_size=1000)
+    for _ in range(50):                        # one task at a time: one worker keeps up
+        q.schedule(lambda: None)
+        q.wait_until_done()
+    assert len(q._threads) == 1
+    gate = threading.Event()
+    for _ in range(5 * BACKLOG_PER_WORKER):    # every task holds its worker: the backlog grows
+        q.schedule(gate.wait)
+    assert len(q._threads) == 4                # the backlog started the others, never more than the setting
+    gate.set()
+    q.wait_until_done()
+    assert q.completed == 50 + 5 * BACKLOG_PER_WORKER
+    q.configure(num_threads=2, max_size=1000, max_bytes=1 << 30)
+    deadline = time.monotonic() + 10
+    while len(q._threads) > 2 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert len(q._threads) == 2
+    q.schedule(lambda: None)
+    q.wait_until_done()
+    assert len(q._threads) == 2
+    q.shutdown()

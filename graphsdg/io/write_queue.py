@@ -5,7 +5,8 @@ is bounded two ways: at most ``/omni/replicator/backend/queueSize`` tasks wait,
 and the arrays held by waiting and running tasks stay under
 ``/graphsdg/io/queueMaxBytes``. A producer that outruns the disk blocks
 ("throttles") instead of growing memory. Both settings, and
-``/omni/replicator/backend/writeThreads``, apply to the live queue.
+``/omni/replicator/backend/writeThreads``, apply to the live queue. Workers start
+as the backlog needs them, up to ``writeThreads``: one while it keeps up.
 
 Tasks run in the order they were scheduled (FIFO; writers such as the WebDataset
 shard writer rely on it). A task that raises is remembered and re-raised in the
@@ -49,6 +50,7 @@ DEFAULT_THREADS = 4
 SIZE_KEY = "/omni/replicator/backend/queueSize"
 BYTES_KEY = "/graphsdg/io/queueMaxBytes"
 _THROTTLE_LOG_EVERY_S = 10.0
+BACKLOG_PER_WORKER = 8   # tasks waiting per started worker before another starts (a BasicWriter frame is ~7)
 
 
 class TaskGroup:
@@ -117,11 +119,13 @@ class WriteQueue:
         self.peak_bytes = 0
 
     # ---- workers ---------------------------------------------------------
-    def _start_threads(self) -> bool:
-        """Bring the pool up to ``num_threads``; False if no thread can start (interpreter shutdown)."""
+    def _start_threads(self, wanted: int = 1) -> bool:
+        """Bring the pool up to ``wanted`` workers, at least one and at most ``num_threads``; False if no
+        thread can start (interpreter shutdown)."""
         alive = [t for t in self._threads if t.is_alive()]
         self._threads = alive
-        while len(self._threads) - self._retire < self.num_threads:
+        wanted = min(max(1, wanted), self.num_threads)
+        while len(self._threads) - self._retire < wanted:
             if self._retire:
                 self._retire -= 1
                 continue
@@ -132,6 +136,16 @@ class WriteQueue:
                 return bool(self._threads)
             self._threads.append(t)
         return True
+
+    def _workers_wanted(self) -> int:
+        """Workers for the current backlog: one, and one more for each :data:`BACKLOG_PER_WORKER` tasks waiting.
+
+        Workers start when the backlog asks for them, not all at once: each one shares the interpreter lock
+        with the thread that renders, and several creating small files in one folder mostly wait for each
+        other in the kernel (measured: four writer threads spent 2.4 ms of system time each a 128x128 frame,
+        one spent 0.6; docs/performance.md).
+        """
+        return 1 + len(self._items) // BACKLOG_PER_WORKER
 
     def _work(self) -> None:
         while True:
@@ -188,7 +202,7 @@ class WriteQueue:
         nbytes = payload_bytes(args, kwargs)
         group = getattr(self._local, "group", None)
         with self._cond:
-            if not self._start_threads():
+            if not self._start_threads(self._workers_wanted()):
                 inline = True
             else:
                 inline = False
@@ -272,8 +286,9 @@ class WriteQueue:
         """Apply new limits to the live queue (extra workers exit once idle)."""
         with self._cond:
             self.max_size, self.max_bytes = max_size, max_bytes
-            if num_threads < self.num_threads and self._threads:
-                self._retire += min(self.num_threads - num_threads, len(self._threads))
+            excess = len(self._threads) - self._retire - num_threads
+            if excess > 0:
+                self._retire += excess
             self.num_threads = num_threads
             self._has_work.notify_all()        # workers to retire find out
             self._cond.notify_all()

@@ -317,7 +317,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="write randomized poses and colours to USD and sync them, instead of straight into "
                             "MuJoCo (Isaac Sim 6's write-to-fabric, on by default)")
     bench.add_argument("--write-threads", type=_positive,
-                       help="writer threads per process, shared by both loops (default: 4 on 16 cores or more, "
+                       help="writer threads per process, shared by both loops; graphsdg starts them as its backlog needs "
+                            "(default: 4 on 16 cores or more, "
                             "a quarter of the cores below, at least 1; with --processes each process's share)")
     bench.add_argument("--msaa", type=_non_negative,
                        help="multisample count of the colour pass, 0 for none (default: graphsdg's 4)")
