@@ -28,7 +28,7 @@ from graphsdg.sim import bounds, placement
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.prims import resolve_prims, sanitize_name
 from graphsdg.maths.rotations import matrix_to_euler_xyz, quat_wxyz_to_matrix
-from graphsdg.stage.xform import set_local_pose, world_matrix
+from graphsdg.stage.xform import parent_world_matrix, set_local_pose, world_matrix
 
 LOOKS = "/Replicator/Looks"
 
@@ -226,8 +226,7 @@ def _obstacles(no_collision_prims: Any) -> np.ndarray:
 def _move_to(targets: list, world_positions: np.ndarray) -> None:
     """Give each prim a local translation putting its origin at the world position (rotation kept)."""
     for prim, p in zip(targets, world_positions):
-        parent = prim.GetParent()
-        parent_m = world_matrix(parent) if parent and parent.IsA(UsdGeom.Xformable) else np.eye(4)
+        parent_m = parent_world_matrix(prim)
         local = np.append(p, 1.0) @ np.linalg.inv(parent_m)
         set_local_pose(prim, position=local[:3])
 

@@ -369,6 +369,15 @@ def decompose(m: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return m[..., 3, :3].copy(), r, scale
 
 
+def compose(t: ArrayLike, r: ArrayLike, s: ArrayLike) -> np.ndarray:
+    """The row-vector 4x4 of translation ``t``, rotation ``r`` (3x3) and per-axis scale ``s``: the inverse of
+    :func:`decompose`."""
+    m = np.eye(4)
+    m[:3, :3] = np.asarray(s, dtype=np.float64)[:, None] * np.asarray(r, dtype=np.float64).T
+    m[3, :3] = t
+    return m
+
+
 def _decompose_one(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rows = m[:3, :3].tolist()
     scale = [max(math.sqrt(x * x + y * y + z * z), 1e-12) for x, y, z in rows]
@@ -390,4 +399,4 @@ def _decompose_one(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 __all__ = ["ROTATION_ORDERS", "rotation_about", "euler_to_matrix", "matrix_to_euler_xyz", "quat_wxyz_to_euler_xyz",
            "euler_xyz_to_quat",
            "quat_wxyz_to_matrix", "matrix_to_quat_wxyz", "quat_multiply", "canonical_quat", "unit_quat",
-           "quat_slerp", "matrix_to_rotation_vector", "look_at_matrix", "decompose"]
+           "quat_slerp", "matrix_to_rotation_vector", "look_at_matrix", "compose", "decompose"]

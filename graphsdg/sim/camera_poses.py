@@ -25,10 +25,9 @@ from typing import Sequence
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg.maths.rotations import decompose, euler_to_matrix, look_at_matrix, quat_wxyz_to_matrix, \
-    unit_quat
+from graphsdg.maths.rotations import compose, decompose, euler_to_matrix, quat_wxyz_to_matrix, unit_quat
 from graphsdg.stage.changes import ChangeSet
-from graphsdg.stage.xform import world_matrix
+from graphsdg.stage.xform import aimed_rotation, parent_world_matrix
 
 _ROTATIONS = (UsdGeom.XformOp.TypeRotateXYZ, UsdGeom.XformOp.TypeOrient)
 
@@ -48,7 +47,7 @@ class CameraPoses:
         """The camera's world transform: its local one from here under its parent's current world transform;
         None when it was not posed here."""
         local = self._local.get(str(prim.GetPath()))
-        return None if local is None else local @ parent_world(prim)
+        return None if local is None else local @ parent_world_matrix(prim)
 
     def set_local(self, path: str, matrix: np.ndarray) -> None:
         self._local[path] = matrix
@@ -95,15 +94,6 @@ def _canonical_stack(xf: UsdGeom.Xformable) -> bool:
     return True
 
 
-def compose(t: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """The row-vector 4x4 of translation ``t``, rotation ``r`` and per-axis scale ``s`` (inverse of
-    :func:`graphsdg.maths.rotations.decompose`)."""
-    m = np.eye(4)
-    m[:3, :3] = s[:, None] * r.T
-    m[3, :3] = t
-    return m
-
-
 def posed_local(current: np.ndarray, parent: np.ndarray, position: Sequence[float] | None,
                 rotation: Sequence[float] | None, look_at: Sequence[float] | None,
                 up: Sequence[float]) -> np.ndarray:
@@ -114,20 +104,11 @@ def posed_local(current: np.ndarray, parent: np.ndarray, position: Sequence[floa
     if position is not None:
         t = np.asarray(position, dtype=np.float64)
     if look_at is not None:
-        eye = np.append(t, 1.0) @ parent
-        r_world = look_at_matrix(eye[:3], look_at, up)
-        _, r_parent, _ = decompose(parent)
-        r = r_world if np.array_equal(r_parent, np.eye(3)) else r_parent.T @ r_world
+        r = aimed_rotation(t, parent, look_at, up)
     elif rotation is not None:
         rot = np.asarray(rotation, dtype=np.float64)
         r = quat_wxyz_to_matrix(unit_quat(rot)) if rot.shape == (4,) else euler_to_matrix(rot, "XYZ")
     return compose(t, r, s)
 
 
-def parent_world(prim: Usd.Prim) -> np.ndarray:
-    """The world transform of ``prim``'s parent (identity at the root)."""
-    parent = prim.GetParent()
-    return world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
-
-
-__all__ = ["CameraPoses", "compose", "parent_world", "posed_local"]
+__all__ = ["CameraPoses", "posed_local"]

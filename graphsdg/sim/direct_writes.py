@@ -18,12 +18,12 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg.sim.camera_poses import parent_world, posed_local
+from graphsdg.sim.camera_poses import posed_local
 from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
 from graphsdg.maths.rotations import canonical_quat, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
     quat_multiply, unit_quat
-from graphsdg.stage.xform import world_matrix
+from graphsdg.stage.xform import parent_world_matrix
 
 
 class DirectTargets:
@@ -39,8 +39,7 @@ class DirectTargets:
         self.has_material = any(b.material for b in self.bindings)
         self.geom_ids = np.array([b.geom_id for b in self.bindings])
         self.mocap_ids = np.array([b.mocap_id for b in self.bindings])
-        parents = [p.GetParent() for p in prims]
-        mats = np.array([world_matrix(p) if p and not p.IsPseudoRoot() else np.eye(4) for p in parents])
+        mats = np.array([parent_world_matrix(p) for p in prims])
         self.parent_t, self.parent_r, self.parent_s = decompose(mats.reshape(-1, 4, 4))
         self.parent_q = matrix_to_quat_wxyz(self.parent_r)
         # most batches sit under an untransformed parent: their local poses are world poses
@@ -189,7 +188,8 @@ def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.n
         if current is None:
             current = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
                                dtype=np.float64)
-        poses.set_local(path, posed_local(current, parent_world(prim), None if positions is None else positions[i],
+        poses.set_local(path, posed_local(current, parent_world_matrix(prim),
+                                          None if positions is None else positions[i],
                                           None if rotations is None else rotations[i],
                                           None if looks is None else looks[i], up))
     return True

@@ -12,7 +12,7 @@ from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.maths.rotations import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_euler_xyz,
                                       quat_wxyz_to_matrix)
-from graphsdg.stage.xform import set_local_pose, world_matrix
+from graphsdg.stage.xform import parent_world_matrix, set_local_pose, world_matrix
 
 
 _IDENTITY = Gf.Matrix4d(1.0)
@@ -96,8 +96,7 @@ class PoseWriter:
 def set_world_pose_sdf(prim: Usd.Prim, pos: np.ndarray, quat_wxyz: np.ndarray,
                        cache: UsdGeom.XformCache) -> None:
     """Write a world pose as translate + orient ops, keeping the prim's scale."""
-    parent = prim.GetParent()
-    parent_m = world_matrix(parent, cache) if parent and parent.IsA(UsdGeom.Xformable) else np.eye(4)
+    parent_m = parent_world_matrix(prim, cache)
     world = np.eye(4)
     world[:3, :3] = quat_wxyz_to_matrix(quat_wxyz).T
     world[3, :3] = pos

@@ -24,7 +24,7 @@ from pxr import Gf, Usd, UsdGeom
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.prims import PrimLike, resolve_prim
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from graphsdg.stage.xform import world_matrix
+from graphsdg.stage.xform import parent_world_matrix, world_matrix
 
 
 def get_world_transform_matrix(prim: PrimLike, time: Usd.TimeCode = Usd.TimeCode.Default()) -> Gf.Matrix4d:
@@ -62,8 +62,7 @@ def local_pose_for_world(prim: PrimLike, position=None, orientation=None) -> tup
         ([-1.0, 0.0, 3.0], [1.0, 0.0, 0.0, 0.0])
     """
     p = resolve_prim(prim)
-    parent = p.GetParent()
-    parent_m = world_matrix(parent) if parent and not parent.IsPseudoRoot() else np.eye(4)
+    parent_m = parent_world_matrix(p)
     world = world_matrix(p)
     if position is not None:
         world[3, :3] = np.asarray(position, dtype=np.float64).reshape(3)

@@ -47,8 +47,5 @@ class PrimReadCache:
             for path in [k for k in self._values if k == root or k.startswith(below)]:
                 del self._values[path]
 
-    def clear(self) -> None:
-        self._values.clear()
-
 
 __all__ = ["PrimReadCache"]

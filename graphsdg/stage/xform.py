@@ -40,6 +40,24 @@ def world_matrix(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -> np.
     return np.array(m, dtype=np.float64)
 
 
+def parent_world_matrix(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -> np.ndarray:
+    """The world transform of ``prim``'s parent (identity at the root or under a prim that is not Xformable)."""
+    parent = prim.GetParent()
+    return world_matrix(parent, cache) if parent and parent.IsA(UsdGeom.Xformable) else np.eye(4)
+
+
+def aimed_rotation(local_position: Sequence[float], parent_m: np.ndarray, target: Sequence[float],
+                   up: Sequence[float]) -> np.ndarray:
+    """The local rotation that turns a prim at ``local_position`` under the parent transform ``parent_m`` so its
+    -Z points at the world point ``target``, its +Y leaning to ``up`` (how cameras and lights aim)."""
+    eye = np.append(np.asarray(local_position, dtype=np.float64), 1.0) @ parent_m
+    r_world = look_at_matrix(eye[:3], target, up)
+    if np.array_equal(parent_m[:3, :3], _IDENTITY3):   # the common case: no rotation above
+        return r_world
+    _, r_parent, _ = decompose(parent_m)
+    return r_parent.T @ r_world
+
+
 UNITS_RESOLVE_SUFFIX = ":unitsResolve"
 
 
@@ -203,13 +221,6 @@ def set_local_pose(prim: Usd.Prim, position: Sequence[float] | None = None,
     if look_at is not None:
         stage = prim.GetStage()
         up = look_at_up_axis if look_at_up_axis is not None else up_axis_vector(stage)
-        parent = prim.GetParent()
-        parent_m = world_matrix(parent) if parent and parent.IsA(UsdGeom.Xformable) else np.eye(4)
         local_t = np.array(ops.translate.Get()) if ops.translate is not None else np.zeros(3)
-        eye = np.append(local_t, 1.0) @ parent_m
-        r_world = look_at_matrix(eye[:3], as_vec3(look_at, "look_at"), as_vec3(up, "look_at_up_axis"))
-        if np.array_equal(parent_m[:3, :3], _IDENTITY3):   # the common case: no rotation above
-            ops.set_rotation_matrix(r_world)
-        else:
-            _, r_parent, _ = decompose(parent_m)
-            ops.set_rotation_matrix(r_parent.T @ r_world)
+        ops.set_rotation_matrix(aimed_rotation(local_t, parent_world_matrix(prim), as_vec3(look_at, "look_at"),
+                                               as_vec3(up, "look_at_up_axis")))
