@@ -38,6 +38,9 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
     "/graphsdg/io/queueMaxBytes": (1 << 30, "bytes of image/array data queued writes may hold before the producer "
                                    "is throttled"),
+    "/graphsdg/io/writeProcesses": ("auto", "writer processes that encode and write image, array and JSON files to "
+                                    "local folders outside the interpreter lock: a count (0: all writes on the "
+                                    "writer threads) or auto (as many as writeThreads on 4 cores or more)"),
     "/graphsdg/io/fsync": (False, "fsync each file and its folder before a write counts as done (survives power "
                            "loss, slower)"),
     "/graphsdg/io/runState": (True, "keep graphsdg_run.json (which frames are complete on disk) in each writer's "
@@ -140,6 +143,13 @@ def _warp_device(key: str, value: Any) -> None:
         raise ValueError(f"setting {key} must be 'cuda', 'cuda:N' or 'cpu', got {value!r}")
 
 
+def _count_or_auto(key: str, value: Any) -> None:
+    if value == "auto":
+        return
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+        raise ValueError(f"setting {key} must be 'auto' or an integer >= 0, got {value!r}")
+
+
 def _path_or_none(key: str, value: Any) -> None:
     if value is not None and not isinstance(value, (str, os.PathLike)):
         raise ValueError(f"setting {key} must be a folder path or None, got {value!r}")
@@ -154,6 +164,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/omni/replicator/backend/queueSize": _integer(1),
     "/omni/replicator/backends/disk/root_dir": _path_or_none,
     "/graphsdg/io/queueMaxBytes": _integer(1),
+    "/graphsdg/io/writeProcesses": _count_or_auto,
     "/graphsdg/io/fsync": _boolean,
     "/graphsdg/io/runState": _boolean,
     "/exts/omni.replicator.core/enableWriteToFabric": _boolean,

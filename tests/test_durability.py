@@ -170,8 +170,8 @@ def test_worker_failure_is_raised_at_the_next_step(out_dir, monkeypatch):
 def test_disk_full_leaves_only_whole_files(out_dir, monkeypatch):
     """A disk that fills up mid-dataset: every file under a final name is whole, no temp file, a clear error."""
     import errno
-    import graphsdg.io.backends as backends
-    real_write_all = backends._write_all
+    import graphsdg.io.atomic_files as atomic_files
+    real_write_all = atomic_files._write_all
     budget = {"bytes": None}
 
     def quota_write_all(fd, data):
@@ -183,7 +183,7 @@ def test_disk_full_leaves_only_whole_files(out_dir, monkeypatch):
         if len(data) > room:
             raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(backends, "_write_all", quota_write_all)
+    monkeypatch.setattr(atomic_files, "_write_all", quota_write_all)
     cube, cam, rp = unit_cube_scene(resolution=(64, 48))
     writer = rep.writers.get("BasicWriter")
     writer.initialize(output_dir=out_dir, rgb=True, bounding_box_2d_tight=True, semantic_segmentation=True)

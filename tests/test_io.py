@@ -247,20 +247,20 @@ def test_seed_custom_writer_example(capsys):
 def test_a_forked_child_names_its_temporary_files_apart():
     """Atomic writes' temporary names carry a per-process token: a forked child (a worker pool's) makes its
     own, so parent and child writing the same file never share a temporary name."""
-    from graphsdg.io import backends
+    from graphsdg.io import atomic_files
 
-    parent = backends._temp_token()
+    parent = atomic_files._temp_token()
     read, write = os.pipe()
     pid = os.fork()
     if pid == 0:                                   # the child: report its token and leave at once
         os.close(read)
-        os.write(write, backends._temp_token().encode())
+        os.write(write, atomic_files._temp_token().encode())
         os._exit(0)
     os.close(write)
     child = os.read(read, 100).decode()
     os.close(read)
     os.waitpid(pid, 0)
-    assert child[:10] != parent[:10] and backends._temp_token()[:10] == parent[:10]
+    assert child[:10] != parent[:10] and atomic_files._temp_token()[:10] == parent[:10]
 
 
 def test_writer_threads_start_as_the_backlog_needs_them():

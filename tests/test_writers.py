@@ -761,15 +761,15 @@ def test_output_dir_that_is_not_writable(tmp_path, monkeypatch):
 def _disk_full_open(monkeypatch, after_bytes=10):
     """Make every file write through graphsdg's backends fail with ENOSPC after ``after_bytes`` bytes."""
     import errno
-    import graphsdg.io.backends as backends
-    real_write_all = backends._write_all
+    import graphsdg.io.atomic_files as atomic_files
+    real_write_all = atomic_files._write_all
 
     def full_write_all(fd, data):
         real_write_all(fd, data[:after_bytes])                      # a partial file really reaches the disk
         if len(data) > after_bytes:
             raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(backends, "_write_all", full_write_all)
+    monkeypatch.setattr(atomic_files, "_write_all", full_write_all)
 
 
 def test_disk_full_during_a_write_leaves_no_truncated_file(out_dir, monkeypatch):

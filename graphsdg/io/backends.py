@@ -8,11 +8,8 @@ Example:
 """
 from __future__ import annotations
 
-import errno
 import inspect
-import itertools
 import os
-import re
 import threading
 import uuid
 from typing import Any, Callable
@@ -21,7 +18,9 @@ from typing import Any, Callable
 from graphsdg import settings_store as settings
 from graphsdg.jobs import frame_plan
 from graphsdg.errors import unknown_name
-from graphsdg.io import encode, object_store
+from graphsdg.io import atomic_files, encode, object_store
+from graphsdg.io.atomic_files import remove_temporaries  # noqa: F401  (part of this module's face)
+from graphsdg.io.written_totals import bytes_written, count_written, files_written  # noqa: F401  (likewise)
 from graphsdg.io.object_store import S3Url, is_s3_url
 from graphsdg.io.write_queue import get_write_queue
 
@@ -45,6 +44,15 @@ class BaseBackend:
         A backend that cannot tell answers False, so a resumed run writes the frame again.
         """
         return False
+
+    def local_path(self, path: str) -> str | None:
+        """The local file that :meth:`write_blob` of ``path`` writes atomically and does nothing else with,
+        or None (a bucket, a backend of several stores, a subclass with its own ``write_blob``).
+
+        The write queue hands such writes to its writer processes (:mod:`graphsdg.io.write_processes`),
+        which write the file themselves.
+        """
+        return None
 
     def schedule(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
         """Run ``fn(*args, backend_instance=self, **kwargs)`` on the write queue."""
@@ -125,6 +133,11 @@ class DiskBackend(BaseBackend):
 
     def write_blob(self, path: str, data: bytes) -> None:
         write_file_atomic(self.resolve(path), data)
+
+    def local_path(self, path: str) -> str | None:
+        if type(self).write_blob is not DiskBackend.write_blob or writes_discarded():
+            return None
+        return self.resolve(path)
 
     def read_blob(self, path: str) -> bytes:
         with open(self.resolve(path), "rb") as f:
@@ -236,69 +249,6 @@ def _check_writable(path: str) -> None:
         raise PermissionError(f"output_dir {path!r} is not writable: {exc.strerror or exc}") from exc
 
 
-_counter_lock = threading.Lock()
-_written = {"files": 0, "bytes": 0}
-_folders_made: set[str] = set()
-_temp_serial = itertools.count()
-_process_token = ""
-
-
-def _temp_token() -> str:
-    """A name part no other write (thread, process, or host sharing the folder) uses at the same time:
-    a random token per process (made again in a forked child) and a serial number."""
-    global _process_token
-    if not _process_token:
-        _process_token = uuid.uuid4().hex[:10]
-    return f"{_process_token}{next(_temp_serial)}"
-
-
-def _forget_process_token() -> None:
-    global _process_token
-    _process_token = ""
-
-
-# a forked child must not reuse its parent's temporary names (asking os.getpid() per file instead was a
-# system call per file)
-os.register_at_fork(after_in_child=_forget_process_token)
-
-
-def files_written() -> int:
-    """Files written by this process (all disk writes, for progress summaries)."""
-    return _written["files"]
-
-
-def bytes_written() -> int:
-    return _written["bytes"]
-
-
-def count_written(nbytes: int) -> None:
-    """Add one written file of ``nbytes`` to the totals (every backend's dataset writes count)."""
-    with _counter_lock:
-        _written["files"] += 1
-        _written["bytes"] += nbytes
-
-
-# ".<file name>.<token>.tmp": a 10-hex-digit process token and a serial (earlier builds: 12 hex digits)
-_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{10,}\.tmp$")
-
-
-def remove_temporaries(output_dir: str) -> int:
-    """Delete the temporary files that interrupted atomic writes left under ``output_dir``; return how many.
-
-    Only call it while nothing writes there (a resumed run before its first frame, a merge after its shards).
-    """
-    removed = 0
-    for folder, _, names in os.walk(output_dir):
-        for name in names:
-            if _TEMPORARY.match(name):
-                try:
-                    os.unlink(os.path.join(folder, name))
-                    removed += 1
-                except FileNotFoundError:
-                    pass
-    return removed
-
-
 def writes_discarded() -> bool:
     """True while ``/graphsdg/io/discardWrites`` is set: disk backends create and write nothing.
 
@@ -307,76 +257,30 @@ def writes_discarded() -> bool:
     return bool(settings.get("/graphsdg/io/discardWrites", False))
 
 
-def _fsync_dir(directory: str) -> None:
-    fd = os.open(directory, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
+def durable_writes() -> bool:
+    """The setting ``/graphsdg/io/fsync``: each file and its folder are synced before a write counts as done."""
+    return bool(settings.get("/graphsdg/io/fsync", False))
 
 
 def write_file_atomic(full_path: str, data: bytes) -> None:
     """Write ``data`` to ``full_path`` so that the file appears whole or not at all.
 
     The bytes go to a temporary name in the same folder, which is then renamed
-    over ``full_path`` (atomic on POSIX). A process that dies at any point leaves
-    either the old file or the new one, never a truncated one. With the setting
-    ``/graphsdg/io/fsync`` the file and the folder are also synced before the
-    write counts as done, so the same holds after a power loss.
+    over ``full_path`` (atomic on POSIX; :func:`graphsdg.io.atomic_files.write_atomic`).
+    A process that dies at any point leaves either the old file or the new one, never
+    a truncated one. With the setting ``/graphsdg/io/fsync`` the file and the folder
+    are also synced before the write counts as done, so the same holds after a power loss.
     """
     _write_atomic(full_path, data, count=True)
-
-
-# os.open + os.write instead of open(): a buffered file object also makes fstat, ioctl and lseek calls, and
-# each system call hands the interpreter lock to another thread and back (a frame of small images writes
-# seven files; the render thread waits for the lock each time the writer takes it)
-_CREATE_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_CLOEXEC", 0)
-
-
-def _write_all(fd: int, data: bytes) -> None:
-    view = memoryview(data)
-    while view:
-        view = view[os.write(fd, view):]
 
 
 def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
     """:func:`write_file_atomic`; ``count=False`` leaves the totals alone (bookkeeping files: the run state)."""
     if writes_discarded():
         return
-    directory = os.path.dirname(full_path)
-    if directory not in _folders_made:   # one makedirs per folder, not per file
-        os.makedirs(directory, exist_ok=True)
-        _folders_made.add(directory)
-    tmp = os.path.join(directory, f".{os.path.basename(full_path)}.{_temp_token()}.tmp")
-    durable = bool(settings.get("/graphsdg/io/fsync", False))
-    try:
-        try:
-            fd = os.open(tmp, _CREATE_FLAGS, 0o666)
-        except FileNotFoundError:   # the folder was removed since: make it again
-            os.makedirs(directory, exist_ok=True)
-            fd = os.open(tmp, _CREATE_FLAGS, 0o666)
-        try:
-            _write_all(fd, data)
-            if durable:
-                os.fsync(fd)
-        finally:
-            os.close(fd)
-        os.replace(tmp, full_path)
-        if durable:
-            _fsync_dir(directory)
-        if count:     # bookkeeping files (the run state) are not part of the dataset's totals
-            with _counter_lock:
-                _written["files"] += 1
-                _written["bytes"] += len(data)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        if isinstance(exc, OSError) and exc.errno == errno.ENOSPC:
-            raise OSError(errno.ENOSPC, f"disk full while writing {full_path!r}; the partial file was removed") \
-                from exc
-        raise
+    atomic_files.write_atomic(full_path, data, durable_writes())
+    if count:     # bookkeeping files (the run state) are not part of the dataset's totals
+        count_written(len(data))
 
 
 class BackendGroup(BaseBackend):
@@ -388,6 +292,11 @@ class BackendGroup(BaseBackend):
     def write_blob(self, path: str, data: bytes) -> None:
         for b in self.backends:
             b.write_blob(path, data)
+
+    def local_path(self, path: str) -> str | None:
+        if type(self).write_blob is not BackendGroup.write_blob or len(self.backends) != 1:
+            return None
+        return self.backends[0].local_path(path)
 
     def read_blob(self, path: str) -> bytes:
         return self.backends[0].read_blob(path)

@@ -1,7 +1,10 @@
 """Replicator's io functions (``rep.functional.write_image`` ...), used by writers.
 
 Each encodes in the calling (worker) thread and writes through
-``backend_instance`` when given, else atomically to ``path`` itself.
+``backend_instance`` when given, else atomically to ``path`` itself. Each carries
+``file_kind`` (``image``, ``npy``, ``json``, ``blob``): the write queue hands a
+write of that kind to a local file to its writer processes, which encode and write
+it the same way (:mod:`graphsdg.io.write_processes`).
 """
 from __future__ import annotations
 
@@ -37,3 +40,9 @@ def write_json(data: Any = None, path: str = "", backend_instance: BaseBackend |
 
 def write_blob(data: bytes = b"", path: str = "", backend_instance: BaseBackend | None = None) -> None:
     _write(path, bytes(data), backend_instance)
+
+
+write_image.file_kind = "image"   # type: ignore[attr-defined]
+write_np.file_kind = "npy"        # type: ignore[attr-defined]
+write_json.file_kind = "json"     # type: ignore[attr-defined]
+write_blob.file_kind = "blob"     # type: ignore[attr-defined]

@@ -8,6 +8,11 @@ and the arrays held by waiting and running tasks stay under
 ``/omni/replicator/backend/writeThreads``, apply to the live queue. Workers start
 as the backlog needs them, up to ``writeThreads``: one while it keeps up.
 
+Writes of image, array and JSON files to a local folder (what BasicWriter and most writers schedule) go to
+writer *processes* instead when ``/graphsdg/io/writeProcesses`` allows them
+(:mod:`graphsdg.io.write_processes`): they encode outside the interpreter lock, so the thread that renders
+no longer waits for it. The limits, the groups, the errors and the waits below cover both kinds of writes.
+
 Tasks run in the order they were scheduled (FIFO; writers such as the WebDataset
 shard writer rely on it). A task that raises is remembered and re-raised in the
 script by :meth:`WriteQueue.raise_errors` (called at every ``step()`` and by
@@ -42,6 +47,8 @@ from graphsdg import settings_store as settings
 from graphsdg.benchmark import profiling
 from graphsdg.jobs.cpu_share import cores_per_process
 from graphsdg.errors import WriterError
+from graphsdg.io.write_processes import FileWrite, WriteProcesses
+from graphsdg.io.written_totals import count_written
 
 log = logging.getLogger("graphsdg.io")
 
@@ -49,6 +56,10 @@ THREADS_KEY = "/omni/replicator/backend/writeThreads"
 DEFAULT_THREADS = 4
 SIZE_KEY = "/omni/replicator/backend/queueSize"
 BYTES_KEY = "/graphsdg/io/queueMaxBytes"
+PROCESSES_KEY = "/graphsdg/io/writeProcesses"
+DISCARD_KEY = "/graphsdg/io/discardWrites"
+FSYNC_KEY = "/graphsdg/io/fsync"
+MIN_CORES_FOR_PROCESSES = 4   # "auto" writes in processes from this many cores (fewer: the threads do as well)
 _THROTTLE_LOG_EVERY_S = 10.0
 BACKLOG_PER_WORKER = 8   # tasks waiting per started worker before another starts (a BasicWriter frame is ~7)
 
@@ -82,6 +93,25 @@ def _describe(fn: Callable[..., Any], kwargs: dict) -> str:
     return f"a background write ({getattr(fn, '__qualname__', type(fn).__name__)})"
 
 
+def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict) -> FileWrite | None:
+    """The write ``fn(*args, **kwargs)`` as data, when a writer process can do it: one of the io functions
+    (``file_kind``) writing to a local file through a plain disk backend or to a path; else None."""
+    kind = getattr(fn, "file_kind", None)
+    path = kwargs.get("path")
+    if kind is None or args or not isinstance(path, str) or not path or \
+            not set(kwargs) <= {"data", "path", "backend_instance", "indent"}:
+        return None
+    backend = kwargs.get("backend_instance")
+    if backend is None:
+        full = None if settings.get(DISCARD_KEY, False) else os.path.abspath(path)
+    else:
+        local_path = getattr(backend, "local_path", None)
+        full = local_path(path) if local_path is not None else None
+    if full is None:
+        return None
+    return FileWrite(kind, full, kwargs.get("data"), kwargs.get("indent"))
+
+
 def _positive_int(key: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise ValueError(f"setting {key} must be a positive integer, got {value!r}")
@@ -92,9 +122,10 @@ class WriteQueue:
     """Runs scheduled callables on worker threads, in order, with bounded memory."""
 
     def __init__(self, num_threads: int | None = None, max_size: int | None = None,
-                 max_bytes: int | None = None) -> None:
+                 max_bytes: int | None = None, num_processes: int = 0) -> None:
         self.num_threads = _positive_int(THREADS_KEY, num_threads if num_threads is not None
                                          else settings.get(THREADS_KEY, DEFAULT_THREADS))
+        self.num_processes = num_processes     # writer processes at most; 0: every write on the threads
         self.max_size = _positive_int(SIZE_KEY, max_size if max_size is not None else settings.get(SIZE_KEY, 1000))
         self.max_bytes = _positive_int(BYTES_KEY, max_bytes if max_bytes is not None
                                        else settings.get(BYTES_KEY, 1 << 30))
@@ -117,6 +148,8 @@ class WriteQueue:
         self.throttled_seconds = 0.0
         self.completed = 0
         self.peak_bytes = 0
+        self._processes: WriteProcesses | None = None
+        self._in_processes = 0            # writes handed to the processes and not finished
 
     # ---- workers ---------------------------------------------------------
     def _start_threads(self, wanted: int = 1) -> bool:
@@ -167,21 +200,28 @@ class WriteQueue:
 
     def _run(self, item: tuple) -> None:
         fn, args, kwargs, nbytes, group = item
-        ok = True
+        error = None
         start = time.perf_counter()
         try:
             fn(*args, **kwargs)
         except BaseException as exc:  # noqa: BLE001 - every failure must reach the script
-            ok = False
-            what = _describe(fn, kwargs)
-            with self._cond:
-                self._errors.append((exc, what))
-            log.error("%s failed: %s", what, exc)
+            error = exc
         profiling.add("encode+write", time.perf_counter() - start)
+        self._settle(nbytes, group, error, _describe(fn, kwargs) if error is not None else "")
+
+    def _settle(self, nbytes: int, group: TaskGroup | None, error: BaseException | None, what: str,
+                in_process: bool = False) -> None:
+        """Account for one finished write (``error``: how it failed, ``what``: which write that was)."""
+        ok = error is None
+        if not ok:
+            with self._cond:
+                self._errors.append((error, what))
+            log.error("%s failed: %s", what, error)
         finished = None
         with self._cond:
             self._unfinished -= 1
             self._bytes -= nbytes
+            self._in_processes -= in_process
             if ok:
                 self.completed += 1
             if group is not None:
@@ -195,12 +235,18 @@ class WriteQueue:
 
     # ---- producers -------------------------------------------------------
     def _full(self, nbytes: int) -> bool:
-        return len(self._items) >= self.max_size or (self._bytes > 0 and self._bytes + nbytes > self.max_bytes)
+        return (len(self._items) + self._in_processes >= self.max_size
+                or (self._bytes > 0 and self._bytes + nbytes > self.max_bytes))
 
     def schedule(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
         """Queue ``fn(*args, **kwargs)``; blocks while the queue is full (backpressure)."""
         nbytes = payload_bytes(args, kwargs)
         group = getattr(self._local, "group", None)
+        if self.num_processes:
+            write = file_write(fn, args, kwargs)
+            if write is not None:
+                self._schedule_in_process(write, nbytes, group)
+                return
         with self._cond:
             if not self._start_threads(self._workers_wanted()):
                 inline = True
@@ -208,14 +254,7 @@ class WriteQueue:
                 inline = False
                 # A task that schedules a follow-up must not wait for room it occupies itself.
                 if self._full(nbytes) and threading.current_thread() not in self._threads:
-                    self._wake_deferred()          # the room can only come from tasks a worker was told about
-                    now = time.perf_counter()
-                    if now - self._last_throttle_log >= _THROTTLE_LOG_EVERY_S:
-                        self._last_throttle_log = now
-                        log.warning("Throttling generation due to I/O bottleneck.")
-                    while self._full(nbytes):
-                        self._cond.wait()
-                    self.throttled_seconds += time.perf_counter() - now
+                    self._throttle(nbytes)
             item = (fn, args, kwargs, nbytes, group)
             self._unfinished += 1
             self._bytes += nbytes
@@ -230,6 +269,57 @@ class WriteQueue:
                     self._has_work.notify()    # one idle worker takes it
         if inline:
             self._run(item)
+
+    def _throttle(self, nbytes: int) -> None:
+        """Wait (lock held) until a task of ``nbytes`` fits the limits."""
+        self._cond.release()
+        try:
+            self._wake_deferred()          # the room can only come from tasks a worker was told about
+        finally:
+            self._cond.acquire()
+        now = time.perf_counter()
+        if now - self._last_throttle_log >= _THROTTLE_LOG_EVERY_S:
+            self._last_throttle_log = now
+            log.warning("Throttling generation due to I/O bottleneck.")
+        while self._full(nbytes):
+            self._cond.wait()
+        self.throttled_seconds += time.perf_counter() - now
+
+    def _schedule_in_process(self, write: FileWrite, nbytes: int, group: TaskGroup | None) -> None:
+        with self._cond:
+            if self._full(nbytes):
+                self._throttle(nbytes)
+            self._unfinished += 1
+            self._in_processes += 1
+            self._bytes += nbytes
+            self.peak_bytes = max(self.peak_bytes, self._bytes)
+            if group is not None:
+                group.pending += 1
+            if self._processes is None:
+                self._processes = WriteProcesses(self.num_processes, self._process_done)
+            self._processes.max_processes = self.num_processes
+        token = (nbytes, group, f"a background write of {write.path!r}")
+        shipped = getattr(self._local, "shipped", None)
+        if shipped is not None:                 # inside batch(): the frame's writes go as one message
+            shipped.append((write, token))
+            return
+        self._send([(write, token)])
+
+    def _send(self, writes: list[tuple[FileWrite, tuple]]) -> None:
+        try:
+            self._processes.send(writes, durable=bool(settings.get(FSYNC_KEY, False)))
+        except Exception as exc:  # noqa: BLE001 - e.g. no process could start: the writes fail, loudly
+            for _, token in writes:
+                self._process_done(token, exc, 0, 0.0)
+
+    def _process_done(self, token: tuple, error: BaseException | None, nbytes_written: int,
+                      seconds: float) -> None:
+        """A writer process finished a write (runs on the thread that reads its replies)."""
+        nbytes, group, what = token
+        if error is None:
+            count_written(nbytes_written)
+        profiling.add("encode+write", seconds)
+        self._settle(nbytes, group, error, what, in_process=True)
 
     @contextlib.contextmanager
     def group(self, on_done: Callable[[bool], None]) -> Iterator[TaskGroup]:
@@ -268,24 +358,33 @@ class WriteQueue:
             yield
             return
         self._local.deferred = 0
+        self._local.shipped = []
         try:
             yield
         finally:
             self._wake_deferred()
             self._local.deferred = None
+            self._local.shipped = None
 
     def _wake_deferred(self) -> None:
-        """Wake a worker for each task this thread scheduled inside :meth:`batch` so far."""
+        """Wake a worker for each task this thread scheduled inside :meth:`batch` so far, and send the writes
+        for the writer processes it collected."""
         count = getattr(self._local, "deferred", None)
         if count:
             with self._cond:
                 self._has_work.notify(count)
             self._local.deferred = 0
+        shipped = getattr(self._local, "shipped", None)
+        if shipped:
+            self._local.shipped = []
+            self._send(shipped)
 
-    def configure(self, num_threads: int, max_size: int, max_bytes: int) -> None:
-        """Apply new limits to the live queue (extra workers exit once idle)."""
+    def configure(self, num_threads: int, max_size: int, max_bytes: int, num_processes: int = 0) -> None:
+        """Apply new limits to the live queue (extra workers exit once idle; writer processes started stay
+        until :meth:`shutdown`, and none are sent new writes once ``num_processes`` is 0)."""
         with self._cond:
             self.max_size, self.max_bytes = max_size, max_bytes
+            self.num_processes = num_processes
             excess = len(self._threads) - self._retire - num_threads
             if excess > 0:
                 self._retire += excess
@@ -337,6 +436,13 @@ class WriteQueue:
             self._threads.clear()
             self._closing = False
             self._retire = 0
+            processes, self._processes = self._processes, None
+        if processes is not None:
+            processes.shutdown()
+
+    def process_ids(self) -> list[int]:
+        """The process ids of the writer processes running now (none until a write needs one)."""
+        return self._processes.pids() if self._processes is not None else []
 
 
 _queue: WriteQueue | None = None
@@ -375,30 +481,49 @@ def default_threads(cores: int | None = None) -> int:
     return min(DEFAULT_THREADS, max(1, cores // 4))
 
 
-_configured_at: tuple[int, tuple[int, int, int]] = (-1, (0, 0, 0))
+def processes_wanted(value: Any, threads: int, cores: int | None = None) -> int:
+    """Writer processes for the setting ``/graphsdg/io/writeProcesses``: a count (0: writes stay on the
+    threads), or ``"auto"``: as many as writer threads on a machine of :data:`MIN_CORES_FOR_PROCESSES` cores
+    or more, none below.
+
+    Example:
+        >>> processes_wanted("auto", 4, cores=16), processes_wanted("auto", 1, cores=2), processes_wanted(2, 4)
+        (4, 0, 2)
+    """
+    if value == "auto":
+        cores = cores if cores is not None else (os.cpu_count() or 1)
+        return threads if cores >= MIN_CORES_FOR_PROCESSES else 0
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise ValueError(f"setting {PROCESSES_KEY} must be 'auto' or a count of processes >= 0, got {value!r}")
+    return int(value)
 
 
-def _configured() -> tuple[int, int, int]:
-    """(threads, queue size, queue bytes) from the settings; read again only when a setting changed (a frame
-    asks for the queue ~10 times)."""
+_configured_at: tuple[int, tuple[int, int, int, int]] = (-1, (0, 0, 0, 0))
+
+
+def _configured() -> tuple[int, int, int, int]:
+    """(threads, queue size, queue bytes, processes) from the settings; read again only when a setting changed
+    (a frame asks for the queue ~10 times)."""
     global _configured_at
     generation = settings.generation()
     if _configured_at[0] != generation:
-        _configured_at = (generation, (_positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS)),
-                                       _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
-                                       _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30))))
+        threads = _positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS))
+        _configured_at = (generation, (threads, _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
+                                       _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30)),
+                                       processes_wanted(settings.get(PROCESSES_KEY, "auto"), threads)))
     return _configured_at[1]
 
 
 def get_write_queue() -> WriteQueue:
     """The process-wide write queue, with the current settings applied."""
     global _queue
-    threads, size, max_bytes = _configured()
+    threads, size, max_bytes, processes = _configured()
     with _queue_lock:
         if _queue is None:
-            _queue = WriteQueue(threads, size, max_bytes)
-        elif (threads, size, max_bytes) != (_queue.num_threads, _queue.max_size, _queue.max_bytes):
-            _queue.configure(threads, size, max_bytes)
+            _queue = WriteQueue(threads, size, max_bytes, processes)
+        elif (threads, size, max_bytes, processes) != (_queue.num_threads, _queue.max_size, _queue.max_bytes,
+                                                       _queue.num_processes):
+            _queue.configure(threads, size, max_bytes, processes)
         return _queue
 
 

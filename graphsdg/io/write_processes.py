@@ -1,0 +1,323 @@
+"""Writer processes: image, array and JSON files encoded and written outside the interpreter lock.
+
+A writer thread shares the interpreter lock with the thread that renders: measured on a GPU host, a
+128x128 frame's main thread took ~60 % more CPU with one writer thread running (15-20 hand-offs of the
+lock a frame; docs/performance.md). So the write queue hands the writes it can describe as data, the
+``rep.functional.write_image`` / ``write_np`` / ``write_json`` / ``write_blob`` calls that BasicWriter
+and most writers schedule to a local file, to writer processes instead:
+
+* each process has a shared arena (an anonymous ``memfd`` mapped on both sides): an array is copied
+  into it once, and only its offset, dtype and shape cross the pipe;
+* a frame's writes go to one process as one message (:meth:`WriteProcesses.send`), and come back as one
+  reply, read by a thread that waits outside the interpreter lock;
+* processes start as the backlog needs them (one while it keeps up), up to a limit; two writes to the
+  same file go to the same process, so the last one scheduled is the one on disk;
+* the processes encode with the same functions as a writer thread (:mod:`graphsdg.io.write_process`),
+  so the files are byte for byte the same.
+
+A write that fails in a process reaches the caller's ``on_done`` with the error, naming the file; a
+process that dies fails every write it held. Writes of other kinds (a writer's own function, an S3
+bucket) stay on the write queue's threads.
+
+Example:
+    >>> import numpy as np, os, tempfile
+    >>> folder = tempfile.mkdtemp()
+    >>> done = []
+    >>> pool = WriteProcesses(max_processes=1, on_done=lambda token, error, nbytes, seconds: done.append(error))
+    >>> pool.send([(FileWrite("npy", os.path.join(folder, "a.npy"), np.arange(3), None), "a")], durable=False)
+    >>> pool.shutdown(); done, np.load(os.path.join(folder, "a.npy")).tolist()
+    ([None], [0, 1, 2])
+"""
+from __future__ import annotations
+
+import builtins
+import collections
+import mmap
+import os
+import subprocess
+import sys
+import threading
+import weakref
+from multiprocessing.connection import Connection
+from typing import Any, Callable, NamedTuple
+
+import numpy as np
+
+from graphsdg.io.write_process import BOOT
+
+ARENA_BYTES = 128 << 20     # per process; pages are touched only as far as the backlog reaches
+INLINE_BYTES = 16 << 10     # arrays smaller than this travel in the message itself
+BATCHES_PER_PROCESS = 2     # batches waiting on every started process before another one starts
+_ALIGN = 64
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+class FileWrite(NamedTuple):
+    """One file to encode and write: ``kind`` is ``image``, ``npy``, ``json`` or ``blob``."""
+
+    kind: str
+    path: str
+    data: Any
+    indent: int | None
+
+
+OnDone = Callable[[Any, "BaseException | None", int, float], None]
+
+
+def rebuilt_error(type_name: str, errno: int | None, message: str, path: str) -> BaseException:
+    """The exception a writer process reported, as the same built-in type where there is one."""
+    cls = getattr(builtins, type_name, None)
+    if errno is not None and isinstance(cls, type) and issubclass(cls, OSError):
+        return cls(errno, message)
+    if isinstance(cls, type) and issubclass(cls, Exception):
+        return cls(message)
+    return RuntimeError(f"{type_name}: {message} (writing {path!r})")
+
+
+class _Batch(NamedTuple):
+    batch_id: int
+    start: int
+    end: int
+    tokens: list
+    paths: list
+
+
+class _Process:
+    """One writer process: its pipes, its arena and the batches it holds (oldest first)."""
+
+    def __init__(self, arena_bytes: int) -> None:
+        request_read, request_write = os.pipe()
+        reply_read, reply_write = os.pipe()
+        arena_fd = os.memfd_create("graphsdg-writes", os.MFD_CLOEXEC)
+        try:
+            os.ftruncate(arena_fd, arena_bytes)
+            self.arena = mmap.mmap(arena_fd, arena_bytes)
+            self.process = subprocess.Popen(
+                [sys.executable, "-c", BOOT, _PACKAGE_DIR, str(request_read), str(reply_write), str(arena_fd),
+                 str(arena_bytes)], pass_fds=(request_read, reply_write, arena_fd), stdin=subprocess.DEVNULL)
+        except BaseException:
+            for fd in (request_write, reply_read):
+                os.close(fd)
+            raise
+        finally:
+            for fd in (request_read, reply_write, arena_fd):
+                os.close(fd)
+        self.size = arena_bytes
+        self.requests = Connection(request_write, readable=False)
+        self.replies = Connection(reply_read, writable=False)
+        self.batches: collections.deque[_Batch] = collections.deque()
+        self.regions: collections.deque[tuple[int, int]] = collections.deque()
+        self.head = 0
+        self.alive = True
+        self.reader: threading.Thread | None = None
+
+    def reserve(self, nbytes: int) -> int | None:
+        """The start of ``nbytes`` free bytes of the arena, or None while there is no room.
+
+        The arena is a ring: batches are freed oldest first, and :attr:`regions` holds the byte ranges of
+        the batches still held, oldest first.
+        """
+        if not self.regions:
+            return 0 if nbytes <= self.size else None
+        tail = self.regions[0][0]
+        if self.regions[-1][0] < tail:                   # wrapped: the room is [head, tail)
+            return self.head if self.head + nbytes <= tail else None
+        if self.head + nbytes <= self.size:              # [head, size), then [0, tail)
+            return self.head
+        return 0 if nbytes <= tail else None
+
+    def forget(self) -> None:
+        """In a forked child: drop the parent's process without touching it."""
+        self.alive = False
+        for connection in (self.requests, self.replies):
+            try:
+                connection.close()
+            except OSError:
+                pass
+
+
+class WriteProcesses:
+    """Up to ``max_processes`` writer processes; ``on_done(token, error, nbytes, seconds)`` per write."""
+
+    def __init__(self, max_processes: int, on_done: OnDone, arena_bytes: int = ARENA_BYTES) -> None:
+        if max_processes < 1:
+            raise ValueError(f"WriteProcesses needs at least one process, got {max_processes!r}")
+        self.max_processes = max_processes
+        self.arena_bytes = arena_bytes
+        self._on_done = on_done
+        self._processes: list[_Process] = []
+        self._owner: dict[str, list] = {}       # path -> [process, writes in flight]
+        self._next_batch = 0
+        self._room = threading.Condition(threading.Lock())
+        _pools.add(self)
+
+    # ---- sending ------------------------------------------------------------
+    def send(self, writes: list[tuple[FileWrite, Any]], durable: bool) -> None:
+        """Encode and write ``writes`` (each with the token its ``on_done`` gets) in one process, as one batch.
+
+        Blocks while the chosen process's arena has no room for the batch's arrays.
+        """
+        if not writes:
+            return
+        arrays = self._layout(writes)
+        total = sum(size for _, _, size in arrays)
+        with self._room:
+            process = self._choose([w.path for w, _ in writes])
+            if total > process.size:                      # larger than a whole arena: everything in the message
+                arrays, total = [], 0
+            start = process.reserve(total) if total else 0
+            while start is None:
+                self._room.wait()
+                if not process.alive:
+                    break
+                start = process.reserve(total)
+            if not process.alive:
+                self._fail_now(writes, process)
+                return
+            tasks = self._tasks(writes, arrays, process, start, durable)
+            batch = _Batch(self._next_batch, start, start + total, [token for _, token in writes],
+                           [w.path for w, _ in writes])
+            self._next_batch += 1
+            process.batches.append(batch)
+            if total:
+                process.head = start + total
+                process.regions.append((start, start + total))
+            for path in batch.paths:
+                self._owner.setdefault(path, [process, 0])[1] += 1
+            try:
+                process.requests.send(("write", batch.batch_id, tasks))
+            except OSError:
+                pass                                   # the reader sees the process's end and fails the batch
+
+    @staticmethod
+    def _layout(writes: list[tuple[FileWrite, Any]]) -> list[tuple[int, np.ndarray, int]]:
+        """(index, contiguous array, aligned size) of each write whose data goes through the arena."""
+        arrays = []
+        for i, (write, _) in enumerate(writes):
+            data = write.data
+            if write.kind in ("image", "npy") and isinstance(data, np.ndarray) and not data.dtype.hasobject \
+                    and data.nbytes >= INLINE_BYTES:
+                arrays.append((i, data, -(-data.nbytes // _ALIGN) * _ALIGN))
+        return arrays
+
+    @staticmethod
+    def _tasks(writes, arrays, process: _Process, start: int, durable: bool) -> list[tuple]:
+        in_arena: dict[int, tuple] = {}
+        offset = start
+        for i, data, size in arrays:
+            view = np.ndarray(data.shape, dtype=data.dtype, buffer=process.arena, offset=offset)
+            np.copyto(view, data, casting="no")
+            in_arena[i] = ("arena", offset, data.dtype, data.shape)
+            offset += size
+        return [(w.kind, w.path, durable, w.indent, in_arena.get(i) or ("value", w.data))
+                for i, (w, _) in enumerate(writes)]
+
+    def _choose(self, paths: list[str]) -> _Process:
+        """The process for a batch: the one still writing any of its files, else the least busy, starting
+        another while every started one holds :data:`BATCHES_PER_PROCESS` batches (lock held)."""
+        for path in paths:
+            owner = self._owner.get(path)
+            if owner is not None and owner[0].alive:
+                return owner[0]
+        alive = [p for p in self._processes if p.alive]
+        self._processes = alive
+        idle = min(alive, key=lambda p: len(p.batches), default=None)
+        if idle is None or (len(idle.batches) >= BATCHES_PER_PROCESS and len(alive) < self.max_processes):
+            return self._start()
+        return idle
+
+    def _start(self) -> _Process:
+        process = _Process(self.arena_bytes)
+        process.reader = threading.Thread(target=self._read, args=(process,), daemon=True,
+                                          name=f"graphsdg-write-process-{process.process.pid}")
+        process.reader.start()
+        self._processes.append(process)
+        return process
+
+    # ---- replies --------------------------------------------------------------
+    def _read(self, process: _Process) -> None:
+        while True:
+            try:
+                _, results, seconds = process.replies.recv()
+            except (EOFError, OSError):
+                break
+            with self._room:
+                batch = process.batches.popleft()    # a process answers its batches in order
+                if batch.end > batch.start:
+                    process.regions.popleft()
+                self._release(batch)
+                self._room.notify_all()
+            share = seconds / max(1, len(results))
+            for token, path, (error, nbytes) in zip(batch.tokens, batch.paths, results):
+                self._on_done(token, None if error is None else rebuilt_error(*error, path), nbytes, share)
+        self._lost(process)
+
+    def _release(self, batch: _Batch) -> None:
+        for path in batch.paths:
+            owner = self._owner.get(path)
+            if owner is not None:
+                owner[1] -= 1
+                if owner[1] <= 0:
+                    del self._owner[path]
+
+    def _lost(self, process: _Process) -> None:
+        """The process ended (stopped, crashed or killed): fail every batch it still held."""
+        code = process.process.wait()
+        with self._room:
+            process.alive = False
+            lost = list(process.batches)
+            process.batches.clear()
+            process.regions.clear()
+            for batch in lost:
+                self._release(batch)
+            self._room.notify_all()
+        for batch in lost:
+            error = RuntimeError(f"the writer process (pid {process.process.pid}) exited with code {code} "
+                                 f"before writing the file")
+            for token in batch.tokens:
+                self._on_done(token, error, 0, 0.0)
+
+    def _fail_now(self, writes: list[tuple[FileWrite, Any]], process: _Process) -> None:
+        error = RuntimeError(f"the writer process (pid {process.process.pid}) exited before the write was sent")
+        for _, token in writes:
+            self._on_done(token, error, 0, 0.0)
+
+    # ---- state --------------------------------------------------------------
+    def pids(self) -> list[int]:
+        """The process ids of the running writer processes."""
+        return [p.process.pid for p in self._processes if p.alive]
+
+    def shutdown(self) -> None:
+        """Let every process finish what it holds, then stop them."""
+        with self._room:
+            processes, self._processes = list(self._processes), []
+        for process in processes:
+            try:
+                process.requests.send(("stop",))
+            except OSError:
+                pass
+        for process in processes:
+            if process.reader is not None:
+                process.reader.join()
+            process.requests.close()
+            process.replies.close()
+            process.arena.close()
+
+    def _forget(self) -> None:
+        for process in self._processes:
+            process.forget()
+        self._processes = []
+        self._owner.clear()
+        self._room = threading.Condition(threading.Lock())
+
+
+_pools: "weakref.WeakSet[WriteProcesses]" = weakref.WeakSet()
+
+
+def _forget_in_child() -> None:
+    # a forked child shares the parent's pipes: it must neither write to nor wait for the parent's processes
+    for pool in list(_pools):
+        pool._forget()
+
+
+os.register_at_fork(after_in_child=_forget_in_child)
