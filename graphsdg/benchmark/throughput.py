@@ -73,6 +73,7 @@ class BenchConfig:
     path_spp: int | None = None          # /rtx/pathtracing/spp of the path tier; None: the setting as it is
     pbr_batch_pixels: int | None = None  # /graphsdg/render/pbrBatchPixels (0: a launch per product); None: as set
     seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
+    write_processes: int | str | None = None   # /graphsdg/io/writeProcesses (a count, 0, auto); None: as set
 
 
 MIN_TIMED_FRAMES = 20
@@ -127,8 +128,23 @@ class BenchResult:
 
 
 def _cpu_seconds() -> float:
+    """CPU seconds of this process (every thread) and of its running writer processes."""
     usage = resource.getrusage(resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime
+    return usage.ru_utime + usage.ru_stime + _writer_processes_cpu_seconds()
+
+
+def _writer_processes_cpu_seconds() -> float:
+    from graphsdg.io.write_queue import current_write_queue
+    queue = current_write_queue()
+    total = 0.0
+    for pid in queue.process_ids() if queue is not None else ():
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:            # it ended: its time is gone with it
+            continue
+        total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")   # utime, stime
+    return total
 
 
 def _peak_rss_mb() -> float:
@@ -208,6 +224,8 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     from graphsdg.io.write_queue import reset_write_queue
 
     rep.settings.set("/omni/replicator/backend/writeThreads", _write_threads(config))
+    if config.write_processes is not None:
+        rep.settings.set("/graphsdg/io/writeProcesses", config.write_processes)
     reset_write_queue()
     if config.image_threads is not None:
         from graphsdg.jobs.cpu_share import limit_image_threads
@@ -253,7 +271,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     t = time.perf_counter()
     rep.orchestrator.wait_until_complete()
     result.drain_seconds = time.perf_counter() - t
-    result.cpu_seconds = _cpu_seconds() - cpu_start
+    result.cpu_seconds = _cpu_seconds() - cpu_start      # before the queue's processes stop
     result.profile = rep.orchestrator.get_profile()
     result.peak_rss_mb = _peak_rss_mb()
     if writer is not None:
@@ -450,7 +468,7 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     import multiprocessing
 
     from graphsdg.jobs.cpu_share import cores_per_process
-    from graphsdg.io.write_queue import threads_per_process
+    from graphsdg.io.write_queue import processes_wanted, threads_per_process
     ctx = multiprocessing.get_context("spawn")
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(processes))
@@ -474,6 +492,8 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
                                                     sum(r["frames"] for r in results), 1),
             "wall s (incl. start-up)": round(elapsed, 1),
             "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads,
+            "writer processes per process": processes_wanted(
+                "auto" if config.write_processes is None else config.write_processes, config.write_threads),
             "OpenCV threads per process": config.image_threads}
 
 

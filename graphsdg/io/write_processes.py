@@ -74,6 +74,11 @@ def rebuilt_error(type_name: str, errno: int | None, message: str, path: str) ->
     return RuntimeError(f"{type_name}: {message} (writing {path!r})")
 
 
+def _child_environment() -> dict[str, str]:
+    """This process's environment, with its module search path (a script may have extended ``sys.path``)."""
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+
+
 class _Batch(NamedTuple):
     batch_id: int
     start: int
@@ -94,7 +99,8 @@ class _Process:
             self.arena = mmap.mmap(arena_fd, arena_bytes)
             self.process = subprocess.Popen(
                 [sys.executable, "-c", BOOT, _PACKAGE_DIR, str(request_read), str(reply_write), str(arena_fd),
-                 str(arena_bytes)], pass_fds=(request_read, reply_write, arena_fd), stdin=subprocess.DEVNULL)
+                 str(arena_bytes)], pass_fds=(request_read, reply_write, arena_fd), stdin=subprocess.DEVNULL,
+                env=_child_environment())
         except BaseException:
             for fd in (request_write, reply_read):
                 os.close(fd)

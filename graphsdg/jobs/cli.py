@@ -68,11 +68,13 @@ def run_bench(args: argparse.Namespace) -> None:
         rt_subframes=args.rt_subframes, wait_for_render=args.wait_for_render,
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
         msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds,
-        render_mode=args.rendermode, path_spp=args.spp, pbr_batch_pixels=args.pbr_batch_pixels)
+        render_mode=args.rendermode, path_spp=args.spp, pbr_batch_pixels=args.pbr_batch_pixels,
+        write_processes=args.write_processes)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
                        f", {args.write_threads} write threads" if args.write_threads is not None else
                        "" if args.processes else f", {_default_write_threads()} write threads",
+                       f", write processes {args.write_processes}" if args.write_processes is not None else "",
                        ", wait_for_render" if args.wait_for_render else "",
                        f", {args.rendermode}" if args.rendermode else "",
                        f", {args.spp} path samples" if args.spp else "",
@@ -154,6 +156,12 @@ def _gl_renderer() -> str:
         return name
     except Exception as exc:  # noqa: BLE001 - informational only
         return f"unknown ({exc})"
+
+
+def _count_or_auto(text: str) -> int | str:
+    if text == "auto":
+        return text
+    return _non_negative(text)
 
 
 def _default_write_threads() -> int:
@@ -320,6 +328,11 @@ def build_parser() -> argparse.ArgumentParser:
                        help="writer threads per process, shared by both loops; graphsdg starts them as its backlog needs "
                             "(default: 4 on 16 cores or more, "
                             "a quarter of the cores below, at least 1; with --processes each process's share)")
+    bench.add_argument("--write-processes", type=_count_or_auto, metavar="N",
+                       help="graphsdg's writer processes per process, which encode and write its image, array "
+                            "and JSON files outside the interpreter lock: a count, 0 for writer threads only, or "
+                            "auto: /graphsdg/io/writeProcesses (default: the setting, auto: as many as writer "
+                            "threads on 4 cores or more)")
     bench.add_argument("--msaa", type=_non_negative,
                        help="multisample count of the colour pass, 0 for none (default: graphsdg's 4)")
     bench.add_argument("--shadow-size", type=_positive,
