@@ -40,7 +40,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                    "is throttled"),
     "/graphsdg/io/writeProcesses": ("auto", "writer processes that encode and write image, array and JSON files to "
                                     "local folders outside the interpreter lock: a count (0: all writes on the "
-                                    "writer threads) or auto (as many as writeThreads on 4 cores or more)"),
+                                    "writer threads) or auto (as many as writeThreads, when that is 2 or more, "
+                                    "on 4 cores or more)"),
     "/graphsdg/io/fsync": (False, "fsync each file and its folder before a write counts as done (survives power "
                            "loss, slower)"),
     "/graphsdg/io/runState": (True, "keep graphsdg_run.json (which frames are complete on disk) in each writer's "

@@ -483,16 +483,20 @@ def default_threads(cores: int | None = None) -> int:
 
 def processes_wanted(value: Any, threads: int, cores: int | None = None) -> int:
     """Writer processes for the setting ``/graphsdg/io/writeProcesses``: a count (0: writes stay on the
-    threads), or ``"auto"``: as many as writer threads on a machine of :data:`MIN_CORES_FOR_PROCESSES` cores
-    or more, none below.
+    threads), or ``"auto"``: as many as writer threads when there are two or more of them on a machine of
+    :data:`MIN_CORES_FOR_PROCESSES` cores or more, else none.
+
+    A process with a single writer thread is one of many sharing a host (``graphsdg bench --processes``,
+    Ray shards): there a thread costs less CPU than a process (measured on a 16-core GPU host, 16 processes
+    at 512x512: 12.1 CPU ms a frame with a thread each, 14.4 with a process each, at the same frames/s).
 
     Example:
-        >>> processes_wanted("auto", 4, cores=16), processes_wanted("auto", 1, cores=2), processes_wanted(2, 4)
+        >>> processes_wanted("auto", 4, cores=16), processes_wanted("auto", 1, cores=16), processes_wanted(2, 1)
         (4, 0, 2)
     """
     if value == "auto":
         cores = cores if cores is not None else (os.cpu_count() or 1)
-        return threads if cores >= MIN_CORES_FOR_PROCESSES else 0
+        return threads if cores >= MIN_CORES_FOR_PROCESSES and threads >= 2 else 0
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
         raise ValueError(f"setting {PROCESSES_KEY} must be 'auto' or a count of processes >= 0, got {value!r}")
     return int(value)

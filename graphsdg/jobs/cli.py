@@ -332,7 +332,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="graphsdg's writer processes per process, which encode and write its image, array "
                             "and JSON files outside the interpreter lock: a count, 0 for writer threads only, or "
                             "auto: /graphsdg/io/writeProcesses (default: the setting, auto: as many as writer "
-                            "threads on 4 cores or more)")
+                            "threads, when 2 or more, on 4 cores or more)")
     bench.add_argument("--msaa", type=_non_negative,
                        help="multisample count of the colour pass, 0 for none (default: graphsdg's 4)")
     bench.add_argument("--shadow-size", type=_positive,
