@@ -5,7 +5,7 @@ graphsdg's phase profile.
 
 docs/performance.md ("Small images on the GPU host") quotes its output. Variants that isolate the writer's
 cost: --skip-write (annotators run, nothing is written), --inline-writes (the write queue runs each task on the
-main thread instead of its worker), --out DIR (another file system, e.g. /dev/shm), --switch-interval S
+main thread instead of its worker), --write-processes N (writes in N writer processes), --out DIR (another file system, e.g. /dev/shm), --switch-interval S
 (``sys.setswitchinterval``), --pin-main CPU (the main thread alone on one core after the warm-up).
 
 Usage (GPU host):
@@ -80,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--asset-count", type=int, default=10, help="assets of each of the 5 shapes (default: 10)")
     p.add_argument("--frames", type=int, default=400, help="timed frames (default: 400)")
     p.add_argument("--write-threads", type=int, default=1, help="writer threads of both loops (default: 1)")
+    p.add_argument("--write-processes", type=int, default=0,
+                   help="graphsdg's writer processes, /graphsdg/io/writeProcesses (default: 0, threads only)")
     p.add_argument("--skip-write", action="store_true", help="compute the annotators but write nothing")
     p.add_argument("--inline-writes", action="store_true", help="run the write tasks on the main thread")
     p.add_argument("--out", default=None, help="output folder (default: a temporary folder)")
@@ -91,10 +93,11 @@ def main(argv: list[str] | None = None) -> int:
         sys.setswitchinterval(a.switch_interval)
     if a.inline_writes:
         from graphsdg.io.write_queue import WriteQueue
-        WriteQueue._start_threads = lambda self: False      # the queue's own fallback: run tasks where scheduled
+        WriteQueue._start_threads = lambda self, wanted=1: False   # the queue's own fallback: run tasks in place
     config = BenchConfig(frames=a.frames, warmup=20, resolution=(a.resolution, a.resolution),
                          asset_count=a.asset_count, annotators=FOUR, render_backend="classic",
-                         write_threads=a.write_threads, skip_write=a.skip_write, out_dir=a.out)
+                         write_threads=a.write_threads, skip_write=a.skip_write, out_dir=a.out,
+                         write_processes=a.write_processes)
     pin = (lambda: os.sched_setaffinity(0, {a.pin_main})) if a.pin_main is not None else None
     with Sampler() as sampler:
         result = run_graphsdg(config, pin)

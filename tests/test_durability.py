@@ -47,6 +47,8 @@ def write(path, data):
 
 backends.write_file_atomic = write
 rep.settings.set("/omni/replicator/backend/writeThreads", 1)
+# the injected failures and delays act in this process: writer processes only where a test asks for them
+rep.settings.set("/graphsdg/io/writeProcesses", int(os.environ.get("WRITE_PROCESSES", "0")))
 rep.set_global_seed(1)
 rep.functional.create.xform(name="World")
 rep.functional.create.dome_light(intensity=600, parent="/World")
@@ -74,6 +76,9 @@ else:
         rep.orchestrator.step()
     if mode == "wait":
         rep.orchestrator.wait_until_complete()
+if os.environ.get("WRITE_PROCESSES"):
+    from graphsdg.io.write_queue import get_write_queue
+    print("writer processes", *get_write_queue().process_ids(), flush=True)
 print("script end", flush=True)
 '''
 
@@ -312,6 +317,22 @@ def test_exit_without_wait_until_complete_still_writes_every_frame(tmp_path):
     assert state["status"] == "exited" and state["complete"] == [[0, 7]] and state["next_frame"] == 8
 
 
+def test_exit_without_wait_until_complete_finishes_the_writer_processes_writes(tmp_path):
+    proc, out = run_job(tmp_path, "steps", 8, env={"WRITE_PROCESSES": "2"})
+    assert proc.returncode == 0, proc.stderr
+    for n in range(8):
+        assert_frame_whole(out, n)
+    state = run_state.read(out)["writers"]["BasicWriter"]
+    assert state["status"] == "exited" and state["complete"] == [[0, 7]]
+    pids = [int(p) for p in next(line for line in proc.stdout.splitlines()
+                                 if line.startswith("writer processes")).split()[2:]]
+    assert pids
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(os.path.exists(f"/proc/{pid}") for pid in pids):
+        time.sleep(0.05)
+    assert not any(os.path.exists(f"/proc/{pid}") for pid in pids)   # no writer process outlives the script
+
+
 def test_exit_flushes_aggregate_files(tmp_path):
     proc, out = run_job(tmp_path, "steps", 3, env={"WRITER": "CocoWriter", "SOURCE_DATE_EPOCH": "1700000000"})
     assert proc.returncode == 0, proc.stderr
@@ -342,12 +363,12 @@ def _interrupt_when_frames_exist(proc, out, count, sig=signal.SIGINT, timeout=60
     return stdout, stderr
 
 
-def _start(tmp_path, mode, frames):
+def _start(tmp_path, mode, frames, env=None):
     script = tmp_path / "job.py"
     script.write_text(JOB)
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, str(script), str(out), mode, str(frames)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=str(tmp_path))
+                            stderr=subprocess.PIPE, text=True, cwd=str(tmp_path), env=dict(os.environ, **(env or {})))
     return proc, out
 
 
@@ -364,9 +385,11 @@ def _assert_resumable(out, status):
     return len(on_disk)
 
 
+@pytest.mark.parametrize("processes", ["0", "2"])
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, (-signal.SIGINT, 130, 1)), (signal.SIGTERM, (143,))])
-def test_signal_during_run_stops_after_the_frame_and_flushes(tmp_path, sig, code):
-    proc, out = _start(tmp_path, "graph", 100000)
+def test_signal_during_run_stops_after_the_frame_and_flushes(tmp_path, sig, code, processes):
+    """Writer threads or writer processes (which ignore the signal: the script decides when writing stops)."""
+    proc, out = _start(tmp_path, "graph", 100000, env={"WRITE_PROCESSES": processes})
     stdout, stderr = _interrupt_when_frames_exist(proc, out, 3, sig)
     assert proc.returncode in code, (proc.returncode, stderr)
     assert "run returned" not in stdout                   # run() re-raises the interrupt after flushing
