@@ -49,17 +49,27 @@ TRIM = False   # --trim: hand freed heap back to the OS before each sample (glib
 
 
 def rss_mb() -> float:
-    """Resident set size of this process in MiB (Linux /proc); with ``TRIM``, after ``malloc_trim(0)``.
+    """Resident set size of this process and its writer processes in MiB (Linux /proc); with ``TRIM``, this
+    process's after ``malloc_trim(0)``.
 
     glibc keeps freed memory in its arenas, so RSS alone moves up and down by a few
     MiB when large blocks (compiled models, frames) are allocated and freed; trimming
-    first shows what is really still allocated.
+    first shows what is really still allocated. The writer processes' shared arenas
+    count twice (in this process and in theirs): an overstatement, not a leak.
     """
     if TRIM:
         import ctypes
         ctypes.CDLL("libc.so.6").malloc_trim(0)
-    with open("/proc/self/statm") as f:
-        pages = int(f.read().split()[1])
+    from graphsdg.io.write_queue import current_write_queue
+    queue = current_write_queue()
+    pids = ["self", *(queue.process_ids() if queue is not None else [])]
+    pages = 0
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/statm") as f:
+                pages += int(f.read().split()[1])
+        except OSError:       # a writer process that ended
+            pass
     return pages * os.sysconf("SC_PAGE_SIZE") / 2 ** 20
 
 

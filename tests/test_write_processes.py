@@ -111,9 +111,9 @@ def test_writes_to_one_file_land_in_the_order_scheduled(out_dir):
         queue.schedule(iof.write_np, data=np.full((64, 64), i, np.float64), path=os.path.join(out_dir, f"{i}.npy"))
     queue.wait_until_done()
     assert len(queue.process_ids()) >= 2
-    path = os.path.join(out_dir, "frame.png")
-    noise = np.random.default_rng(0).integers(0, 256, (2000, 2000, 3), dtype=np.uint8)   # slow to encode
-    queue.schedule(iof.write_image, data=noise, path=path)
+    path = os.path.join(out_dir, "frame.json")
+    slow = {"values": np.random.default_rng(0).random(400_000)}         # ~0.1 s to turn into JSON
+    queue.schedule(iof.write_json, data=slow, path=path)
     queue.schedule(iof.write_blob, data=b"the last write", path=path)   # an idle process would finish it first
     queue.wait_until_done()
     assert open(path, "rb").read() == b"the last write"
@@ -202,6 +202,10 @@ def test_writes_that_are_not_plain_local_files_stay_on_the_threads(out_dir):
     queue = get_write_queue()
     seen = []
     queue.schedule(seen.append, "custom")                        # a writer's own function
+    big = np.zeros((1024, 1024, 3), np.uint8)                    # 3 MiB: copying it costs more than it saves
+    queue.schedule(iof.write_image, data=big, path=os.path.join(out_dir, "big.png"))
+    queue.wait_until_done()
+    assert queue.process_ids() == [] and np.asarray(Image.open(os.path.join(out_dir, "big.png"))).shape == big.shape
 
     class CountingDisk(rep.backends.DiskBackend):                # a backend with a write_blob of its own
         def write_blob(self, path, data):

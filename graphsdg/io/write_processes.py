@@ -17,7 +17,8 @@ and most writers schedule to a local file, to writer processes instead:
 
 A write that fails in a process reaches the caller's ``on_done`` with the error, naming the file; a
 process that dies fails every write it held. Writes of other kinds (a writer's own function, an S3
-bucket) stay on the write queue's threads.
+bucket) and writes of large arrays (``write_queue.PROCESS_WRITE_MAX_BYTES``: copying them costs more
+than it saves) stay on the write queue's threads.
 
 Example:
     >>> import numpy as np, os, tempfile

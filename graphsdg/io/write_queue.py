@@ -60,6 +60,12 @@ PROCESSES_KEY = "/graphsdg/io/writeProcesses"
 DISCARD_KEY = "/graphsdg/io/discardWrites"
 FSYNC_KEY = "/graphsdg/io/fsync"
 MIN_CORES_FOR_PROCESSES = 4   # "auto" writes in processes from this many cores (fewer: the threads do as well)
+# Writes holding more bytes than this stay on the threads: copying them into a writer process's arena costs the
+# thread that renders more than the lock hand-offs it saves, and encoding a large image releases the lock most
+# of the time anyway. Measured on an H200 host (docs/performance.md): 1280x720 RGBA 264 / 272 frames/s with
+# threads, 240 / 255 with processes; 1920x1080 with four annotators 47.8 against 38.1; at 512x512 (1 MiB an
+# image) both alike; at 256x256 processes +25-55 %.
+PROCESS_WRITE_MAX_BYTES = 1 << 20
 _THROTTLE_LOG_EVERY_S = 10.0
 BACKLOG_PER_WORKER = 8   # tasks waiting per started worker before another starts (a BasicWriter frame is ~7)
 
@@ -242,7 +248,7 @@ class WriteQueue:
         """Queue ``fn(*args, **kwargs)``; blocks while the queue is full (backpressure)."""
         nbytes = payload_bytes(args, kwargs)
         group = getattr(self._local, "group", None)
-        if self.num_processes:
+        if self.num_processes and nbytes <= PROCESS_WRITE_MAX_BYTES:
             write = file_write(fn, args, kwargs)
             if write is not None:
                 self._schedule_in_process(write, nbytes, group)
