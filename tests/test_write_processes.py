@@ -75,7 +75,7 @@ def test_a_failed_write_reaches_the_script_naming_the_file(out_dir):
     backend.schedule(iof.write_image, data=np.zeros((64, 64, 3), np.uint8), path="blocker/rgb_0000.png")
     backend.schedule(iof.write_np, data=np.arange(5), path="fine.npy")
     with pytest.raises(WriterError, match=r"background write of '.*blocker/rgb_0000\.png' failed: "
-                                          r"(NotADirectoryError|FileExistsError)"):
+                                          r"(NotADirectoryError|FileExistsError): \[Errno \d+\] [A-Z][^\[]*: '"):
         queue.wait_until_done()
     assert queue.process_ids()
     assert np.load(os.path.join(out_dir, "fine.npy")).tolist() == [0, 1, 2, 3, 4]

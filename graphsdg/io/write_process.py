@@ -63,8 +63,11 @@ def _write_one(arena: mmap.mmap, task: tuple) -> tuple[tuple | None, int]:
         data = encoded(kind, path, _payload(arena, payload), indent)
         write_atomic(path, data, durable)
         return None, len(data)
+    except OSError as exc:     # sent as (errno, text) so the parent rebuilds it as str() shows it here
+        text = exc.strerror or str(exc)
+        return (type(exc).__name__, exc.errno, text if exc.filename is None else f"{text}: {exc.filename!r}"), 0
     except Exception as exc:  # noqa: BLE001 - every failure goes back to the script
-        return (type(exc).__name__, getattr(exc, "errno", None), str(exc)), 0
+        return (type(exc).__name__, None, str(exc)), 0
 
 
 def main(request_fd: int, reply_fd: int, arena_fd: int, arena_bytes: int) -> None:

@@ -293,7 +293,8 @@ class WriteQueue:
 
     def _schedule_in_process(self, write: FileWrite, nbytes: int, group: TaskGroup | None) -> None:
         with self._cond:
-            if self._full(nbytes):
+            # a writer thread's follow-up must not wait for room its own task occupies
+            if self._full(nbytes) and threading.current_thread() not in self._threads:
                 self._throttle(nbytes)
             self._unfinished += 1
             self._in_processes += 1
