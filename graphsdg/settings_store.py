@@ -38,8 +38,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
     "/graphsdg/io/queueMaxBytes": (1 << 30, "bytes of image/array data queued writes may hold before the producer "
                                    "is throttled"),
-    "/graphsdg/io/writeProcesses": ("auto", "writer processes that encode and write image, array and JSON files to "
-                                    "local folders outside the interpreter lock: a count (0: all writes on the "
+    "/graphsdg/io/writeProcesses": ("auto", "writer processes that encode and write image, array and JSON files of up "
+                                    "to 1 MiB to local folders outside the interpreter lock: a count (0: all writes on the "
                                     "writer threads) or auto (as many as writeThreads, when that is 2 or more, "
                                     "on 4 cores or more)"),
     "/graphsdg/io/fsync": (False, "fsync each file and its folder before a write counts as done (survives power "
