@@ -14,7 +14,8 @@ pytest.importorskip("mujoco_warp_pbr", reason="needs the gpu extra: pip install 
 
 import graphsdg as rep  # noqa: E402
 from graphsdg.render.camera import camera_view  # noqa: E402
-from graphsdg.render.pbr import PbrRenderer, id_codes  # noqa: E402
+from graphsdg.render.pbr import PbrRenderer  # noqa: E402
+from graphsdg.render.pbr_outputs import code_format, code_table  # noqa: E402
 from graphsdg.runtime import runtime  # noqa: E402
 
 W, H = 32, 24
@@ -55,7 +56,8 @@ def test_pbr_labels_match_the_classic_path_and_colour_has_its_layout(renderer):
     # the 600-nit dome behind everything shows white, as it does on the classic path
     sky = out.geom_ids == -1
     assert sky.any() and (out.color[sky][:, :3] == 255).all()
-    assert np.array_equal(out.id_lut[out.id_codes], out.geom_ids)
+    # ids come back as one byte a pixel (a scene under 255 geoms), read through their table as the classic ids
+    assert out.id_codes.dtype == np.uint8 and np.array_equal(out.id_lut[out.id_codes], classic.geom_ids)
 
 
 def test_pbr_follows_poses_and_is_deterministic(renderer):
@@ -75,12 +77,12 @@ def test_pbr_follows_poses_and_is_deterministic(renderer):
     assert np.array_equal(moved.geom_ids, classic.geom_ids)
 
 
-def test_id_codes_index_their_table():
-    ids = np.array([[-1, 0], [5, 254]], dtype=np.int32)
-    codes, lut = id_codes(ids, 255)
-    assert codes.dtype == np.uint16 and np.array_equal(lut[codes], ids)
-    codes, lut = id_codes(ids[:, :1], 10)
-    assert codes.dtype == np.uint8 and len(lut) == 256 and np.array_equal(lut[codes], ids[:, :1])
+def test_id_codes_use_the_fewest_bytes_and_their_table_maps_them_to_geoms():
+    assert code_format(10) == (np.uint8, 256) and code_format(254) == (np.uint8, 256)
+    assert code_format(255) == (np.uint16, 65536) and code_format(70000) == (np.uint32, 70002)
+    table = code_table(255)
+    assert table[0] == -1 and table[1] == 0 and table[255] == 254 and (table[256:] == -1).all()
+    assert len(code_table(10)) == 256 and (code_table(10)[11:] == -1).all()
 
 
 def test_pbr_follows_rescaled_meshes_sizes_and_camera_intrinsics(renderer):

@@ -55,6 +55,7 @@ from graphsdg.render import mesh_folds, pbr_scene
 from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderRequest, launch_groups, pbr_missing,
                                      requested_backend)
 from graphsdg.render.camera import CameraView
+from graphsdg.render.lookup import lookup
 from graphsdg.maths.rotations import decompose
 from graphsdg.render.rasterizer import PASSES, Rasterizer, RenderOutputs
 from graphsdg.sim import lights as lightmap
@@ -171,14 +172,14 @@ class PbrRenderer:
                 use_skybox=env is None, mesh_bvh_frame="mujoco",
                 tier=mjpbr.Tier.PATH if path else mjpbr.Tier.REALTIME, path_samples=request.path_samples,
                 denoise=path and request.denoise, camera_rays=[pbr_scene.camera_rays(v) for v in views])
-        layouts = [self._layout(v) for v in views]
+        layouts = [self._layout(v, model.ngeom) for v in views]
         return _Context(key=key, model=m, data=d, rc=rc, cameras=cameras, env_yaw=yaw, layouts=layouts,
                         rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(sim, rc),
                         uploads=self._uploads.PinnedUploads(self._device))
 
-    def _layout(self, view: CameraView):
+    def _layout(self, view: CameraView, ngeom: int):
         return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
-                                           view.far, self._device)
+                                           view.far, self._device, ngeom)
 
     def _mesh_state(self, sim: SimScene, rc) -> _MeshState:
         """The context was built from the model's current vertices: every mesh's BVH is up to date."""
@@ -280,7 +281,8 @@ class PbrRenderer:
                     (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes,
                      bool({"segmentation", "depth"} & r.passes)) for layout, r in zip(ctx.layouts, requests)])
         self.stats["products"] += len(requests)
-        return [self._outputs_of(sim, r, host, acc) for r, host in zip(requests, hosts)]
+        return [self._outputs_of(sim, r, host, layout.table, acc)
+                for r, host, layout in zip(requests, hosts, ctx.layouts)]
 
     def _launch(self, ctx: _Context, seeds: tuple) -> None:
         """One launch of every camera of ``ctx``, with the next seed of this set of products."""
@@ -289,8 +291,10 @@ class PbrRenderer:
         self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
         self.stats["color"] += 1
 
-    def _outputs_of(self, sim: SimScene, request: RenderRequest, host, acc: np.ndarray | None) -> RenderOutputs:
-        """One product's :class:`RenderOutputs` from its host arrays (``acc``: an averaged colour, if any)."""
+    def _outputs_of(self, sim: SimScene, request: RenderRequest, host, table: np.ndarray,
+                    acc: np.ndarray | None) -> RenderOutputs:
+        """One product's :class:`RenderOutputs` from its host arrays, ``table`` its id codes' code -> geom table
+        (``acc``: an averaged colour, if any)."""
         view, passes = request.view, request.passes
         out = RenderOutputs()
         if acc is not None:
@@ -306,10 +310,9 @@ class PbrRenderer:
         if "depth" in passes:
             out.put("depth", host.depth)
         if "segmentation" in passes:
-            codes, lut = id_codes(host.geom_ids, sim.model.ngeom)
-            out.put("id_codes", codes)
-            out.id_lut = lut
-            out.put("geom_ids", host.geom_ids)
+            out.put("id_codes", host.codes)
+            out.id_lut = table
+            out.put("geom_ids", lambda: lookup(table, out.id_codes))
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
         return out
 
@@ -428,7 +431,7 @@ class PbrRenderer:
         keys = [_rays_key(v) for v in views]
         if keys != ctx.rays_keys:
             self._mjpbr.set_camera_rays(ctx.rc, [pbr_scene.camera_rays(v) for v in views])
-            ctx.layouts = [layout if key == old else self._layout(view)
+            ctx.layouts = [layout if key == old else self._layout(view, layout.ngeom)
                            for layout, key, old, view in zip(ctx.layouts, keys, ctx.rays_keys, views)]
             ctx.rays_keys = keys
 
@@ -466,14 +469,3 @@ def _counts(stamps: np.ndarray, n: int) -> np.ndarray:
 def _rays_key(view: CameraView) -> tuple:
     """What a view's camera rays and depth conversion depend on besides its pose."""
     return (view.projection, view.width, view.height, view.fx, view.fy, view.cx, view.cy, view.near, view.far)
-
-
-def id_codes(geom_ids: np.ndarray, ngeom: int) -> tuple[np.ndarray, np.ndarray]:
-    """Codes (geom id + 1, 0 background) and their ``code -> geom id`` table, as the classic path reports them:
-    uint8-sized tables are 256 long, uint16 ones 65536 (every code indexes the table)."""
-    bits = 8 if ngeom + 1 < (1 << 8) else 16 if ngeom + 1 < (1 << 16) else 32
-    size = 1 << bits if bits < 32 else ngeom + 2
-    lut = np.full(size, -1, dtype=np.int32)
-    lut[1:ngeom + 1] = np.arange(ngeom, dtype=np.int32)
-    dtype = np.uint8 if bits == 8 else np.uint16 if bits == 16 else np.uint32
-    return (geom_ids + 1).astype(dtype), lut

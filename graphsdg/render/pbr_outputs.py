@@ -3,18 +3,22 @@
 The renderer leaves one camera's pixels in three device buffers: colour packed as
 ``0xAARRGGBB`` words (8-bit sRGB), the hit distance along each ray, and
 ``(object id, object type)`` pairs. Annotators want RGBA bytes, planar depth with
-``inf`` on misses and past the far plane, and int32 geom ids with -1 for background
+``inf`` on misses and past the far plane, and the geom drawn at each pixel as the
+classic path reads it back: id codes (geom id + 1, 0 for background) in the fewest
+bytes that hold them, with their code -> geom table
 (:class:`~graphsdg.render.rasterizer.RenderOutputs`). One kernel converts all three
 where the pixels already are (one launch per camera of a batched render), then each
 asked-for array comes back in one copy into page-locked host memory, all cameras' copies
-behind one wait: about a third of the bytes the renderer's own float
-``get_rgb`` readback moves, and no per-pixel numpy work on the CPU.
+behind one wait: about a quarter of the bytes the renderer's own float
+``get_rgb`` readback moves, and no per-pixel numpy work on the CPU (scenes under 255
+geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host).
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import warp as wp
@@ -27,7 +31,7 @@ GEOM_TYPE = 5          # mujoco.mjtObj.mjOBJ_GEOM, as the renderer writes it int
 @wp.kernel(enable_backward=False)
 def _classic_layout(packed: wp.array2d[wp.uint32], distance: wp.array2d[wp.float32], seg: wp.array2d[wp.vec2i],
                     rgb_adr: int, depth_adr: int, seg_adr: int, cosines: wp.array[wp.float32], near: float,
-                    far: float, rgba: wp.array[wp.uint32], depth: wp.array[wp.float32], ids: wp.array[wp.int32]):
+                    far: float, rgba: wp.array[wp.uint32], depth: wp.array[wp.float32], codes: wp.array(dtype=Any)):
     p = wp.tid()
     word = packed[0, rgb_adr + p]
     # 0xAARRGGBB -> bytes R, G, B, A in memory (little endian 0xAABBGGRR)
@@ -35,11 +39,33 @@ def _classic_layout(packed: wp.array2d[wp.uint32], distance: wp.array2d[wp.float
         | ((word & wp.uint32(0xFF)) << wp.uint32(16))
     pair = seg[0, seg_adr + p]
     geom = wp.where(pair[1] == GEOM_TYPE, pair[0], -1)
-    ids[p] = geom
+    codes[p] = codes.dtype(geom + 1)      # one instance of the kernel per code type (uint8, uint16, uint32)
     z = near + distance[0, depth_adr + p] * cosines[p]
     if geom < 0 or z > far:
         z = wp.inf
     depth[p] = z
+
+
+def code_format(ngeom: int) -> tuple[type, int]:
+    """(NumPy type of the id codes, length of their code -> geom table) for a model of ``ngeom`` geoms: codes
+    run from 0 (background) to ``ngeom``, in uint8 or uint16 when they fit, as the classic path reads them."""
+    if ngeom + 1 < 1 << 8:
+        return np.uint8, 1 << 8
+    if ngeom + 1 < 1 << 16:
+        return np.uint16, 1 << 16
+    return np.uint32, ngeom + 2
+
+
+def code_table(ngeom: int) -> np.ndarray:
+    """The code -> geom id table of :func:`code_format`: code ``c`` is geom ``c - 1``, code 0 and codes past
+    the model -1 (every code of the type indexes it)."""
+    _, size = code_format(ngeom)
+    table = np.full(size, -1, dtype=np.int32)
+    table[1:ngeom + 1] = np.arange(ngeom, dtype=np.int32)
+    return table
+
+
+_WARP_CODE_TYPES = {np.uint8: wp.uint8, np.uint16: wp.uint16, np.uint32: wp.uint32}
 
 
 @dataclass
@@ -48,27 +74,32 @@ class HostFrame:
 
     rgba: np.ndarray | None       # (H, W, 4) uint8
     depth: np.ndarray | None      # (H, W) float32 planar z, inf on misses and beyond the far plane
-    geom_ids: np.ndarray | None   # (H, W) int32, -1 background
+    codes: np.ndarray | None      # (H, W) id codes (:func:`code_format`): geom id + 1, 0 background
 
 
 class ClassicLayout:
-    """Device buffers and page-locked host buffers of one camera's outputs at one resolution.
+    """Device buffers and page-locked host buffers of one camera's outputs at one resolution, for a model of
+    ``ngeom`` geoms (the id codes' type, :func:`code_format`).
 
     ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos).
     """
 
-    def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str) -> None:
+    def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str,
+                 ngeom: int) -> None:
         n = width * height
         self.shape, self.near, self.far, self.device = (height, width), float(near), float(far), device
+        self.ngeom = int(ngeom)
+        code_type, _ = code_format(self.ngeom)
+        self.table = code_table(self.ngeom)
         self.cosines = wp.array(np.ascontiguousarray(cosines, dtype=np.float32).ravel(), dtype=wp.float32,
                                 device=device)
         self.rgba = wp.empty(n, dtype=wp.uint32, device=device)
         self.depth = wp.empty(n, dtype=wp.float32, device=device)
-        self.ids = wp.empty(n, dtype=wp.int32, device=device)
+        self.codes = wp.empty(n, dtype=_WARP_CODE_TYPES[code_type], device=device)
         pinned = wp.get_device(device).is_cuda
         self.host_rgba = wp.empty(n, dtype=wp.uint32, device="cpu", pinned=pinned)
         self.host_depth = wp.empty(n, dtype=wp.float32, device="cpu", pinned=pinned)
-        self.host_ids = wp.empty(n, dtype=wp.int32, device="cpu", pinned=pinned)
+        self.host_codes = wp.empty(n, dtype=_WARP_CODE_TYPES[code_type], device="cpu", pinned=pinned)
         self._adrs: dict[tuple, int] = {}
         self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
 
@@ -78,7 +109,7 @@ class ClassicLayout:
                   inputs=[base.rgb_data, base.depth_data, base.seg_data, self._adr(base, "rgb", camera),
                           self._adr(base, "depth", camera), self._adr(base, "seg", camera), self.cosines, self.near,
                           self.far],
-                  outputs=[self.rgba, self.depth, self.ids], device=self.device)
+                  outputs=[self.rgba, self.depth, self.codes], device=self.device)
 
     def _adr(self, base, kind: str, camera: int) -> int:
         """The camera's first pixel in one of ``base``'s buffers (read from the device once)."""
@@ -90,8 +121,8 @@ class ClassicLayout:
     def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
         """Queue one device copy of each asked-for array into its page-locked host buffer."""
         self._wanted = (colour, depth, ids)
-        for want, src, dst in zip(self._wanted, (self.rgba, self.depth, self.ids),
-                                  (self.host_rgba, self.host_depth, self.host_ids)):
+        for want, src, dst in zip(self._wanted, (self.rgba, self.depth, self.codes),
+                                  (self.host_rgba, self.host_depth, self.host_codes)):
             if want:
                 wp.copy(dst, src)
 
@@ -100,10 +131,10 @@ class ClassicLayout:
         next render."""
         h, w = self.shape
         own = [np.array(dst.numpy()) if want else None
-               for want, dst in zip(self._wanted, (self.host_rgba, self.host_depth, self.host_ids))]
+               for want, dst in zip(self._wanted, (self.host_rgba, self.host_depth, self.host_codes))]
         return HostFrame(rgba=None if own[0] is None else own[0].view(np.uint8).reshape(h, w, 4),
                          depth=None if own[1] is None else own[1].reshape(h, w),
-                         geom_ids=None if own[2] is None else own[2].reshape(h, w))
+                         codes=None if own[2] is None else own[2].reshape(h, w))
 
 
 def read_all(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> list[HostFrame]:
@@ -117,4 +148,4 @@ def read_all(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> list[HostFr
     return [layout.take() for layout, *_ in reads]
 
 
-__all__ = ["ClassicLayout", "HostFrame", "read_all"]
+__all__ = ["ClassicLayout", "HostFrame", "code_format", "code_table", "read_all"]
