@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from graphsdg.benchmark.throughput import _steady_rate
+from graphsdg.benchmark.throughput import BenchConfig, _steady_rate, summarize_processes
 from graphsdg.jobs.cpu_share import cores_per_process, limit_image_threads
 from graphsdg.io.write_queue import threads_per_process
 
@@ -20,6 +20,20 @@ def test_steady_rate_counts_only_frames_while_every_process_runs():
     a, b = _process(0.0, 0.1, 100), _process(2.0, 0.05, 100)
     assert math.isclose(_steady_rate([a, b]), 30.0, rel_tol=0.02)
     assert math.isclose(_steady_rate([a]), 10.0, rel_tol=1e-9)
+
+
+def test_a_processes_row_counts_images_of_every_camera_and_the_cores_kept_busy():
+    # two processes, 2 cameras each: A 100 frames over 0-10 s with 40 CPU s, B 100 frames over 2-7 s with 30
+    a, b = _process(0.0, 0.1, 100), _process(2.0, 0.05, 100)
+    a["cpu"], b["cpu"] = 40.0, 30.0
+    row = summarize_processes([a, b], BenchConfig(num_cameras=2, write_threads=1, write_processes=0), 12.0)
+    assert row["processes"] == 2
+    assert math.isclose(row["aggregate frames/s (all frames / common window)"], 20.0)      # 200 frames in 10 s
+    assert math.isclose(row["images/s (aggregate x cameras)"], 40.0)
+    assert math.isclose(row["cores busy (CPU s / window s)"], 7.0)                        # 70 CPU s in 10 s
+    assert math.isclose(row["CPU ms per frame (all threads)"], 350.0)
+    assert math.isclose(row["sum of per-process frames/s"], 30.0) and row["slowest process frames/s"] == 10.0
+    assert row["writer processes per process"] == 0 and row["wall s (incl. start-up)"] == 12.0
 
 
 def test_steady_rate_is_undefined_when_the_processes_never_overlap():

@@ -468,7 +468,7 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     import multiprocessing
 
     from graphsdg.jobs.cpu_share import cores_per_process
-    from graphsdg.io.write_queue import processes_wanted, threads_per_process
+    from graphsdg.io.write_queue import threads_per_process
     ctx = multiprocessing.get_context("spawn")
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(processes))
@@ -481,15 +481,29 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
         with concurrent.futures.ProcessPoolExecutor(processes, mp_context=ctx) as ex:
             results = list(ex.map(_worker, configs, [barrier] * processes))
     elapsed = time.perf_counter() - start
+    return summarize_processes(results, config, elapsed)
+
+
+def summarize_processes(results: list[dict], config: BenchConfig, elapsed: float) -> dict[str, float]:
+    """The table row of a ``--processes`` run from each process's ``_worker`` result.
+
+    Besides frames/s: images/s (frames times cameras: a step of K cameras writes K annotated images) and
+    the cores the processes kept busy over the common window (their CPU seconds over its length), which
+    tells a CPU-bound host (close to the core count) from one held back elsewhere (the GPU, say).
+    """
+    from graphsdg.io.write_queue import processes_wanted
     per_process = [r["frames"] / r["wall"] for r in results]
     window = max(r["start"] + r["wall"] for r in results) - min(r["start"] for r in results)
-    return {"processes": processes,
-            "aggregate frames/s (all frames / common window)": round(sum(r["frames"] for r in results) / window, 1),
+    aggregate = sum(r["frames"] for r in results) / window
+    cpu = sum(r["cpu"] for r in results)
+    return {"processes": len(results),
+            "aggregate frames/s (all frames / common window)": round(aggregate, 1),
             "steady frames/s (all processes running)": round(_steady_rate(results), 1),
+            "images/s (aggregate x cameras)": round(aggregate * config.num_cameras, 1),
             "sum of per-process frames/s": round(sum(per_process), 1),
             "slowest process frames/s": round(min(per_process), 1),
-            "CPU ms per frame (all threads)": round(1000 * sum(r["cpu"] for r in results) /
-                                                    sum(r["frames"] for r in results), 1),
+            "CPU ms per frame (all threads)": round(1000 * cpu / sum(r["frames"] for r in results), 1),
+            "cores busy (CPU s / window s)": round(cpu / window, 1),
             "wall s (incl. start-up)": round(elapsed, 1),
             "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads,
             "writer processes per process": processes_wanted(

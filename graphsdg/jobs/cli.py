@@ -352,8 +352,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "most N, 0 for a launch per product: /graphsdg/render/pbrBatchPixels (default: the "
                             "setting, 2097152: eight 512x512 products)")
     bench.add_argument("--processes", type=_non_negative, default=0,
-                       help="run this many graphsdg processes at once and report their aggregate frames/s "
-                            "(no hand-written loop); 0 runs one process with the loop (default: 0)")
+                       help="run this many graphsdg processes at once and report their aggregate frames/s, "
+                            "images/s (frames times cameras) and the cores they kept busy (no hand-written "
+                            "loop); 0 runs one process with the loop (default: 0)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
     bench.add_argument("--profile", action="store_true",
                        help="also print milliseconds per frame of each phase (randomize, render passes, "
