@@ -7,10 +7,10 @@ process starts in ~0.1 s.
 
 The protocol, over two pipes (``multiprocessing.connection`` framing, pickled tuples):
 
-* in: ``("write", batch_id, [(kind, path, durable, indent, payload), ...])`` where ``payload`` is
+* in: ``("write", [(kind, path, durable, indent, payload), ...])`` (a batch) where ``payload`` is
   ``("arena", offset, dtype, shape)`` (an array in the shared arena) or ``("value", obj)``;
   ``("stop",)`` or the pipe's end: leave once everything before it is written;
-* out: ``(batch_id, [(error, nbytes), ...], seconds)`` once a batch is written, in order; ``error`` is
+* out: ``([(error, nbytes), ...], seconds)`` once a batch is written, batches in the order sent; ``error`` is
   None or ``(type name, errno, message)``.
 
 Signals for the session (Ctrl-C, ``kill`` of the group) are ignored: the parent decides when writes stop,
@@ -84,11 +84,11 @@ def main(request_fd: int, reply_fd: int, arena_fd: int, arena_bytes: int) -> Non
             break
         if message[0] == "stop":
             break
-        _, batch_id, tasks = message
+        _, tasks = message
         start = time.perf_counter()
         results = [_write_one(arena, task) for task in tasks]
         try:
-            replies.send((batch_id, results, time.perf_counter() - start))
+            replies.send((results, time.perf_counter() - start))
         except OSError:               # the parent is gone: nobody waits for the rest
             break
     sys.exit(0)

@@ -84,7 +84,8 @@ def _child_environment() -> dict[str, str]:
 
 
 class _Batch(NamedTuple):
-    batch_id: int
+    """A batch sent to one process: its arrays' bytes ``[start, end)`` of the arena, each write's token and path."""
+
     start: int
     end: int
     tokens: list
@@ -157,7 +158,6 @@ class WriteProcesses:
         self._on_done = on_done
         self._processes: list[_Process] = []
         self._owner: dict[str, list] = {}       # path -> [process, writes in flight]
-        self._next_batch = 0
         self._room = threading.Condition(threading.Lock())
         _pools.add(self)
 
@@ -185,9 +185,8 @@ class WriteProcesses:
                 self._fail_now(writes, process)
                 return
             tasks = self._tasks(writes, arrays, process, start, durable)
-            batch = _Batch(self._next_batch, start, start + total, [token for _, token in writes],
+            batch = _Batch(start, start + total, [token for _, token in writes],
                            [w.path for w, _ in writes])
-            self._next_batch += 1
             process.batches.append(batch)
             if total:
                 process.head = start + total
@@ -195,7 +194,7 @@ class WriteProcesses:
             for path in batch.paths:
                 self._owner.setdefault(path, [process, 0])[1] += 1
             try:
-                process.requests.send(("write", batch.batch_id, tasks))
+                process.requests.send(("write", tasks))
             except OSError:
                 pass                                   # the reader sees the process's end and fails the batch
 
@@ -248,7 +247,7 @@ class WriteProcesses:
     def _read(self, process: _Process) -> None:
         while True:
             try:
-                _, results, seconds = process.replies.recv()
+                results, seconds = process.replies.recv()
             except (EOFError, OSError):
                 break
             with self._room:
