@@ -85,6 +85,25 @@ def test_id_codes_use_the_fewest_bytes_and_their_table_maps_them_to_geoms():
     assert len(code_table(10)) == 256 and (code_table(10)[11:] == -1).all()
 
 
+def test_pbr_ids_of_a_scene_of_more_than_255_geoms_come_back_in_two_bytes(renderer):
+    """A crowded scene (300 boxes: codes past one byte): the GPU writes uint16 codes, and their table gives the
+    classic path's geom ids."""
+    rep.functional.create.dome_light(intensity=600)
+    xs, ys = np.meshgrid(np.linspace(-2.0, 2.0, 20), np.linspace(-1.5, 1.5, 15))
+    positions = np.stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)], axis=1)
+    rep.functional.create_batch.cube(count=300, position=positions, scale=0.12, name="Box")
+    cam = rep.functional.create.camera(position=(0, 0, 6), look_at=(0, 0, 0))
+    sim = runtime().sim
+    assert sim.ensure_compiled().model.ngeom >= 300
+    sim.require_offscreen(W, H)
+    view = camera_view(cam, W, H)
+    out = renderer.render(sim, view, {"segmentation"})
+    classic = runtime().rasterizer.render(sim, view, {"segmentation"})
+    assert out.id_codes.dtype == np.uint16 and len(out.id_lut) == 1 << 16
+    assert len(np.unique(out.geom_ids)) > 50, "many boxes in view"
+    assert (out.id_lut[out.id_codes] != classic.geom_ids).sum() <= 2   # pixel centres on an edge may differ
+
+
 def test_pbr_follows_rescaled_meshes_sizes_and_camera_intrinsics(renderer):
     """Randomizers that rescale meshes and primitives, or change a camera's focal length, reach the renderer
     without a new render context: its ids stay the classic path's, pixel for pixel."""
