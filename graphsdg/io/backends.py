@@ -22,7 +22,7 @@ from graphsdg.io import atomic_files, encode, object_store
 from graphsdg.io.atomic_files import remove_temporaries  # noqa: F401  (part of this module's face)
 from graphsdg.io.written_totals import bytes_written, count_written, files_written  # noqa: F401  (likewise)
 from graphsdg.io.object_store import S3Url, is_s3_url
-from graphsdg.io.write_queue import get_write_queue
+from graphsdg.io.write_queue import durable_writes, get_write_queue, writes_discarded
 
 
 class BaseBackend:
@@ -247,19 +247,6 @@ def _check_writable(path: str) -> None:
         os.unlink(probe)
     except OSError as exc:
         raise PermissionError(f"output_dir {path!r} is not writable: {exc.strerror or exc}") from exc
-
-
-def writes_discarded() -> bool:
-    """True while ``/graphsdg/io/discardWrites`` is set: disk backends create and write nothing.
-
-    ``graphsdg graph SCRIPT`` runs a script this way to build its graph without touching its outputs.
-    """
-    return bool(settings.get("/graphsdg/io/discardWrites", False))
-
-
-def durable_writes() -> bool:
-    """The setting ``/graphsdg/io/fsync``: each file and its folder are synced before a write counts as done."""
-    return bool(settings.get("/graphsdg/io/fsync", False))
 
 
 def write_file_atomic(full_path: str, data: bytes) -> None:

@@ -57,8 +57,6 @@ DEFAULT_THREADS = 4
 SIZE_KEY = "/omni/replicator/backend/queueSize"
 BYTES_KEY = "/graphsdg/io/queueMaxBytes"
 PROCESSES_KEY = "/graphsdg/io/writeProcesses"
-DISCARD_KEY = "/graphsdg/io/discardWrites"
-FSYNC_KEY = "/graphsdg/io/fsync"
 MIN_CORES_FOR_PROCESSES = 4   # "auto" writes in processes from this many cores (fewer: the threads do as well)
 # Writes holding more bytes than this stay on the threads: copying them into a writer process's arena costs the
 # thread that renders more than the lock hand-offs it saves, and encoding a large image releases the lock most
@@ -99,6 +97,19 @@ def _describe(fn: Callable[..., Any], kwargs: dict) -> str:
     return f"a background write ({getattr(fn, '__qualname__', type(fn).__name__)})"
 
 
+def writes_discarded() -> bool:
+    """True while ``/graphsdg/io/discardWrites`` is set: disk backends create and write nothing.
+
+    ``graphsdg graph SCRIPT`` runs a script this way to build its graph without touching its outputs.
+    """
+    return bool(settings.get("/graphsdg/io/discardWrites", False))
+
+
+def durable_writes() -> bool:
+    """The setting ``/graphsdg/io/fsync``: each file and its folder are synced before a write counts as done."""
+    return bool(settings.get("/graphsdg/io/fsync", False))
+
+
 def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict) -> FileWrite | None:
     """The write ``fn(*args, **kwargs)`` as data, when a writer process can do it: one of the io functions
     (``file_kind``) writing to a local file through a plain disk backend or to a path; else None."""
@@ -109,7 +120,7 @@ def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict) -> FileWrite |
         return None
     backend = kwargs.get("backend_instance")
     if backend is None:
-        full = None if settings.get(DISCARD_KEY, False) else os.path.abspath(path)
+        full = None if writes_discarded() else os.path.abspath(path)
     else:
         local_path = getattr(backend, "local_path", None)
         full = local_path(path) if local_path is not None else None
@@ -314,7 +325,7 @@ class WriteQueue:
 
     def _send(self, writes: list[tuple[FileWrite, tuple]]) -> None:
         try:
-            self._processes.send(writes, durable=bool(settings.get(FSYNC_KEY, False)))
+            self._processes.send(writes, durable=durable_writes())
         except Exception as exc:  # noqa: BLE001 - e.g. no process could start: the writes fail, loudly
             for _, token in writes:
                 self._process_done(token, exc, 0, 0.0)
