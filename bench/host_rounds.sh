@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The host at 512x512 run after run: classic and pbr, N processes each, alternately for R rounds, each row
-# stamped with the time, the GPU's SM clock and temperature, and the free memory of the host. Round 10 saw pbr's
+# stamped with the time, the GPU's SM clock and temperature, the free memory of the host, and the speed of its
+# cores (bench/cpu_speed.py: a fixed piece of CPU work on one core and on all at once, and the steal time). Round 10 saw pbr's
 # 16-process rate fall run after run on one H200 machine (1,582.7 -> 1,127.4 frames/s as its CPU time per frame
 # rose from 8.8 to 14.7 ms) while classic held ~1,004 (docs/performance.md, "The host at 512x512, round 10");
 # this script repeats that sequence with the machine's state beside each row. Appends every table to $1.
@@ -17,7 +18,7 @@ state() {
   if command -v nvidia-smi >/dev/null; then
     gpu=$(nvidia-smi --query-gpu=clocks.sm,temperature.gpu --format=csv,noheader | head -1)
   fi
-  echo "$(date +%T) GPU (SM clock, temperature): ${gpu}; host memory available: $(awk '/MemAvailable/ {print int($2/1024)}' /proc/meminfo) MiB"
+  echo "$(date +%T) GPU (SM clock, temperature): ${gpu}; host memory available: $(awk '/MemAvailable/ {print int($2/1024)}' /proc/meminfo) MiB; $(python3 "$(dirname "$0")/cpu_speed.py" --processes "$procs")"
 }
 for round in $(seq "$rounds"); do
   for backend in ${BACKENDS:-pbr classic}; do

@@ -57,17 +57,17 @@ class Sampler:
 
     def __init__(self) -> None:
         self.samples: list[tuple[dict, dict]] = []
-        self._cpu_seconds = throughput._cpu_seconds
+        self._cpu_counters = throughput._cpu_counters
 
     def __enter__(self) -> "Sampler":
-        def sampled() -> float:
+        def sampled():
             self.samples.append((thread_times(), switches()))
-            return self._cpu_seconds()
-        throughput._cpu_seconds = sampled
+            return self._cpu_counters()
+        throughput._cpu_counters = sampled
         return self
 
     def __exit__(self, *exc) -> None:
-        throughput._cpu_seconds = self._cpu_seconds
+        throughput._cpu_counters = self._cpu_counters
 
     def report(self, frames: int) -> str:
         (t0, s0), (t1, s1) = self.samples[0], self.samples[-1]

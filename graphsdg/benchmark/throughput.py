@@ -102,6 +102,8 @@ class BenchResult:
     drain_seconds: float = 0.0
     started_at: float = 0.0               # wall clock (time.time()) when the timed frames began
     cpu_seconds: float = 0.0              # process CPU time (all threads) over the timed frames and the drain
+    system_seconds: float = 0.0           # the part of cpu_seconds spent in the kernel (system calls, faults)
+    page_faults: int = 0                  # minor page faults over the same span (fresh pages the kernel mapped)
     peak_rss_mb: float = 0.0
     profile: dict[str, float] = field(default_factory=dict)
 
@@ -124,26 +126,32 @@ class BenchResult:
                 "frames/s incl. drain": round(self.fps_with_drain, 2), "min ms": round(float(ft.min()), 2),
                 "mean ms": round(float(ft.mean()), 2), "max ms": round(float(ft.max()), 2),
                 "CPU ms/frame": round(1000 * self.cpu_seconds / self.frames, 1) if self.frames else 0.0,
+                "of which system ms": round(1000 * self.system_seconds / self.frames, 1) if self.frames else 0.0,
+                "page faults/frame": round(self.page_faults / self.frames) if self.frames else 0,
                 "peak RSS MB": round(self.peak_rss_mb, 1)}
 
 
-def _cpu_seconds() -> float:
-    """CPU seconds of this process (every thread) and of its running writer processes."""
+def _cpu_counters() -> np.ndarray:
+    """(all CPU seconds, system CPU seconds, minor page faults) of this process (every thread) and of its
+    running writer processes."""
     usage = resource.getrusage(resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime + _writer_processes_cpu_seconds()
+    own = np.array([usage.ru_utime + usage.ru_stime, usage.ru_stime, usage.ru_minflt])
+    return own + _writer_processes_cpu_counters()
 
 
-def _writer_processes_cpu_seconds() -> float:
+def _writer_processes_cpu_counters() -> np.ndarray:
+    """(all CPU seconds, system CPU seconds, minor page faults) of this process's running writer processes."""
     from graphsdg.io.write_queue import current_write_queue
     queue = current_write_queue()
-    total = 0.0
+    total = np.zeros(3)
     for pid in queue.process_ids() if queue is not None else ():
         try:
             with open(f"/proc/{pid}/stat") as f:
                 fields = f.read().rsplit(")", 1)[1].split()
         except OSError:            # it ended: its time is gone with it
             continue
-        total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")   # utime, stime
+        user, system = (int(v) / os.sysconf("SC_CLK_TCK") for v in fields[11:13])   # utime, stime
+        total += (user + system, system, int(fields[7]))                             # minflt
     return total
 
 
@@ -257,7 +265,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
         before_timing()
     rep.orchestrator.reset_profile()
     result.started_at = time.time()
-    cpu_start = _cpu_seconds()
+    cpu_start = _cpu_counters()
     start = last = time.perf_counter()
     for _ in range(frames):
         t = time.perf_counter()
@@ -271,7 +279,8 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     t = time.perf_counter()
     rep.orchestrator.wait_until_complete()
     result.drain_seconds = time.perf_counter() - t
-    result.cpu_seconds = _cpu_seconds() - cpu_start      # before the queue's processes stop
+    result.cpu_seconds, result.system_seconds, result.page_faults = _cpu_counters() - cpu_start   # before the
+    # queue's processes stop
     result.profile = rep.orchestrator.get_profile()
     result.peak_rss_mb = _peak_rss_mb()
     if writer is not None:
@@ -406,7 +415,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     result = BenchResult(label="hand-written MuJoCo loop", frames=frames, cameras=config.num_cameras)
     pending.clear()
     profiling.reset()
-    cpu_start = _cpu_seconds()
+    cpu_start = _cpu_counters()
     start = last = time.perf_counter()
     for i in range(frames):
         frame(draws.draw(), i)
@@ -420,7 +429,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     for f in pending:
         f.result()
     result.drain_seconds = time.perf_counter() - t
-    result.cpu_seconds = _cpu_seconds() - cpu_start
+    result.cpu_seconds, result.system_seconds, result.page_faults = _cpu_counters() - cpu_start
     result.peak_rss_mb = _peak_rss_mb()
     result.profile = profiling.snapshot()
     pool.shutdown()
@@ -442,6 +451,7 @@ def _worker(config_dict: dict, barrier) -> dict:
     config = BenchConfig(**config_dict)
     r = run_graphsdg(config, before_timing=barrier.wait)
     return {"frames": r.frames, "wall": r.wall_seconds, "start": r.started_at, "cpu": r.cpu_seconds,
+            "system": r.system_seconds, "page_faults": r.page_faults,
             "frame_ends": (r.started_at + np.cumsum(r.frame_times)).tolist()}
 
 
@@ -496,13 +506,18 @@ def summarize_processes(results: list[dict], config: BenchConfig, elapsed: float
     window = max(r["start"] + r["wall"] for r in results) - min(r["start"] for r in results)
     aggregate = sum(r["frames"] for r in results) / window
     cpu = sum(r["cpu"] for r in results)
+    system = sum(r.get("system", 0.0) for r in results)
+    faults = sum(r.get("page_faults", 0) for r in results)
+    frames = sum(r["frames"] for r in results)
     return {"processes": len(results),
             "aggregate frames/s (all frames / common window)": round(aggregate, 1),
             "steady frames/s (all processes running)": round(_steady_rate(results), 1),
             "images/s (aggregate x cameras)": round(aggregate * config.num_cameras, 1),
             "sum of per-process frames/s": round(sum(per_process), 1),
             "slowest process frames/s": round(min(per_process), 1),
-            "CPU ms per frame (all threads)": round(1000 * cpu / sum(r["frames"] for r in results), 1),
+            "CPU ms per frame (all threads)": round(1000 * cpu / frames, 1),
+            "of which system (kernel) ms": round(1000 * system / frames, 1),
+            "minor page faults per frame": round(faults / frames),
             "cores busy (CPU s / window s)": round(cpu / window, 1),
             "wall s (incl. start-up)": round(elapsed, 1),
             "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads,
