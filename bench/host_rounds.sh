@@ -6,7 +6,8 @@
 # rose from 8.8 to 14.7 ms) while classic held ~1,004 (docs/performance.md, "The host at 512x512, round 10");
 # this script repeats that sequence with the machine's state beside each row. Appends every table to $1.
 # Usage: bash bench/host_rounds.sh REPORT.md [ROUNDS] [PROCESSES]   (pbr needs graphsdg[gpu], Python >= 3.12)
-# Environment: BACKENDS (default "pbr classic"), FRAMES per process (default 600).
+# Environment: BACKENDS (default "pbr classic"), FRAMES per process (default 600), TEMP_DIR (the folder, and so
+# the file system, the frames are written to: bench --temp-dir; default the system's temporary folder).
 set -euo pipefail
 report=${1:-host_rounds.md}
 rounds=${2:-3}
@@ -24,7 +25,7 @@ for round in $(seq "$rounds"); do
   for backend in ${BACKENDS:-pbr classic}; do
     echo "round $round, $backend: $(state)" | tee -a "$report"
     python3 -m graphsdg.jobs.cli bench "${four[@]}" --num-frames "${FRAMES:-600}" --backend "$backend" --processes "$procs" \
-      --report "$report"
+      ${TEMP_DIR:+--temp-dir "$TEMP_DIR"} --report "$report"
   done
 done
 echo "end: $(state)" | tee -a "$report"

@@ -91,7 +91,8 @@ def test_every_bench_option_is_described_in_its_help():
 
 
 @pytest.mark.parametrize("bad", [["--asset-count", "0"], ["--num-frames", "-1"], ["--msaa", "-2"],
-                                 ["--rt-subframes", "0"], ["--seconds", "0"], ["--backend", "rtx"]])
+                                 ["--rt-subframes", "0"], ["--seconds", "0"], ["--backend", "rtx"],
+                                 ["--temp-dir", "/no/such/folder"]])
 def test_bench_refuses_bad_values_naming_them(bad, capsys):
     from graphsdg.jobs.cli import build_parser
     with pytest.raises(SystemExit):
@@ -115,3 +116,34 @@ def test_timed_frames_fit_the_time_budget(frames, seconds, warmup_times, expecte
 def test_one_process_gets_writer_threads_for_its_cores(cores, threads):
     from graphsdg.io.write_queue import default_threads
     assert default_threads(cores) == threads
+
+
+def test_file_system_of_names_the_deepest_mount_holding_the_path(tmp_path):
+    from graphsdg.benchmark.throughput import file_system_of
+    assert file_system_of("/proc/self/status") == "proc"          # /proc, not the root file system around it
+    assert file_system_of("/") not in ("proc", "unknown")
+    with open("/proc/mounts") as f:
+        mounts = {line.split()[1]: line.split()[2] for line in f}
+    if "/dev/shm" in mounts:
+        assert file_system_of("/dev/shm/any/file") == mounts["/dev/shm"]
+
+
+def test_a_bench_run_writes_its_frames_inside_temp_dir_and_removes_them(tmp_path):
+    import os
+
+    from graphsdg.benchmark.throughput import run_graphsdg
+    seen = []
+
+    def look():   # after the warm-up: its frames are in a folder of the run's own under temp_dir
+        from graphsdg.orchestrator import wait_until_complete
+        wait_until_complete()
+        for folder, _, names in os.walk(tmp_path):
+            seen.extend(os.path.join(folder, n) for n in names)
+
+    config = BenchConfig(frames=2, warmup=2, asset_count=1, resolution=(64, 48), annotators=("rgb",),
+                         temp_dir=str(tmp_path), write_processes=0)
+    result = run_graphsdg(config, before_timing=look)
+    assert result.frames == 2
+    pngs = [p for p in seen if p.endswith(".png")]
+    assert len(pngs) == 2 and all(os.path.relpath(p, tmp_path).startswith("graphsdg_bench_") for p in pngs)
+    assert os.listdir(tmp_path) == []                              # the run's folder is gone with its frames

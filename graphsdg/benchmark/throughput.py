@@ -74,6 +74,8 @@ class BenchConfig:
     pbr_batch_pixels: int | None = None  # /graphsdg/render/pbrBatchPixels (0: a launch per product); None: as set
     seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
     write_processes: int | str | None = None   # /graphsdg/io/writeProcesses (a count, 0, auto); None: as set
+    temp_dir: str | None = None          # where each run makes (and then removes) its output folder; None: the
+    #                                      system's temporary folder. It picks the file system the frames go to.
 
 
 MIN_TIMED_FRAMES = 20
@@ -153,6 +155,29 @@ def _writer_processes_cpu_counters() -> np.ndarray:
         user, system = (int(v) / os.sysconf("SC_CLK_TCK") for v in fields[11:13])   # utime, stime
         total += (user + system, system, int(fields[7]))                             # minflt
     return total
+
+
+def file_system_of(path: str) -> str:
+    """The type of the file system holding ``path`` (``ext4``, ``tmpfs``, ...), from /proc/mounts; "unknown"
+    where that cannot be read.
+
+    Example:
+        >>> file_system_of("/proc")
+        'proc'
+    """
+    try:
+        with open("/proc/mounts") as f:
+            mounts = [line.split()[1:3] for line in f]
+    except OSError:
+        return "unknown"
+    real = os.path.realpath(path)
+    best, kind = "", "unknown"
+    for point, fs in mounts:
+        point = point.replace("\\040", " ")
+        inside = real == point or real.startswith(point.rstrip("/") + "/")
+        if inside and len(point) >= len(best):
+            best, kind = point, fs
+    return kind
 
 
 def _peak_rss_mb() -> float:
@@ -247,7 +272,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
             a.attach(rps)
         writer = None
     else:
-        out = config.out_dir or (tmp := tempfile.mkdtemp(prefix="graphsdg_bench_"))
+        out = config.out_dir or (tmp := tempfile.mkdtemp(prefix="graphsdg_bench_", dir=config.temp_dir))
         writer = rep.writers.get("BasicWriter")
         writer.initialize(output_dir=out, **flags)
         writer.attach(rps)
@@ -334,7 +359,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     need_depth = bool(want & {"distance_to_image_plane", "distance_to_camera"})
     need_seg = bool(want - {"rgb", "distance_to_image_plane", "distance_to_camera"})
     pool = concurrent.futures.ThreadPoolExecutor(_write_threads(config))
-    tmp = tempfile.mkdtemp(prefix="mujoco_bench_")
+    tmp = tempfile.mkdtemp(prefix="mujoco_bench_", dir=config.temp_dir)
     pending: list[concurrent.futures.Future] = []
     draws = Randomization(config)
     cam = mujoco.MjvCamera()

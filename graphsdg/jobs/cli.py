@@ -69,7 +69,7 @@ def run_bench(args: argparse.Namespace) -> None:
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
         msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds,
         render_mode=args.rendermode, path_spp=args.spp, pbr_batch_pixels=args.pbr_batch_pixels,
-        write_processes=args.write_processes)
+        write_processes=args.write_processes, temp_dir=args.temp_dir)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
                        f", {args.write_threads} write threads" if args.write_threads is not None else
@@ -83,7 +83,7 @@ def run_bench(args: argparse.Namespace) -> None:
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
     settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
-                     f"{'skip-write' if args.skip_write else 'written'}")
+                     f"{'skip-write' if args.skip_write else 'written to ' + _written_where(args.temp_dir)}")
     machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}, render backend: " \
               f"{_render_backend(args.backend)}"
     if args.processes:
@@ -235,6 +235,21 @@ def _hint(exc: BaseException) -> str:
     return "rerun with --debug for the traceback"
 
 
+def _folder(value: str) -> str:
+    if not os.path.isdir(value):
+        raise argparse.ArgumentTypeError(f"{value!r} is not an existing folder")
+    return value
+
+
+def _written_where(temp_dir: str | None) -> str:
+    """Where the bench's frames go, for its report: the folder and its file system's type."""
+    import tempfile
+
+    from graphsdg.benchmark.throughput import file_system_of
+    folder = temp_dir or tempfile.gettempdir()
+    return f"{folder} ({file_system_of(folder)})"
+
+
 def _positive(value: str) -> int:
     n = int(value)
     if n < 1:
@@ -333,6 +348,10 @@ def build_parser() -> argparse.ArgumentParser:
                             "and JSON files outside the interpreter lock: a count, 0 for writer threads only, or "
                             "auto: /graphsdg/io/writeProcesses (default: the setting, auto: as many as writer "
                             "threads, when 2 or more, on 4 cores or more)")
+    bench.add_argument("--temp-dir", type=_folder,
+                       help="folder in which each run makes its output folder and removes it afterwards: it "
+                            "picks the file system the frames are written to, e.g. /dev/shm for memory "
+                            "(default: the system's temporary folder)")
     bench.add_argument("--msaa", type=_non_negative,
                        help="multisample count of the colour pass, 0 for none (default: graphsdg's 4)")
     bench.add_argument("--shadow-size", type=_positive,
