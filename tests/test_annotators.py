@@ -744,3 +744,49 @@ def test_tight_box_occlusion_is_filled_only_when_paid_for():
     occ.attach(rp)
     rep.orchestrator.step()
     assert tight.get_data()["data"][0]["occlusionRatio"] == pytest.approx(0.0, abs=0.01)
+
+
+def _code_bounds(codes: np.ndarray, rows: int, shift: int = 0) -> np.ndarray:
+    """(rows, 4) x_min, y_min, x_max, y_max of each code's pixels (x moved by ``shift``), -1 rows for absent codes."""
+    bounds = np.full((rows, 4), -1, dtype=np.int32)
+    for code in np.unique(codes):
+        ys, xs = np.nonzero(codes == code)
+        bounds[code] = xs.min() + shift, ys.min(), xs.max() + shift, ys.max()
+    return bounds
+
+
+def test_tight_boxes_and_label_tables_read_a_backends_code_bounds_when_it_makes_them(monkeypatch):
+    """A backend that makes each id code's pixel bounds (pbr, on its device) hands them with the codes: the tight
+    boxes and the segmentation's drawn-label table come from them, equal to what the pixels give."""
+    _, rp = _scene(camera_position=(0.0, -5.0, 1.0))
+    rep.functional.create.cube(position=(-1.2, 0, 0), scale=0.8, semantics={"class": "box"})
+    rep.functional.create.sphere(position=(1.2, 0, 0), scale=0.7, semantics={"class": "ball"})
+    rep.functional.create.cylinder(position=(0, 0, 1.2), scale=0.5, semantics={"class": "can"})
+    boxes, seg = _attach(rp, "bounding_box_2d_tight", "semantic_segmentation")
+    rep.orchestrator.step(delta_time=0)
+    from_pixels, labels = boxes.get_data()["data"].copy(), seg.get_data()["info"]["idToLabels"]
+    assert len(from_pixels) == 3
+
+    rasterizer = runtime().rasterizer
+    shift = {"x": 0}
+
+    class WithCodeBounds:
+        def render_batch(self, sim, requests):
+            outs = rasterizer.render_batch(sim, requests)
+            for out in outs:
+                if out.id_lut is not None:
+                    out.put("code_boxes", _code_bounds(out.id_codes, len(out.id_lut), shift["x"]))
+            return outs
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(type(runtime()), "renderer", property(lambda self: WithCodeBounds()))
+    rep.orchestrator.step(delta_time=0)
+    assert np.array_equal(boxes.get_data()["data"], from_pixels)
+    assert seg.get_data()["info"]["idToLabels"] == labels
+    shift["x"] = 1            # the boxes are the backend's: bounds it moves, the rows move with
+    rep.orchestrator.step(delta_time=0)
+    moved = boxes.get_data()["data"]
+    assert np.array_equal(moved["x_min"], from_pixels["x_min"] + 1)
+    assert np.array_equal(moved["x_max"], from_pixels["x_max"] + 1)

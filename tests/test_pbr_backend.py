@@ -58,6 +58,8 @@ def test_pbr_labels_match_the_classic_path_and_colour_has_its_layout(renderer):
     assert sky.any() and (out.color[sky][:, :3] == 255).all()
     # ids come back as one byte a pixel (a scene under 255 geoms), read through their table as the classic ids
     assert out.id_codes.dtype == np.uint8 and np.array_equal(out.id_lut[out.id_codes], classic.geom_ids)
+    # each code's pixel bounds, made on the device, are the pixels' own
+    assert np.array_equal(out.code_boxes, _pixel_bounds(out.id_codes, len(out.code_boxes)))
 
 
 def test_pbr_follows_poses_and_is_deterministic(renderer):
@@ -102,6 +104,22 @@ def test_pbr_ids_of_a_scene_of_more_than_255_geoms_come_back_in_two_bytes(render
     assert out.id_codes.dtype == np.uint16 and len(out.id_lut) == 1 << 16
     assert len(np.unique(out.geom_ids)) > 50, "many boxes in view"
     assert (out.id_lut[out.id_codes] != classic.geom_ids).sum() <= 2   # pixel centres on an edge may differ
+    # two-byte codes' bounds from the device, one row per geom (+ background), as the pixels give them; the
+    # annotators' per-geom boxes from them are the ones the CPU path gets from the runs of the pixels
+    assert out.code_boxes.shape == (sim.model.ngeom + 1, 4)
+    assert np.array_equal(out.code_boxes, _pixel_bounds(out.id_codes, sim.model.ngeom + 1))
+    from graphsdg.annotate.frame import _geom_boxes_of_codes, _run_boxes, _runs
+    assert np.array_equal(_geom_boxes_of_codes(out.code_boxes, out.id_lut, sim.model.ngeom),
+                          _run_boxes(_runs(out.geom_ids), W, sim.model.ngeom))
+
+
+def _pixel_bounds(codes: np.ndarray, rows: int) -> np.ndarray:
+    """(rows, 4) x_min, y_min, x_max, y_max of each code's pixels, -1 rows for codes no pixel has."""
+    bounds = np.full((rows, 4), -1, dtype=np.int32)
+    for code in np.unique(codes):
+        ys, xs = np.nonzero(codes == code)
+        bounds[code] = xs.min(), ys.min(), xs.max(), ys.max()
+    return bounds
 
 
 def test_pbr_follows_rescaled_meshes_sizes_and_camera_intrinsics(renderer):
@@ -204,3 +222,32 @@ def test_pbr_motion_blur_smears_by_the_projected_travel():
     assert extra == pytest.approx(float(np.linalg.norm(uv[1] - uv[0])), abs=2.0)
     lit = moving[moving > 3]
     assert lit.min() < 100 and lit.max() >= 200      # a smear: partly covered ends
+
+
+def test_pbr_tight_boxes_and_segmentation_ids_come_from_the_devices_code_bounds():
+    """Through the orchestrator on pbr: the tight boxes annotator reads each geom's pixel bounds as the device
+    made them (no pass over the pixels on the CPU), and they bound exactly the pixels the semantic
+    segmentation image gives each class; the segmentation's label table lists the classes drawn."""
+    from graphsdg import settings
+    rep.stage.new_stage()
+    settings.set("/graphsdg/render/backend", "pbr")
+    settings.set("/graphsdg/render/pbrDevice", DEVICE)
+    rep.functional.create.dome_light(intensity=600)
+    rep.functional.create.cube(position=(0, 0, 0.5), semantics={"class": "box"})
+    rep.functional.create.sphere(position=(1.2, 0.3, 0.4), scale=0.8, semantics={"class": "ball"})
+    rep.functional.create.cylinder(position=(-1.0, 0.8, 0.4), scale=0.6, semantics={"class": "can"})
+    cam = rep.functional.create.camera(position=(3, -4, 2.5), look_at=(0.3, 0, 0.4))
+    rp = rep.create.render_product(cam, (48, 32))
+    boxes, seg = rep.annotators.get("bounding_box_2d_tight"), rep.annotators.get("semantic_segmentation")
+    boxes.attach(rp)
+    seg.attach(rp)
+    rep.orchestrator.step(delta_time=0)
+    assert type(runtime().renderer).__name__ == "PbrRenderer"
+    rows, image = boxes.get_data()["data"], seg.get_data()["data"]
+    labels = seg.get_data()["info"]["idToLabels"]
+    assert sorted(v["class"] for k, v in labels.items() if v.get("class") in ("box", "ball", "can")) == \
+        ["ball", "box", "can"]
+    assert len(rows) == 3
+    for row in rows:
+        ys, xs = np.nonzero(image == row["semanticId"])
+        assert (row["x_min"], row["y_min"], row["x_max"], row["y_max"]) == (xs.min(), ys.min(), xs.max(), ys.max())

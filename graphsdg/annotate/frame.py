@@ -194,6 +194,14 @@ class FrameView:
         codes = self.outputs.id_codes
         return None if codes is None else (codes, self.outputs.id_lut)
 
+    def _code_boxes(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The renderer's pixel bounds of each id code and the code -> geom table, or None where it made none
+        (:class:`~graphsdg.render.rasterizer.RenderOutputs`)."""
+        if self.outputs is None or self.outputs.id_lut is None:
+            return None
+        boxes = self.outputs.code_boxes
+        return None if boxes is None else (boxes, self.outputs.id_lut)
+
     def cached(self, key: object, build):
         """Compute ``build()`` once per frame under ``key``."""
         if key not in self._cache:
@@ -253,8 +261,15 @@ class FrameView:
         return self.ids_through(lut)   # one lookup per pixel
 
     def present_geoms(self) -> np.ndarray:
-        """Geom ids drawn in this frame (-1 included when background shows), from the runs, not every pixel."""
-        return self.cached("present_geoms", lambda: np.unique(self.runs()[2]))
+        """Geom ids drawn in this frame (-1 included when background shows): from the renderer's code bounds
+        where it made them, else from the runs, not every pixel."""
+        def build():
+            coded = self._code_boxes()
+            if coded is None:
+                return np.unique(self.runs()[2])
+            boxes, code_to_geom = coded
+            return np.unique(code_to_geom[np.flatnonzero(boxes[:, 2] >= 0)])
+        return self.cached("present_geoms", build)
 
     def runs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Horizontal runs of equal geom id in the id image: (flat start, flat end inclusive, geom id)."""
@@ -310,7 +325,13 @@ class FrameView:
 
     def geom_boxes(self) -> np.ndarray:
         """(ngeom, 4) inclusive pixel bounds of every geom drawn in the id pass (-1 rows if not drawn)."""
-        return self.cached("geom_boxes", lambda: _run_boxes(self.runs(), self.width, self.sim.model.ngeom))
+        def build():
+            ngeom = self.sim.model.ngeom
+            coded = self._code_boxes()
+            if coded is None:
+                return _run_boxes(self.runs(), self.width, ngeom)
+            return _geom_boxes_of_codes(*coded, ngeom)
+        return self.cached("geom_boxes", build)
 
     def footprints(self, semantic_filter: SemanticFilter = ALL_LABELS) -> Footprints:
         """Unoccluded footprint of every instance in view, from isolated id renders.
@@ -445,6 +466,16 @@ def _run_boxes(runs: tuple[np.ndarray, np.ndarray, np.ndarray], w: int, n: int) 
     np.maximum.at(hi_x, labels, ex)
     present = hi_x >= 0
     boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
+    return boxes
+
+
+def _geom_boxes_of_codes(code_boxes: np.ndarray, code_to_geom: np.ndarray, ngeom: int) -> np.ndarray:
+    """(ngeom, 4) inclusive pixel bounds of each geom (-1 rows: not drawn) from its id code's bounds."""
+    boxes = np.full((ngeom, 4), -1, dtype=np.int32)
+    drawn = np.flatnonzero(code_boxes[:, 2] >= 0)
+    geoms = code_to_geom[drawn]
+    keep = geoms >= 0
+    boxes[geoms[keep]] = code_boxes[drawn[keep]]
     return boxes
 
 

@@ -311,6 +311,7 @@ class PbrRenderer:
             out.put("depth", host.depth)
         if "segmentation" in passes:
             out.put("id_codes", host.codes)
+            out.put("code_boxes", host.code_boxes)
             out.id_lut = table
             out.put("geom_ids", lambda: lookup(table, out.id_codes))
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
@@ -397,7 +398,8 @@ class PbrRenderer:
             state.stamps = stamps
             bounds = folds.folded_bounds(state.relative, state.half_extents).astype(np.float32)
             if state.bounds is None or not np.array_equal(bounds, state.bounds):
-                ctx.rc.base.mesh_bounds_size.assign(bounds)
+                # through the page-locked buffers: a pageable copy waits for the stream's earlier work
+                ctx.uploads.put("mesh_bounds_size", ctx.rc.base.mesh_bounds_size, bounds)
                 state.bounds = bounds
         return folds.traced_frames(xmat, state.geom_mesh, state.relative, state.moved)
 

@@ -6,7 +6,8 @@ The renderer leaves one camera's pixels in three device buffers: colour packed a
 ``inf`` on misses and past the far plane, and the geom drawn at each pixel as the
 classic path reads it back: id codes (geom id + 1, 0 for background) in the fewest
 bytes that hold them, with their code -> geom table
-(:class:`~graphsdg.render.rasterizer.RenderOutputs`). One kernel converts all three
+(:class:`~graphsdg.render.rasterizer.RenderOutputs`), and each code's pixel bounds (the
+tight boxes' and drawn-geom lists' input, :class:`HostFrame`). One kernel converts all three
 where the pixels already are (one launch per camera of a batched render), then each
 asked-for array comes back in one copy into page-locked host memory, all cameras' copies
 behind one wait: about a quarter of the bytes the renderer's own float
@@ -46,6 +47,36 @@ def _classic_layout(packed: wp.array2d[wp.uint32], distance: wp.array2d[wp.float
     depth[p] = z
 
 
+@wp.kernel(enable_backward=False)
+def _clear_boxes(boxes: wp.array2d[wp.int32]):
+    i = wp.tid()
+    boxes[i, 0] = 2147483647
+    boxes[i, 1] = 2147483647
+    boxes[i, 2] = -1
+    boxes[i, 3] = -1
+
+
+@wp.kernel(enable_backward=False)
+def _code_boxes(codes: wp.array(dtype=Any), width: int, boxes: wp.array2d[wp.int32]):
+    # one thread a row, walking its runs of equal code: only a run's ends can be a code's extremes in x, and
+    # every run gives its row to y, so the atomics are per run, not per pixel
+    y = wp.tid()
+    row = y * width
+    start = int(0)
+    code = int(codes[row])
+    for x in range(1, width + 1):
+        here = int(-1)
+        if x < width:
+            here = int(codes[row + x])
+        if here != code:
+            wp.atomic_min(boxes, code, 0, start)
+            wp.atomic_min(boxes, code, 1, y)
+            wp.atomic_max(boxes, code, 2, x - 1)
+            wp.atomic_max(boxes, code, 3, y)
+            start = x
+            code = here
+
+
 def code_format(ngeom: int) -> tuple[type, int]:
     """(NumPy type of the id codes, length of their code -> geom table) for a model of ``ngeom`` geoms: codes
     run from 0 (background) to ``ngeom``, in uint8 or uint16 when they fit, as the classic path reads them."""
@@ -75,6 +106,8 @@ class HostFrame:
     rgba: np.ndarray | None       # (H, W, 4) uint8
     depth: np.ndarray | None      # (H, W) float32 planar z, inf on misses and beyond the far plane
     codes: np.ndarray | None      # (H, W) id codes (:func:`code_format`): geom id + 1, 0 background
+    code_boxes: np.ndarray | None = None   # (ngeom + 1, 4) int32 inclusive pixel bounds x_min, y_min, x_max,
+    #                                        y_max of each code (row = code), -1 rows for codes not drawn
 
 
 class ClassicLayout:
@@ -100,6 +133,8 @@ class ClassicLayout:
         self.host_rgba = wp.empty(n, dtype=wp.uint32, device="cpu", pinned=pinned)
         self.host_depth = wp.empty(n, dtype=wp.float32, device="cpu", pinned=pinned)
         self.host_codes = wp.empty(n, dtype=_WARP_CODE_TYPES[code_type], device="cpu", pinned=pinned)
+        self.boxes = wp.empty((self.ngeom + 1, 4), dtype=wp.int32, device=device)
+        self.host_boxes = wp.empty((self.ngeom + 1, 4), dtype=wp.int32, device="cpu", pinned=pinned)
         self._adrs: dict[tuple, int] = {}
         self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
 
@@ -118,11 +153,21 @@ class ClassicLayout:
             self._adrs[key] = int(getattr(base, f"{kind}_adr").numpy()[camera])
         return self._adrs[key]
 
+    def queue_boxes(self) -> None:
+        """Queue the pixel bounds of every code of the converted ids (:attr:`HostFrame.code_boxes`), so the
+        annotators' tight boxes and drawn-geom lists need no pass over the pixels on the CPU."""
+        h, w = self.shape
+        wp.launch(_clear_boxes, dim=self.ngeom + 1, inputs=[self.boxes], device=self.device)
+        wp.launch(_code_boxes, dim=h, inputs=[self.codes, w, self.boxes], device=self.device)
+
     def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
-        """Queue one device copy of each asked-for array into its page-locked host buffer."""
+        """Queue one device copy of each asked-for array into its page-locked host buffer (with the ids, their
+        codes' pixel bounds)."""
         self._wanted = (colour, depth, ids)
-        for want, src, dst in zip(self._wanted, (self.rgba, self.depth, self.codes),
-                                  (self.host_rgba, self.host_depth, self.host_codes)):
+        if ids:
+            self.queue_boxes()
+        for want, src, dst in zip(self._wanted + (ids,), (self.rgba, self.depth, self.codes, self.boxes),
+                                  (self.host_rgba, self.host_depth, self.host_codes, self.host_boxes)):
             if want:
                 wp.copy(dst, src)
 
@@ -132,9 +177,13 @@ class ClassicLayout:
         h, w = self.shape
         own = [np.array(dst.numpy()) if want else None
                for want, dst in zip(self._wanted, (self.host_rgba, self.host_depth, self.host_codes))]
+        boxes = None
+        if own[2] is not None:
+            boxes = np.array(self.host_boxes.numpy())
+            boxes[boxes[:, 2] < 0] = -1          # codes no pixel has: -1 rows, as the classic path's boxes
         return HostFrame(rgba=None if own[0] is None else own[0].view(np.uint8).reshape(h, w, 4),
                          depth=None if own[1] is None else own[1].reshape(h, w),
-                         codes=None if own[2] is None else own[2].reshape(h, w))
+                         codes=None if own[2] is None else own[2].reshape(h, w), code_boxes=boxes)
 
 
 def read_all(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> list[HostFrame]:

@@ -67,6 +67,10 @@ class RenderOutputs:
     * ``id_codes`` and ``id_lut``: the same ids as read back, uint16/uint32 (H, W)
       codes, and the table ``id_lut[code]`` -> geom id (so a per-geom table can
       be applied to the pixels in one lookup: ``table[id_lut][id_codes]``)
+    * ``code_boxes``: int32 (len, 4) inclusive pixel bounds (x_min, y_min, x_max,
+      y_max) of each id code, row = code, -1 rows for codes no pixel has; made
+      where the ids are (the pbr backend's GPU) when the backend can, else absent
+      and derived from the pixels by the annotators
     * ``render_isolated``: follow-up renders of the same view and state,
       ``(geom ids, crop) -> int32 ids of the crop``
 
@@ -102,6 +106,7 @@ class RenderOutputs:
     depth = property(lambda self: self.get("depth"))
     geom_ids = property(lambda self: self.get("geom_ids"))
     id_codes = property(lambda self: self.get("id_codes"))
+    code_boxes = property(lambda self: self.get("code_boxes"))
 
 
 def make_gl_context():
