@@ -251,3 +251,23 @@ def test_pbr_tight_boxes_and_segmentation_ids_come_from_the_devices_code_bounds(
     for row in rows:
         ys, xs = np.nonzero(image == row["semanticId"])
         assert (row["x_min"], row["y_min"], row["x_max"], row["y_max"]) == (xs.min(), ys.min(), xs.max(), ys.max())
+
+
+def test_a_deferred_pbr_render_gives_its_own_frames_pixels_when_read_after_the_next_render(renderer):
+    """``defer`` (a pipelined step) leaves the copies in flight; the pixels are taken on first use, or before
+    the next render reuses the buffers, so a deferred frame read late still shows its own instant."""
+    from graphsdg.render.backend import RenderRequest
+    cube, ball, cam = _scene()
+    sim = runtime().sim
+    view = camera_view(cam, W, H)
+    sim.require_offscreen(W, H)
+    passes = {"color", "depth", "segmentation"}
+    now = renderer.render(sim, view, passes)
+    deferred = renderer.render_batch(sim, [RenderRequest(view, passes, defer=True)])[0]
+    rep.functional.modify.pose(cube, position_value=(-1.5, 0, 0.5))
+    sim.sync_dirty_prims()
+    sim.forward()
+    moved = renderer.render(sim, view, passes)          # reuses the deferred render's buffers
+    assert not np.array_equal(moved.geom_ids, now.geom_ids)
+    for name in ("color", "depth", "id_codes", "code_boxes"):
+        assert np.array_equal(deferred.get(name), now.get(name)), name

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import mujoco
 import numpy as np
@@ -123,6 +123,7 @@ class PbrRenderer:
         self._renders: dict[tuple, int] = {}     # per launch's camera paths: the seed of its next launch
         self._isolated = None                    # classic rasteriser for render_isolated footprints
         self.stats: dict[str, int] = {"color": 0, "contexts": 0, "products": 0}
+        self._queued: list = []                  # pbr_outputs.QueuedReads of deferred renders not yet taken
 
     # ---- contexts ------------------------------------------------------
     def _key(self, sim: SimScene, views: list[CameraView], subframes: int) -> tuple:
@@ -254,6 +255,7 @@ class PbrRenderer:
                 raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
             if r.subframes < 1:
                 raise ValueError(f"subframes must be >= 1, got {r.subframes}")
+        self._take_queued()
         views = [r.view for r in requests]
         wp, first = self._wp, requests[0]
         ctx = self._context(sim, views, first.subframes)
@@ -277,12 +279,22 @@ class PbrRenderer:
                 for index, layout in enumerate(ctx.layouts):
                     layout.convert(ctx.rc.base, index)
             with profiling.timed("readback:pbr"):
-                hosts = self._outputs.read_all([
+                queued = self._outputs.queue_reads([
                     (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes,
                      bool({"segmentation", "depth"} & r.passes)) for layout, r in zip(ctx.layouts, requests)])
+                if all(r.defer for r in requests):   # pipelined: the copies finish while the script goes on
+                    self._queued.append(queued)
+                else:
+                    queued.hosts()
         self.stats["products"] += len(requests)
-        return [self._outputs_of(sim, r, host, layout.table, acc)
-                for r, host, layout in zip(requests, hosts, ctx.layouts)]
+        return [self._outputs_of(sim, r, _host_of(queued, i), layout.table, acc)
+                for i, (r, layout) in enumerate(zip(requests, ctx.layouts))]
+
+    def _take_queued(self) -> None:
+        """Take every deferred render's pixels still in page-locked buffers, before a render reuses them."""
+        queued, self._queued = self._queued, []
+        for reads in queued:
+            reads.hosts()
 
     def _launch(self, ctx: _Context, seeds: tuple) -> None:
         """One launch of every camera of ``ctx``, with the next seed of this set of products."""
@@ -291,27 +303,31 @@ class PbrRenderer:
         self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
         self.stats["color"] += 1
 
-    def _outputs_of(self, sim: SimScene, request: RenderRequest, host, table: np.ndarray,
+    def _outputs_of(self, sim: SimScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,
                     acc: np.ndarray | None) -> RenderOutputs:
-        """One product's :class:`RenderOutputs` from its host arrays, ``table`` its id codes' code -> geom table
-        (``acc``: an averaged colour, if any)."""
+        """One product's :class:`RenderOutputs`, its passes taken from ``host()`` (its
+        :class:`~graphsdg.render.pbr_outputs.HostFrame`, waited for on first use when the render was deferred);
+        ``table`` its id codes' code -> geom table (``acc``: an averaged colour, if any)."""
         view, passes = request.view, request.passes
         out = RenderOutputs()
         if acc is not None:
             colour = np.clip(acc, 0.0, 1.0).astype(np.float32)
             rgba = np.full((view.height, view.width, 4), 255, dtype=np.uint8)
             rgba[..., :3] = np.rint(colour * 255.0)
+            if "color" in passes:
+                out.put("color", rgba)
+            if "hdr" in passes:
+                out.put("hdr", colour)
         else:
-            rgba = host.rgba
-        if "color" in passes:
-            out.put("color", rgba)
-        if "hdr" in passes:
-            out.put("hdr", colour if acc is not None else rgba[..., :3].astype(np.float32) / 255.0)
+            if "color" in passes:
+                out.put("color", lambda: host().rgba)
+            if "hdr" in passes:
+                out.put("hdr", lambda: host().rgba[..., :3].astype(np.float32) / 255.0)
         if "depth" in passes:
-            out.put("depth", host.depth)
+            out.put("depth", lambda: host().depth)
         if "segmentation" in passes:
-            out.put("id_codes", host.codes)
-            out.put("code_boxes", host.code_boxes)
+            out.put("id_codes", lambda: host().codes)
+            out.put("code_boxes", lambda: host().code_boxes)
             out.id_lut = table
             out.put("geom_ids", lambda: lookup(table, out.id_codes))
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
@@ -457,10 +473,16 @@ class PbrRenderer:
         return self._isolated
 
     def close(self) -> None:
+        self._take_queued()
         self._contexts.clear()
         if self._isolated is not None:
             self._isolated.close()
             self._isolated = None
+
+
+def _host_of(queued, index: int) -> Callable[[], Any]:
+    """The getter of product ``index``'s host arrays among a launch's queued reads."""
+    return lambda: queued.hosts()[index]
 
 
 def _counts(stamps: np.ndarray, n: int) -> np.ndarray:

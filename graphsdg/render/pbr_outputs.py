@@ -10,7 +10,8 @@ bytes that hold them, with their code -> geom table
 tight boxes' and drawn-geom lists' input, :class:`HostFrame`). One kernel converts all three
 where the pixels already are (one launch per camera of a batched render), then each
 asked-for array comes back in one copy into page-locked host memory, all cameras' copies
-behind one wait: about a quarter of the bytes the renderer's own float
+behind one event, waited for when the pixels are first used (a pipelined step's go on copying while
+the script randomizes the next frame): about a quarter of the bytes the renderer's own float
 ``get_rgb`` readback moves, and no per-pixel numpy work on the CPU (scenes under 255
 geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host).
 
@@ -186,15 +187,31 @@ class ClassicLayout:
                          codes=None if own[2] is None else own[2].reshape(h, w), code_boxes=boxes)
 
 
-def read_all(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> list[HostFrame]:
-    """Each ``(layout, colour, depth, ids)``'s asked-for arrays on the host: every copy queued, then one wait
-    for all of them (polled: ``wp.synchronize_device`` would spin a core in CUDA's wait)."""
+class QueuedReads:
+    """Copies queued by :func:`queue_reads`, behind one event: :meth:`hosts` waits for them and takes the arrays,
+    once. Until then the layouts' page-locked buffers are in use: take them before those layouts read again."""
+
+    def __init__(self, layouts: list[ClassicLayout], done: Any) -> None:
+        self._layouts, self._done = layouts, done
+        self._hosts: list[HostFrame] | None = None
+
+    def hosts(self) -> list[HostFrame]:
+        """Each layout's :class:`HostFrame`, waiting for the copies the first time (polled: CUDA's own
+        synchronize would spin a core in its wait)."""
+        if self._hosts is None:
+            done = self._done
+            if done is not None:
+                wait_until(lambda: done.is_complete)
+            self._hosts = [layout.take() for layout in self._layouts]
+        return self._hosts
+
+
+def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> QueuedReads:
+    """Queue each ``(layout, colour, depth, ids)``'s asked-for copies, all behind one event."""
     for layout, colour, depth, ids in reads:
         layout.queue_read(colour, depth, ids)
-    if reads and wp.get_device(reads[0][0].device).is_cuda:   # CPU copies are done when wp.copy returns
-        done = wp.record_event()
-        wait_until(lambda: done.is_complete)
-    return [layout.take() for layout, *_ in reads]
+    cuda = bool(reads) and wp.get_device(reads[0][0].device).is_cuda   # CPU copies are done when queued
+    return QueuedReads([layout for layout, *_ in reads], wp.record_event() if cuda else None)
 
 
-__all__ = ["ClassicLayout", "HostFrame", "code_format", "code_table", "read_all"]
+__all__ = ["ClassicLayout", "HostFrame", "QueuedReads", "code_format", "code_table", "queue_reads"]
