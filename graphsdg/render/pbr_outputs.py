@@ -98,6 +98,7 @@ def code_table(ngeom: int) -> np.ndarray:
 
 
 _WARP_CODE_TYPES = {np.uint8: wp.uint8, np.uint16: wp.uint16, np.uint32: wp.uint32}
+_ALIGN = 256           # bytes: each output's start in the layout's one allocation
 
 
 @dataclass
@@ -127,15 +128,22 @@ class ClassicLayout:
         self.table = code_table(self.ngeom)
         self.cosines = wp.array(np.ascontiguousarray(cosines, dtype=np.float32).ravel(), dtype=wp.float32,
                                 device=device)
-        self.rgba = wp.empty(n, dtype=wp.uint32, device=device)
-        self.depth = wp.empty(n, dtype=wp.float32, device=device)
-        self.codes = wp.empty(n, dtype=_WARP_CODE_TYPES[code_type], device=device)
-        pinned = wp.get_device(device).is_cuda
-        self.host_rgba = wp.empty(n, dtype=wp.uint32, device="cpu", pinned=pinned)
-        self.host_depth = wp.empty(n, dtype=wp.float32, device="cpu", pinned=pinned)
-        self.host_codes = wp.empty(n, dtype=_WARP_CODE_TYPES[code_type], device="cpu", pinned=pinned)
-        self.boxes = wp.empty((self.ngeom + 1, 4), dtype=wp.int32, device=device)
-        self.host_boxes = wp.empty((self.ngeom + 1, 4), dtype=wp.int32, device="cpu", pinned=pinned)
+        # The outputs lie in one device allocation, mirrored by one page-locked host buffer, so a frame's reads
+        # are one copy of the span they cover, not one per array (each copy is a driver call of its own).
+        parts = [("rgba", wp.uint32, (n,)), ("depth", wp.float32, (n,)), ("codes", _WARP_CODE_TYPES[code_type], (n,)),
+                 ("boxes", wp.int32, (self.ngeom + 1, 4))]
+        self._spans: dict[str, tuple[int, int, np.dtype, tuple]] = {}
+        end = 0
+        for name, dtype, shape in parts:
+            start = -(-end // _ALIGN) * _ALIGN
+            end = start + int(np.prod(shape)) * wp.types.type_size_in_bytes(dtype)
+            self._spans[name] = (start, end, np.dtype(wp.dtype_to_numpy(dtype)), shape)
+        self._device_bytes = wp.empty(end, dtype=wp.uint8, device=device)
+        self._host_bytes = wp.empty(end, dtype=wp.uint8, device="cpu", pinned=wp.get_device(device).is_cuda)
+        self._host_view = self._host_bytes.numpy()
+        for name, dtype, shape in parts:    # typed views of the allocation, which the layout keeps alive
+            setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
+                                         shape=shape, device=device))
         self._adrs: dict[tuple, int] = {}
         self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
 
@@ -161,30 +169,35 @@ class ClassicLayout:
         wp.launch(_clear_boxes, dim=self.ngeom + 1, inputs=[self.boxes], device=self.device)
         wp.launch(_code_boxes, dim=h, inputs=[self.codes, w, self.boxes], device=self.device)
 
+    def _parts(self) -> list[str]:
+        colour, depth, ids = self._wanted
+        return [name for name, want in (("rgba", colour), ("depth", depth), ("codes", ids), ("boxes", ids)) if want]
+
     def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
-        """Queue one device copy of each asked-for array into its page-locked host buffer (with the ids, their
-        codes' pixel bounds)."""
+        """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds)
+        into the page-locked host buffer."""
         self._wanted = (colour, depth, ids)
         if ids:
             self.queue_boxes()
-        for want, src, dst in zip(self._wanted + (ids,), (self.rgba, self.depth, self.codes, self.boxes),
-                                  (self.host_rgba, self.host_depth, self.host_codes, self.host_boxes)):
-            if want:
-                wp.copy(dst, src)
+        parts = self._parts()
+        if parts:
+            lo, hi = self._spans[parts[0]][0], self._spans[parts[-1]][1]
+            wp.copy(self._host_bytes, self._device_bytes, dest_offset=lo, src_offset=lo, count=hi - lo)
 
     def take(self) -> HostFrame:
         """The queued copies (done) as arrays of their own: annotators and writer threads keep them past the
-        next render."""
+        next render (each its own copy, so keeping one keeps no other alive)."""
+        own = {}
+        for name in self._parts():
+            start, end, dtype, shape = self._spans[name]
+            own[name] = np.array(self._host_view[start:end]).view(dtype).reshape(shape)
         h, w = self.shape
-        own = [np.array(dst.numpy()) if want else None
-               for want, dst in zip(self._wanted, (self.host_rgba, self.host_depth, self.host_codes))]
-        boxes = None
-        if own[2] is not None:
-            boxes = np.array(self.host_boxes.numpy())
+        rgba, boxes = own.get("rgba"), own.get("boxes")
+        if boxes is not None:
             boxes[boxes[:, 2] < 0] = -1          # codes no pixel has: -1 rows, as the classic path's boxes
-        return HostFrame(rgba=None if own[0] is None else own[0].view(np.uint8).reshape(h, w, 4),
-                         depth=None if own[1] is None else own[1].reshape(h, w),
-                         codes=None if own[2] is None else own[2].reshape(h, w), code_boxes=boxes)
+        return HostFrame(rgba=None if rgba is None else rgba.view(np.uint8).reshape(h, w, 4),
+                         depth=own["depth"].reshape(h, w) if "depth" in own else None,
+                         codes=own["codes"].reshape(h, w) if "codes" in own else None, code_boxes=boxes)
 
 
 class QueuedReads:
