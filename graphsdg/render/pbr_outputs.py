@@ -8,9 +8,9 @@ classic path reads it back: id codes (geom id + 1, 0 for background) in the fewe
 bytes that hold them, with their code -> geom table
 (:class:`~graphsdg.render.rasterizer.RenderOutputs`), and each code's pixel bounds (the
 tight boxes' and drawn-geom lists' input, :class:`HostFrame`). One kernel converts all three
-where the pixels already are (one launch per camera of a batched render), then each
-asked-for array comes back in one copy into page-locked host memory, all cameras' copies
-behind one event, waited for when the pixels are first used (a pipelined step's go on copying while
+where the pixels already are (one launch per camera of a batched render); a camera's outputs
+share one device allocation, so its asked-for arrays come back in one copy into page-locked
+host memory, all cameras' copies behind one event, waited for when the pixels are first used (a pipelined step's go on copying while
 the script randomizes the next frame): about a quarter of the bytes the renderer's own float
 ``get_rgb`` readback moves, and no per-pixel numpy work on the CPU (scenes under 255
 geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host).
@@ -130,8 +130,8 @@ class ClassicLayout:
                                 device=device)
         # The outputs lie in one device allocation, mirrored by one page-locked host buffer, so a frame's reads
         # are one copy of the span they cover, not one per array (each copy is a driver call of its own).
-        parts = [("rgba", wp.uint32, (n,)), ("depth", wp.float32, (n,)), ("codes", _WARP_CODE_TYPES[code_type], (n,)),
-                 ("boxes", wp.int32, (self.ngeom + 1, 4))]
+        parts = [("rgba", wp.uint32, (n,)), ("depth", wp.float32, (n,)),
+                 ("codes", _WARP_CODE_TYPES[code_type], (n,)), ("boxes", wp.int32, (self.ngeom + 1, 4))]
         self._spans: dict[str, tuple[int, int, np.dtype, tuple]] = {}
         end = 0
         for name, dtype, shape in parts:

@@ -67,8 +67,9 @@ class RenderOutputs:
     * ``id_codes`` and ``id_lut``: the same ids as read back, uint16/uint32 (H, W)
       codes, and the table ``id_lut[code]`` -> geom id (so a per-geom table can
       be applied to the pixels in one lookup: ``table[id_lut][id_codes]``)
-    * ``code_boxes``: int32 (len, 4) inclusive pixel bounds (x_min, y_min, x_max,
-      y_max) of each id code, row = code, -1 rows for codes no pixel has; made
+    * ``code_boxes``: int32 (n, 4) inclusive pixel bounds (x_min, y_min, x_max,
+      y_max) of each id code, row = code (n at most ``len(id_lut)``), -1 rows for
+      codes no pixel has; made
       where the ids are (the pbr backend's GPU) when the backend can, else absent
       and derived from the pixels by the annotators
     * ``render_isolated``: follow-up renders of the same view and state,
