@@ -147,3 +147,38 @@ def test_a_bench_run_writes_its_frames_inside_temp_dir_and_removes_them(tmp_path
     pngs = [p for p in seen if p.endswith(".png")]
     assert len(pngs) == 2 and all(os.path.relpath(p, tmp_path).startswith("graphsdg_bench_") for p in pngs)
     assert os.listdir(tmp_path) == []                              # the run's folder is gone with its frames
+
+
+def _result(label: str, frames: int, wall: float, cpu: float = 0.0):
+    from graphsdg.benchmark.throughput import BenchResult
+    return BenchResult(label, frames, 1, frame_times=[wall / frames] * frames, wall_seconds=wall, cpu_seconds=cpu)
+
+
+def test_rounds_give_each_run_with_its_own_rounds_ratio_and_the_medians():
+    from graphsdg.benchmark.throughput import round_summaries
+    # graphsdg 100, 120, 90 frames/s against the loop's 100, 100, 150: ratios 1.0, 1.2, 0.6
+    rounds = [(_result("graphsdg", 100, 1.0, cpu=1.0), _result("loop", 100, 1.0)),
+              (_result("graphsdg", 120, 1.0, cpu=3.0), _result("loop", 100, 1.0)),
+              (_result("graphsdg", 90, 1.0, cpu=2.0), _result("loop", 150, 1.0))]
+    rows = round_summaries(rounds)
+    assert [r["run"] for r in rows] == ["graphsdg (round 1)", "loop (round 1)", "graphsdg (round 2)", "loop (round 2)",
+                                        "graphsdg (round 3)", "loop (round 3)", "graphsdg (median of 3)",
+                                        "loop (median of 3)"]
+    assert [r["ratio to hand-written"] for r in rows[:6:2]] == [1.0, 1.2, 0.6]
+    ours, loop = rows[6], rows[7]
+    assert ours["frames/s"] == 100.0 and loop["frames/s"] == 100.0
+    assert ours["ratio to hand-written"] == 1.0                  # the median of the rounds' ratios
+    assert ours["CPU ms/frame"] == 22.2                          # medians column by column: of 10, 25, 22.2 ms
+    single = round_summaries([(_result("graphsdg", 50, 1.0), None)])
+    assert [r["run"] for r in single] == ["graphsdg"] and "ratio to hand-written" not in single[0]
+
+
+def test_bench_rounds_alternate_both_loops_in_one_run(capsys):
+    from graphsdg.jobs.cli import main
+    assert main(["bench", "--num-frames", "3", "--warmup", "1", "--resolution", "32", "24", "--asset-count", "1",
+                 "--rounds", "2", "--skip-write"]) == 0
+    out = capsys.readouterr().out
+    assert "2 rounds alternately" in out
+    for row in ("graphsdg (round 1)", "hand-written MuJoCo loop (round 1)", "graphsdg (round 2)",
+                "hand-written MuJoCo loop (round 2)", "graphsdg (median of 2)", "hand-written MuJoCo loop (median of 2)"):
+        assert f"| {row} |" in out

@@ -472,6 +472,41 @@ def run_pair(config: BenchConfig) -> tuple[BenchResult, BenchResult]:
     return run_graphsdg(config), run_handwritten(config)
 
 
+def round_summaries(rounds: list[tuple[BenchResult, BenchResult | None]]) -> list[dict]:
+    """The bench table's rows for ``rounds`` of (graphsdg, hand-written loop or None): each run's
+    :meth:`BenchResult.summary` with its ratio to the loop of its own round, then, with several rounds, the
+    median of every column per side (the ratio: the median of the rounds' ratios).
+
+    Example:
+        >>> g, h = BenchResult("graphsdg", 10, 1, wall_seconds=1.0), BenchResult("loop", 10, 1, wall_seconds=2.0)
+        >>> [row["ratio to hand-written"] for row in round_summaries([(g, h)])]
+        [2.0, 1.0]
+    """
+    several = len(rounds) > 1
+    rows: list[dict] = []
+    sides: dict[str, list[dict]] = {}
+    for k, (ours, loop) in enumerate(rounds, 1):
+        for result in (ours, loop):
+            if result is None:
+                continue
+            row = result.summary()
+            if loop is not None:
+                ratio = ours.fps / loop.fps if loop.fps else float("nan")
+                row["ratio to hand-written"] = round(ratio, 2) if result is ours else 1.0
+            sides.setdefault(row["run"], []).append(row)
+            if several:
+                row["run"] = f"{row['run']} (round {k})"
+            rows.append(row)
+    if several:
+        for label, runs in sides.items():
+            median = {"run": f"{label} (median of {len(runs)})"}
+            for key in runs[0]:
+                if key != "run":
+                    median[key] = round(float(np.median([r[key] for r in runs])), 2)
+            rows.append(median)
+    return rows
+
+
 def _worker(config_dict: dict, barrier) -> dict:
     config = BenchConfig(**config_dict)
     r = run_graphsdg(config, before_timing=barrier.wait)

@@ -78,7 +78,8 @@ def run_bench(args: argparse.Namespace) -> None:
                        ", wait_for_render" if args.wait_for_render else "",
                        f", {args.rendermode}" if args.rendermode else "",
                        f", {args.spp} path samples" if args.spp else "",
-                       f", pbr batch pixels {args.pbr_batch_pixels}" if args.pbr_batch_pixels is not None else ""])
+                       f", pbr batch pixels {args.pbr_batch_pixels}" if args.pbr_batch_pixels is not None else "",
+                       f", {args.rounds} rounds alternately" if args.rounds > 1 and not args.processes else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
     settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
@@ -90,29 +91,24 @@ def run_bench(args: argparse.Namespace) -> None:
         row = throughput.run_processes(config, args.processes)
         table = throughput.format_table([row])
     else:
-        rows = [throughput.run_graphsdg(config)]
-        if not args.no_baseline:
-            rows.append(throughput.run_handwritten(config))
-        summaries = [r.summary() for r in rows]
-        if len(rows) == 2:
-            ratio = rows[0].fps / rows[1].fps if rows[1].fps else float("nan")
-            for s in summaries:
-                s["ratio to hand-written"] = round(ratio, 2) if s["run"] == "graphsdg" else 1.0
-        table = throughput.format_table(summaries)
-        if args.profile:
-            prof = rows[0].profile
-            frame_ms = 1000.0 / rows[0].fps if rows[0].fps else 0.0
+        rounds = [throughput.run_pair(config) if not args.no_baseline else (throughput.run_graphsdg(config), None)
+                  for _ in range(args.rounds)]
+        table = throughput.format_table(throughput.round_summaries(rounds))
+        if args.profile:   # the first round's phases
+            ours, loop = rounds[0]
+            prof = ours.profile
+            frame_ms = 1000.0 / ours.fps if ours.fps else 0.0
             table += "\n\n" + throughput.format_table(
-                [{"phase": k, "ms/frame": round(v / rows[0].frames * 1000, 2),
+                [{"phase": k, "ms/frame": round(v / ours.frames * 1000, 2),
                   "share of frame": "(worker threads)" if k == "encode+write" else
-                  f"{v / rows[0].frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
+                  f"{v / ours.frames * 1000 / frame_ms:.0%}" if frame_ms else "-"}
                  for k, v in sorted(prof.items(), key=lambda kv: -kv[1])])
             table += f"\n\ngraphsdg frame time {frame_ms:.2f} ms"
-            if len(rows) == 2 and rows[1].profile:
-                base_ms = 1000.0 / rows[1].fps if rows[1].fps else 0.0
+            if loop is not None and loop.profile:
+                base_ms = 1000.0 / loop.fps if loop.fps else 0.0
                 table += "\n\n" + throughput.format_table(
-                    [{"hand-written phase": k, "ms/frame": round(v / rows[1].frames * 1000, 2)}
-                     for k, v in sorted(rows[1].profile.items(), key=lambda kv: -kv[1])])
+                    [{"hand-written phase": k, "ms/frame": round(v / loop.frames * 1000, 2)}
+                     for k, v in sorted(loop.profile.items(), key=lambda kv: -kv[1])])
                 table += f"\n\nhand-written frame time {base_ms:.2f} ms"
     text = f"### {settings_line}\n\nMachine: {machine}\n\n{table}\n"
     print(text)
@@ -375,6 +371,10 @@ def build_parser() -> argparse.ArgumentParser:
                             "images/s (frames times cameras) and the cores they kept busy (no hand-written "
                             "loop); 0 runs one process with the loop (default: 0)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
+    bench.add_argument("--rounds", type=_positive, default=1,
+                       help="run graphsdg and the hand-written loop this many times each, alternately, in one "
+                            "process; the table adds the medians, the ratio being the median of the rounds' "
+                            "ratios, so a machine whose speed drifts between runs weighs on both (default: 1)")
     bench.add_argument("--profile", action="store_true",
                        help="also print milliseconds per frame of each phase (randomize, render passes, "
                             "annotators, writing) for both runs")
