@@ -182,3 +182,10 @@ def test_bench_rounds_alternate_both_loops_in_one_run(capsys):
     for row in ("graphsdg (round 1)", "hand-written MuJoCo loop (round 1)", "graphsdg (round 2)",
                 "hand-written MuJoCo loop (round 2)", "graphsdg (median of 2)", "hand-written MuJoCo loop (median of 2)"):
         assert f"| {row} |" in out
+
+
+def test_bench_rounds_refuse_processes_naming_both(capsys):
+    from graphsdg.jobs.cli import main
+    assert main(["bench", "--rounds", "3", "--processes", "2", "--num-frames", "2"]) != 0
+    err = capsys.readouterr().err
+    assert "--rounds 3" in err and "--processes 2" in err

@@ -59,6 +59,9 @@ def run_bench(args: argparse.Namespace) -> None:
     from graphsdg.benchmark import throughput
 
     annotators = tuple(throughput.ANNOTATOR_FLAGS) if args.annotators == ["all"] else tuple(args.annotators)
+    if args.rounds > 1 and args.processes:
+        raise ValueError(f"--rounds {args.rounds} alternates the one-process comparison with the hand-written loop; "
+                         f"with --processes {args.processes} there is none: run the command again instead")
     unknown = [a for a in annotators if a not in throughput.ANNOTATOR_FLAGS]
     if unknown:
         raise ValueError(f"unknown benchmark annotator(s) {unknown}; known: {sorted(throughput.ANNOTATOR_FLAGS)}")
@@ -79,7 +82,7 @@ def run_bench(args: argparse.Namespace) -> None:
                        f", {args.rendermode}" if args.rendermode else "",
                        f", {args.spp} path samples" if args.spp else "",
                        f", pbr batch pixels {args.pbr_batch_pixels}" if args.pbr_batch_pixels is not None else "",
-                       f", {args.rounds} rounds alternately" if args.rounds > 1 and not args.processes else ""])
+                       f", {args.rounds} rounds alternately" if args.rounds > 1 else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
     settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
