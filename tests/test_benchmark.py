@@ -179,8 +179,9 @@ def test_bench_rounds_alternate_both_loops_in_one_run(capsys):
                  "--rounds", "2", "--skip-write"]) == 0
     out = capsys.readouterr().out
     assert "2 rounds alternately" in out
-    for row in ("graphsdg (round 1)", "hand-written MuJoCo loop (round 1)", "graphsdg (round 2)",
-                "hand-written MuJoCo loop (round 2)", "graphsdg (median of 2)", "hand-written MuJoCo loop (median of 2)"):
+    loop = "hand-written MuJoCo loop"
+    for row in ("graphsdg (round 1)", f"{loop} (round 1)", "graphsdg (round 2)", f"{loop} (round 2)",
+                "graphsdg (median of 2)", f"{loop} (median of 2)"):
         assert f"| {row} |" in out
 
 

@@ -10,8 +10,9 @@ bytes that hold them, with their code -> geom table
 tight boxes' and drawn-geom lists' input, :class:`HostFrame`). One kernel converts all three
 where the pixels already are (one launch per camera of a batched render); a camera's outputs
 share one device allocation, so its asked-for arrays come back in one copy into page-locked
-host memory, all cameras' copies behind one event, waited for when the pixels are first used (a pipelined step's go on copying while
-the script randomizes the next frame): about a quarter of the bytes the renderer's own float
+host memory, all cameras' copies behind one event, waited for when the pixels are first used
+(a pipelined step's go on copying while the script randomizes the next frame): about a quarter
+of the bytes the renderer's own float
 ``get_rgb`` readback moves, and no per-pixel numpy work on the CPU (scenes under 255
 geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host).
 
