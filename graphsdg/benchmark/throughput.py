@@ -502,7 +502,10 @@ def round_summaries(rounds: list[tuple[BenchResult, BenchResult | None]]) -> lis
             median = {"run": f"{label} (median of {len(runs)})"}
             for key in runs[0]:
                 if key != "run":
-                    median[key] = round(float(np.median([r[key] for r in runs])), 2)
+                    values = [r[key] for r in runs]
+                    middle = round(float(np.median(values)), 2)
+                    median[key] = int(middle) if all(isinstance(v, int) for v in values) and middle.is_integer() \
+                        else middle
             rows.append(median)
     return rows
 
