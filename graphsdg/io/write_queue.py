@@ -515,8 +515,7 @@ def processes_wanted(value: Any, threads: int, cores: int | None = None) -> int:
     if value == "auto":
         cores = cores if cores is not None else (os.cpu_count() or 1)
         return threads if cores >= MIN_CORES_FOR_PROCESSES and threads >= 2 else 0
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"setting {PROCESSES_KEY} must be 'auto' or a count of processes >= 0, got {value!r}")
+    settings.VALIDATORS[PROCESSES_KEY](PROCESSES_KEY, value)   # a default edited by hand lands here unchecked
     return int(value)
 
 

@@ -109,8 +109,20 @@ class BackendRequest:
     denoise: bool
 
 
+_requested: tuple[int, BackendRequest | None] = (-1, None)
+
+
 def requested_backend() -> BackendRequest:
-    """The render backend and tier the current settings ask for (see the module docstring)."""
+    """The render backend and tier the current settings ask for (see the module docstring); read again only
+    when a setting changed (a pbr frame asks several times)."""
+    global _requested
+    generation = settings.generation()
+    if _requested[0] != generation or _requested[1] is None:
+        _requested = (generation, _read_request())
+    return _requested[1]
+
+
+def _read_request() -> BackendRequest:
     backend = str(settings.get(BACKEND_KEY, "auto")).strip().lower()
     if backend not in BACKENDS:   # the validator refuses these on set(); a default edited by hand lands here
         raise ValueError(f"setting {BACKEND_KEY} must be one of {BACKENDS}, got {backend!r}")

@@ -126,7 +126,8 @@ class PbrRenderer:
         self._queued: list = []                  # pbr_outputs.QueuedReads of deferred renders not yet taken
 
     # ---- contexts ------------------------------------------------------
-    def _key(self, sim: SimScene, views: list[CameraView], subframes: int, request: BackendRequest) -> tuple:
+    def _key(self, sim: SimScene, views: list[CameraView], subframes: int) -> tuple:
+        request = requested_backend()
         model = sim.model
         drawn = drawn_geom_mask(model)
         per_axis = math.ceil(math.sqrt(subframes)) if request.tier == "realtime" else 1
@@ -134,11 +135,11 @@ class PbrRenderer:
         return (id(model), sim.model_version, sizes, request.tier, request.path_samples, request.denoise, per_axis,
                 drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)))
 
-    def _context(self, sim: SimScene, views: list[CameraView], subframes: int, request: BackendRequest) -> _Context:
+    def _context(self, sim: SimScene, views: list[CameraView], subframes: int) -> _Context:
         sim.require_pbr_cameras(len(views))
         if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, pbr_camera_name(len(views) - 1)) < 0:
             sim.recompile(keep_state=True)   # compiled while the classic backend drew: add the PBR cameras
-        key = self._key(sim, views, subframes, request)
+        key = self._key(sim, views, subframes)
         ctx = self._contexts.pop(key, None)
         if ctx is None:
             for stale in [k for k in self._contexts if k[:2] != key[:2]]:   # built for another model
@@ -146,15 +147,16 @@ class PbrRenderer:
             while len(self._contexts) >= self.MAX_CONTEXTS:   # the least recently used goes
                 del self._contexts[next(iter(self._contexts))]
             with profiling.timed("render:pbr_context"):
-                ctx = self._build(sim, views, key, request)
+                ctx = self._build(sim, views, key)
             self.stats["contexts"] += 1
         self._contexts[key] = ctx    # (re)inserted last: the most recently used
         return ctx
 
-    def _build(self, sim: SimScene, views: list[CameraView], key: tuple, request: BackendRequest) -> _Context:
+    def _build(self, sim: SimScene, views: list[CameraView], key: tuple) -> _Context:
         wp, mjw, mjpbr = self._wp, self._mjw, self._mjpbr
         model = sim.model
         cameras = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, pbr_camera_name(i)) for i in range(len(views))]
+        request = requested_backend()
         exposure_setting = float(settings.get("/graphsdg/render/exposure", 1.0))
         env, yaw = self._environment(sim)
         path = request.tier == "path"
@@ -218,8 +220,7 @@ class PbrRenderer:
     def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
                defer: bool = False, motion=None) -> RenderOutputs:
         """Render ``passes`` of ``view``: colour, depth and ids from the same rays (see the module docstring)."""
-        return self._render_launch(sim, [RenderRequest(view, passes, subframes, defer, motion)],
-                                   requested_backend())[0]
+        return self._render_launch(sim, [RenderRequest(view, passes, subframes, defer, motion)])[0]
 
     def render_batch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
         """Render a step's products: those one launch can draw together (no motion blur, one launch of samples,
@@ -232,11 +233,11 @@ class PbrRenderer:
                     if self._one_launch(r, tier) and r.subframes == requests[0].subframes]
         for group in launch_groups([requests[i].view.width * requests[i].view.height for i in together]):
             chosen = [together[j] for j in group]
-            for i, out in zip(chosen, self._render_launch(sim, [requests[i] for i in chosen], tier)):
+            for i, out in zip(chosen, self._render_launch(sim, [requests[i] for i in chosen])):
                 outputs[i] = out
         for i, r in enumerate(requests):
             if outputs[i] is None:
-                outputs[i] = self._render_launch(sim, [r], tier)[0]
+                outputs[i] = self._render_launch(sim, [r])[0]
         return outputs
 
     @staticmethod
@@ -245,11 +246,9 @@ class PbrRenderer:
         no path samples beyond one launch's."""
         return request.motion is None and (tier.tier == "realtime" or request.subframes <= max(1, tier.path_samples))
 
-    def _render_launch(self, sim: SimScene, requests: list[RenderRequest], tier: BackendRequest
-                       ) -> list[RenderOutputs]:
+    def _render_launch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
         """Render ``requests`` (several only when each takes one launch: :meth:`_one_launch`) as the cameras of
-        one render context, in the settings' ``tier`` (:func:`~graphsdg.render.backend.requested_backend`, read
-        once a step)."""
+        one render context."""
         for r in requests:
             unknown = set(r.passes) - set(PASSES)
             if unknown:
@@ -259,12 +258,12 @@ class PbrRenderer:
         self._take_queued()
         views = [r.view for r in requests]
         wp, first = self._wp, requests[0]
-        ctx = self._context(sim, views, first.subframes, tier)
+        ctx = self._context(sim, views, first.subframes)
         seeds = tuple(v.path for v in views)
         with wp.ScopedDevice(self._device):
             with profiling.timed("render:pbr_upload"):
                 self._upload_state(sim, views, ctx)
-            path = tier.tier == "path"
+            path = requested_backend().tier == "path"
             launches = max(1, math.ceil(first.subframes / max(1, ctx.rc.path_samples))) if path else 1
             acc = self._motion_blur(sim, ctx, first.motion, launches) if first.motion is not None else None
             if acc is not None:
