@@ -63,7 +63,7 @@ class BenchConfig:
     wait_for_render: bool = False       # benchmark_sdg.py's default: pipelined steps
     write_to_fabric: bool = True
     seed: int = 11
-    out_dir: str | None = None
+    out_dir: str | None = None           # keep the frames here (graphsdg's; the loop's in its "hand-written" folder)
     write_threads: int | None = None     # None: write_queue.default_threads(), or with --processes their share
     msaa_samples: int | None = None      # None: graphsdg's default (/graphsdg/render/msaaSamples)
     shadow_size: int | None = None       # None: graphsdg's default (/graphsdg/render/shadowSize)
@@ -336,6 +336,12 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     geom_ids = np.array([g.geom_id for g in geoms])
     unit_size = model.geom_size[geom_ids].copy()
     is_mesh = np.array([g.type_name in ("Mesh", "Cone") for g in geoms])
+    # MuJoCo draws a mesh at its compiled vertices: a scaled mesh (cone, torus) is drawn through its scene
+    # geom's matrix scaled by s, with its offset from the body (geom_pos) scaled in the model
+    mesh_geoms, mesh_rows = geom_ids[is_mesh], np.flatnonzero(is_mesh)
+    unit_mesh_pos = model.geom_pos[mesh_geoms].copy()
+    mesh_row_of = {int(g): int(k) for g, k in zip(mesh_geoms, mesh_rows)}
+    geom_obj = int(mujoco.mjtObj.mjOBJ_GEOM)
     w, h = config.resolution
     model.vis.global_.offwidth, model.vis.global_.offheight = max(w, 64), max(h, 64)
     vfov = np.degrees(2 * np.arctan(20.955 / 24.0 / 2 * h / w))
@@ -359,7 +365,11 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     need_depth = bool(want & {"distance_to_image_plane", "distance_to_camera"})
     need_seg = bool(want - {"rgb", "distance_to_image_plane", "distance_to_camera"})
     pool = concurrent.futures.ThreadPoolExecutor(_write_threads(config))
-    tmp = tempfile.mkdtemp(prefix="mujoco_bench_", dir=config.temp_dir)
+    if config.out_dir:
+        tmp = os.path.join(config.out_dir, "hand-written")
+        os.makedirs(tmp, exist_ok=True)
+    else:
+        tmp = tempfile.mkdtemp(prefix="mujoco_bench_", dir=config.temp_dir)
     pending: list[concurrent.futures.Future] = []
     draws = Randomization(config)
     cam = mujoco.MjvCamera()
@@ -375,6 +385,11 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
         else:
             np.save(path, payload)
 
+    def scale_meshes(scene, scale):
+        for g in scene.geoms[:scene.ngeom]:
+            if g.objtype == geom_obj and g.objid in mesh_row_of:
+                g.mat = g.mat * scale[mesh_row_of[g.objid]]
+
     def frame(draw, index):
         t0 = time.perf_counter()
         data.mocap_pos[mocap] = draw["position"]
@@ -383,6 +398,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
             mujoco.mju_euler2Quat(quat, np.radians(rot), "XYZ")
             data.mocap_quat[mid] = quat
         model.geom_size[geom_ids[~is_mesh]] = unit_size[~is_mesh] * draw["scale"][~is_mesh, :1]
+        model.geom_pos[mesh_geoms] = unit_mesh_pos * draw["scale"][mesh_rows, :1]
         model.geom_rgba[geom_ids, :3] = draw["color"]
         mujoco.mj_kinematics(model, data)
         profiling.add("baseline:randomize", time.perf_counter() - t0)
@@ -393,12 +409,14 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
             cam.azimuth = np.degrees(np.arctan2(pos[1], pos[0])) + 180
             cam.elevation = -np.degrees(np.arcsin(pos[2] / d))
             renderer.update_scene(data, cam)
+            scale_meshes(renderer.scene, draw["scale"][:, 0])
             with profiling.timed("baseline:render:rgb"):
                 rgb = renderer.render()
             if not config.skip_write:
                 pending.append(pool.submit(write, f"{tmp}/rgb_{c}_{index}.png", rgb[..., ::-1].copy()))
             if need_depth or need_seg:
                 id_renderer.update_scene(data, cam)
+                scale_meshes(id_renderer.scene, draw["scale"][:, 0])
             if need_depth:
                 id_renderer.enable_depth_rendering()
                 with profiling.timed("baseline:render:depth"):
@@ -460,8 +478,9 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     pool.shutdown()
     renderer.close()
     id_renderer.close()
-    import shutil
-    shutil.rmtree(tmp, ignore_errors=True)
+    if not config.out_dir:
+        import shutil
+        shutil.rmtree(tmp, ignore_errors=True)
     for rp in rps:
         rp.destroy()
     return result
