@@ -206,8 +206,10 @@ def _camera_view(rt, rp) -> CameraView:
     """A render product's camera now (its pose written with write-to-fabric, when it was; its lens as last
     read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
-    lens = rt.sim.prim_reads.get(str(prim.GetPath()), "lens", lambda: read_lens(prim))
-    return camera_view(prim, rp.width, rp.height, world=rt.sim.camera_poses.world(prim), lens=lens)
+    sim = rt.sim
+    lens = sim.prim_reads.get(str(prim.GetPath()), "lens", lambda: read_lens(prim))
+    return camera_view(prim, rp.width, rp.height, world=sim.camera_poses.world(prim), lens=lens,
+                       meters_per_unit=sim.world_transforms.meters_per_unit())
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:

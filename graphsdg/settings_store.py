@@ -238,6 +238,9 @@ def get(key: str, default: Any = None) -> Any:
         value = _values.get(key, _MISSING)
         if value is not _MISSING:
             return value
+        known = KNOWN_KEYS.get(key)   # a known key left at its default (most of a frame's reads)
+        if known is not None:
+            return known[0] if known[0] is not None else default
     k = normalize_key(key)
     with _lock:
         if k in _values:

@@ -229,10 +229,11 @@ def read_lens(prim: Usd.Prim) -> CameraLens:
 
 
 def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCache | None = None,
-                world: np.ndarray | None = None, lens: CameraLens | None = None) -> CameraView:
+                world: np.ndarray | None = None, lens: CameraLens | None = None,
+                meters_per_unit: float | None = None) -> CameraView:
     """Read a ``UsdGeom.Camera`` prim at a resolution. ``world``: its world transform when it is not the
     stage's (a camera posed with write-to-fabric, :mod:`graphsdg.sim.camera_poses`); ``lens``: its
-    :func:`read_lens`, when the caller keeps it."""
+    :func:`read_lens`, and ``meters_per_unit``: the stage's, when the caller keeps them."""
     if lens is None:
         lens = read_lens(prim)
     t, r, _ = decompose(world if world is not None else world_matrix(prim, cache))
@@ -243,4 +244,5 @@ def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCac
         horizontal_aperture_offset=lens.horizontal_aperture_offset,
         vertical_aperture_offset=lens.vertical_aperture_offset, near=lens.near, far=lens.far, width=int(width),
         height=int(height), projection=lens.projection, focus_distance=lens.focus_distance, f_stop=lens.f_stop,
-        meters_per_unit=float(UsdGeom.GetStageMetersPerUnit(prim.GetStage()) or 1.0))
+        meters_per_unit=meters_per_unit if meters_per_unit is not None else
+        float(UsdGeom.GetStageMetersPerUnit(prim.GetStage()) or 1.0))

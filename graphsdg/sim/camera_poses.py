@@ -20,7 +20,7 @@ Example:
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 from pxr import Usd, UsdGeom
@@ -35,7 +35,9 @@ _ROTATIONS = (UsdGeom.XformOp.TypeRotateXYZ, UsdGeom.XformOp.TypeOrient)
 class CameraPoses:
     """Local transforms (row-vector 4x4) of cameras posed with write-to-fabric, by prim path."""
 
-    def __init__(self) -> None:
+    def __init__(self, parent_world: Callable[[Usd.Prim, str], np.ndarray] | None = None) -> None:
+        # (prim, its path) -> its parent's world transform now; the scene's reads are kept until the stage changes
+        self._parent_world = parent_world or (lambda prim, path: parent_world_matrix(prim))
         self._local: dict[str, np.ndarray] = {}
         self._canonical: dict[str, bool] = {}     # whether a camera's op stack is the canonical one
 
@@ -46,8 +48,13 @@ class CameraPoses:
     def world(self, prim: Usd.Prim) -> np.ndarray | None:
         """The camera's world transform: its local one from here under its parent's current world transform;
         None when it was not posed here."""
-        local = self._local.get(str(prim.GetPath()))
-        return None if local is None else local @ parent_world_matrix(prim)
+        path = str(prim.GetPath())
+        local = self._local.get(path)
+        return None if local is None else local @ self._parent_world(prim, path)
+
+    def parent_world(self, prim: Usd.Prim, path: str) -> np.ndarray:
+        """The world transform of ``prim``'s parent now (read-only)."""
+        return self._parent_world(prim, path)
 
     def set_local(self, path: str, matrix: np.ndarray) -> None:
         self._local[path] = matrix

@@ -188,7 +188,7 @@ def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.n
         if current is None:
             current = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
                                dtype=np.float64)
-        poses.set_local(path, posed_local(current, parent_world_matrix(prim),
+        poses.set_local(path, posed_local(current, poses.parent_world(prim, path),
                                           None if positions is None else positions[i],
                                           None if rotations is None else rotations[i],
                                           None if looks is None else looks[i], up))

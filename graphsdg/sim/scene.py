@@ -38,6 +38,7 @@ from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
 from graphsdg.sim.camera_poses import CameraPoses
+from graphsdg.stage.world_transforms import WorldTransforms
 from graphsdg.sim.compiled_scene import BodyBinding, CompiledScene
 from graphsdg.sim.compiler import compile_stage
 from graphsdg.sim.edit_aspects import ALL_ASPECTS, INHERITED_ASPECTS, edit_aspects
@@ -90,7 +91,8 @@ class SimScene:
         # that draws its copy through the maps must take new vertices only for these
         self.mesh_reshapes = np.zeros(0, dtype=np.int64)
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
-        self.camera_poses = CameraPoses()   # cameras posed with write-to-fabric
+        self.world_transforms = WorldTransforms(stage)   # read once until the stage changes
+        self.camera_poses = CameraPoses(self.world_transforms.parent_world)   # cameras posed with write-to-fabric
         self.prim_reads = PrimReadCache()   # values read from prims until the stage edits them
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
