@@ -231,3 +231,26 @@ def test_the_setting_is_checked_and_auto_follows_the_cores():
     assert processes_wanted("auto", 1, cores=16) == 0        # one writer thread: one of many processes on a host
     assert processes_wanted("auto", 4, cores=2) == 0
     assert processes_wanted(3, 1, cores=2) == 3
+
+
+def test_no_thread_reads_the_replies_the_threads_using_the_pool_take_them(out_dir):
+    # a reader thread woken by every reply took the interpreter lock from the thread that renders; now the
+    # pool's users collect replies (at each send, and while they wait or ask for progress)
+    import threading
+    import time
+    rep.settings.set("/graphsdg/io/writeProcesses", 1)
+    before = set(threading.enumerate())
+    queue = get_write_queue()
+    path = os.path.join(out_dir, "a.npy")
+    queue.schedule(iof.write_np, data=np.ones((128, 128)), path=path)
+    assert queue.process_ids() and set(threading.enumerate()) == before
+    deadline = time.monotonic() + 60
+    while not queue.is_done():                                  # asking takes the reply that came
+        assert time.monotonic() < deadline
+        time.sleep(0.005)
+    assert np.load(path).sum() == 128 * 128 and queue.pending() == 0
+    for i in range(30):                                         # many more replies than sends wait unread
+        queue.schedule(iof.write_np, data=np.full((64, 64), i, np.float64), path=os.path.join(out_dir, f"{i}.npy"))
+    queue.wait_until_done()
+    assert [float(np.load(os.path.join(out_dir, f"{i}.npy"))[0, 0]) for i in range(30)] == list(range(30))
+    assert set(threading.enumerate()) == before

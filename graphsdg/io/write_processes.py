@@ -9,7 +9,10 @@ and most writers schedule to a local file, to writer processes instead:
 * each process has a shared arena (an anonymous ``memfd`` mapped on both sides): an array is copied
   into it once, and only its offset, dtype and shape cross the pipe;
 * a frame's writes go to one process as one message (:meth:`WriteProcesses.send`), and come back as one
-  reply, read by a thread that waits outside the interpreter lock;
+  reply, taken by the threads that use the pool (:meth:`WriteProcesses.collect`: at each send, and by
+  whoever waits for writes to finish). No thread of its own reads them: measured on a GPU host, a reader
+  thread woken by each reply took the interpreter lock from the thread that renders about once a frame,
+  costing it ~0.2 ms of a 3.5 ms 128x128 frame;
 * processes start as the backlog needs them (one while it keeps up), up to a limit; two writes to the
   same file go to the same process, so the last one scheduled is the one on disk;
 * the processes encode with the same functions as a writer thread (:mod:`graphsdg.io.write_process`),
@@ -33,13 +36,14 @@ from __future__ import annotations
 
 import builtins
 import collections
+import fcntl
 import mmap
 import os
 import subprocess
 import sys
 import threading
 import weakref
-from multiprocessing.connection import Connection
+from multiprocessing.connection import Connection, wait
 from typing import Any, Callable, NamedTuple
 
 import numpy as np
@@ -50,6 +54,7 @@ ARENA_BYTES = 128 << 20     # per process; pages are touched only as far as the 
 INLINE_BYTES = 16 << 10     # arrays smaller than this travel in the message itself
 BATCHES_PER_PROCESS = 2     # batches waiting on every started process before another one starts
 _ALIGN = 64
+REPLY_PIPE_BYTES = 1 << 20
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -98,6 +103,10 @@ class _Process:
     def __init__(self, arena_bytes: int) -> None:
         request_read, request_write = os.pipe()
         reply_read, reply_write = os.pipe()
+        try:   # replies wait in the pipe until a thread of the pool collects them: room for thousands
+            fcntl.fcntl(reply_write, fcntl.F_SETPIPE_SZ, REPLY_PIPE_BYTES)
+        except OSError:
+            pass   # the system's limit is lower: the default size (64 KiB: ~600 replies)
         arena_fd = os.memfd_create("graphsdg-writes", os.MFD_CLOEXEC)
         try:
             os.ftruncate(arena_fd, arena_bytes)
@@ -120,7 +129,6 @@ class _Process:
         self.regions: collections.deque[tuple[int, int]] = collections.deque()
         self.head = 0
         self.alive = True
-        self.reader: threading.Thread | None = None
 
     def reserve(self, nbytes: int) -> int | None:
         """The start of ``nbytes`` free bytes of the arena, or None while there is no room.
@@ -158,7 +166,8 @@ class WriteProcesses:
         self._on_done = on_done
         self._processes: list[_Process] = []
         self._owner: dict[str, list] = {}       # path -> [process, writes in flight]
-        self._room = threading.Condition(threading.Lock())
+        self._room = threading.Lock()           # the processes, their batches and arenas
+        self._collecting = threading.RLock()    # one thread takes replies at a time (re-entered from on_done)
         _pools.add(self)
 
     # ---- sending ------------------------------------------------------------
@@ -171,32 +180,37 @@ class WriteProcesses:
             return
         arrays = self._layout(writes)
         total = sum(size for _, _, size in arrays)
+        self.collect(timeout=0)                           # what finished since: room, and which process is idle
         with self._room:
             process = self._choose([w.path for w, _ in writes])
             if total > process.size:                      # larger than a whole arena: everything in the message
                 arrays, total = [], 0
-            start = process.reserve(total) if total else 0
-            while start is None:
-                self._room.wait()
+        while True:
+            with self._room:                              # reserved and taken in one hold of the lock
+                start = process.reserve(total) if total else 0
                 if not process.alive:
-                    break
-                start = process.reserve(total)
-            if not process.alive:
-                self._fail_now(writes, process)
-                return
-            tasks = self._tasks(writes, arrays, process, start, durable)
-            batch = _Batch(start, start + total, [token for _, token in writes],
-                           [w.path for w, _ in writes])
-            process.batches.append(batch)
-            if total:
-                process.head = start + total
-                process.regions.append((start, start + total))
-            for path in batch.paths:
-                self._owner.setdefault(path, [process, 0])[1] += 1
-            try:
-                process.requests.send(("write", tasks))
-            except OSError:
-                pass                                   # the reader sees the process's end and fails the batch
+                    self._fail_now(writes, process)
+                    return
+                if start is not None:
+                    self._commit(writes, arrays, total, process, start, durable)
+                    return
+            self.collect(timeout=None)                    # the room comes back as the process answers
+
+    def _commit(self, writes: list[tuple[FileWrite, Any]], arrays: list, total: int, process: _Process, start: int,
+                durable: bool) -> None:
+        """Copy the batch's arrays into ``process``'s arena at ``start`` and send it (lock held)."""
+        tasks = self._tasks(writes, arrays, process, start, durable)
+        batch = _Batch(start, start + total, [token for _, token in writes], [w.path for w, _ in writes])
+        process.batches.append(batch)
+        if total:
+            process.head = start + total
+            process.regions.append((start, start + total))
+        for path in batch.paths:
+            self._owner.setdefault(path, [process, 0])[1] += 1
+        try:
+            process.requests.send(("write", tasks))
+        except OSError:
+            pass                                   # collect() sees the process's end and fails the batch
 
     @staticmethod
     def _layout(writes: list[tuple[FileWrite, Any]]) -> list[tuple[int, np.ndarray, int]]:
@@ -237,29 +251,51 @@ class WriteProcesses:
 
     def _start(self) -> _Process:
         process = _Process(self.arena_bytes)
-        process.reader = threading.Thread(target=self._read, args=(process,), daemon=True,
-                                          name=f"graphsdg-write-process-{process.process.pid}")
-        process.reader.start()
         self._processes.append(process)
         return process
 
     # ---- replies --------------------------------------------------------------
-    def _read(self, process: _Process) -> None:
+    def collect(self, timeout: float | None = 0) -> bool:
+        """Take the replies the processes have sent: each finished write reaches ``on_done``, its arena room
+        is free again, and a process that ended fails the writes it held.
+
+        ``timeout=0`` takes what is there (and returns at once while another thread collects); otherwise
+        waits up to ``timeout`` seconds (``None``: without limit) for a reply or a process's end. Returns
+        whether anything was taken.
+        """
+        if not self._collecting.acquire(blocking=timeout != 0):
+            return False
+        try:
+            with self._room:
+                live = {p.replies: p for p in self._processes if p.alive}
+            if not live:
+                return False
+            taken = False
+            for connection in wait(list(live), timeout):
+                taken = True
+                self._take(live[connection])
+            return taken
+        finally:
+            self._collecting.release()
+
+    def _take(self, process: _Process) -> None:
+        """Every reply waiting from ``process`` (at least one, or its end)."""
         while True:
             try:
                 results, seconds = process.replies.recv()
             except (EOFError, OSError):
-                break
+                self._lost(process)
+                return
             with self._room:
                 batch = process.batches.popleft()    # a process answers its batches in order
                 if batch.end > batch.start:
                     process.regions.popleft()
                 self._release(batch)
-                self._room.notify_all()
             share = seconds / max(1, len(results))
             for token, path, (error, nbytes) in zip(batch.tokens, batch.paths, results):
                 self._on_done(token, None if error is None else rebuilt_error(*error, path), nbytes, share)
-        self._lost(process)
+            if not process.replies.poll(0):
+                return
 
     def _release(self, batch: _Batch) -> None:
         for path in batch.paths:
@@ -279,7 +315,6 @@ class WriteProcesses:
             process.regions.clear()
             for batch in lost:
                 self._release(batch)
-            self._room.notify_all()
         for batch in lost:
             error = RuntimeError(f"the writer process (pid {process.process.pid}) exited with code {code} "
                                  f"before writing the file")
@@ -305,9 +340,11 @@ class WriteProcesses:
                 process.requests.send(("stop",))
             except OSError:
                 pass
+        with self._collecting:
+            for process in processes:
+                while process.alive:                   # its last replies, then its end
+                    self._take(process)
         for process in processes:
-            if process.reader is not None:
-                process.reader.join()
             process.requests.close()
             process.replies.close()
             process.arena.close()
@@ -317,7 +354,8 @@ class WriteProcesses:
             process.forget()
         self._processes = []
         self._owner.clear()
-        self._room = threading.Condition(threading.Lock())
+        self._room = threading.Lock()
+        self._collecting = threading.RLock()
 
 
 _pools: "weakref.WeakSet[WriteProcesses]" = weakref.WeakSet()

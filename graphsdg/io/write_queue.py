@@ -65,6 +65,7 @@ MIN_CORES_FOR_PROCESSES = 4   # "auto" writes in processes from this many cores 
 # image) both alike; at 256x256 processes +25-55 %.
 PROCESS_WRITE_MAX_BYTES = 1 << 20
 _THROTTLE_LOG_EVERY_S = 10.0
+PROGRESS_POLL_S = 0.02  # a waiter collecting writer processes' replies looks at the threads' tasks this often
 BACKLOG_PER_WORKER = 8   # tasks waiting per started worker before another starts (a BasicWriter frame is ~7)
 
 
@@ -299,8 +300,21 @@ class WriteQueue:
             self._last_throttle_log = now
             log.warning("Throttling generation due to I/O bottleneck.")
         while self._full(nbytes):
-            self._cond.wait()
+            self._wait_for_progress()
         self.throttled_seconds += time.perf_counter() - now
+
+    def _wait_for_progress(self) -> None:
+        """Wait (lock held) for some write to finish. No thread reads the writer processes' replies on its
+        own (:meth:`WriteProcesses.collect`): while writes are in processes, the waiting thread collects them."""
+        processes = self._processes
+        if not self._in_processes or processes is None:
+            self._cond.wait()
+            return
+        self._cond.release()
+        try:
+            processes.collect(timeout=PROGRESS_POLL_S)   # a thread's task finishing meanwhile is seen at the next turn
+        finally:
+            self._cond.acquire()
 
     def _schedule_in_process(self, write: FileWrite, nbytes: int, group: TaskGroup | None) -> None:
         with self._cond:
@@ -332,7 +346,7 @@ class WriteQueue:
 
     def _process_done(self, token: tuple, error: BaseException | None, nbytes_written: int,
                       seconds: float) -> None:
-        """A writer process finished a write (runs on the thread that reads its replies)."""
+        """A writer process finished a write (runs on the thread that collected its reply)."""
         nbytes, group, what = token
         if error is None:
             count_written(nbytes_written)
@@ -411,14 +425,23 @@ class WriteQueue:
             self._cond.notify_all()
 
     # ---- state -----------------------------------------------------------
+    def _collect(self) -> None:
+        """Take the writer processes' replies that have come (finished writes, failures)."""
+        processes = self._processes
+        if processes is not None and self._in_processes:
+            processes.collect(timeout=0)
+
     def pending(self) -> int:
         """Tasks scheduled and not finished (waiting or running)."""
+        self._collect()
         return self._unfinished
 
     def queued_bytes(self) -> int:
+        self._collect()
         return self._bytes
 
     def is_done(self) -> bool:
+        self._collect()
         return self._unfinished == 0
 
     def wait_until_done(self) -> None:
@@ -426,10 +449,11 @@ class WriteQueue:
         self._wake_deferred()
         with self._cond:
             while self._unfinished:
-                self._cond.wait()
+                self._wait_for_progress()
         self.raise_errors()
 
     def raise_errors(self) -> None:
+        self._collect()
         with self._cond:
             errors, self._errors = self._errors, []
         if errors:
@@ -443,7 +467,7 @@ class WriteQueue:
         self._wake_deferred()
         with self._cond:
             while self._unfinished:
-                self._cond.wait()
+                self._wait_for_progress()
             self._closing = True
             self._has_work.notify_all()
             self._cond.notify_all()
