@@ -330,7 +330,7 @@ class WriteQueue:
             if self._processes is None:
                 self._processes = WriteProcesses(self.num_processes, self._process_done)
             self._processes.max_processes = self.num_processes
-        token = (nbytes, group, f"a background write of {write.path!r}")
+        token = (nbytes, group, write.path)   # the path names the write if it fails
         shipped = getattr(self._local, "shipped", None)
         if shipped is not None:                 # inside batch(): the frame's writes go as one message
             shipped.append((write, token))
@@ -347,11 +347,12 @@ class WriteQueue:
     def _process_done(self, token: tuple, error: BaseException | None, nbytes_written: int,
                       seconds: float) -> None:
         """A writer process finished a write (runs on the thread that collected its reply)."""
-        nbytes, group, what = token
+        nbytes, group, path = token
         if error is None:
             count_written(nbytes_written)
         profiling.add("encode+write", seconds)
-        self._settle(nbytes, group, error, what, in_process=True)
+        self._settle(nbytes, group, error, f"a background write of {path!r}" if error is not None else "",
+                     in_process=True)
 
     @contextlib.contextmanager
     def group(self, on_done: Callable[[bool], None]) -> Iterator[TaskGroup]:
