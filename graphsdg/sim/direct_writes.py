@@ -21,6 +21,7 @@ from pxr import Usd, UsdGeom
 from graphsdg.sim.camera_poses import posed_local
 from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
+from graphsdg.sim.uniform_scales import UniformScalePlan
 from graphsdg.maths.rotations import canonical_quat, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
     quat_multiply, unit_quat
 from graphsdg.stage.xform import parent_world_matrix
@@ -69,6 +70,18 @@ class DirectTargets:
         self.scale_rows = list(self.scales)
         for b, row in zip(self.bindings, self.scale_rows):
             b.scale = row
+
+    def uniform_plan(self, model: mujoco.MjModel) -> UniformScalePlan | None:
+        """How this batch's uniform rescales are written (:mod:`graphsdg.sim.uniform_scales`), or None where
+        they take the general path; worked out on first use (the targets are cached per compile)."""
+        if not hasattr(self, "_uniform_plan"):
+            plan = None
+            if UniformScalePlan.fits(self, model):
+                prims = np.flatnonzero(~self.is_mesh)
+                unit = _simple_sizes(self, np.ones((len(self.prims), 3)))[1][prims]
+                plan = UniformScalePlan(self, model, unit, _half_extents(self, prims, unit))
+            self._uniform_plan = plan
+        return self._uniform_plan
 
     def current_scales(self) -> np.ndarray:
         """:attr:`scales`, after taking back the rows of bindings whose ``scale`` was replaced since (a USD
@@ -135,10 +148,15 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
         return False
     m, d = sim.model, sim.data
     n = len(prims)
+    uniform = None
     if scales is not None:
         world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3)
         if not t.parent_is_identity:
             world_scale = world_scale * t.parent_s
+        plan = t.uniform_plan(m)
+        if plan is not None:
+            uniform = plan.prepare(world_scale, t.current_scales())
+    if scales is not None and uniform is None:
         sized, sizes = _simple_sizes(t, world_scale)
         for i in np.flatnonzero(~sized & ~t.is_mesh):   # unevenly scaled spheres, x/y-axis tubes
             kind, size, _ = primitive_size(t.prims[i], world_scale[i])
@@ -155,7 +173,9 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
         local_q = unit_quat(rot.reshape(n, 4)) if rot.shape[-1] == 4 else euler_xyz_to_quat(rot.reshape(n, 3))
         d.mocap_quat[t.mocap_ids] = local_q if t.parent_is_identity else \
             canonical_quat(quat_multiply(t.parent_q, local_q))
-    if scales is not None:
+    if uniform is not None:
+        plan.write(sim, uniform, world_scale, t.current_scales())
+    elif scales is not None:
         current = t.current_scales()
         _write_mesh_scales(sim, t, world_scale, current)
         rows = np.flatnonzero(sized)

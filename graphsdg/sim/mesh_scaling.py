@@ -104,21 +104,25 @@ class MeshMaps(MutableMapping):
         ids = np.flatnonzero(self.present)
         return ids, self.matrices[ids]
 
-    def compose(self, mesh_ids: np.ndarray, linears: np.ndarray) -> None:
+    def compose(self, mesh_ids: np.ndarray, linears: np.ndarray, distinct: bool = False) -> None:
         """``self[m] = linear @ self[m]`` (``linear`` for a mesh with no map yet) for each mesh ``m`` of
         ``mesh_ids`` and its (3, 3) ``linear``.
 
         The products are those of a loop over the meshes, batched into one
         ``matmul`` (the same numbers, bit for bit); a mesh listed twice is composed
-        in order, one pair at a time.
+        in order, one pair at a time. ``distinct``: the caller knows the ids are
+        distinct and not negative (a plan checked them once), so they are not checked.
         """
         ids = np.asarray(mesh_ids, dtype=np.int64)
         linears = np.asarray(linears, dtype=np.float64).reshape(-1, 3, 3)
         if not ids.size:
             return
-        if (ids < 0).any():
+        if not distinct and (ids < 0).any():
             raise KeyError(f"mesh ids are >= 0, got {int(ids.min())}")
-        if not _distinct(ids):
+        if distinct and int(ids.max()) < len(self.present) and self.present[ids].all():
+            self.matrices[ids] = np.matmul(linears, self.matrices[ids])   # every mesh has a map already
+            return
+        if not distinct and not _distinct(ids):
             for mesh_id, linear in zip(ids.tolist(), linears):
                 previous = self.get(mesh_id)
                 self[mesh_id] = linear if previous is None else linear @ previous

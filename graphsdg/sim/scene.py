@@ -143,15 +143,19 @@ class SimScene:
         self.mesh_maps.compose(mesh_ids, linears)
         self.stamp_meshes(mesh_ids, mapped=True)
 
-    def stamp_meshes(self, mesh_ids, mapped: bool = False) -> None:
+    def stamp_meshes(self, mesh_ids, mapped: bool = False, distinct: bool = False) -> None:
         """Record that meshes ``mesh_ids``' vertices changed (see :attr:`mesh_stamps`); ``mapped``: by a linear
-        map composed into :attr:`mesh_maps` (else :attr:`mesh_reshapes` counts the change too)."""
+        map composed into :attr:`mesh_maps` (else :attr:`mesh_reshapes` counts the change too); ``distinct``:
+        no id repeats (one indexed addition instead of ``np.add.at``)."""
         nmesh = self.model.nmesh
         if self.mesh_stamps.shape[0] != nmesh:
             self.mesh_stamps = np.zeros(nmesh, dtype=np.int64)
         if self.mesh_reshapes.shape[0] != nmesh:
             self.mesh_reshapes = np.zeros(nmesh, dtype=np.int64)
         ids = np.asarray(list(mesh_ids) if isinstance(mesh_ids, set) else mesh_ids, dtype=np.int64)
+        if distinct and mapped:
+            self.mesh_stamps[ids] += 1
+            return
         np.add.at(self.mesh_stamps, ids, 1)
         if not mapped:
             np.add.at(self.mesh_reshapes, ids, 1)
