@@ -297,3 +297,22 @@ def test_cameras_with_other_op_stacks_are_authored():
     rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
     assert runtime().sim.camera_poses.local(str(cam.GetPath())) is None
     assert tuple(cam.GetAttribute("xformOp:translate").Get()) == (4.0, 1.0, 2.0)
+
+
+def test_camera_poses_keep_the_parts_they_were_composed_from_until_the_stage_edits_the_camera():
+    from pxr import Sdf
+
+    from graphsdg.maths.rotations import compose, decompose, euler_to_matrix
+    from graphsdg.sim.camera_poses import CameraPoses
+    from graphsdg.stage.changes import ChangeSet
+    poses = CameraPoses()
+    m = compose(np.array([1.0, 2.0, 3.0]), euler_to_matrix(np.array([10.0, 20.0, 30.0]), "XYZ"),
+                np.array([1.0, 2.0, 1.0]))
+    poses.set_local("/C", m)                                 # no parts given: decomposed when asked
+    for got, want in zip(poses.local_parts("/C"), decompose(m)):
+        np.testing.assert_allclose(got, want)
+    parts = (np.zeros(3), np.eye(3), np.ones(3))
+    poses.set_local("/C", compose(*parts), parts)
+    assert poses.local_parts("/C") is parts
+    poses.forget_edited(ChangeSet(edited={Sdf.Path("/C"): {"xformOp:translate"}}))
+    assert poses.local_parts("/C") is None and poses.local("/C") is None

@@ -3,11 +3,9 @@ bit for bit, as the general path of direct writes."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import graphsdg as rep
 from graphsdg.runtime import runtime
-from graphsdg.sim import direct_writes
 from graphsdg.sim.direct_writes import DirectTargets, targets_for
 
 SHAPES = ("cube", "cone", "cylinder", "sphere", "torus")

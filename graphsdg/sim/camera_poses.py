@@ -39,6 +39,7 @@ class CameraPoses:
         # (prim, its path) -> its parent's world transform now; the scene's reads are kept until the stage changes
         self._parent_world = parent_world or (lambda prim, path: parent_world_matrix(prim))
         self._local: dict[str, np.ndarray] = {}
+        self._parts: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}   # decompose(_local[path])
         self._canonical: dict[str, bool] = {}     # whether a camera's op stack is the canonical one
 
     def local(self, path: str) -> np.ndarray | None:
@@ -56,8 +57,25 @@ class CameraPoses:
         """The world transform of ``prim``'s parent now (read-only)."""
         return self._parent_world(prim, path)
 
-    def set_local(self, path: str, matrix: np.ndarray) -> None:
+    def set_local(self, path: str, matrix: np.ndarray,
+                  parts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> None:
+        """Pose the camera at ``path`` with the local transform ``matrix``; ``parts``: its (translation,
+        rotation, scale), when the caller composed it from them (the next pose starts from them)."""
         self._local[path] = matrix
+        if parts is None:
+            self._parts.pop(path, None)
+        else:
+            self._parts[path] = parts
+
+    def local_parts(self, path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """(translation, rotation, scale) of :meth:`local`, or None when the camera was not posed here."""
+        parts = self._parts.get(path)
+        if parts is None:
+            local = self._local.get(path)
+            if local is None:
+                return None
+            parts = self._parts[path] = decompose(local)
+        return parts
 
     def forget_edited(self, changes: ChangeSet) -> None:
         """Drop the poses of cameras whose own ``xformOp``s the stage changed, or that a structural change at
@@ -66,12 +84,13 @@ class CameraPoses:
             return
         for root in map(str, changes.structural):
             below = root.rstrip("/") + "/"
-            for table in (self._local, self._canonical):
+            for table in (self._local, self._parts, self._canonical):
                 for path in [k for k in table if k == root or k.startswith(below)]:
                     del table[path]
         for path, names in changes.edited.items():
             if "*" in names or any(n.startswith("xformOp") for n in names):
                 self._local.pop(str(path), None)
+                self._parts.pop(str(path), None)
                 self._canonical.pop(str(path), None)
 
     def is_canonical(self, prim: Usd.Prim) -> bool:
@@ -107,7 +126,15 @@ def posed_local(current: np.ndarray, parent: np.ndarray, position: Sequence[floa
     """A camera's new local transform: ``current`` with a new ``position`` (local), ``rotation`` (Euler XYZ
     degrees or a (w, x, y, z) quaternion, local) or aim at the world point ``look_at``, under the parent's
     world transform ``parent``; as :func:`graphsdg.stage.xform.set_local_pose` authors it."""
-    t, r, s = decompose(current)
+    return compose(*posed_parts(decompose(current), parent, position, rotation, look_at, up))
+
+
+def posed_parts(current: tuple[np.ndarray, np.ndarray, np.ndarray], parent: np.ndarray,
+                position: Sequence[float] | None, rotation: Sequence[float] | None,
+                look_at: Sequence[float] | None, up: Sequence[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`posed_local` from and to (translation, rotation, scale): a camera posed every frame is not
+    decomposed again each time."""
+    t, r, s = current
     if position is not None:
         t = np.asarray(position, dtype=np.float64)
     if look_at is not None:
@@ -115,7 +142,7 @@ def posed_local(current: np.ndarray, parent: np.ndarray, position: Sequence[floa
     elif rotation is not None:
         rot = np.asarray(rotation, dtype=np.float64)
         r = quat_wxyz_to_matrix(unit_quat(rot)) if rot.shape == (4,) else euler_to_matrix(rot, "XYZ")
-    return compose(t, r, s)
+    return t, r, s
 
 
-__all__ = ["CameraPoses", "posed_local"]
+__all__ = ["CameraPoses", "posed_local", "posed_parts"]

@@ -18,11 +18,11 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg.sim.camera_poses import posed_local
+from graphsdg.sim.camera_poses import posed_parts
 from graphsdg.sim.gprims import primitive_size
 from graphsdg.sim.scene import SimScene
 from graphsdg.sim.uniform_scales import UniformScalePlan
-from graphsdg.maths.rotations import canonical_quat, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
+from graphsdg.maths.rotations import canonical_quat, compose, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
     quat_multiply, unit_quat
 from graphsdg.stage.xform import parent_world_matrix
 
@@ -204,14 +204,13 @@ def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.n
         return False
     for i, prim in enumerate(prims):
         path = str(prim.GetPath())
-        current = poses.local(path)
+        current = poses.local_parts(path)
         if current is None:
-            current = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
-                               dtype=np.float64)
-        poses.set_local(path, posed_local(current, poses.parent_world(prim, path),
-                                          None if positions is None else positions[i],
-                                          None if rotations is None else rotations[i],
-                                          None if looks is None else looks[i], up))
+            current = decompose(np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
+                                         dtype=np.float64))
+        parts = posed_parts(current, poses.parent_world(prim, path), None if positions is None else positions[i],
+                            None if rotations is None else rotations[i], None if looks is None else looks[i], up)
+        poses.set_local(path, compose(*parts), parts)
     return True
 
 

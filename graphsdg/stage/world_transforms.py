@@ -27,10 +27,7 @@ from __future__ import annotations
 import numpy as np
 from pxr import Tf, Usd, UsdGeom
 
-from graphsdg.stage.xform import world_matrix
-
-_IDENTITY = np.eye(4)
-_IDENTITY.flags.writeable = False
+from graphsdg.stage.xform import IDENTITY4, world_matrix
 
 
 class WorldTransforms:
@@ -53,12 +50,15 @@ class WorldTransforms:
 
     def parent_world(self, prim: Usd.Prim, path: str | None = None) -> np.ndarray:
         """The world transform of ``prim``'s parent (identity at the root or under a prim that is not
-        Xformable); ``path``: the prim's path as a string, when the caller has it."""
+        Xformable: then :data:`graphsdg.stage.xform.IDENTITY4` itself); ``path``: the prim's path as a
+        string, when the caller has it."""
         key = str(prim.GetPath()) if path is None else path
         found = self._parents.get(key)
         if found is None:
             parent = prim.GetParent()
-            found = world_matrix(parent) if parent and parent.IsA(UsdGeom.Xformable) else _IDENTITY
+            found = world_matrix(parent) if parent and parent.IsA(UsdGeom.Xformable) else IDENTITY4
+            if found is not IDENTITY4 and np.array_equal(found, IDENTITY4):
+                found = IDENTITY4           # readers skip the product with it (xform.aimed_rotation)
             found.flags.writeable = False   # shared by every reader until the stage changes
             self._parents[key] = found
         return found

@@ -24,6 +24,10 @@ _ROTATE_OPS = {
 }
 _OP_ORDER_BY_TYPE = {v: k for k, v in _ROTATE_OPS.items()}
 _IDENTITY3 = np.eye(3)
+# The identity transform shared by readers that keep world transforms (stage/world_transforms.py): a parent
+# given as this very object is known to move nothing, with no comparison
+IDENTITY4 = np.eye(4)
+IDENTITY4.flags.writeable = False
 
 
 def up_axis_vector(stage: Usd.Stage) -> tuple[float, float, float]:
@@ -50,6 +54,8 @@ def aimed_rotation(local_position: Sequence[float], parent_m: np.ndarray, target
                    up: Sequence[float]) -> np.ndarray:
     """The local rotation that turns a prim at ``local_position`` under the parent transform ``parent_m`` so its
     -Z points at the world point ``target``, its +Y leaning to ``up`` (how cameras and lights aim)."""
+    if parent_m is IDENTITY4:
+        return look_at_matrix(local_position, target, up)
     eye = np.append(np.asarray(local_position, dtype=np.float64), 1.0) @ parent_m
     r_world = look_at_matrix(eye[:3], target, up)
     if np.array_equal(parent_m[:3, :3], _IDENTITY3):   # the common case: no rotation above
