@@ -118,8 +118,7 @@ def semantic_segmentation(frame: FrameView, params: dict) -> dict:
     present = sorted(set(drawn.tolist()) | set(RESERVED))
     key = _color_key if params.get("colorize") else str
     if params.get("colorize"):
-        all_ids = set(imap.semantic_ids.tolist()) | set(RESERVED)
-        data = frame.colorized_id_image("semantic", filt, {i: color_of(i) for i in all_ids})
+        data = frame.colorized_id_image("semantic", filt)
     else:
         data = frame.semantic_image(filt).copy()
     return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},

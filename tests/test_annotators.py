@@ -790,3 +790,29 @@ def test_tight_boxes_and_label_tables_read_a_backends_code_bounds_when_it_makes_
     moved = boxes.get_data()["data"]
     assert np.array_equal(moved["x_min"], from_pixels["x_min"] + 1)
     assert np.array_equal(moved["x_max"], from_pixels["x_max"] + 1)
+
+
+def test_tight_boxes_of_one_geom_instances_equal_the_union_of_their_geoms(monkeypatch):
+    # one geom an instance (randomized assets): the boxes come straight from the geoms' boxes; they must be
+    # what the general union of each instance's geoms gives
+    from graphsdg.annotate.frame import InstanceMap
+    rep.stage.new_stage()
+    rep.functional.create.dome_light(intensity=500)
+    rng = np.random.default_rng(3)
+    for i in range(8):
+        rep.functional.create.cube(position=tuple(rng.uniform(-1.5, 1.5, 3)), scale=0.4 + 0.2 * (i % 3),
+                                   semantics={"class": f"c{i % 3}"})
+    cam = rep.functional.create.camera(position=(6, 6, 5), look_at=(0, 0, 0))
+    rp = rep.create.render_product(cam, (96, 72))
+    boxes = rep.annotators.get("bounding_box_2d_tight")
+    boxes.attach(rp)
+    rep.orchestrator.step()
+    fast = boxes.get_data()
+    original = InstanceMap.derived
+    monkeypatch.setattr(InstanceMap, "derived",
+                        lambda self, key, build: False if key == "one_geom_each" else original(self, key, build))
+    rep.orchestrator.step(delta_time=0)
+    general = boxes.get_data()
+    assert len(fast["data"]) >= 4
+    assert np.array_equal(fast["data"], general["data"])
+    assert fast["info"]["primPaths"] == general["info"]["primPaths"]

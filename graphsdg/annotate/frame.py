@@ -15,12 +15,13 @@ ones (Replicator's ``matchingLabels``), several per type kept as a list.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
 from pxr import Usd
 
-from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, labels_key
+from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, color_of, labels_key
 from graphsdg.annotate.motion import PoseSnapshot, history
 from graphsdg.annotate.semantic_filter import ALL_LABELS, SemanticFilter
 from graphsdg.render.camera import CameraView
@@ -48,9 +49,32 @@ class InstanceMap:
     semantic_ids: np.ndarray               # uint32 semantic id per instance
     geom_instance: np.ndarray              # int32 per geom
     semantic_labels: dict[int, dict[str, list[str]]]   # semantic id -> labels
+    # values derived from the fields above (per-geom lookup tables...), kept as long as the map is: a map
+    # is rebuilt when the labels or the model change, and the same one serves every frame until then
+    _derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     def geoms_of(self, index: int) -> np.ndarray:
         return np.nonzero(self.geom_instance == index)[0]
+
+    def derived(self, key: object, build: Callable[[], Any]) -> Any:
+        """``build()`` once for this map under ``key`` (a table every frame would otherwise rebuild)."""
+        found = self._derived.get(key)
+        if found is None:
+            found = self._derived[key] = build()
+        return found
+
+    def id_lut(self, kind: str) -> np.ndarray:
+        """geom index -> ``"semantic"`` or ``"instance"`` id (unlabelled geoms 1), with index -1 (the
+        background) -> 0."""
+        def build():
+            per_instance = self.semantic_ids if kind == "semantic" else self.instance_ids
+            lut = np.full(len(self.geom_instance) + 1, UNLABELLED_ID, dtype=np.uint32)
+            labelled = self.geom_instance >= 0
+            lut[:-1][labelled] = per_instance[self.geom_instance[labelled]]
+            lut[-1] = BACKGROUND_ID
+            lut.flags.writeable = False
+            return lut
+        return self.derived(("id_lut", kind), build)
 
 
 @dataclass
@@ -223,42 +247,32 @@ class FrameView:
 
     def semantic_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """uint32 (H, W): semantic id per pixel; 0 background, 1 unlabelled geometry."""
-        def build():
-            imap = self.instance_map(semantic_filter)
-            return self._id_image(semantic_filter, imap.semantic_ids)
-        return self.cached(("semantic_image", semantic_filter.text), build)
+        return self.cached(("semantic_image", semantic_filter.text),
+                           lambda: self._id_image(semantic_filter, "semantic"))
 
     def instance_id_image(self, semantic_filter: SemanticFilter = ALL_LABELS) -> np.ndarray:
         """uint32 (H, W): instance id per pixel; 0 background, 1 unlabelled geometry."""
-        def build():
-            imap = self.instance_map(semantic_filter)
-            return self._id_image(semantic_filter, imap.instance_ids)
-        return self.cached(("instance_id_image", semantic_filter.text), build)
+        return self.cached(("instance_id_image", semantic_filter.text),
+                           lambda: self._id_image(semantic_filter, "instance"))
 
-    def _id_lut(self, per_instance: np.ndarray, imap: InstanceMap) -> np.ndarray:
-        """geom index -> id (unlabelled geoms 1), with index -1 (background) -> 0."""
-        lut = np.full(len(imap.geom_instance) + 1, UNLABELLED_ID, dtype=np.uint32)
-        labelled = imap.geom_instance >= 0
-        lut[:-1][labelled] = per_instance[imap.geom_instance[labelled]]
-        lut[-1] = BACKGROUND_ID
-        return lut
-
-    def colorized_id_image(self, kind: str, semantic_filter: SemanticFilter, colors: dict[int, tuple]) -> np.ndarray:
-        """uint8 (H, W, 4): the ``"semantic"``/``"instance"`` id image already coloured, in one
-        lookup per pixel (geom -> packed RGBA) instead of ids then colours."""
+    def colorized_id_image(self, kind: str, semantic_filter: SemanticFilter) -> np.ndarray:
+        """uint8 (H, W, 4): the ``"semantic"``/``"instance"`` id image already coloured with
+        :func:`graphsdg.annotate.ids.color_of`, in one lookup per pixel (geom -> packed RGBA) instead of ids
+        then colours."""
         imap = self.instance_map(semantic_filter)
-        per_instance = imap.semantic_ids if kind == "semantic" else imap.instance_ids
-        ids = self._id_lut(per_instance, imap)
-        # one colour per distinct id, spread over the geoms (a Python step per geom cost ~1 us each: 5 ms a frame
-        # at 5,000 assets)
-        distinct, slot = np.unique(ids, return_inverse=True)
-        palette = np.array([colors[int(v)] for v in distinct.tolist()], dtype=np.uint8).reshape(-1, 4)[slot]
-        packed = self.ids_through(np.ascontiguousarray(palette).view(np.uint32)[:, 0])
+
+        def palette():   # packed RGBA per geom index (and the background's last)
+            ids = imap.id_lut(kind)
+            # one colour per distinct id, spread over the geoms (a Python step per geom cost ~1 us each: 5 ms
+            # a frame at 5,000 assets)
+            distinct, slot = np.unique(ids, return_inverse=True)
+            rgba = np.array([color_of(int(v)) for v in distinct.tolist()], dtype=np.uint8).reshape(-1, 4)[slot]
+            return np.ascontiguousarray(rgba).view(np.uint32)[:, 0]
+        packed = self.ids_through(imap.derived(("palette", kind), palette))
         return packed.view(np.uint8).reshape(*packed.shape, 4)
 
-    def _id_image(self, semantic_filter: SemanticFilter, per_instance: np.ndarray) -> np.ndarray:
-        lut = self._id_lut(per_instance, self.instance_map(semantic_filter))
-        return self.ids_through(lut)   # one lookup per pixel
+    def _id_image(self, semantic_filter: SemanticFilter, kind: str) -> np.ndarray:
+        return self.ids_through(self.instance_map(semantic_filter).id_lut(kind))   # one lookup per pixel
 
     def present_geoms(self) -> np.ndarray:
         """Geom ids drawn in this frame (-1 included when background shows): from the renderer's code bounds
@@ -286,9 +300,7 @@ class FrameView:
         """Sorted distinct ``"semantic"`` or ``"instance"`` ids in this frame, from the drawn geoms
         (one histogram of the id image shared by every id annotator, not one scan each)."""
         def build():
-            imap = self.instance_map(semantic_filter)
-            per_instance = imap.semantic_ids if kind == "semantic" else imap.instance_ids
-            return np.unique(self._id_lut(per_instance, imap)[self.present_geoms()])
+            return np.unique(self.instance_map(semantic_filter).id_lut(kind)[self.present_geoms()])
         return self.cached(("present_ids", kind, semantic_filter.text), build)
 
     # ---- boxes and occlusion -------------------------------------------
@@ -313,6 +325,10 @@ class FrameView:
             owner = imap.geom_instance[drawn] if drawn.size else np.zeros(0, dtype=np.int32)
             keep = owner >= 0
             drawn, owner = drawn[keep], owner[keep]
+            if imap.derived("one_geom_each", lambda: bool((np.bincount(imap.geom_instance[imap.geom_instance >= 0],
+                                                                        minlength=1) <= 1).all())):
+                order = np.argsort(owner, kind="stable")   # an instance's box is its one geom's
+                return owner[order].astype(np.intp), geom_boxes[drawn[order]].astype(np.int32, copy=False), None
             big = np.iinfo(np.int32).max
             lo = np.full((n, 2), big, dtype=np.int32)
             hi = np.full((n, 2), -1, dtype=np.int32)
