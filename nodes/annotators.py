@@ -112,17 +112,23 @@ def distance_to_camera(frame: FrameView, params: dict) -> dict:
 def semantic_segmentation(frame: FrameView, params: dict) -> dict:
     """uint32 (H, W) semantic ids (uint8 (H, W, 4) with ``colorize``); ``idToLabels``."""
     filt = semantic_filter(params)
-    imap = frame.instance_map(filt)
-    lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
+    colorize = bool(params.get("colorize"))
+    table = _semantic_rows(frame.instance_map(filt), colorize)
     drawn = frame.present_ids("semantic", filt)
-    present = sorted(set(drawn.tolist()) | set(RESERVED))
-    key = _color_key if params.get("colorize") else str
-    if params.get("colorize"):
-        data = frame.colorized_id_image("semantic", filt)
-    else:
-        data = frame.semantic_image(filt).copy()
-    return {"data": data, "info": {"idToLabels": {key(i): joined(lists[i]) for i in present},
-                                   "idToLabelLists": {key(i): lists[i] for i in present}}}
+    rows = [table[i] for i in sorted(set(drawn.tolist()) | set(RESERVED))]
+    data = frame.colorized_id_image("semantic", filt) if colorize else frame.semantic_image(filt).copy()
+    return {"data": data, "info": {"idToLabels": {key: labels for key, labels, _ in rows},
+                                   "idToLabelLists": {key: lists for key, _, lists in rows}}}
+
+
+def _semantic_rows(imap, colorize: bool) -> dict[int, tuple[str, dict, dict]]:
+    """Semantic id -> (its key in the info tables, its joined labels, its label lists), the reserved ids
+    included; kept with the instance map (the same every frame until the labels change)."""
+    def build():
+        lists = {**{i: {RESERVED_TYPE: [name]} for i, name in RESERVED.items()}, **imap.semantic_labels}
+        key = _color_key if colorize else str
+        return {i: (key(i), joined(labels), labels) for i, labels in lists.items()}
+    return imap.derived(("semantic_rows", colorize), build)
 
 
 def instance_segmentation(frame: FrameView, params: dict) -> dict:
@@ -159,9 +165,10 @@ def instance_id_segmentation(frame: FrameView, params: dict) -> dict:
 
 # ---- boxes and occlusion ----------------------------------------------------
 def _box_info(imap, rows_sem: np.ndarray, idx: np.ndarray) -> dict:
-    ids = np.unique(rows_sem)
-    return {"idToLabels": {str(int(s)): joined(imap.semantic_labels[int(s)]) for s in ids},
-            "idToLabelLists": {str(int(s)): imap.semantic_labels[int(s)] for s in ids},
+    table = _semantic_rows(imap, False)
+    rows = [table[s] for s in np.unique(rows_sem).tolist()]
+    return {"idToLabels": {key: labels for key, labels, _ in rows},
+            "idToLabelLists": {key: lists for key, _, lists in rows},
             "bboxIds": imap.instance_ids[idx].astype(np.uint32),
             "primPaths": [imap.paths[i] for i in idx]}
 
