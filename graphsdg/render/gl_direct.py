@@ -37,6 +37,7 @@ _SIGNATURES: dict[str, tuple[Any, tuple]] = {
     "glBindFramebuffer": (None, (_u, _u)),
     "glBindBuffer": (None, (_u, _u)),
     "glReadBuffer": (None, (_u,)),
+    "glDrawBuffer": (None, (_u,)),
     "glPixelStorei": (None, (_u, _i)),
     "glFenceSync": (_p, (_u, _u)),
     "glClientWaitSync": (_u, (_p, _u, _u64)),

@@ -115,6 +115,15 @@ class PendingPixels:
         return out
 
 
+def restore_offscreen_bindings(ctx: mujoco.MjrContext) -> None:
+    """What ``mujoco.mjr_setBuffer(mjFB_OFFSCREEN, ctx)`` binds in a context without a window (its offscreen
+    framebuffer for drawing and reading, colour attachment 0 both ways), through calls that keep the
+    interpreter lock: the binding's own call releases it, ~8 us a read on a GPU host, three reads a frame."""
+    gld.glBindFramebuffer(GL.GL_FRAMEBUFFER, ctx.offFBO)
+    gld.glReadBuffer(GL.GL_COLOR_ATTACHMENT0)
+    gld.glDrawBuffer(GL.GL_COLOR_ATTACHMENT0)
+
+
 class PixelReads:
     """A pool of pixel-buffer objects for one GL context, and the reads that use them.
 
@@ -187,8 +196,8 @@ class PixelReads:
             self._fences = bool(GL.glFenceSync)
         fence = gld.glFenceSync(GL.GL_SYNC_GPU_COMMANDS_COMPLETE, 0) if self._fences else None
         gld.glBindBuffer(GL.GL_PIXEL_PACK_BUFFER, 0)
+        restore_offscreen_bindings(ctx)   # MuJoCo's own bindings back
         gld.check(f"queuing a read of {kind} pixels")
-        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # MuJoCo's own bindings back
         shape = (height, width, channels) if channels > 1 else (height, width)
         return PendingPixels(self, pbo, nbytes, shape, dtype, decode, fence)
 
