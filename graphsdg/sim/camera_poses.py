@@ -136,7 +136,7 @@ def posed_parts(current: tuple[np.ndarray, np.ndarray, np.ndarray], parent: np.n
     decomposed again each time."""
     t, r, s = current
     if position is not None:
-        t = np.asarray(position, dtype=np.float64)
+        t = np.array(position, dtype=np.float64)   # a copy: the parts are kept for the next pose
     if look_at is not None:
         r = aimed_rotation(t, parent, look_at, up)
     elif rotation is not None:

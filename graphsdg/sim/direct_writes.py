@@ -27,8 +27,13 @@ from graphsdg.maths.rotations import canonical_quat, compose, decompose, euler_x
 from graphsdg.stage.xform import parent_world_matrix
 
 
+_NOT_WORKED_OUT = object()
+
+
 class DirectTargets:
     """Compiled-model indices of a list of prims, cached per compiled model."""
+
+    _uniform_plan: UniformScalePlan | None | object = _NOT_WORKED_OUT   # see uniform_plan()
 
     def __init__(self, sim: SimScene, prims: Sequence[Usd.Prim]) -> None:
         c = sim.ensure_compiled()
@@ -74,7 +79,7 @@ class DirectTargets:
     def uniform_plan(self, model: mujoco.MjModel) -> UniformScalePlan | None:
         """How this batch's uniform rescales are written (:mod:`graphsdg.sim.uniform_scales`), or None where
         they take the general path; worked out on first use (the targets are cached per compile)."""
-        if not hasattr(self, "_uniform_plan"):
+        if self._uniform_plan is _NOT_WORKED_OUT:
             plan = None
             if UniformScalePlan.fits(self, model):
                 prims = np.flatnonzero(~self.is_mesh)
