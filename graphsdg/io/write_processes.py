@@ -39,6 +39,7 @@ import collections
 import fcntl
 import mmap
 import os
+import pickle
 import select
 import subprocess
 import sys
@@ -209,7 +210,9 @@ class WriteProcesses:
         for path in batch.paths:
             self._owner.setdefault(path, [process, 0])[1] += 1
         try:
-            process.requests.send(("write", tasks))
+            # plain pickle: Connection.send's ForkingPickler copies its reducer table for every message, and the
+            # tasks hold nothing that needs its reducers (the process reads them with Connection.recv)
+            process.requests.send_bytes(pickle.dumps(("write", tasks), protocol=pickle.HIGHEST_PROTOCOL))
         except OSError:
             pass                                   # collect() sees the process's end and fails the batch
 
@@ -231,7 +234,8 @@ class WriteProcesses:
         for i, data, size in arrays:
             view = np.ndarray(data.shape, dtype=data.dtype, buffer=process.arena, offset=offset)
             np.copyto(view, data, casting="no")
-            in_arena[i] = ("arena", offset, data.dtype, data.shape)
+            # a plain dtype crosses as its string (pickling the dtype object costs several times as much)
+            in_arena[i] = ("arena", offset, data.dtype.str if data.dtype.names is None else data.dtype, data.shape)
             offset += size
         return [(w.kind, w.path, durable, w.indent, in_arena.get(i) or ("value", w.data))
                 for i, (w, _) in enumerate(writes)]
