@@ -357,7 +357,8 @@ class Rasterizer:
             raise ValueError(f"resolution {view.width}x{view.height} exceeds the offscreen buffer "
                              f"{model.vis.global_.offwidth}x{model.vis.global_.offheight}")
         out = RenderOutputs()
-        bounds = geometry_bounds(model, sim.data)   # one state for all of this render's passes
+        drawn = drawn_geom_mask(model)
+        bounds = geometry_bounds(model, sim.data, drawn)   # one state for all of this render's passes
         colour = "color" in passes or "hdr" in passes
         # Without MSAA the colour pass's depth buffer is sampled at pixel centres, so colour and
         # depth come from one render; with MSAA it holds an off-centre sample, so depth is read
@@ -368,7 +369,7 @@ class Rasterizer:
         if colour:
             scene_far = self._render_color(sim, view, bounds, subframes, out, want_color="color" in passes,
                                            want_linear="hdr" in passes, want_depth=depth_with_colour,
-                                           motion=motion)
+                                           motion=motion, drawn=drawn)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
             codes, lut, depth = self._render_ids(sim, view, bounds, None, with_depth="depth" in passes,
                                                  scene_far=scene_far)
@@ -384,9 +385,10 @@ class Rasterizer:
 
     def _render_color(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], subframes: int,
                       out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool,
-                      motion: MotionSamples | None = None) -> float | None:
+                      motion: MotionSamples | None = None, drawn: np.ndarray | None = None) -> float | None:
         """Draw and queue the colour pass; returns the far plane when the scene is left as updated for
-        the unjittered view (one subframe), else None."""
+        the unjittered view (one subframe), else None. ``drawn``: :func:`drawn_geom_mask` of the model, when
+        the caller has it."""
         assert self._scene is not None and self._mjr is not None and self._reads is not None
         scene, ctx = self._scene, self._mjr
         w, h = view.width, view.height
@@ -396,8 +398,9 @@ class Rasterizer:
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         # a one-colour sky is one flat rectangle behind the geometry, cheaper than MuJoCo's skybox draw
         background = self._flat_sky
-        if background is not None and not sky.fill_is_exact(sim.model, drawn_geom_mask(sim.model)):
-            background = None
+        if background is not None:
+            if not sky.fill_is_exact(sim.model, drawn_geom_mask(sim.model) if drawn is None else drawn):
+                background = None
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = background is None
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
         if background is not None:
@@ -521,15 +524,17 @@ def _put_average(out: RenderOutputs, mean: np.ndarray, want_color: bool, want_li
         out.put("hdr", mean / np.float32(255))
 
 
-def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, float]:
-    """(centre, radius) of a sphere around every drawn, bounded geom where it is now.
+def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData,
+                    drawn: np.ndarray | None = None) -> tuple[np.ndarray, float]:
+    """(centre, radius) of a sphere around every drawn, bounded geom where it is now (``drawn``:
+    :func:`drawn_geom_mask` of the model, when the caller has it).
 
     Poses written since the compile (randomization, physics) move geoms away
     from the model's compile-time ``stat.center`` / ``stat.extent``, which are
     the fallback when no geom is bounded (planes alone).
     """
     radii = np.asarray(model.geom_rbound)
-    bounded = (radii > 0) & drawn_geom_mask(model)
+    bounded = (radii > 0) & (drawn_geom_mask(model) if drawn is None else drawn)
     if not bounded.any():
         return np.asarray(model.stat.center, dtype=np.float64), float(model.stat.extent)
     pos, r = np.asarray(data.geom_xpos)[bounded], radii[bounded][:, None]
