@@ -467,21 +467,21 @@ def _run_boxes(runs: tuple[np.ndarray, np.ndarray, np.ndarray], w: int, n: int) 
     """
     boxes = np.full((n, 4), -1, dtype=np.int32)
     starts, ends, labels = runs
-    keep = labels >= 0
-    if n == 0 or not keep.any():
+    if n == 0 or not labels.size:
         return boxes
-    starts, ends, labels = starts[keep], ends[keep], labels[keep]
     sy, sx = np.divmod(starts, w)
-    ex = ends % w
+    # slot 0 collects the unlabelled runs (label -1), so no run is filtered out first (four one-dimensional
+    # scatters: NumPy's fast path; a scatter of (x, y) rows is ~10 times slower)
+    slot = labels + 1
     big = np.iinfo(np.int64).max
-    lo_x, lo_y = np.full(n, big), np.full(n, big)
-    hi_x, hi_y = np.full(n, -1), np.full(n, -1)
-    np.minimum.at(lo_x, labels, sx)
-    np.minimum.at(lo_y, labels, sy)
-    np.maximum.at(hi_y, labels, sy)
-    np.maximum.at(hi_x, labels, ex)
-    present = hi_x >= 0
-    boxes[present] = np.stack([lo_x, lo_y, hi_x, hi_y], 1)[present]
+    lo_x, lo_y = np.full(n + 1, big), np.full(n + 1, big)
+    hi_x, hi_y = np.full(n + 1, -1), np.full(n + 1, -1)
+    np.minimum.at(lo_x, slot, sx)
+    np.minimum.at(lo_y, slot, sy)
+    np.maximum.at(hi_y, slot, sy)
+    np.maximum.at(hi_x, slot, ends % w)
+    present = hi_x[1:] >= 0
+    boxes[present] = np.stack([lo_x[1:], lo_y[1:], hi_x[1:], hi_y[1:]], 1)[present]
     return boxes
 
 
