@@ -37,6 +37,8 @@ from typing import Iterator
 import mujoco
 from OpenGL import GL
 
+from graphsdg.render.readback import restore_offscreen_bindings
+
 
 _COLOUR_FORMATS = {8: GL.GL_R8, 16: GL.GL_RG8, 24: GL.GL_RGBA8}
 
@@ -78,12 +80,12 @@ class IdFramebuffer:
         """Make MuJoCo's offscreen framebuffer this one (single-sample) for the block."""
         fbo, samples = ctx.offFBO, ctx.offSamples
         ctx.offFBO, ctx.offSamples = self.fbo, 0
-        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)   # binds it for drawing and reading
+        restore_offscreen_bindings(ctx)   # binds it for drawing and reading
         try:
             yield
         finally:
             ctx.offFBO, ctx.offSamples = fbo, samples
-            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, ctx)
+            restore_offscreen_bindings(ctx)
 
     def free(self) -> None:
         """Delete the framebuffer and its storage (the context must be current)."""

@@ -158,9 +158,10 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
         world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3)
         if not t.parent_is_identity:
             world_scale = world_scale * t.parent_s
+        current = t.current_scales()
         plan = t.uniform_plan(m)
         if plan is not None:
-            uniform = plan.prepare(world_scale, t.current_scales())
+            uniform = plan.prepare(world_scale, current)
     if scales is not None and uniform is None:
         sized, sizes = _simple_sizes(t, world_scale)
         for i in np.flatnonzero(~sized & ~t.is_mesh):   # unevenly scaled spheres, x/y-axis tubes
@@ -179,9 +180,8 @@ def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray 
         d.mocap_quat[t.mocap_ids] = local_q if t.parent_is_identity else \
             canonical_quat(quat_multiply(t.parent_q, local_q))
     if uniform is not None:
-        plan.write(sim, uniform, world_scale, t.current_scales())
+        plan.write(sim, uniform, world_scale, current)
     elif scales is not None:
-        current = t.current_scales()
         _write_mesh_scales(sim, t, world_scale, current)
         rows = np.flatnonzero(sized)
         if rows.size:

@@ -153,12 +153,11 @@ class SimScene:
         if self.mesh_reshapes.shape[0] != nmesh:
             self.mesh_reshapes = np.zeros(nmesh, dtype=np.int64)
         ids = np.asarray(list(mesh_ids) if isinstance(mesh_ids, set) else mesh_ids, dtype=np.int64)
-        if distinct and mapped:
-            self.mesh_stamps[ids] += 1
-            return
-        np.add.at(self.mesh_stamps, ids, 1)
-        if not mapped:
-            np.add.at(self.mesh_reshapes, ids, 1)
+        for counts in (self.mesh_stamps,) if mapped else (self.mesh_stamps, self.mesh_reshapes):
+            if distinct:
+                counts[ids] += 1
+            else:
+                np.add.at(counts, ids, 1)
 
     def recompile(self, keep_state: bool = True) -> CompiledScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
