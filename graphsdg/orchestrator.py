@@ -12,7 +12,6 @@ import enum
 import logging
 import sys
 import time
-from fractions import Fraction
 from typing import Any, Callable
 
 from graphsdg import settings_store as settings
@@ -28,6 +27,7 @@ from graphsdg.io.location import open_location
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
 from graphsdg.jobs import frame_plan
 from graphsdg.jobs.progress import Progress
+from graphsdg.maths.reference_time import reference_time
 from graphsdg.render import motion_blur
 from graphsdg.render.attachments import attachments
 from graphsdg.render.backend import RenderRequest
@@ -293,12 +293,12 @@ class _Capture:
                 t = _timed(f"annotate:{a.spec.name}", t)
             if frame.outputs is not None:
                 frame.outputs.finish()   # a pass no annotator read still holds a pixel buffer: hand it back
-        reference_time = Fraction(self.sim_time).limit_denominator(1_000_000)
+        time_ratio = reference_time(self.sim_time)
         with get_write_queue().batch():   # the frame's files wake the writer threads once
-            self._write(rt, outputs, reference_time)
+            self._write(rt, outputs, time_ratio)
         _timed("write", t)
 
-    def _write(self, rt, outputs: dict, reference_time: Fraction) -> None:
+    def _write(self, rt, outputs: dict, time_ratio: tuple[int, int]) -> None:
         for writer in self.writers:
             if writer not in rt.writers or not writer.wants_frame(self.fired):
                 continue
@@ -306,7 +306,7 @@ class _Capture:
             if self.planned_frame is not None:   # sharded / resumed: the frame's number in the whole dataset
                 extra["frame_index"] = _state.frame_bases.get(id(writer), 0) + self.planned_frame
             data = writer.build_payload(outputs, self.trigger_outputs,
-                                        (reference_time.numerator, reference_time.denominator), extra=extra or None)
+                                        time_ratio, extra=extra or None)
             with run_state.frame(writer, self.stage_step, data.get("frame_index")):   # for graphsdg_run.json
                 writer._write(data)   # metadata.txt on the first frame, then write(); errors reach the script
 

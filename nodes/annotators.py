@@ -13,7 +13,6 @@ types) or ``semanticFilter`` (a predicate, see
 """
 from __future__ import annotations
 
-from fractions import Fraction
 
 import numpy as np
 from pxr import Usd, UsdGeom
@@ -25,6 +24,7 @@ from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, color_of
 from graphsdg.annotate.motion import motion_vectors as motion_between
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.annotate.skeletons import skeleton_data as skeletons_seen
+from graphsdg.maths.reference_time import reference_time as maths_reference_time
 
 BBOX_2D_DTYPE = np.dtype([("semanticId", "<u4"), ("x_min", "<i4"), ("y_min", "<i4"), ("x_max", "<i4"),
                           ("y_max", "<i4"), ("occlusionRatio", "<f4")])
@@ -337,8 +337,8 @@ def skeleton_data(frame: FrameView, params: dict) -> dict:
 
 def reference_time(frame: FrameView, params: dict) -> dict:
     """The simulation time of the capture as a fraction."""
-    t = Fraction(frame.sim_time).limit_denominator(1_000_000)
-    return {"info": {"referenceTimeNumerator": t.numerator, "referenceTimeDenominator": t.denominator}}
+    numerator, denominator = maths_reference_time(frame.sim_time)
+    return {"info": {"referenceTimeNumerator": numerator, "referenceTimeDenominator": denominator}}
 
 
 # ---- registration -----------------------------------------------------------

@@ -121,7 +121,7 @@ def test_writes_to_one_file_land_in_the_order_scheduled(out_dir):
 
 def test_the_arena_is_a_ring_with_backpressure_and_oversized_arrays_travel_in_the_message(tmp_path):
     done = []
-    pool = WriteProcesses(1, on_done=lambda token, error, nbytes, seconds: done.append((token, error)),
+    pool = WriteProcesses(1, on_done=lambda finished, seconds: done.extend((t, e) for t, e, _ in finished),
                           arena_bytes=1 << 20)
     arrays = [np.full((400, 256), i, np.float32) for i in range(12)]      # 400 KB each: ~2 fit at a time
     for i, a in enumerate(arrays):
@@ -254,3 +254,38 @@ def test_no_thread_reads_the_replies_the_threads_using_the_pool_take_them(out_di
     queue.wait_until_done()
     assert [float(np.load(os.path.join(out_dir, f"{i}.npy"))[0, 0]) for i in range(30)] == list(range(30))
     assert set(threading.enumerate()) == before
+
+
+def test_a_group_closed_inside_a_batch_reports_when_its_writes_are_written(out_dir):
+    """A frame's group closes before the batch holding its writes is sent: it must not report them done then."""
+    rep.settings.set("/graphsdg/io/writeProcesses", 1)
+    queue = get_write_queue()
+    done = []
+    os.makedirs(out_dir, exist_ok=True)
+    open(os.path.join(out_dir, "blocker"), "w").close()                 # a file where a folder must go
+    with queue.batch():
+        with queue.group(done.append):
+            queue.schedule(iof.write_np, data=np.arange(3), path=os.path.join(out_dir, "a.npy"))
+            queue.schedule(iof.write_json, data={"a": 1}, path=os.path.join(out_dir, "a.json"))
+        with queue.group(done.append):
+            queue.schedule(iof.write_np, data=np.arange(3), path=os.path.join(out_dir, "blocker", "b.npy"))
+        with queue.group(done.append):
+            pass                                             # nothing scheduled: done when the block ends
+        assert done == [True] and queue.pending() == 0      # the batch's writes are not sent yet
+    with pytest.raises(WriterError, match="blocker/b.npy"):
+        queue.wait_until_done()
+    assert sorted(done) == [False, True, True]
+    assert np.load(os.path.join(out_dir, "a.npy")).tolist() == [0, 1, 2]
+
+
+def test_a_batch_larger_than_the_queue_goes_whole_once_the_queue_is_empty(out_dir):
+    rep.settings.set("/graphsdg/io/writeProcesses", 1)
+    rep.settings.set("/omni/replicator/backend/queueSize", 2)
+    queue = get_write_queue()
+    for frame in range(4):
+        with queue.batch():
+            for i in range(5):
+                queue.schedule(iof.write_np, data=np.full(4, frame), path=os.path.join(out_dir, f"{frame}_{i}.npy"))
+        assert queue.pending() <= 5
+    queue.wait_until_done()
+    assert [np.load(os.path.join(out_dir, f"{f}_4.npy"))[0] for f in range(4)] == [0, 1, 2, 3]

@@ -124,9 +124,14 @@ class DiskBackend(BaseBackend):
         return path
 
     def resolve(self, path: str) -> str:
-        if self.output_dir is None:
+        """The absolute path of ``path`` under the output folder; raises if it would leave the folder."""
+        root = self.output_dir
+        if root is None:
             raise RuntimeError("DiskBackend was not initialized; call backend.initialize(output_dir=...)")
-        full = os.path.normpath(os.path.join(self.output_dir, path))
+        if path and path[0] != "/" and path[-1] != "/" and "/." not in path and "//" not in path and \
+                path[0] != "." and root[-1] != "/":
+            return f"{root}/{path}"   # already normal (a writer's own names, every frame): nothing to collapse
+        full = os.path.normpath(os.path.join(root, path))
         if not (full == self.output_dir or full.startswith(self.output_dir + os.sep)):
             raise ValueError(f"path {path!r} escapes the output directory {self.output_dir!r}")
         return full

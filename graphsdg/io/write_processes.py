@@ -18,8 +18,8 @@ and most writers schedule to a local file, to writer processes instead:
 * the processes encode with the same functions as a writer thread (:mod:`graphsdg.io.write_process`),
   so the files are byte for byte the same.
 
-A write that fails in a process reaches the caller's ``on_done`` with the error, naming the file; a
-process that dies fails every write it held. Writes of other kinds (a writer's own function, an S3
+Each batch that finishes reaches the caller's ``on_done`` once, with every write's token and outcome (a
+write that failed carries its error, naming the file); a process that dies fails every write it held. Writes of other kinds (a writer's own function, an S3
 bucket) and writes of large arrays (``write_queue.PROCESS_WRITE_MAX_BYTES``: copying them costs more
 than it saves) stay on the write queue's threads.
 
@@ -27,7 +27,7 @@ Example:
     >>> import numpy as np, os, tempfile
     >>> folder = tempfile.mkdtemp()
     >>> done = []
-    >>> pool = WriteProcesses(max_processes=1, on_done=lambda token, error, nbytes, seconds: done.append(error))
+    >>> pool = WriteProcesses(max_processes=1, on_done=lambda finished, seconds: done.extend(e for _, e, _ in finished))
     >>> pool.send([(FileWrite("npy", os.path.join(folder, "a.npy"), np.arange(3), None), "a")], durable=False)
     >>> pool.shutdown(); done, np.load(os.path.join(folder, "a.npy")).tolist()
     ([None], [0, 1, 2])
@@ -69,7 +69,9 @@ class FileWrite(NamedTuple):
     indent: int | None
 
 
-OnDone = Callable[[Any, "BaseException | None", int, float], None]
+# on_done(finished, seconds): a batch's writes as (token, error or None, bytes written), and the seconds the
+# process spent on them; called once per batch, on the thread that took the reply
+OnDone = Callable[[list[tuple[Any, "BaseException | None", int]], float], None]
 
 
 def rebuilt_error(type_name: str, errno: int | None, message: str, path: str) -> BaseException:
@@ -158,7 +160,7 @@ class _Process:
 
 
 class WriteProcesses:
-    """Up to ``max_processes`` writer processes; ``on_done(token, error, nbytes, seconds)`` per write."""
+    """Up to ``max_processes`` writer processes; ``on_done(finished, seconds)`` once per batch (:data:`OnDone`)."""
 
     def __init__(self, max_processes: int, on_done: OnDone, arena_bytes: int = ARENA_BYTES) -> None:
         if max_processes < 1:
@@ -296,9 +298,8 @@ class WriteProcesses:
                 if batch.end > batch.start:
                     process.regions.popleft()
                 self._release(batch)
-            share = seconds / max(1, len(results))
-            for token, path, (error, nbytes) in zip(batch.tokens, batch.paths, results):
-                self._on_done(token, None if error is None else rebuilt_error(*error, path), nbytes, share)
+            self._on_done([(token, None if error is None else rebuilt_error(*error, path), nbytes)
+                           for token, path, (error, nbytes) in zip(batch.tokens, batch.paths, results)], seconds)
             if not select.select([process.replies.fileno()], [], [], 0)[0]:
                 return
 
@@ -323,13 +324,11 @@ class WriteProcesses:
         for batch in lost:
             error = RuntimeError(f"the writer process (pid {process.process.pid}) exited with code {code} "
                                  f"before writing the file")
-            for token in batch.tokens:
-                self._on_done(token, error, 0, 0.0)
+            self._on_done([(token, error, 0) for token in batch.tokens], 0.0)
 
     def _fail_now(self, writes: list[tuple[FileWrite, Any]], process: _Process) -> None:
         error = RuntimeError(f"the writer process (pid {process.process.pid}) exited before the write was sent")
-        for _, token in writes:
-            self._on_done(token, error, 0, 0.0)
+        self._on_done([(token, error, 0) for _, token in writes], 0.0)
 
     # ---- state --------------------------------------------------------------
     def pids(self) -> list[int]:

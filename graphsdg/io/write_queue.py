@@ -75,8 +75,13 @@ class TaskGroup:
     def __init__(self, on_done: Callable[[bool], None]) -> None:
         self.on_done = on_done
         self.pending = 0
+        self.unsent = 0      # held in a batch() until it ends: counted by the thread that owns the group, unlocked
         self.failed = False
         self.closed = False
+
+    def finished(self) -> bool:
+        """Whether the block ended and every task it scheduled is done (the queue's lock held)."""
+        return self.closed and self.pending == 0 and self.unsent == 0
 
 
 def payload_bytes(args: tuple, kwargs: dict) -> int:
@@ -227,34 +232,41 @@ class WriteQueue:
         profiling.add("encode+write", time.perf_counter() - start)
         self._settle(nbytes, group, error, _describe(fn, kwargs) if error is not None else "")
 
-    def _settle(self, nbytes: int, group: TaskGroup | None, error: BaseException | None, what: str,
-                in_process: bool = False) -> None:
-        """Account for one finished write (``error``: how it failed, ``what``: which write that was)."""
-        ok = error is None
-        if not ok:
-            with self._cond:
-                self._errors.append((error, what))
+    def _settle(self, nbytes: int, group: TaskGroup | None, error: BaseException | None, what: str) -> None:
+        """Account for one finished write on a thread (``error``: how it failed, ``what``: which write that was)."""
+        self._settle_all([(nbytes, group, error, what)], in_processes=0)
+
+    def _settle_all(self, finished: list[tuple[int, TaskGroup | None, BaseException | None, str]],
+                    in_processes: int) -> None:
+        """Account for finished writes, each ``(nbytes, group, error, what)``, in one hold of the lock (a writer
+        process's batch is a frame's files); ``in_processes`` of them ran in writer processes."""
+        failed = [(error, what) for _, _, error, what in finished if error is not None]
+        for error, what in failed:
             log.error("%s failed: %s", what, error)
-        finished = None
+        done: list[TaskGroup] = []
         with self._cond:
-            self._unfinished -= 1
-            self._bytes -= nbytes
-            self._in_processes -= in_process
-            if ok:
-                self.completed += 1
-            if group is not None:
-                group.pending -= 1
-                group.failed |= not ok
-                if group.closed and group.pending == 0:
-                    finished = group
+            self._errors += failed
+            self._unfinished -= len(finished)
+            self._in_processes -= in_processes
+            self.completed += len(finished) - len(failed)
+            for nbytes, group, error, _ in finished:
+                self._bytes -= nbytes
+                if group is not None:
+                    group.pending -= 1
+                    group.failed |= error is not None
+                    if group.finished():
+                        done.append(group)
             self._cond.notify_all()
-        if finished is not None:
-            finished.on_done(not finished.failed)
+        for group in done:
+            group.on_done(not group.failed)
 
     # ---- producers -------------------------------------------------------
-    def _full(self, nbytes: int) -> bool:
-        return (len(self._items) + self._in_processes >= self.max_size
-                or (self._bytes > 0 and self._bytes + nbytes > self.max_bytes))
+    def _full(self, nbytes: int, count: int = 1) -> bool:
+        """Whether ``count`` more tasks holding ``nbytes`` exceed a limit (a batch of more tasks than the queue
+        holds waits until nothing is queued, then goes whole)."""
+        queued = len(self._items) + self._in_processes
+        return (queued > 0 and queued + count > self.max_size) or \
+            (self._bytes > 0 and self._bytes + nbytes > self.max_bytes)
 
     def schedule(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
         """Queue ``fn(*args, **kwargs)``; blocks while the queue is full (backpressure)."""
@@ -288,8 +300,8 @@ class WriteQueue:
         if inline:
             self._run(item)
 
-    def _throttle(self, nbytes: int) -> None:
-        """Wait (lock held) until a task of ``nbytes`` fits the limits."""
+    def _throttle(self, nbytes: int, count: int = 1) -> None:
+        """Wait (lock held) until ``count`` tasks of ``nbytes`` in all fit the limits."""
         self._cond.release()
         try:
             self._wake_deferred()          # the room can only come from tasks a worker was told about
@@ -299,7 +311,7 @@ class WriteQueue:
         if now - self._last_throttle_log >= _THROTTLE_LOG_EVERY_S:
             self._last_throttle_log = now
             log.warning("Throttling generation due to I/O bottleneck.")
-        while self._full(nbytes):
+        while self._full(nbytes, count):
             self._wait_for_progress()
         self.throttled_seconds += time.perf_counter() - now
 
@@ -317,42 +329,47 @@ class WriteQueue:
             self._cond.acquire()
 
     def _schedule_in_process(self, write: FileWrite, nbytes: int, group: TaskGroup | None) -> None:
+        shipped = getattr(self._local, "shipped", None)
+        if shipped is not None:   # inside batch(): the frame's writes are counted and sent as one, at its end
+            if group is not None:
+                group.unsent += 1
+            shipped.append((write, (nbytes, group, write.path)))   # the path names the write if it fails
+            return
+        self._ship([(write, (nbytes, group, write.path))])
+
+    def _ship(self, writes: list[tuple[FileWrite, tuple]], unsent: bool = False) -> None:
+        """Count ``writes`` (each with its token: bytes, group, path) as queued, waiting for room first, then send
+        them to one writer process as one batch. ``unsent``: their groups counted them as held by a batch."""
+        nbytes = sum(token[0] for _, token in writes)
         with self._cond:
             # a writer thread's follow-up must not wait for room its own task occupies
-            if self._full(nbytes) and threading.current_thread() not in self._threads:
-                self._throttle(nbytes)
-            self._unfinished += 1
-            self._in_processes += 1
+            if self._full(nbytes, len(writes)) and threading.current_thread() not in self._threads:
+                self._throttle(nbytes, len(writes))
+            self._unfinished += len(writes)
+            self._in_processes += len(writes)
             self._bytes += nbytes
             self.peak_bytes = max(self.peak_bytes, self._bytes)
-            if group is not None:
-                group.pending += 1
+            for _, (_, group, _) in writes:
+                if group is not None:
+                    group.pending += 1
+                    group.unsent -= unsent
             if self._processes is None:
-                self._processes = WriteProcesses(self.num_processes, self._process_done)
+                self._processes = WriteProcesses(self.num_processes, self._processes_done)
             self._processes.max_processes = self.num_processes
-        token = (nbytes, group, write.path)   # the path names the write if it fails
-        shipped = getattr(self._local, "shipped", None)
-        if shipped is not None:                 # inside batch(): the frame's writes go as one message
-            shipped.append((write, token))
-            return
-        self._send([(write, token)])
-
-    def _send(self, writes: list[tuple[FileWrite, tuple]]) -> None:
         try:
             self._processes.send(writes, durable=durable_writes())
         except Exception as exc:  # noqa: BLE001 - e.g. no process could start: the writes fail, loudly
-            for _, token in writes:
-                self._process_done(token, exc, 0, 0.0)
+            self._processes_done([(token, exc, 0) for _, token in writes], 0.0)
 
-    def _process_done(self, token: tuple, error: BaseException | None, nbytes_written: int,
-                      seconds: float) -> None:
-        """A writer process finished a write (runs on the thread that collected its reply)."""
-        nbytes, group, path = token
-        if error is None:
-            count_written(nbytes_written)
+    def _processes_done(self, finished: list[tuple[tuple, BaseException | None, int]], seconds: float) -> None:
+        """A writer process finished a batch: each write's token, error and bytes written (runs on the thread
+        that collected the reply)."""
+        written = [nbytes for _, error, nbytes in finished if error is None]
+        if written:
+            count_written(sum(written), len(written))
         profiling.add("encode+write", seconds)
-        self._settle(nbytes, group, error, f"a background write of {path!r}" if error is not None else "",
-                     in_process=True)
+        self._settle_all([(nbytes, group, error, f"a background write of {path!r}" if error is not None else "")
+                          for (nbytes, group, path), error, _ in finished], in_processes=len(finished))
 
     @contextlib.contextmanager
     def group(self, on_done: Callable[[bool], None]) -> Iterator[TaskGroup]:
@@ -374,7 +391,7 @@ class WriteQueue:
             self._local.group = outer
             with self._cond:
                 group.closed = True
-                finished = group.pending == 0
+                finished = group.finished()
             if finished:
                 group.on_done(not group.failed)
 
@@ -410,7 +427,7 @@ class WriteQueue:
         shipped = getattr(self._local, "shipped", None)
         if shipped:
             self._local.shipped = []
-            self._send(shipped)
+            self._ship(shipped, unsent=True)
 
     def configure(self, num_threads: int, max_size: int, max_bytes: int, num_processes: int = 0) -> None:
         """Apply new limits to the live queue (extra workers exit once idle; writer processes started stay

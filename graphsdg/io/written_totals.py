@@ -22,8 +22,8 @@ def bytes_written() -> int:
     return _written["bytes"]
 
 
-def count_written(nbytes: int) -> None:
-    """Add one written file of ``nbytes`` to the totals."""
+def count_written(nbytes: int, files: int = 1) -> None:
+    """Add ``files`` written files of ``nbytes`` in all to the totals."""
     with _lock:
-        _written["files"] += 1
+        _written["files"] += files
         _written["bytes"] += nbytes

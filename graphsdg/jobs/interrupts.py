@@ -20,12 +20,13 @@ Example:
 """
 from __future__ import annotations
 
+import _signal   # signal's C functions: the module's wrappers turn every number into an enum (~30 calls a step)
 import contextlib
 import signal
 import threading
 from typing import Callable, Iterator
 
-_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_SIGNALS = (int(signal.SIGINT), int(signal.SIGTERM))
 
 
 class HeldSignals:
@@ -46,7 +47,7 @@ class HeldSignals:
 
     def restore(self) -> None:
         for sig, handler in self.saved.items():
-            signal.signal(sig, handler)
+            _signal.signal(sig, handler)
         self.saved.clear()
 
 
@@ -69,10 +70,10 @@ def deferred(on_signal: Callable[[int], None] | None = None) -> Iterator[HeldSig
         return
     held = HeldSignals(on_signal)
     for sig in _SIGNALS:
-        current = signal.getsignal(sig)
+        current = _signal.getsignal(sig)
         if _default(sig, current):
             held.saved[sig] = current
-            signal.signal(sig, held._handler)
+            _signal.signal(sig, held._handler)
     _active = held
     try:
         yield held

@@ -130,13 +130,13 @@ def make_gl_context():
     return GLContext(64, 64)
 
 
-def _is_current(gl) -> bool:
-    """Whether ``gl`` (an EGL context) is already current on this thread; False when unknown."""
+def _egl_context_address(gl) -> int | None:
+    """The address of ``gl``'s EGL context (to compare with the current one), or None when it is not EGL's."""
     context = getattr(gl, "_context", None)
     if context is None or os.environ.get("MUJOCO_GL", "").lower() != "egl":
-        return False
+        return None
     import ctypes
-    return gl_direct.egl_current_context() == ctypes.cast(context, ctypes.c_void_p).value
+    return ctypes.cast(context, ctypes.c_void_p).value
 
 
 def halton(index: int, base: int) -> float:
@@ -158,6 +158,7 @@ class Rasterizer:
 
     def __init__(self) -> None:
         self._gl = None
+        self._gl_address: int | None = None   # its EGL context's address, when it is EGL's
         self._mjr: mujoco.MjrContext | None = None
         self._scene: mujoco.MjvScene | None = None
         self._option = mujoco.MjvOption()
@@ -180,8 +181,10 @@ class Rasterizer:
     def _ensure_gl(self) -> None:
         if self._gl is None:
             self._gl = make_gl_context()
+            self._gl_address = _egl_context_address(self._gl)
             self._reads = PixelReads(self._ensure_gl)
-        if not _is_current(self._gl):   # re-binding a current context can flush the GL pipeline
+        # re-binding a current context can flush the GL pipeline
+        if self._gl_address is None or gl_direct.egl_current_context() != self._gl_address:
             self._gl.make_current()
 
     def bind(self, sim: SimScene) -> None:

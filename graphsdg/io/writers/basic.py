@@ -79,6 +79,7 @@ class BasicWriter(Writer):
                           "instance_id_segmentation": colorize_instance_id_segmentation,
                           "instance_segmentation": colorize_instance_segmentation}
         self._options = {"colorize_depth"} if colorize_depth else set()   # the layout's optional files
+        self._writes: dict[str, tuple[tuple[LayoutFile, str, Any], ...]] = {}   # stem -> _writes_of(stem)
         self._provenance = bool(provenance)
         flags = {"rgb": rgb, "bounding_box_2d_tight": bounding_box_2d_tight,
                  "bounding_box_2d_loose": bounding_box_2d_loose, "semantic_segmentation": semantic_segmentation,
@@ -142,6 +143,15 @@ class BasicWriter(Writer):
         """The files :meth:`_write_one` writes for ``stem`` (BasicWriter's layout table)."""
         return files_of(stem, self._options)
 
+    def _writes_of(self, stem: str) -> tuple[tuple[LayoutFile, str, Any], ...]:
+        """Each file of ``stem`` with its extension and the io function that writes it (worked out once a stem:
+        a frame writes several files)."""
+        writes = self._writes.get(stem)
+        if writes is None:
+            writes = self._writes[stem] = tuple((file, self._ext(file), _WRITE_BY_EXT[self._ext(file)])
+                                                for file in self._files_of(stem))
+        return writes
+
     def _ext(self, file: LayoutFile) -> str:
         return self._image_ext if file.ext == IMAGE else file.ext
 
@@ -164,9 +174,8 @@ class BasicWriter(Writer):
         return all(self.backend.exists(f) for f in self.expected_files(frame_index))
 
     def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
-        for file in self._files_of(stem):
-            ext = self._ext(file)
-            self.backend.schedule(_WRITE_BY_EXT[ext], data=file.content(payload),
+        for file, ext, write in self._writes_of(stem):
+            self.backend.schedule(write, data=file.content(payload),
                                   path=f"{self._path(stem, rp_name, multi, file.suffix)}.{ext}")
 
 
