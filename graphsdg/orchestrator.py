@@ -34,6 +34,7 @@ from graphsdg.render.backend import RenderRequest
 from graphsdg.render.camera import CameraView, camera_view, read_lens
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import stage_context
+from graphsdg.stage.prims import prim_facts
 
 log = logging.getLogger("graphsdg.orchestrator")
 
@@ -207,7 +208,7 @@ def _camera_view(rt, rp) -> CameraView:
     read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
     sim = rt.sim
-    lens = sim.prim_reads.get(str(prim.GetPath()), "lens", lambda: read_lens(prim))
+    lens = sim.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
     return camera_view(prim, rp.width, rp.height, world=sim.camera_poses.world(prim), lens=lens,
                        meters_per_unit=sim.world_transforms.meters_per_unit())
 

@@ -25,7 +25,7 @@ from graphsdg.runtime import runtime
 from graphsdg.sim import direct_writes
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
-from graphsdg.stage.prims import resolve_prim, resolve_prims
+from graphsdg.stage.prims import prim_facts, resolve_prim, resolve_prims
 from graphsdg.stage.xform import as_vec3, set_local_pose, up_axis_vector, world_matrix
 from graphsdg.maths.rotations import decompose
 
@@ -88,7 +88,7 @@ def _pose_cameras(targets: list, position_value: Any, rotation_value: Any, look_
                   look_at_up_axis: Any) -> bool:
     """Write-to-fabric for cameras (:mod:`graphsdg.sim.camera_poses`); False when the prims are not all
     cameras with graphsdg's op stack."""
-    if not targets or not all(p.IsA(UsdGeom.Camera) for p in targets):
+    if not targets or not all(prim_facts.is_a(p, UsdGeom.Camera) for p in targets):
         return False
     n = len(targets)
     positions = None if position_value is None else per_prim_array(position_value, n, "position_value")

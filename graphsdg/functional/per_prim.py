@@ -44,6 +44,10 @@ def per_prim_array(value: Any, count: int, what: str, width: int = 3, uniform: b
     if arr.ndim == 0 and uniform:
         return np.full((count, width), float(arr))
     if arr.ndim == 1 and arr.shape[0] in ((3, 4) if width in (3, 4) else (width,)):
+        if count == 1:   # one prim (a camera, say): a read-only row view, as broadcast_to gives, at a tenth of the cost
+            row = arr[None]
+            row.flags.writeable = False
+            return row
         return np.broadcast_to(arr, (count, arr.shape[0]))
     if arr.ndim == 1 and uniform_per_prim and arr.shape[0] == count:
         return np.repeat(arr[:, None], width, axis=1)

@@ -252,8 +252,9 @@ def quat_multiply(a: ArrayLike, b: ArrayLike) -> np.ndarray:
 
 def canonical_quat(q: np.ndarray) -> np.ndarray:
     """(..., 4) float64 quaternions normalised with w >= 0 (one of the two for each rotation), in place."""
-    q /= np.linalg.norm(q, axis=-1, keepdims=True)
-    q[q[..., 0] < 0] *= -1
+    # the sum np.linalg.norm makes (bit for bit), without its dispatch: a frame converts every batch's rotations
+    q /= np.sqrt(np.add.reduce(q * q, axis=-1, keepdims=True))
+    np.negative(q, out=q, where=q[..., :1] < 0)
     return q
 
 

@@ -19,6 +19,7 @@ from pxr import Usd, UsdGeom
 
 from graphsdg.errors import InvalidPrimError
 from graphsdg.maths.rotations import decompose
+from graphsdg.stage.prims import prim_facts
 from graphsdg.stage.xform import world_matrix
 
 
@@ -238,7 +239,7 @@ def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCac
         lens = read_lens(prim)
     t, r, _ = decompose(world if world is not None else world_matrix(prim, cache))
     return CameraView(
-        path=str(prim.GetPath()), position=t, rotation=r, focal_length=lens.focal_length,
+        path=prim_facts.path(prim), position=t, rotation=r, focal_length=lens.focal_length,
         horizontal_aperture=lens.horizontal_aperture,
         vertical_aperture=lens.horizontal_aperture * height / width,
         horizontal_aperture_offset=lens.horizontal_aperture_offset,

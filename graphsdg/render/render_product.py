@@ -14,7 +14,7 @@ from pxr import Usd, UsdGeom
 from graphsdg import settings_store as settings
 from graphsdg.errors import InvalidPrimError, RenderProductDestroyedError
 from graphsdg.stage.context import get_stage
-from graphsdg.stage.prims import resolve_prim
+from graphsdg.stage.prims import resolve_prim, structure_version
 
 DEFAULT_NAME = "Replicator"
 
@@ -42,6 +42,7 @@ class RenderProduct:
         self.path = f"/Render/RenderProduct_{name}"
         self.hydra_texture = HydraTexture()
         self._destroyed = False
+        self._camera_prim: tuple | None = None   # (id of the stage, camera path, structure version, prim)
 
     @property
     def width(self) -> int:
@@ -62,11 +63,22 @@ class RenderProduct:
                 f"rep.create.render_product(camera, resolution)")
 
     def camera_prim(self, stage: Usd.Stage | None = None) -> Usd.Prim:
+        """The camera's prim on ``stage`` (default: the current one); raises if it is gone or no camera.
+
+        The prim object is kept while the stage's structure stands still (:func:`structure_version`): a
+        frame asks for it several times, and each USD lookup costs tens of microseconds inside a capture
+        loop."""
         stage = stage or get_stage()
+        version = structure_version()
+        kept = self._camera_prim
+        if kept is not None and kept[0] == id(stage) and kept[1] == self.camera and kept[2] == version:
+            return kept[3]
         prim = stage.GetPrimAtPath(self.camera)
         if not prim or not prim.IsA(UsdGeom.Camera):
             raise InvalidPrimError(f"render product {self.name!r}: camera {self.camera!r} no longer exists "
                                    f"or is not a Camera")
+        # the stage by id: holding it would keep its layers, and the edits in them, alive after it is closed
+        self._camera_prim = (id(stage), self.camera, version, prim)
         return prim
 
     def destroy(self) -> None:
@@ -74,6 +86,7 @@ class RenderProduct:
         if self._destroyed:
             return
         self._destroyed = True
+        self._camera_prim = None
         registry.remove(self)
 
     def __repr__(self) -> str:

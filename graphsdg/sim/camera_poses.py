@@ -27,6 +27,7 @@ from pxr import Usd, UsdGeom
 
 from graphsdg.maths.rotations import compose, decompose, euler_to_matrix, quat_wxyz_to_matrix, unit_quat
 from graphsdg.stage.changes import ChangeSet
+from graphsdg.stage.prims import prim_facts
 from graphsdg.stage.xform import aimed_rotation, parent_world_matrix
 
 _ROTATIONS = (UsdGeom.XformOp.TypeRotateXYZ, UsdGeom.XformOp.TypeOrient)
@@ -49,7 +50,7 @@ class CameraPoses:
     def world(self, prim: Usd.Prim) -> np.ndarray | None:
         """The camera's world transform: its local one from here under its parent's current world transform;
         None when it was not posed here."""
-        path = str(prim.GetPath())
+        path = prim_facts.path(prim)
         local = self._local.get(path)
         return None if local is None else local @ self._parent_world(prim, path)
 
@@ -93,13 +94,15 @@ class CameraPoses:
                 self._parts.pop(str(path), None)
                 self._canonical.pop(str(path), None)
 
-    def is_canonical(self, prim: Usd.Prim) -> bool:
-        """Whether ``prim``'s op stack is at most a translate, one ``rotateXYZ`` or ``orient``, and a scale, in
-        that order, with no reset of the parent's transform (cached until the prim's transform is edited)."""
-        path = str(prim.GetPath())
+    def is_canonical(self, prim: Usd.Prim, path: str | None = None) -> bool:
+        """Whether ``prim`` (at ``path``, when the caller has it) is a camera whose op stack is at most a
+        translate, one ``rotateXYZ`` or ``orient``, and a scale, in that order, with no reset of the parent's
+        transform (cached until the prim's transform is edited or the stage changes above it)."""
+        path = prim_facts.path(prim) if path is None else path
         known = self._canonical.get(path)
         if known is None:
-            known = self._canonical[path] = _canonical_stack(UsdGeom.Xformable(prim))
+            known = self._canonical[path] = prim_facts.is_a(prim, UsdGeom.Camera) and \
+                _canonical_stack(UsdGeom.Xformable(prim))
         return known
 
 

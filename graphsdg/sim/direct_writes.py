@@ -24,6 +24,7 @@ from graphsdg.sim.scene import SimScene
 from graphsdg.sim.uniform_scales import UniformScalePlan
 from graphsdg.maths.rotations import canonical_quat, compose, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
     quat_multiply, unit_quat
+from graphsdg.stage.prims import prim_facts
 from graphsdg.stage.xform import parent_world_matrix
 
 
@@ -201,14 +202,14 @@ def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.n
     ``positions`` / ``rotations``: (N, 3) or (N, 4) local values or None; ``looks``: a world point per
     camera or None; ``up``: the up axis of the aim.
     """
-    if not prims or not all(p.IsA(UsdGeom.Camera) for p in prims):
+    if not prims:
         return False
     sim.sync_dirty_prims()   # edits authored before this write must not undo it at the next sync
     poses = sim.camera_poses
-    if not all(poses.is_canonical(p) for p in prims):
+    paths = [prim_facts.path(p) for p in prims]
+    if not all(poses.is_canonical(p, path) for p, path in zip(prims, paths)):
         return False
-    for i, prim in enumerate(prims):
-        path = str(prim.GetPath())
+    for i, (prim, path) in enumerate(zip(prims, paths)):
         current = poses.local_parts(path)
         if current is None:
             current = decompose(np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),

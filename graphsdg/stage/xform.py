@@ -191,7 +191,7 @@ def as_vec3(value: object, what: str) -> np.ndarray:
         arr = np.zeros(0)
     if arr.shape == () and what.startswith("scale"):
         arr = np.full(3, float(arr))
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+    if arr.shape != (3,) or not np.isfinite(arr).all():
         raise ValueError(f"{what} must be 3 finite numbers, got {describe(value)}")
     return arr
 
