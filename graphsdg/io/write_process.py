@@ -8,7 +8,8 @@ process starts in ~0.1 s.
 The protocol, over two pipes (``multiprocessing.connection`` framing, pickled tuples):
 
 * in: ``("write", [(kind, path, durable, indent, payload), ...])`` (a batch) where ``payload`` is
-  ``("arena", offset, dtype, shape)`` (an array in the shared arena) or ``("value", obj)``;
+  ``("arena", offset, dtype, shape)`` (an array in the shared arena), ``("bytes", dtype, shape, bytes)`` (a small
+  array's bytes) or ``("value", obj)``; ``dtype`` is a plain dtype's string or a structured one's pickle;
   ``("stop",)`` or the pipe's end: leave once everything before it is written;
 * out: ``([(error, nbytes), ...], seconds)`` once a batch is written, batches in the order sent; ``error`` is
   None or ``(type name, errno, message)``.
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import mmap
 import os
+import pickle
 import signal
 import sys
 import time
@@ -50,10 +52,25 @@ def encoded(kind: str, path: str, data: Any, indent: int | None) -> bytes:
     raise ValueError(f"unknown write kind {kind!r}; expected image, npy, json or blob")
 
 
+_DTYPES: dict[str | bytes, np.dtype] = {}
+
+
+def _dtype(token: str | bytes) -> np.dtype:
+    """The dtype a token names (``write_processes.dtype_token``: a plain dtype's string, a structured one's
+    pickle)."""
+    dtype = _DTYPES.get(token)
+    if dtype is None:
+        dtype = _DTYPES[token] = np.dtype(token) if isinstance(token, str) else pickle.loads(token)
+    return dtype
+
+
 def _payload(arena: mmap.mmap, payload: tuple) -> Any:
     if payload[0] == "arena":
-        _, offset, dtype, shape = payload
-        return np.ndarray(shape, dtype=dtype, buffer=arena, offset=offset)
+        _, offset, token, shape = payload
+        return np.ndarray(shape, dtype=_dtype(token), buffer=arena, offset=offset)
+    if payload[0] == "bytes":
+        _, token, shape, data = payload
+        return np.frombuffer(data, dtype=_dtype(token)).reshape(shape)
     return payload[1]
 
 

@@ -84,6 +84,19 @@ def rebuilt_error(type_name: str, errno: int | None, message: str, path: str) ->
     return RuntimeError(f"{type_name}: {message} (writing {path!r})")
 
 
+_DTYPE_TOKENS: dict[np.dtype, str | bytes] = {}
+
+
+def dtype_token(dtype: np.dtype) -> str | bytes:
+    """What a dtype crosses the pipe as: a plain one as its string, a structured one as its pickle (made once
+    a dtype): pickling a structured dtype object costs ~8 us, several times the rest of a frame's message."""
+    token = _DTYPE_TOKENS.get(dtype)
+    if token is None:
+        token = _DTYPE_TOKENS[dtype] = dtype.str if dtype.names is None else \
+            pickle.dumps(dtype, protocol=pickle.HIGHEST_PROTOCOL)
+    return token
+
+
 def _child_environment() -> dict[str, str]:
     """This process's environment, with its module search path (a script may have extended ``sys.path``) and
     one thread for NumPy's BLAS and OpenMP (a writer process encodes on its own thread: measured on a 16-core
@@ -184,7 +197,8 @@ class WriteProcesses:
             return
         arrays = self._layout(writes)
         total = sum(size for _, _, size in arrays)
-        self.collect(timeout=0)                           # what finished since: room, and which process is idle
+        if self._busy():
+            self.collect(timeout=0)                       # what finished since: which process is idle
         with self._room:
             process = self._choose([w.path for w, _ in writes])
             if total > process.size:                      # larger than a whole arena: everything in the message
@@ -231,16 +245,27 @@ class WriteProcesses:
 
     @staticmethod
     def _tasks(writes, arrays, process: _Process, start: int, durable: bool) -> list[tuple]:
-        in_arena: dict[int, tuple] = {}
+        payloads: dict[int, tuple] = {}
         offset = start
         for i, data, size in arrays:
             view = np.ndarray(data.shape, dtype=data.dtype, buffer=process.arena, offset=offset)
             np.copyto(view, data, casting="no")
-            # a plain dtype crosses as its string (pickling the dtype object costs several times as much)
-            in_arena[i] = ("arena", offset, data.dtype.str if data.dtype.names is None else data.dtype, data.shape)
+            payloads[i] = ("arena", offset, dtype_token(data.dtype), data.shape)
             offset += size
-        return [(w.kind, w.path, durable, w.indent, in_arena.get(i) or ("value", w.data))
+        for i, (w, _) in enumerate(writes):
+            data = w.data
+            if i not in payloads and type(data) is np.ndarray and not data.dtype.hasobject:
+                # a small array (box rows, say) as its bytes: pickling it would pickle its dtype as well
+                payloads[i] = ("bytes", dtype_token(data.dtype), data.shape, data.tobytes())
+        return [(w.kind, w.path, durable, w.indent, payloads.get(i) or ("value", w.data))
                 for i, (w, _) in enumerate(writes)]
+
+    def _busy(self) -> bool:
+        """Whether a started process holds :data:`BATCHES_PER_PROCESS` batches. Replies only lower the counts,
+        so while none does, taking them could not change :meth:`_choose`'s choice; they are then left for the
+        next send (about half the frames take none: each ``select`` and ``recv`` costs the thread that
+        renders). The arena's room is taken back when a reservation needs it."""
+        return any(len(p.batches) >= BATCHES_PER_PROCESS for p in self._processes)
 
     def _choose(self, paths: list[str]) -> _Process:
         """The process for a batch: the one still writing any of its files, else the least busy, starting

@@ -15,8 +15,8 @@ no longer waits for it. The limits, the groups, the errors and the waits below c
 
 Tasks run in the order they were scheduled (FIFO; writers such as the WebDataset
 shard writer rely on it). A task that raises is remembered and re-raised in the
-script by :meth:`WriteQueue.raise_errors` (called at every ``step()`` and by
-``wait_until_complete()``), never only logged.
+script by :meth:`WriteQueue.raise_errors` (called at every ``step()``, which raises the failures already
+taken in, and by ``wait_until_complete()``, which waits for all of them), never only logged.
 
 :meth:`WriteQueue.group` collects the tasks scheduled inside a block (one frame of
 one writer) and reports when all of them are done: the run-state index of
@@ -470,8 +470,14 @@ class WriteQueue:
                 self._wait_for_progress()
         self.raise_errors()
 
-    def raise_errors(self) -> None:
-        self._collect()
+    def raise_errors(self, collect: bool = True) -> None:
+        """Raise the first failure of a finished write (a :class:`WriterError` naming it), if any.
+
+        ``collect=False`` raises only what is known, without taking the writer processes' replies first:
+        a frame's step (replies are taken at each frame's send, so a process's failure surfaces a frame or
+        two later; :meth:`wait_until_done` takes them all)."""
+        if collect:
+            self._collect()
         with self._cond:
             errors, self._errors = self._errors, []
         if errors:
