@@ -166,7 +166,7 @@ def instance_id_segmentation(frame: FrameView, params: dict) -> dict:
 # ---- boxes and occlusion ----------------------------------------------------
 def _box_info(imap, rows_sem: np.ndarray, idx: np.ndarray) -> dict:
     table = _semantic_rows(imap, False)
-    rows = [table[s] for s in np.unique(rows_sem).tolist()]
+    rows = [table[s] for s in sorted(set(rows_sem.tolist()))]
     return {"idToLabels": {key: labels for key, labels, _ in rows},
             "idToLabelLists": {key: lists for key, _, lists in rows},
             "bboxIds": imap.instance_ids[idx].astype(np.uint32),

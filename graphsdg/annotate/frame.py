@@ -21,7 +21,7 @@ from typing import Any, Callable
 import numpy as np
 from pxr import Usd
 
-from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, color_of, labels_key
+from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, color_of, labels_key, sorted_unique
 from graphsdg.annotate.motion import PoseSnapshot, history
 from graphsdg.annotate.semantic_filter import ALL_LABELS, SemanticFilter
 from graphsdg.render.camera import CameraView
@@ -280,9 +280,9 @@ class FrameView:
         def build():
             coded = self._code_boxes()
             if coded is None:
-                return np.unique(self.runs()[2])
+                return sorted_unique(self.runs()[2])
             boxes, code_to_geom = coded
-            return np.unique(code_to_geom[np.flatnonzero(boxes[:, 2] >= 0)])
+            return sorted_unique(code_to_geom[np.flatnonzero(boxes[:, 2] >= 0)])
         return self.cached("present_geoms", build)
 
     def runs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -300,7 +300,7 @@ class FrameView:
         """Sorted distinct ``"semantic"`` or ``"instance"`` ids in this frame, from the drawn geoms
         (one histogram of the id image shared by every id annotator, not one scan each)."""
         def build():
-            return np.unique(self.instance_map(semantic_filter).id_lut(kind)[self.present_geoms()])
+            return sorted_unique(self.instance_map(semantic_filter).id_lut(kind)[self.present_geoms()])
         return self.cached(("present_ids", kind, semantic_filter.text), build)
 
     # ---- boxes and occlusion -------------------------------------------
