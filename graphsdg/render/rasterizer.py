@@ -542,7 +542,9 @@ def geometry_bounds(model: mujoco.MjModel, data: mujoco.MjData,
         return np.asarray(model.stat.center, dtype=np.float64), float(model.stat.extent)
     pos, r = np.asarray(data.geom_xpos)[bounded], radii[bounded][:, None]
     center = 0.5 * ((pos - r).min(axis=0) + (pos + r).max(axis=0))
-    return center, float((np.linalg.norm(pos - center, axis=1) + r[:, 0]).max())
+    offsets = pos - center
+    # np.linalg.norm's sum, bit for bit, without its dispatch (every render)
+    return center, float((np.sqrt(np.add.reduce(offsets * offsets, axis=1)) + r[:, 0]).max())
 
 
 def effective_far(center: np.ndarray, radius: float, view: CameraView) -> float:
@@ -643,15 +645,29 @@ def _flags_at(flags: np.ndarray, ids: np.ndarray) -> np.ndarray:
     return out
 
 
+_GEOM_OBJ = int(mujoco.mjtObj.mjOBJ_GEOM)   # an int: comparing with the enum costs microseconds per geom
+_UNSET_LUTS: dict[int, np.ndarray] = {}
+
+
+def _unset_lut(size: int) -> np.ndarray:
+    """A read-only int32 table of ``size`` -1s, copied for each render (cheaper than ``np.full`` each time)."""
+    lut = _UNSET_LUTS.get(size)
+    if lut is None:
+        lut = _UNSET_LUTS[size] = np.full(size, -1, dtype=np.int32)
+        lut.flags.writeable = False
+    return lut
+
+
 def _segid_lut(scene: mujoco.MjvScene) -> np.ndarray:
     """MuJoCo's id colours (segid + 1) -> geom id for the geoms of ``scene`` now; -1 for anything else.
 
     Sized 2^8 or 2^16 when the codes (1..ngeom, 0 the background) fit in those
     bits, so every code read back indexes it.
     """
-    size = next((1 << b for b in (8, 16) if scene.ngeom < (1 << b)), scene.ngeom + 2)
-    lut = np.full(size, -1, dtype=np.int32)
-    geom_obj = int(mujoco.mjtObj.mjOBJ_GEOM)   # an int: comparing with the enum costs microseconds per geom
+    ngeom = scene.ngeom
+    size = 1 << 8 if ngeom < 1 << 8 else 1 << 16 if ngeom < 1 << 16 else ngeom + 2
+    lut = _unset_lut(size).copy()
+    geom_obj = _GEOM_OBJ
     geoms = geom_array(scene)
     if geoms is not None:
         segid = geoms["segid"]

@@ -36,6 +36,9 @@ def drawn_geom_mask(model: mujoco.MjModel) -> np.ndarray:
     return drawn
 
 
+_quality: list = [None, None]   # (settings generation, largest image) and the answer for them
+
+
 def render_quality(largest_image: int = 4096) -> tuple[int, int]:
     """(shadow map size, MSAA samples) for the current settings.
 
@@ -44,10 +47,14 @@ def render_quality(largest_image: int = 4096) -> tuple[int, int]:
     the largest image (``largest_image``, its longer edge), up to 4096 px, never
     below ``/graphsdg/render/shadowSize``.
     """
+    key = (settings.generation(), largest_image)
+    if _quality[0] == key:          # every render asks; the settings rarely change
+        return _quality[1]
     shadow = int(settings.get("/graphsdg/render/shadowSize", 1024))
     samples = int(settings.get("/graphsdg/render/msaaSamples", 4))
     if str(settings.get("/rtx/rendermode", "")).lower() == "pathtracing":
         shadow, samples = max(shadow, min(4096, 8 * int(largest_image))), max(samples, 8)
+    _quality[:] = [key, (shadow, samples)]
     return shadow, samples
 
 
