@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 from OpenGL import GL
 from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no client-array wrapping: a PBO offset
+from OpenGL.raw.GL.VERSION.GL_3_0 import glBlitFramebuffer as raw_blit_framebuffer   # no error check of its own
 
 from graphsdg.benchmark import profiling
 from graphsdg.render import gl_direct as gld
@@ -179,10 +180,11 @@ class PixelReads:
         nbytes = width * height * channels * np.dtype(dtype).itemsize
         source = ctx.offFBO
         if ctx.offSamples and kind == "rgba":
-            # what mjr_readPixels does: resolve the multisampled buffer into the single-sample one
-            GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, ctx.offFBO)
-            GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
-            GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+            # what mjr_readPixels does: resolve the multisampled buffer into the single-sample one (the blit
+            # releases the interpreter lock: on Mesa it is the resolve's work; errors are checked below)
+            gld.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, ctx.offFBO)
+            gld.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, ctx.offFBO_r)
+            raw_blit_framebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
             source = ctx.offFBO_r
         # the short calls keep the interpreter lock (gl_direct); the read itself (on Mesa it renders the
         # frame) and the blit release it
