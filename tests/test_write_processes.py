@@ -289,3 +289,32 @@ def test_a_batch_larger_than_the_queue_goes_whole_once_the_queue_is_empty(out_di
         assert queue.pending() <= 5
     queue.wait_until_done()
     assert [np.load(os.path.join(out_dir, f"{f}_4.npy"))[0] for f in range(4)] == [0, 1, 2, 3]
+
+
+def test_schedule_many_sends_the_files_as_one_batch_and_honours_a_backends_own_schedule(out_dir, monkeypatch):
+    rep.settings.set("/graphsdg/io/writeProcesses", 1)
+    batches = []
+    real_send = WriteProcesses.send
+    monkeypatch.setattr(WriteProcesses, "send", lambda self, writes, durable: (batches.append(len(writes)),
+                                                                              real_send(self, writes, durable)))
+    backend = rep.backends.get("DiskBackend", init_params={"output_dir": out_dir})
+    calls = [(iof.write_np, {"data": np.arange(i + 1), "path": f"a_{i}.npy"}) for i in range(3)]
+    calls.append((iof.write_json, {"data": {"n": 3}, "path": "a.json"}))
+    calls.append((lambda backend_instance, text: backend_instance.write_blob("b.txt", text.encode()),
+                  {"text": "on a thread"}))                       # not a file write a process can do
+    backend.schedule_many(calls)
+    get_write_queue().wait_until_done()
+    assert batches == [4]
+    assert [np.load(os.path.join(out_dir, f"a_{i}.npy")).tolist() for i in range(3)] == [[0], [0, 1], [0, 1, 2]]
+    assert json.load(open(os.path.join(out_dir, "a.json"))) == {"n": 3}
+    assert open(os.path.join(out_dir, "b.txt")).read() == "on a thread"
+
+    class Counting(type(backend)):
+        def schedule(self, fn, *args, **kwargs):
+            seen.append(kwargs["path"])
+            super().schedule(fn, *args, **kwargs)
+    seen = []
+    counting = Counting(out_dir)
+    counting.schedule_many(calls[:2])
+    get_write_queue().wait_until_done()
+    assert seen == ["a_0.npy", "a_1.npy"]

@@ -58,6 +58,20 @@ class BaseBackend:
         """Run ``fn(*args, backend_instance=self, **kwargs)`` on the write queue."""
         get_write_queue().schedule(fn, *args, backend_instance=self, **kwargs)
 
+    def schedule_many(self, calls: list[tuple[Callable[..., Any], dict[str, Any]]]) -> None:
+        """:meth:`schedule` ``fn(**kwargs)`` for each ``(fn, kwargs)``, in order, in one call to the queue (a
+        frame's files: :meth:`WriteQueue.schedule_many <graphsdg.io.write_queue.WriteQueue.schedule_many>`).
+
+        Example:
+            >>> backend.schedule_many([(write_image, {"data": rgb, "path": "rgb_0000.png"}),
+            ...                        (write_json, {"data": labels, "path": "labels_0000.json"})])  # doctest: +SKIP
+        """
+        if type(self).schedule is not BaseBackend.schedule:   # a backend that schedules its own way
+            for fn, kwargs in calls:
+                self.schedule(fn, **kwargs)
+            return
+        get_write_queue().schedule_many([(fn, {**kwargs, "backend_instance": self}) for fn, kwargs in calls])
+
     # BackendDispatch-style helpers
     def write_image(self, path: str, data: Any) -> None:
         self.write_blob(path, encode.encode_image(data, os.path.splitext(path)[1] or ".png"))

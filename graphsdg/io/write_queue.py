@@ -116,13 +116,15 @@ def durable_writes() -> bool:
     return bool(settings.get("/graphsdg/io/fsync", False))
 
 
+_FILE_WRITE_ARGUMENTS = frozenset({"data", "path", "backend_instance", "indent"})
+
+
 def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict) -> FileWrite | None:
     """The write ``fn(*args, **kwargs)`` as data, when a writer process can do it: one of the io functions
     (``file_kind``) writing to a local file through a plain disk backend or to a path; else None."""
     kind = getattr(fn, "file_kind", None)
     path = kwargs.get("path")
-    if kind is None or args or not isinstance(path, str) or not path or \
-            not set(kwargs) <= {"data", "path", "backend_instance", "indent"}:
+    if kind is None or args or not isinstance(path, str) or not path or not kwargs.keys() <= _FILE_WRITE_ARGUMENTS:
         return None
     backend = kwargs.get("backend_instance")
     if backend is None:
@@ -299,6 +301,29 @@ class WriteQueue:
                     self._has_work.notify()    # one idle worker takes it
         if inline:
             self._run(item)
+
+    def schedule_many(self, calls: list[tuple[Callable[..., Any], dict[str, Any]]]) -> None:
+        """:meth:`schedule` ``fn(**kwargs)`` of each ``(fn, kwargs)``, in order: a frame's files in one call.
+
+        The writes a writer process can do go to one process as one batch (at the end of an enclosing
+        :meth:`batch`), the rest to the threads as :meth:`schedule` sends them; the queue's state is looked
+        up once for all of them (inside a capture loop each lookup costs tens of microseconds a file).
+        """
+        shipped = getattr(self._local, "shipped", None)
+        own = shipped is None
+        writes = [] if own else shipped
+        group = getattr(self._local, "group", None)
+        for fn, kwargs in calls:
+            nbytes = payload_bytes((), kwargs)
+            write = file_write(fn, (), kwargs) if self.num_processes and nbytes <= PROCESS_WRITE_MAX_BYTES else None
+            if write is None:
+                self.schedule(fn, **kwargs)
+                continue
+            if group is not None and not own:
+                group.unsent += 1
+            writes.append((write, (nbytes, group, write.path)))
+        if own and writes:
+            self._ship(writes)
 
     def _throttle(self, nbytes: int, count: int = 1) -> None:
         """Wait (lock held) until ``count`` tasks of ``nbytes`` in all fit the limits."""
@@ -586,6 +611,9 @@ def _configured() -> tuple[int, int, int, int]:
 def get_write_queue() -> WriteQueue:
     """The process-wide write queue, with the current settings applied."""
     global _queue
+    queue = _queue
+    if queue is not None and _configured_at[0] == settings.generation():   # no setting changed since applied
+        return queue
     threads, size, max_bytes, processes = _configured()
     with _queue_lock:
         if _queue is None:

@@ -128,19 +128,26 @@ class BasicWriter(Writer):
             self._frame_id = int(data["frame_index"])
         annotators = data["annotators"]
         multi = len({rp for per_rp in annotators.values() for rp in per_rp}) > 1
+        calls: list[tuple[Any, dict[str, Any]]] = []
         for anno_name, per_rp in annotators.items():
             stem = self._stems.get(anno_name, anno_name[:-5] if anno_name.endswith("_fast") else anno_name)
             for rp_name, payload in per_rp.items():
-                self._write_one(stem, rp_name, multi, payload)
+                calls += self._writes_for(stem, rp_name, multi, payload)
         if self._provenance:
             record = dict(data.get("provenance") or {})
             record["trigger_outputs"] = dict(data.get("trigger_outputs", {}))
-            self.backend.schedule(iof.write_json, data=record,
-                                  path=f"provenance_{self._sequence}{self._frame_id:0{self._padding}d}.json")
+            calls.append((iof.write_json, {"data": record, "path": f"provenance_{self._sequence}"
+                                                                    f"{self._frame_id:0{self._padding}d}.json"}))
+        schedule_many = getattr(self.backend, "schedule_many", None)
+        if schedule_many is not None:
+            schedule_many(calls)             # the frame's files in one call to the write queue
+        else:                                # a backend of the script's own, with schedule() alone
+            for fn, kwargs in calls:
+                self.backend.schedule(fn, **kwargs)
         self._frame_id += 1
 
     def _files_of(self, stem: str) -> tuple[LayoutFile, ...]:
-        """The files :meth:`_write_one` writes for ``stem`` (BasicWriter's layout table)."""
+        """The files :meth:`_writes_for` writes for ``stem`` (BasicWriter's layout table)."""
         return files_of(stem, self._options)
 
     def _writes_of(self, stem: str) -> tuple[tuple[LayoutFile, str, Any], ...]:
@@ -173,10 +180,11 @@ class BasicWriter(Writer):
         """Whether every file of frame ``frame_index`` exists in the backend (a folder or a bucket)."""
         return all(self.backend.exists(f) for f in self.expected_files(frame_index))
 
-    def _write_one(self, stem: str, rp_name: str, multi: bool, payload: dict) -> None:
-        for file, ext, write in self._writes_of(stem):
-            self.backend.schedule(write, data=file.content(payload),
-                                  path=f"{self._path(stem, rp_name, multi, file.suffix)}.{ext}")
+    def _writes_for(self, stem: str, rp_name: str, multi: bool, payload: dict) -> list[tuple[Any, dict[str, Any]]]:
+        """The ``(io function, arguments)`` of each file of one annotator's ``payload`` for one render product."""
+        return [(write, {"data": file.content(payload),
+                         "path": f"{self._path(stem, rp_name, multi, file.suffix)}.{ext}"})
+                for file, ext, write in self._writes_of(stem)]
 
 
 def sequence_prefix(trigger_outputs: dict) -> str:
