@@ -52,6 +52,12 @@ class BaseBackend:
         The write queue hands such writes to its writer processes (:mod:`graphsdg.io.write_processes`),
         which write the file themselves.
         """
+        resolve = self.local_resolver()
+        return resolve(path) if resolve is not None else None
+
+    def local_resolver(self) -> Callable[[str], str] | None:
+        """:meth:`local_path` as a function of the path, taken once for a frame's files; None when this backend
+        writes no local files. Backends that do override this."""
         return None
 
     def schedule(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> None:
@@ -153,10 +159,10 @@ class DiskBackend(BaseBackend):
     def write_blob(self, path: str, data: bytes) -> None:
         write_file_atomic(self.resolve(path), data)
 
-    def local_path(self, path: str) -> str | None:
+    def local_resolver(self) -> Callable[[str], str] | None:
         if type(self).write_blob is not DiskBackend.write_blob or writes_discarded():
             return None
-        return self.resolve(path)
+        return self.resolve
 
     def read_blob(self, path: str) -> bytes:
         with open(self.resolve(path), "rb") as f:
@@ -299,10 +305,10 @@ class BackendGroup(BaseBackend):
         for b in self.backends:
             b.write_blob(path, data)
 
-    def local_path(self, path: str) -> str | None:
+    def local_resolver(self) -> Callable[[str], str] | None:
         if type(self).write_blob is not BackendGroup.write_blob or len(self.backends) != 1:
             return None
-        return self.backends[0].local_path(path)
+        return self.backends[0].local_resolver()
 
     def read_blob(self, path: str) -> bytes:
         return self.backends[0].read_blob(path)

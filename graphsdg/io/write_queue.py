@@ -119,9 +119,11 @@ def durable_writes() -> bool:
 _FILE_WRITE_ARGUMENTS = frozenset({"data", "path", "backend_instance", "indent"})
 
 
-def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict) -> FileWrite | None:
+def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict,
+               resolvers: dict[int, Callable[[str], str] | None] | None = None) -> FileWrite | None:
     """The write ``fn(*args, **kwargs)`` as data, when a writer process can do it: one of the io functions
-    (``file_kind``) writing to a local file through a plain disk backend or to a path; else None."""
+    (``file_kind``) writing to a local file through a plain disk backend or to a path; else None.
+    ``resolvers``: each backend's ``local_resolver()`` by ``id``, kept by a caller that writes many files."""
     kind = getattr(fn, "file_kind", None)
     path = kwargs.get("path")
     if kind is None or args or not isinstance(path, str) or not path or not kwargs.keys() <= _FILE_WRITE_ARGUMENTS:
@@ -130,11 +132,22 @@ def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict) -> FileWrite |
     if backend is None:
         full = None if writes_discarded() else os.path.abspath(path)
     else:
-        local_path = getattr(backend, "local_path", None)
-        full = local_path(path) if local_path is not None else None
+        if resolvers is None or id(backend) not in resolvers:
+            resolver = getattr(backend, "local_resolver", None)
+            resolver = resolver() if resolver is not None else _path_only(backend)
+            if resolvers is None:
+                resolvers = {}
+            resolvers[id(backend)] = resolver
+        resolve = resolvers[id(backend)]
+        full = resolve(path) if resolve is not None else None
     if full is None:
         return None
     return FileWrite(kind, full, kwargs.get("data"), kwargs.get("indent"))
+
+
+def _path_only(backend: Any) -> Callable[[str], str | None] | None:
+    """A backend without ``local_resolver`` (not a :class:`BaseBackend`): its ``local_path``, if it has one."""
+    return getattr(backend, "local_path", None)
 
 
 def _positive_int(key: str, value: Any) -> int:
@@ -313,9 +326,11 @@ class WriteQueue:
         own = shipped is None
         writes = [] if own else shipped
         group = getattr(self._local, "group", None)
+        resolvers: dict[int, Callable[[str], str] | None] = {}   # the backends' local_resolver(), once each
         for fn, kwargs in calls:
             nbytes = payload_bytes((), kwargs)
-            write = file_write(fn, (), kwargs) if self.num_processes and nbytes <= PROCESS_WRITE_MAX_BYTES else None
+            write = file_write(fn, (), kwargs, resolvers) if self.num_processes and nbytes <= PROCESS_WRITE_MAX_BYTES \
+                else None
             if write is None:
                 self.schedule(fn, **kwargs)
                 continue
