@@ -18,8 +18,9 @@ and most writers schedule to a local file, to writer processes instead:
 * the processes encode with the same functions as a writer thread (:mod:`graphsdg.io.write_process`),
   so the files are byte for byte the same.
 
-Each batch that finishes reaches the caller's ``on_done`` once, with every write's token and outcome (a
-write that failed carries its error, naming the file); a process that dies fails every write it held. Writes of other kinds (a writer's own function, an S3
+Finished batches reach the caller's ``on_done`` as their replies are taken, with every write's token and
+outcome (a write that failed carries its error, naming the file); a process that dies fails every write it
+held. Writes of other kinds (a writer's own function, an S3
 bucket) and writes of large arrays (``write_queue.PROCESS_WRITE_MAX_BYTES``: copying them costs more
 than it saves) stay on the write queue's threads.
 
@@ -55,6 +56,7 @@ from graphsdg.io.write_process import BOOT
 ARENA_BYTES = 128 << 20     # per process; pages are touched only as far as the backlog reaches
 INLINE_BYTES = 16 << 10     # arrays smaller than this travel in the message itself
 BATCHES_PER_PROCESS = 2     # batches waiting on every started process before another one starts
+COLLECT_AFTER = 4           # batches a process holds before a send takes its replies (they wait in the pipe)
 _ALIGN = 64
 REPLY_PIPE_BYTES = 1 << 20
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -69,8 +71,8 @@ class FileWrite(NamedTuple):
     indent: int | None
 
 
-# on_done(finished, seconds): a batch's writes as (token, error or None, bytes written), and the seconds the
-# process spent on them; called once per batch, on the thread that took the reply
+# on_done(finished, seconds): the writes of the batches whose replies were taken together, as (token, error or
+# None, bytes written), and the seconds the process spent on them; on the thread that took the replies
 OnDone = Callable[[list[tuple[Any, "BaseException | None", int]], float], None]
 
 
@@ -173,7 +175,8 @@ class _Process:
 
 
 class WriteProcesses:
-    """Up to ``max_processes`` writer processes; ``on_done(finished, seconds)`` once per batch (:data:`OnDone`)."""
+    """Up to ``max_processes`` writer processes; ``on_done(finished, seconds)`` as their replies are taken
+    (:data:`OnDone`)."""
 
     def __init__(self, max_processes: int, on_done: OnDone, arena_bytes: int = ARENA_BYTES) -> None:
         if max_processes < 1:
@@ -197,10 +200,16 @@ class WriteProcesses:
             return
         arrays = self._layout(writes)
         total = sum(size for _, _, size in arrays)
-        if self._busy():
-            self.collect(timeout=0)                       # what finished since: which process is idle
+        paths = [w.path for w, _ in writes]
+        if any(len(p.batches) >= COLLECT_AFTER for p in self._processes):
+            self.collect(timeout=0)
         with self._room:
-            process = self._choose([w.path for w, _ in writes])
+            process = self._choose(paths)
+        if process is None:                               # the counts say every process is busy: see if so
+            self.collect(timeout=0)
+            with self._room:
+                process = self._choose(paths, may_start=True)
+        with self._room:
             if total > process.size:                      # larger than a whole arena: everything in the message
                 arrays, total = [], 0
         while True:
@@ -260,16 +269,13 @@ class WriteProcesses:
         return [(w.kind, w.path, durable, w.indent, payloads.get(i) or ("value", w.data))
                 for i, (w, _) in enumerate(writes)]
 
-    def _busy(self) -> bool:
-        """Whether a started process holds :data:`BATCHES_PER_PROCESS` batches. Replies only lower the counts,
-        so while none does, taking them could not change :meth:`_choose`'s choice; they are then left for the
-        next send (about half the frames take none: each ``select`` and ``recv`` costs the thread that
-        renders). The arena's room is taken back when a reservation needs it."""
-        return any(len(p.batches) >= BATCHES_PER_PROCESS for p in self._processes)
+    def _choose(self, paths: list[str], may_start: bool = False) -> _Process | None:
+        """The process for a batch: the one still writing any of its files, else the least busy; while every
+        started one holds :data:`BATCHES_PER_PROCESS` batches, another one (``may_start``) or None (lock held).
 
-    def _choose(self, paths: list[str]) -> _Process:
-        """The process for a batch: the one still writing any of its files, else the least busy, starting
-        another while every started one holds :data:`BATCHES_PER_PROCESS` batches (lock held)."""
+        The counts fall only as replies are taken, and a send takes them only when it must (here, or once a
+        process holds :data:`COLLECT_AFTER` batches): each ``select`` and ``recv`` costs the thread that renders.
+        """
         for path in paths:
             owner = self._owner.get(path)
             if owner is not None and owner[0].alive:
@@ -277,8 +283,10 @@ class WriteProcesses:
         alive = [p for p in self._processes if p.alive]
         self._processes = alive
         idle = min(alive, key=lambda p: len(p.batches), default=None)
-        if idle is None or (len(idle.batches) >= BATCHES_PER_PROCESS and len(alive) < self.max_processes):
+        if idle is None:
             return self._start()
+        if len(idle.batches) >= BATCHES_PER_PROCESS and len(alive) < self.max_processes:
+            return self._start() if may_start else None
         return idle
 
     def _start(self) -> _Process:
@@ -311,22 +319,29 @@ class WriteProcesses:
             self._collecting.release()
 
     def _take(self, process: _Process) -> None:
-        """Every reply waiting from ``process`` (at least one, or its end)."""
-        while True:
-            try:
-                results, seconds = process.replies.recv()
-            except (EOFError, OSError):
-                self._lost(process)
-                return
-            with self._room:
-                batch = process.batches.popleft()    # a process answers its batches in order
-                if batch.end > batch.start:
-                    process.regions.popleft()
-                self._release(batch)
-            self._on_done([(token, None if error is None else rebuilt_error(*error, path), nbytes)
-                           for token, path, (error, nbytes) in zip(batch.tokens, batch.paths, results)], seconds)
-            if not select.select([process.replies.fileno()], [], [], 0)[0]:
-                return
+        """Every reply waiting from ``process`` (at least one, or its end), to ``on_done`` in one call."""
+        finished: list[tuple[Any, BaseException | None, int]] = []
+        spent = 0.0
+        try:
+            while True:
+                try:
+                    results, seconds = process.replies.recv()
+                except (EOFError, OSError):
+                    self._lost(process)
+                    return
+                with self._room:
+                    batch = process.batches.popleft()    # a process answers its batches in order
+                    if batch.end > batch.start:
+                        process.regions.popleft()
+                    self._release(batch)
+                finished += [(token, None if error is None else rebuilt_error(*error, path), nbytes)
+                             for token, path, (error, nbytes) in zip(batch.tokens, batch.paths, results)]
+                spent += seconds
+                if not select.select([process.replies.fileno()], [], [], 0)[0]:
+                    return
+        finally:
+            if finished:
+                self._on_done(finished, spent)
 
     def _release(self, batch: _Batch) -> None:
         for path in batch.paths:
