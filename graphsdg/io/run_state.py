@@ -47,7 +47,7 @@ import os
 import threading
 import time
 import weakref
-from typing import Any, Iterator
+from typing import Any
 
 from graphsdg import settings_store as settings
 from graphsdg.io.location import open_location
@@ -242,23 +242,21 @@ def _read_quietly(output_dir: str) -> dict | None:
         return None
 
 
-@contextlib.contextmanager
-def frame(writer: Any, step: int, frame_index: int | None = None) -> Iterator[None]:
-    """Wrap one ``writer._write(data)``: the tasks it schedules make up one frame.
+def frame(writer: Any, step: int, frame_index: int | None = None) -> contextlib.AbstractContextManager:
+    """A ``with`` block around one ``writer._write(data)``: the tasks it schedules make up one frame (the
+    frame is registered as the block is made, which ``with`` does at once).
 
     ``frame_index``: the frame's number in the whole dataset, when the run assigns
     one (sharded and resumed runs pass ``data["frame_index"]``).
     """
     ledger = ledger_for(writer)
     if ledger is None:
-        yield
-        return
+        return contextlib.nullcontext()
     first = ledger.status != "writing" or ledger.begun == 0
     number = ledger.begin(step, frame_index)
     if first:     # the file exists whenever frames are in flight, so a killed run always leaves one
         _save_quietly()
-    with get_write_queue().group(lambda ok: ledger.files_done(number, ok)):
-        yield
+    return get_write_queue().group(lambda ok: ledger.files_done(number, ok))
 
 
 def file_name() -> str:

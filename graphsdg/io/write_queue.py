@@ -34,12 +34,11 @@ Example:
 from __future__ import annotations
 
 import collections
-import contextlib
 import logging
 import os
 import threading
 import time
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
 import numpy as np
 
@@ -70,18 +69,64 @@ BACKLOG_PER_WORKER = 8   # tasks waiting per started worker before another start
 
 
 class TaskGroup:
-    """The tasks scheduled inside one :meth:`WriteQueue.group` block."""
+    """The tasks scheduled inside one :meth:`WriteQueue.group` block (the block is the group's ``with``)."""
 
-    def __init__(self, on_done: Callable[[bool], None]) -> None:
+    def __init__(self, on_done: Callable[[bool], None], queue: "WriteQueue | None" = None) -> None:
         self.on_done = on_done
         self.pending = 0
         self.unsent = 0      # held in a batch() until it ends: counted by the thread that owns the group, unlocked
         self.failed = False
         self.closed = False
+        self._queue = queue
+        self._outer: TaskGroup | None = None
+
+    def __enter__(self) -> "TaskGroup":
+        local = self._queue._local
+        self._outer = getattr(local, "group", None)
+        local.group = self
+        return self
+
+    def __exit__(self, exc_type: type | None, *exc: object) -> bool:
+        queue = self._queue
+        queue._local.group = self._outer
+        with queue._cond:
+            if exc_type is not None:
+                self.failed = True
+            self.closed = True
+            finished = self.finished()
+        if finished:
+            self.on_done(not self.failed)
+        return False
 
     def finished(self) -> bool:
         """Whether the block ended and every task it scheduled is done (the queue's lock held)."""
         return self.closed and self.pending == 0 and self.unsent == 0
+
+
+class _BatchBlock:
+    """:meth:`WriteQueue.batch`'s block."""
+
+    __slots__ = ("queue", "outermost")
+
+    def __init__(self, queue: "WriteQueue") -> None:
+        self.queue, self.outermost = queue, False
+
+    def __enter__(self) -> None:
+        local = self.queue._local
+        if getattr(local, "deferred", None) is None:
+            self.outermost = True
+            local.deferred = 0
+            local.shipped = []
+
+    def __exit__(self, *exc: object) -> bool:
+        if self.outermost:
+            local = self.queue._local
+            try:
+                self.queue._wake_deferred()
+            finally:
+                local.deferred = None
+                local.shipped = None
+        return False
 
 
 def payload_bytes(args: tuple, kwargs: dict) -> int:
@@ -411,50 +456,25 @@ class WriteQueue:
         self._settle_all([(nbytes, group, error, f"a background write of {path!r}" if error is not None else "")
                           for (nbytes, group, path), error, _ in finished], in_processes=len(finished))
 
-    @contextlib.contextmanager
-    def group(self, on_done: Callable[[bool], None]) -> Iterator[TaskGroup]:
-        """Tag the tasks this thread schedules in the block; ``on_done(all_succeeded)`` runs when all are done.
+    def group(self, on_done: Callable[[bool], None]) -> TaskGroup:
+        """A ``with`` block tagging the tasks this thread schedules in it; ``on_done(all_succeeded)`` runs when
+        all are done (a block that raises counts as failed).
 
         ``on_done`` runs once, on the worker that finishes the last task (or here,
-        when the block scheduled nothing or everything already finished).
+        when the block scheduled nothing or everything already finished). A class, not a generator context
+        manager: a frame opens one per writer.
         """
-        outer = getattr(self._local, "group", None)
-        group = TaskGroup(on_done)
-        self._local.group = group
-        try:
-            yield group
-        except BaseException:
-            with self._cond:
-                group.failed = True
-            raise
-        finally:
-            self._local.group = outer
-            with self._cond:
-                group.closed = True
-                finished = group.finished()
-            if finished:
-                group.on_done(not group.failed)
+        return TaskGroup(on_done, self)
 
-    @contextlib.contextmanager
-    def batch(self) -> Iterator[None]:
-        """Schedule the block's tasks with one wake-up of the workers, when it ends.
+    def batch(self) -> "_BatchBlock":
+        """A ``with`` block whose tasks are scheduled with one wake-up of the workers, when it ends.
 
         A frame's files are several tasks; waking an idle worker for each made it take the interpreter
         lock from the scheduling thread once per task (docs/performance.md, small images). Inside the block
         a full queue, :meth:`wait_until_done` and :meth:`shutdown` still wake the workers first. Nested
         blocks wake at the end of the outermost.
         """
-        if getattr(self._local, "deferred", None) is not None:
-            yield
-            return
-        self._local.deferred = 0
-        self._local.shipped = []
-        try:
-            yield
-        finally:
-            self._wake_deferred()
-            self._local.deferred = None
-            self._local.shipped = None
+        return _BatchBlock(self)
 
     def _wake_deferred(self) -> None:
         """Wake a worker for each task this thread scheduled inside :meth:`batch` so far, and send the writes

@@ -21,10 +21,9 @@ Example:
 from __future__ import annotations
 
 import _signal   # signal's C functions: the module's wrappers turn every number into an enum (~30 calls a step)
-import contextlib
 import signal
 import threading
-from typing import Callable, Iterator
+from typing import Callable
 
 _SIGNALS = (int(signal.SIGINT), int(signal.SIGTERM))
 
@@ -59,27 +58,41 @@ def _default(sig: int, handler: object) -> bool:
     return handler is signal.default_int_handler if sig == signal.SIGINT else handler == signal.SIG_DFL
 
 
-@contextlib.contextmanager
-def deferred(on_signal: Callable[[int], None] | None = None) -> Iterator[HeldSignals | None]:
-    """Hold SIGINT/SIGTERM during the block; yields the :class:`HeldSignals`, or ``None`` when an enclosing
-    block already holds them (or this is not the main thread). The caller decides what to do afterwards
-    (see :func:`raise_for`)."""
-    global _active
-    if _active is not None or threading.current_thread() is not threading.main_thread():
-        yield None
-        return
-    held = HeldSignals(on_signal)
-    for sig in _SIGNALS:
-        current = _signal.getsignal(sig)
-        if _default(sig, current):
-            held.saved[sig] = current
-            _signal.signal(sig, held._handler)
-    _active = held
-    try:
-        yield held
-    finally:
-        _active = None
-        held.restore()
+def deferred(on_signal: Callable[[int], None] | None = None) -> "_Deferred":
+    """A ``with`` block holding SIGINT/SIGTERM; ``as`` gives the :class:`HeldSignals`, or ``None`` when an
+    enclosing block already holds them (or this is not the main thread). The caller decides what to do
+    afterwards (see :func:`raise_for`)."""
+    return _Deferred(on_signal)
+
+
+class _Deferred:
+    """:func:`deferred`'s block (a class: every step opens one, and a generator context manager costs
+    several times as much)."""
+
+    __slots__ = ("on_signal", "held")
+
+    def __init__(self, on_signal: Callable[[int], None] | None) -> None:
+        self.on_signal, self.held = on_signal, None
+
+    def __enter__(self) -> HeldSignals | None:
+        global _active
+        if _active is not None or threading.current_thread() is not threading.main_thread():
+            return None
+        held = HeldSignals(self.on_signal)
+        for sig in _SIGNALS:
+            current = _signal.getsignal(sig)
+            if _default(sig, current):
+                held.saved[sig] = current
+                _signal.signal(sig, held._handler)
+        _active = self.held = held
+        return held
+
+    def __exit__(self, *exc: object) -> bool:
+        global _active
+        if self.held is not None:
+            _active = None
+            self.held.restore()
+        return False
 
 
 def raise_for(signum: int) -> None:

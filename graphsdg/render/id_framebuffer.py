@@ -31,9 +31,6 @@ Example (inside a current GL context)::
 """
 from __future__ import annotations
 
-import contextlib
-from typing import Iterator
-
 import mujoco
 from OpenGL import GL
 
@@ -75,17 +72,9 @@ class IdFramebuffer:
             raise RuntimeError(f"the GL driver cannot make a {code_bits}-bit id + DEPTH_COMPONENT32F "
                                f"framebuffer of {width}x{height} (status 0x{int(status):x})")
 
-    @contextlib.contextmanager
-    def bound(self, ctx: mujoco.MjrContext) -> Iterator[None]:
-        """Make MuJoCo's offscreen framebuffer this one (single-sample) for the block."""
-        fbo, samples = ctx.offFBO, ctx.offSamples
-        ctx.offFBO, ctx.offSamples = self.fbo, 0
-        restore_offscreen_bindings(ctx)   # binds it for drawing and reading
-        try:
-            yield
-        finally:
-            ctx.offFBO, ctx.offSamples = fbo, samples
-            restore_offscreen_bindings(ctx)
+    def bound(self, ctx: mujoco.MjrContext) -> "_Bound":
+        """Make MuJoCo's offscreen framebuffer this one (single-sample) for the ``with`` block."""
+        return _Bound(self.fbo, ctx)
 
     def free(self) -> None:
         """Delete the framebuffer and its storage (the context must be current)."""
@@ -93,3 +82,25 @@ class IdFramebuffer:
             GL.glDeleteFramebuffers(1, [self.fbo])
             GL.glDeleteRenderbuffers(len(self._renderbuffers), self._renderbuffers)
             self.fbo, self._renderbuffers = 0, []
+
+
+class _Bound:
+    """:meth:`IdFramebuffer.bound`'s block (a class: a generator context manager costs several times as
+    much to enter and leave, once a frame)."""
+
+    __slots__ = ("fbo", "ctx", "saved")
+
+    def __init__(self, fbo: int, ctx: mujoco.MjrContext) -> None:
+        self.fbo, self.ctx = fbo, ctx
+
+    def __enter__(self) -> None:
+        ctx = self.ctx
+        self.saved = ctx.offFBO, ctx.offSamples
+        ctx.offFBO, ctx.offSamples = self.fbo, 0
+        restore_offscreen_bindings(ctx)   # binds it for drawing and reading
+
+    def __exit__(self, *exc: object) -> bool:
+        ctx = self.ctx
+        ctx.offFBO, ctx.offSamples = self.saved
+        restore_offscreen_bindings(ctx)
+        return False
