@@ -210,4 +210,7 @@ def test_the_hand_written_loop_draws_the_frames_graphsdg_draws(tmp_path):
         assert hit.mean() > 0.05                                        # the frame shows the assets
         assert (hit == loop_hit).mean() > 0.99                          # up to an edge pixel here and there
         both = hit & loop_hit
-        assert np.mean(np.abs(ours[both] - loop[both]) < 0.01) > 0.99
+        # within 0.25 % of the distance: the loop's depth buffer resolves ~1 cm at the scene's ~12 m, and on a GPU
+        # host `auto` renders graphsdg's frames with the pbr backend, whose depths are exact (measured on an H200:
+        # up to 1.5 cm apart); a shape drawn at another size differs by far more, and in what is hit
+        assert np.mean(np.abs(ours[both] - loop[both]) < 0.0025 * loop[both]) > 0.99
