@@ -9,8 +9,9 @@ and most writers schedule to a local file, to writer processes instead:
 * each process has a shared arena (an anonymous ``memfd`` mapped on both sides): an array is copied
   into it once, and only its offset, dtype and shape cross the pipe;
 * a frame's writes go to one process as one message (:meth:`WriteProcesses.send`), and come back as one
-  reply, taken by the threads that use the pool (:meth:`WriteProcesses.collect`: at each send, and by
-  whoever waits for writes to finish). No thread of its own reads them: measured on a GPU host, a reader
+  reply, taken by the threads that use the pool (:meth:`WriteProcesses.collect`: by a send that finds a
+  process holding :data:`COLLECT_AFTER` batches or must choose whether to start another, and by whoever
+  waits for writes to finish). No thread of its own reads them: measured on a GPU host, a reader
   thread woken by each reply took the interpreter lock from the thread that renders about once a frame,
   costing it ~0.2 ms of a 3.5 ms 128x128 frame;
 * processes start as the backlog needs them (one while it keeps up), up to a limit; two writes to the

@@ -71,7 +71,7 @@ BACKLOG_PER_WORKER = 8   # tasks waiting per started worker before another start
 class TaskGroup:
     """The tasks scheduled inside one :meth:`WriteQueue.group` block (the block is the group's ``with``)."""
 
-    def __init__(self, on_done: Callable[[bool], None], queue: "WriteQueue | None" = None) -> None:
+    def __init__(self, on_done: Callable[[bool], None], queue: "WriteQueue") -> None:
         self.on_done = on_done
         self.pending = 0
         self.unsent = 0      # held in a batch() until it ends: counted by the thread that owns the group, unlocked
@@ -447,8 +447,8 @@ class WriteQueue:
             self._processes_done([(token, exc, 0) for _, token in writes], 0.0)
 
     def _processes_done(self, finished: list[tuple[tuple, BaseException | None, int]], seconds: float) -> None:
-        """A writer process finished a batch: each write's token, error and bytes written (runs on the thread
-        that collected the reply)."""
+        """Writer-process batches finished: each write's token, error and bytes written (runs on the thread
+        that took the replies)."""
         written = [nbytes for _, error, nbytes in finished if error is None]
         if written:
             count_written(sum(written), len(written))
@@ -534,8 +534,8 @@ class WriteQueue:
         """Raise the first failure of a finished write (a :class:`WriterError` naming it), if any.
 
         ``collect=False`` raises only what is known, without taking the writer processes' replies first:
-        a frame's step (replies are taken at each frame's send, so a process's failure surfaces a frame or
-        two later; :meth:`wait_until_done` takes them all)."""
+        a frame's step (replies are taken as frames are sent, every few frames, so a process's failure
+        surfaces a few frames later; :meth:`wait_until_done` takes them all)."""
         if collect:
             self._collect()
         with self._cond:
