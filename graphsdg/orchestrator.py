@@ -133,7 +133,7 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None, def
     queue = get_write_queue()
     try:
         rt.complete_capture()   # the previous step's, when it was pipelined
-        queue.raise_errors(collect=False)   # writer processes' replies are taken as each frame is sent
+        queue.raise_errors(collect=False)   # writer processes' replies are taken as frames are sent
     except BaseException:
         run_state.mark_failed()
         raise
