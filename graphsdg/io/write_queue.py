@@ -177,22 +177,23 @@ def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict,
     if backend is None:
         full = None if writes_discarded() else os.path.abspath(path)
     else:
-        if resolvers is None or id(backend) not in resolvers:
-            resolver = getattr(backend, "local_resolver", None)
-            resolver = resolver() if resolver is not None else _path_only(backend)
-            if resolvers is None:
-                resolvers = {}
-            resolvers[id(backend)] = resolver
-        resolve = resolvers[id(backend)]
+        if resolvers is not None and id(backend) in resolvers:
+            resolve = resolvers[id(backend)]
+        else:
+            resolve = _resolver(backend)
+            if resolvers is not None:
+                resolvers[id(backend)] = resolve
         full = resolve(path) if resolve is not None else None
     if full is None:
         return None
     return FileWrite(kind, full, kwargs.get("data"), kwargs.get("indent"))
 
 
-def _path_only(backend: Any) -> Callable[[str], str | None] | None:
-    """A backend without ``local_resolver`` (not a :class:`BaseBackend`): its ``local_path``, if it has one."""
-    return getattr(backend, "local_path", None)
+def _resolver(backend: Any) -> Callable[[str], str | None] | None:
+    """The backend's ``local_resolver()``; for an object without one (not a ``BaseBackend``), its ``local_path``
+    if it has one."""
+    local_resolver = getattr(backend, "local_resolver", None)
+    return local_resolver() if local_resolver is not None else getattr(backend, "local_path", None)
 
 
 def _positive_int(key: str, value: Any) -> int:
@@ -367,23 +368,19 @@ class WriteQueue:
         :meth:`batch`), the rest to the threads as :meth:`schedule` sends them; the queue's state is looked
         up once for all of them (inside a capture loop each lookup costs tens of microseconds a file).
         """
-        shipped = getattr(self._local, "shipped", None)
-        own = shipped is None
-        writes = [] if own else shipped
         group = getattr(self._local, "group", None)
         resolvers: dict[int, Callable[[str], str] | None] = {}   # the backends' local_resolver(), once each
+        writes = []
         for fn, kwargs in calls:
             nbytes = payload_bytes((), kwargs)
             write = file_write(fn, (), kwargs, resolvers) if self.num_processes and nbytes <= PROCESS_WRITE_MAX_BYTES \
                 else None
             if write is None:
                 self.schedule(fn, **kwargs)
-                continue
-            if group is not None and not own:
-                group.unsent += 1
-            writes.append((write, (nbytes, group, write.path)))
-        if own and writes:
-            self._ship(writes)
+            else:
+                writes.append((write, (nbytes, group, write.path)))   # the path names the write if it fails
+        if writes:
+            self._to_processes(writes, group)
 
     def _throttle(self, nbytes: int, count: int = 1) -> None:
         """Wait (lock held) until ``count`` tasks of ``nbytes`` in all fit the limits."""
@@ -414,13 +411,18 @@ class WriteQueue:
             self._cond.acquire()
 
     def _schedule_in_process(self, write: FileWrite, nbytes: int, group: TaskGroup | None) -> None:
+        self._to_processes([(write, (nbytes, group, write.path))], group)   # the path names the write if it fails
+
+    def _to_processes(self, writes: list[tuple[FileWrite, tuple]], group: TaskGroup | None) -> None:
+        """Send ``writes`` (of this thread's ``group``) to a writer process now, or, inside :meth:`batch`, with
+        the rest of the frame's writes when it ends (their group holds them as unsent until then)."""
         shipped = getattr(self._local, "shipped", None)
-        if shipped is not None:   # inside batch(): the frame's writes are counted and sent as one, at its end
-            if group is not None:
-                group.unsent += 1
-            shipped.append((write, (nbytes, group, write.path)))   # the path names the write if it fails
+        if shipped is None:
+            self._ship(writes)
             return
-        self._ship([(write, (nbytes, group, write.path))])
+        if group is not None:
+            group.unsent += len(writes)
+        shipped += writes
 
     def _ship(self, writes: list[tuple[FileWrite, tuple]], unsent: bool = False) -> None:
         """Count ``writes`` (each with its token: bytes, group, path) as queued, waiting for room first, then send
