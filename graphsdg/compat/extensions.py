@@ -53,7 +53,14 @@ KNOWN: dict[str, tuple[str, ...]] = {
     "isaacsim.examples.interactive": ("isaacsim.examples.interactive",),
 }
 # off until enabled, as in Isaac Sim's standalone Python experience
-OFF_AT_START = frozenset({"isaacsim.test.utils", "omni.simready.explorer"})
+OFF_AT_START: set[str] = {"isaacsim.test.utils", "omni.simready.explorer"}
+
+
+def declare(provided: dict[str, tuple[str, ...]], off_at_start=()) -> None:
+    """Add a compat area's extensions (name -> module prefixes) to :data:`KNOWN`, some of them off at start."""
+    KNOWN.update(provided)
+    OFF_AT_START.update(off_at_start)
+    _manager._reset()
 
 
 class UnknownExtensionError(CompatImportError):

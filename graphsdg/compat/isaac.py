@@ -23,16 +23,29 @@ from graphsdg.compat.modules import ROOTS, CompatFinder, CompatModule, Forwardin
 from graphsdg.sim import transforms
 from graphsdg.sim.timeline import TimelineEventType
 
-# Compat modules of one Isaac area each; every one has ``modules() -> list[ModuleType]`` returning
-# CompatModules named by their full Isaac name (:func:`_mount` links them under their parents), and may
-# have ``install()`` / ``uninstall()``, called by :func:`install` / :func:`uninstall` to hook into pxr or
-# graphsdg's runtime and to let go again.
-AREAS = ("graphsdg.compat.extensions", "graphsdg.compat.test_utils", "graphsdg.compat.event_dispatch",
-         "graphsdg.compat.physics_core",
-         "graphsdg.compat.physx_schema", "graphsdg.compat.experimental", "graphsdg.compat.simready",
-         "graphsdg.compat.simulation_manager", "graphsdg.compat.deformables",
-         "graphsdg.compat.viewport", "graphsdg.compat.core_utils", "graphsdg.compat.experimental_semantics",
-         "graphsdg.compat.omni_usd_functions")
+# Compat modules of one Isaac area each: every module of graphsdg.compat with a ``modules() -> list[ModuleType]``
+# function returning CompatModules named by their full Isaac name (:func:`_mount` links them under their parents).
+# An area may have ``install()`` / ``uninstall()``, called by :func:`install` / :func:`uninstall` to hook into pxr or
+# graphsdg's runtime and to let go again, and ``EXTENSIONS`` (extension name -> module prefixes it provides) and
+# ``OFF_AT_START`` (those of its extensions Isaac leaves off), which join :mod:`graphsdg.compat.extensions`' tables.
+def _discover_areas() -> tuple[str, ...]:
+    import pkgutil
+
+    import graphsdg.compat as package
+    names = []
+    for info in sorted(pkgutil.iter_modules(package.__path__), key=lambda i: i.name):
+        if info.name in ("isaac", "modules", "pytest_plugin") or info.ispkg:
+            continue
+        name = f"{package.__name__}.{info.name}"
+        if callable(getattr(importlib.import_module(name), "modules", None)):
+            names.append(name)
+    return tuple(names)
+
+
+AREAS = _discover_areas()
+for _area in AREAS:
+    _module = importlib.import_module(_area)
+    extensions.declare(getattr(_module, "EXTENSIONS", {}), getattr(_module, "OFF_AT_START", ()))
 
 _installed: dict[str, types.ModuleType] = {}
 _finder: CompatFinder | None = None
