@@ -2,15 +2,32 @@
 
 Usage::
 
-    pytest -p graphsdg.compat.pytest_plugin tests_written_for_isaac/
+    pytest -p graphsdg.compat.pytest_plugin --import-mode=importlib path/to/ext/python/tests/
 
 It installs the Isaac module names (:func:`graphsdg.compat.isaac.install`)
 before test collection, so ``import omni.kit.test`` and
 ``import omni.replicator.core as rep`` at the top of a test file work, and
 removes them when the session ends. It is opt-in: a plain ``pytest`` run never
 installs them.
+
+A test file that belongs to a Kit extension (an ``extension.toml`` under a
+``config/`` folder of one of its parent folders) gets what Kit's test runner
+gives it: the extension's ``[dependencies]`` and the ``dependencies`` of each
+``[[test]]`` entry that selects the file are enabled, and that entry's
+``--/path=value`` arguments that name a setting graphsdg honours are applied,
+before the file is imported (the rest tune Kit's renderer and app loop, which
+graphsdg does not have). Extensions graphsdg does not know are not enabled: a
+name the test then imports from one fails there, naming the module.
 """
 from __future__ import annotations
+
+import fnmatch
+import sys
+import warnings
+from pathlib import Path
+from typing import Any
+
+_seen_tomls: dict[Path, dict | None] = {}
 
 
 def pytest_configure(config) -> None:
@@ -21,3 +38,111 @@ def pytest_configure(config) -> None:
 def pytest_unconfigure(config) -> None:
     from graphsdg.compat import isaac
     isaac.uninstall()
+
+
+def pytest_collect_file(file_path: Path, parent):
+    """Prepare an extension's test environment before pytest imports one of its test files."""
+    if file_path.suffix == ".py" and file_path.name.startswith("test"):
+        prepare_extension_test(file_path)
+    return None
+
+
+def find_extension_toml(test_file: Path) -> Path | None:
+    """The ``config/extension.toml`` of the Kit extension ``test_file`` belongs to, if any."""
+    for folder in test_file.resolve().parents:
+        candidate = folder / "config" / "extension.toml"
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _load(toml_path: Path) -> dict | None:
+    if toml_path not in _seen_tomls:
+        if sys.version_info >= (3, 11):
+            import tomllib
+        else:   # pragma: no cover - Python 3.10
+            try:
+                import tomli as tomllib
+            except ModuleNotFoundError:
+                warnings.warn(f"{toml_path}: reading extension.toml needs Python >= 3.11 or the 'tomli' package; "
+                              f"its test dependencies are not enabled", stacklevel=2)
+                _seen_tomls[toml_path] = None
+                return None
+        with open(toml_path, "rb") as f:
+            _seen_tomls[toml_path] = tomllib.load(f)
+    return _seen_tomls[toml_path]
+
+
+def test_module_name(manifest: dict, toml_path: Path, test_file: Path) -> str:
+    """The dotted module name Kit gives ``test_file``: the extension's python module + ``.tests.`` + its stem."""
+    modules = manifest.get("python", {}).get("module", [])
+    root = modules[0]["name"] if modules else toml_path.parent.parent.name
+    return f"{root}.tests.{test_file.stem}"
+
+
+def selected_test_entries(manifest: dict, module_name: str) -> list[dict[str, Any]]:
+    """The ``[[test]]`` entries whose ``pythonTests`` include (and do not exclude) ``module_name``'s tests."""
+    chosen = []
+    for entry in manifest.get("test", []):
+        tests = entry.get("pythonTests", {})
+        include, exclude = tests.get("include"), tests.get("exclude", [])
+        probe = f"{module_name}.Test.test_x"   # Kit's patterns match "module*test_*"
+        if include is not None and not any(fnmatch.fnmatch(probe, p) for p in include):
+            continue
+        if any(fnmatch.fnmatch(probe, p) for p in exclude):
+            continue
+        chosen.append(entry)
+    return chosen
+
+
+def setting_arguments(args: list[str]) -> dict[str, Any]:
+    """``--/a/b=value`` arguments of a ``[[test]]`` entry as settings (values parsed as Kit does: bool, int, float, str)."""
+    settings = {}
+    for arg in args:
+        if not arg.startswith("--/") or "=" not in arg:
+            continue
+        path, _, raw = arg[2:].partition("=")
+        settings[path] = _parse_value(raw)
+    return settings
+
+
+def _parse_value(raw: str) -> Any:
+    text = raw.strip()
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    if len(text) >= 2 and text[0] == text[-1] and text[0] in "\"'":
+        return text[1:-1]
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def prepare_extension_test(test_file: Path) -> list[str]:
+    """Enable what Kit's runner enables for ``test_file`` and apply its settings; returns the extensions enabled."""
+    toml_path = find_extension_toml(test_file)
+    if toml_path is None:
+        return []
+    manifest = _load(toml_path)
+    if manifest is None:
+        return []
+    entries = selected_test_entries(manifest, test_module_name(manifest, toml_path, test_file))
+    wanted = list(manifest.get("dependencies", {}))
+    for entry in entries:
+        wanted += list(entry.get("dependencies", []))
+    from graphsdg.compat import extensions, kit
+    enabled = []
+    for name in dict.fromkeys(wanted):
+        try:
+            extensions.enable_extension(name)
+            enabled.append(name)
+        except extensions.UnknownExtensionError:
+            continue   # a name the test uses from it fails where it is used, naming the module
+    from graphsdg import settings_store
+    for entry in entries:
+        for path, value in setting_arguments(entry.get("args", [])).items():
+            if path in settings_store.KNOWN_KEYS:
+                kit.get_settings().set(path, value)
+    return enabled

@@ -1,0 +1,77 @@
+"""The opt-in pytest plugin gives an Isaac extension's test files what Kit's test runner gives them."""
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+from graphsdg.compat import pytest_plugin
+
+MANIFEST = textwrap.dedent('''
+    [package]
+    version = "1.0.0"
+
+    [dependencies]
+    "omni.replicator.core" = {}
+
+    [[python.module]]
+    name = "my.ext"
+
+    [[test]]
+    name = "plain"
+    pythonTests.exclude = ["my.ext.tests.test_special*test_*"]
+    dependencies = ["isaacsim.test.utils", "some.unknown.extension"]
+    args = ["--/omni/replicator/RTSubframes=3", "--/rtx/descriptorSets=360000"]
+
+    [[test]]
+    name = "special"
+    pythonTests.include = ["my.ext.tests.test_special*test_*"]
+    dependencies = ["omni.simready.explorer"]
+''')
+
+TEST_FILE = textwrap.dedent('''
+    import carb.settings
+    import omni.kit.test
+    from isaacsim.test.utils.file_validation import validate_folder_contents   # off until enabled
+
+    class TestPlain(omni.kit.test.AsyncTestCase):
+        async def test_setting_applied(self):
+            self.assertEqual(carb.settings.get_settings().get("/omni/replicator/RTSubframes"), 3)
+            self.assertTrue(callable(validate_folder_contents))
+''')
+
+
+def _extension(tmp_path: Path) -> Path:
+    root = tmp_path / "my.ext"
+    (root / "config").mkdir(parents=True)
+    (root / "config" / "extension.toml").write_text(MANIFEST)
+    tests = root / "python" / "tests"
+    tests.mkdir(parents=True)
+    (tests / "__init__.py").write_text("")
+    (tests / "test_plain.py").write_text(TEST_FILE)
+    (tests / "test_special.py").write_text("def test_nothing():\n    pass\n")
+    return root
+
+
+def test_entries_select_by_kit_patterns(tmp_path):
+    root = _extension(tmp_path)
+    manifest = pytest_plugin._load(root / "config" / "extension.toml")
+    plain = pytest_plugin.selected_test_entries(manifest, "my.ext.tests.test_plain")
+    special = pytest_plugin.selected_test_entries(manifest, "my.ext.tests.test_special")
+    assert [e["name"] for e in plain] == ["plain"]
+    assert [e["name"] for e in special] == ["special"]
+    assert pytest_plugin.test_module_name(manifest, root / "config" / "extension.toml",
+                                          root / "python" / "tests" / "test_plain.py") == "my.ext.tests.test_plain"
+
+
+def test_setting_arguments_parse_like_kit():
+    assert pytest_plugin.setting_arguments(["--enable", "x", "--/a/b=1", "--/c=true", '--/d="Z"', "--/e=0.5"]) == {
+        "/a/b": 1, "/c": True, "/d": "Z", "/e": 0.5}
+
+
+def test_extension_tests_run_with_their_dependencies_enabled(tmp_path):
+    root = _extension(tmp_path)
+    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "graphsdg.compat.pytest_plugin",
+                          "--import-mode=importlib", "-p", "no:cacheprovider", str(root / "python" / "tests")],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "2 passed" in run.stdout
