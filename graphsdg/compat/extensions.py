@@ -69,6 +69,11 @@ class UnknownExtensionError(CompatImportError):
 
 def _check(name: str) -> str:
     ext = str(name).split("-")[0]   # Kit ids carry a version: "omni.simready.explorer-1.2.3"
+    from graphsdg.compat import out_of_scope
+    why = out_of_scope.reason(ext) if ext not in KNOWN else None
+    if why is not None:
+        raise UnknownExtensionError(f"extension {name!r} is out of scope for graphsdg's compat mode: {why}. "
+                                    f"{PORTING}", name=str(name))
     if ext not in KNOWN:
         raise UnknownExtensionError(
             f"extension {name!r} is not available in graphsdg's compat mode; known extensions: "

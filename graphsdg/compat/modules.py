@@ -22,6 +22,8 @@ import importlib.util
 import types
 from typing import Any, Callable, Iterable
 
+from graphsdg.compat import out_of_scope
+
 ROOTS = ("omni", "carb", "isaacsim")
 PORTING = "See docs/porting.md for the mapped Isaac Sim API."
 
@@ -81,6 +83,10 @@ class CompatFinder(importlib.abc.MetaPathFinder):
                                         f"enabled; call isaacsim.core.utils.extensions.enable_extension("
                                         f"{extension!r}) first, as in Isaac Sim.", name=fullname)
             return importlib.util.spec_from_loader(fullname, _ExistingModule(self.provided[fullname]))
+        why = out_of_scope.reason(fullname)
+        if why is not None:
+            raise CompatImportError(f"{fullname} is out of scope for graphsdg's compat mode: {why}. {PORTING}",
+                                    name=fullname)
         parent, _, leaf = fullname.rpartition(".")
         owner = self.provided.get(parent)
         if owner is not None:

@@ -30,9 +30,19 @@ from typing import Any
 _seen_tomls: dict[Path, dict | None] = {}
 
 
+def pytest_addoption(parser) -> None:
+    parser.addoption("--resolution-scale", type=float, default=None, metavar="F",
+                     help="create every render product at F times the resolution a test asks for "
+                          "(as graphsdg run --resolution-scale)")
+
+
 def pytest_configure(config) -> None:
     from graphsdg.compat import isaac
     isaac.install()
+    scale = config.getoption("--resolution-scale", None)
+    if scale is not None:
+        from graphsdg import settings_store
+        settings_store.set("/graphsdg/render/resolutionScale", scale)
 
 
 def pytest_unconfigure(config) -> None:

@@ -1,0 +1,40 @@
+"""Isaac capabilities left out on purpose fail at import or enable time, saying why."""
+import importlib
+
+import pytest
+
+from graphsdg.compat import isaac
+from graphsdg.compat.modules import CompatImportError
+
+
+@pytest.fixture
+def compat():
+    isaac.install()
+    yield
+    isaac.uninstall()
+
+
+@pytest.mark.parametrize("module, words", [
+    ("isaacsim.ros2.bridge", "ROS 2"),
+    ("omni.kit.livestream.webrtc", "livestream"),
+    ("isaacsim.replicator.nurec_utils", "NuRec"),
+    ("isaacsim.replicator.teleop", "teleoperation"),
+    ("omni.ui", "UI"),
+])
+def test_import_names_the_module_and_the_reason(compat, module, words):
+    with pytest.raises(CompatImportError) as caught:
+        importlib.import_module(module)
+    message = str(caught.value)
+    assert "out of scope" in message and words in message
+    assert module.split(".")[0] in message
+
+
+def test_enabling_an_out_of_scope_extension_says_why(compat):
+    from isaacsim.core.utils.extensions import enable_extension
+    with pytest.raises(CompatImportError, match=r"'isaacsim.ros2.bridge' is out of scope.*ROS 2"):
+        enable_extension("isaacsim.ros2.bridge")
+
+
+def test_an_unmapped_name_still_gets_the_generic_answer(compat):
+    with pytest.raises(CompatImportError, match="not available in graphsdg's compat mode"):
+        importlib.import_module("isaacsim.no_such_module")
