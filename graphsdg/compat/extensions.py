@@ -154,8 +154,25 @@ def get_extension_path_from_name(extension_name: str) -> str:
                             f"are part of graphsdg). {PORTING}", name=str(extension_name))
 
 
+class IExt:
+    """omni.ext.IExt: the base of a Kit extension's entry class (Kit calls on_startup / on_shutdown on it)."""
+
+    def on_startup(self, ext_id: str) -> None:
+        """Called when the extension is enabled; the base does nothing."""
+
+    def on_shutdown(self) -> None:
+        """Called when the extension is disabled; the base does nothing."""
+
+
+def get_extension_name(ext_id: str) -> str:
+    """omni.ext.get_extension_name: the name part of a Kit extension id ("omni.foo-1.2.3" -> "omni.foo")."""
+    return str(ext_id).split("-")[0]
+
+
 def modules() -> list[types.ModuleType]:
     """``isaacsim.core.utils.extensions`` (and its older name under ``omni.isaac``-less Isaac 6 layout)."""
-    return [CompatModule("isaacsim.core.utils.extensions", enable_extension=enable_extension,
+    return [CompatModule("omni.ext", IExt=IExt, ExtensionManager=ExtensionManager,
+                         get_extension_name=get_extension_name),
+            CompatModule("isaacsim.core.utils.extensions", enable_extension=enable_extension,
                          disable_extension=disable_extension, get_extension_id=get_extension_id,
                          get_extension_path_from_name=get_extension_path_from_name)]
