@@ -20,9 +20,10 @@ from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
 from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims, is_random_value
 from graphsdg.graph.registry import register_node
+from graphsdg.graph.value_shapes import SCALAR, VEC3, attribute_shapes
 from graphsdg.stage.context import get_stage
 
-from .modify import POSE_PORTS, apply_pose, sample_port
+from .modify import POSE_PORTS, apply_pose
 
 # ports in the order of the calls' parameters (a node lists its values in this order)
 POSE = {"position": Port("vec3"), "scale": Port("vec3|float"), "rotation": Port("vec3"),
@@ -88,8 +89,10 @@ class CreateNode(Node):
         if any(is_random_value(self.values.get(p)) for p in POSE_PORTS):
             apply_pose(ctx, prims)
         for port, attr in self.attribute_ports.items():
-            if ctx.is_random(port):
-                for prim, v in zip(prims, sample_port(ctx, port, len(prims))):
+            if ctx.is_random(port) and prims:
+                shapes = attribute_shapes(prims[0].GetAttribute(attr).GetTypeName()) \
+                    if prims[0].GetAttribute(attr) else SCALAR
+                for prim, v in zip(prims, ctx.per_prim(port, len(prims), shapes)):
                     FM.attribute(prim, attr, self.convert(port, v))
         return {"prims": prims}
 
@@ -270,7 +273,9 @@ class CreateMaterialOmniPBR(CreateNode):
         inputs = {}
         for port, mdl in MDL_INPUTS.items():
             if ctx.is_random(port):
-                inputs[mdl] = sample_port(ctx, port, len(mats))
+                shapes = VEC3 if port in ("diffuse", "emissive_color") else SCALAR
+                values = ctx.per_prim(port, len(mats), shapes)
+                inputs[mdl] = values if port == "diffuse_texture" else np.array(values, dtype=np.float64)
         if inputs:
             FM.material_inputs(mats, **inputs)
         return {"prims": mats}

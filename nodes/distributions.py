@@ -218,9 +218,14 @@ class Choice(Distribution):
 
 @register_node
 class Sequence(Distribution):
-    """The next of ``items`` on each execution, wrapping around (a fixed shuffle if ``ordered=False``)."""
+    """The next of ``items`` on each execution, wrapping around (a fixed shuffle if ``ordered=False``).
 
-    # with N targets an execution takes N consecutive items; ``stride`` skips items
+    One draw per execution, whatever the number of target prims (Replicator's sequence has no
+    ``num_samples``): every prim gets the item, or, when the item holds one value per prim
+    (``sequence([(True, False, True), ...])`` on three prims), prim ``i`` its ``i``-th value.
+    ``stride`` makes each draw ``stride`` consecutive items (one per prim when it equals their count).
+    """
+
     type_name = "distribution.sequence"
     call = Call(name_before="stride")
     inputs = {"items": Port(list, required=True), "ordered": Port(bool, True), "seed": Port(int, -1),
@@ -239,18 +244,36 @@ class Sequence(Distribution):
         if stride is not None and (isinstance(stride, bool) or not isinstance(stride, int) or stride < 1):
             raise ValueError(f"sequence: stride must be a positive integer, got {stride!r}")
 
+    def compute(self, ctx: ExecContext) -> dict[str, Any]:
+        return {"samples": Samples(self, lambda: ctx.rng, lambda gen, n: self.draw(gen, n, ctx), 1,
+                                   per_execution=True)}
+
     def draw(self, gen, n, ctx):
         items = list(ctx.value("items"))
-        stride = int(self.value_of("stride") or 1)
+        stride = self.value_of("stride")
         order = np.arange(len(items))
         if not self.value_of("ordered"):
             seed = self.value_of("seed")
             perm_gen = (np.random.default_rng(int(seed)) if seed is not None and seed != -1
                         else stream("graph-node", self.stable_id, "permutation"))
             order = perm_gen.permutation(len(items))
-        start = ctx.exec_index * n
-        picks = [items[int(order[((start + i) * stride) % len(items)])] for i in range(n)]
-        return _stack(_expand(picks))
+        if stride is None:
+            pick = items[int(order[ctx.exec_index % len(items)])]
+            return [pick if isinstance(pick, Samples) else _stack([pick])[0] if _numeric_item(pick) else pick]
+        start = ctx.exec_index * int(stride)
+        chunk = [items[int(order[(start + i) % len(items)])] for i in range(int(stride))]
+        return [_stack(_expand(chunk))]
+
+
+def _numeric_item(value: Any) -> bool:
+    """Whether ``value`` is a number or a flat/nested tuple of numbers (drawn as an array)."""
+    if isinstance(value, (bool, np.bool_, str, ReplicatorItem)) or value is None:
+        return False
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        return False
+    return arr.dtype.kind in "iuf" and arr.dtype != object
 
 
 @register_node

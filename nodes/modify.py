@@ -7,61 +7,64 @@ import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
 from graphsdg.functional import modify as F
-from graphsdg.functional.per_prim import per_prim_array
 from graphsdg.graph.calls import Call
-from graphsdg.graph.node import ExecContext, Node, Port
+from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
+from graphsdg.graph.value_shapes import SCALAR, SCALAR_OR_VEC3, WHOLE, attribute_shapes, spread_value
+from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
+from graphsdg.stage.prims import resolve_prim
 from graphsdg.stage.xform import world_matrix
 
 TARGET = {"input_prims": Port("prims", required=True)}
 POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
 
 
-def pose_rows(ctx: ExecContext, port: str, n: int, what: str, uniform: bool = False) -> Any:
-    """Pose port ``port`` (sampled or plain) as ``(n, 3)`` rows for ``functional.modify.pose``'s ``what``.
-
-    A scalar distribution draws one number per prim, which fills that prim's row; a
-    plain vector is one value for every prim, also when there are as many prims as
-    it has numbers; a single number fills every row only where ``uniform`` (scale).
-    """
-    value, sampled = _port_value(ctx, port, n)
-    if value is None:
+def pose_rows(ctx: ExecContext, port: str, n: int) -> np.ndarray | None:
+    """Pose port ``port`` as ``(n, 3)`` rows: one value (a number fills x, y and z) or one per prim, plain or
+    drawn (:mod:`graphsdg.graph.value_shapes`)."""
+    values = ctx.per_prim(port, n, SCALAR_OR_VEC3)
+    if values is None:
         return None
-    if sampled and np.ndim(value) == 1:
-        value = np.asarray(value, dtype=np.float64)[:, None]     # one number per prim, never a shared row
-    return per_prim_array(value, n, what, uniform=uniform, uniform_per_prim=True)
+    return np.array([np.broadcast_to(np.asarray(v, dtype=np.float64), (3,)) for v in values])
 
 
 def look_at_points(value: Any, n: int) -> Any:
-    """A look-at target as world point(s): a point, one point per prim, or prims (their positions)."""
+    """A look-at target as world point(s): a point, one point per prim, or prims (the mean of their positions)."""
     if value is None:
         return None
-    prims = [v for v in (value if isinstance(value, (list, tuple)) else [value])
-             if isinstance(v, (Usd.Prim, Sdf.Path)) or hasattr(v, "GetPrim")]
+    if isinstance(value, Samples):
+        value = value.one()
+    prims = _look_at_prims(value)
     if prims:
-        p = prims[0].GetPrim() if hasattr(prims[0], "GetPrim") else prims[0]
-        return world_matrix(p)[3, :3]
-    if isinstance(value, list) and value and isinstance(value[0], list):  # a prim list from an item
-        return look_at_points(value[0], n)
+        return np.mean([world_matrix(p)[3, :3] for p in prims], axis=0)
     return np.asarray(value, dtype=np.float64)
+
+
+def _look_at_prims(value: Any) -> list[Usd.Prim]:
+    """The prims a look-at value names (prims, paths, or an item's prim lists), or [] for coordinates."""
+    items = value if isinstance(value, (list, tuple)) else [value]
+    prims: list[Usd.Prim] = []
+    for v in items:
+        if isinstance(v, (list, tuple)) and v and not isinstance(v[0], (int, float, np.number)):
+            prims += _look_at_prims(list(v))
+        elif isinstance(v, Usd.Prim) or hasattr(v, "GetPrim"):
+            prims.append(v.GetPrim() if hasattr(v, "GetPrim") else v)
+        elif isinstance(v, (str, Sdf.Path)):
+            prims.append(resolve_prim(v))
+    return prims
 
 
 def sample_port(ctx: ExecContext, port: str, n: int) -> Any:
     """``n`` samples of ``port`` (recorded as provenance) or its plain value."""
-    return _port_value(ctx, port, n)[0]
-
-
-def _port_value(ctx: ExecContext, port: str, n: int) -> tuple[Any, bool]:
-    """:func:`sample_port`'s value and whether it was drawn from a distribution."""
     if not ctx.given(port):
-        return None, False
+        return None
     value = ctx.value(port)
     if isinstance(value, Samples):
         drawn = value.take(n)
         ctx.record(port, drawn)
-        return drawn, True
-    return value, False
+        return drawn
+    return value
 
 
 def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
@@ -69,14 +72,14 @@ def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
     n = len(prims)
     if n == 0:
         return
-    position = pose_rows(ctx, "position", n, "position_value")
-    rotation = pose_rows(ctx, "rotation", n, "rotation_value")
-    position = _with_components(ctx, prims, position, "position", n)
-    rotation = _with_components(ctx, prims, rotation, "rotation", n)
-    scale = pose_rows(ctx, "scale", n, "scale_value", uniform=True)
-    size = sample_port(ctx, "size", n)
-    pivot = pose_rows(ctx, "pivot", n, "pivot_value")
-    look_at = look_at_points(sample_port(ctx, "look_at", n), n)
+    position = _with_components(ctx, prims, pose_rows(ctx, "position", n), "position", n)
+    rotation = _with_components(ctx, prims, pose_rows(ctx, "rotation", n), "rotation", n)
+    scale = pose_rows(ctx, "scale", n)
+    size = ctx.per_prim("size", n, SCALAR_OR_VEC3) if "size" in ctx.node.inputs else None
+    if size is not None:
+        size = [np.asarray(v, dtype=np.float64) for v in size]
+    pivot = pose_rows(ctx, "pivot", n) if "pivot" in ctx.node.inputs else None
+    look_at = look_at_points(ctx.value("look_at"), n) if ctx.given("look_at") else None
     up = ctx.value("look_at_up_axis") if ctx.given("look_at_up_axis") else None
     order = ctx.value("rotation_order") if "rotation_order" in ctx.node.inputs else "XYZ"
     F.pose(prims, position_value=position, rotation_value=rotation, scale_value=scale, look_at_value=look_at,
@@ -88,17 +91,16 @@ def _with_components(ctx: ExecContext, prims: list[Usd.Prim], full: Any, base: s
     ports = [f"{base}_{axis}" for axis in "xyz"]
     if not any(p in ctx.node.inputs and ctx.given(p) for p in ports):
         return full
-    from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
     rows = []
     for prim in prims:
         m = np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()))
         t, r, _ = decompose(m)
         rows.append(t if base == "position" else np.array(matrix_to_euler_xyz(r)))
-    out = np.array(rows) if full is None else np.broadcast_to(np.asarray(full, dtype=np.float64), (n, 3)).copy()
+    out = np.array(rows) if full is None else np.array(full, dtype=np.float64)
     for axis, port in enumerate(ports):
-        value = sample_port(ctx, port, n)
-        if value is not None:
-            out[:, axis] = np.broadcast_to(np.asarray(value, dtype=np.float64).reshape(-1), (n,))
+        values = ctx.per_prim(port, n, SCALAR)
+        if values is not None:
+            out[:, axis] = np.asarray(values, dtype=np.float64).reshape(n)
     return out
 
 
@@ -150,14 +152,22 @@ class Attribute(Node):
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
+        if not prims:
+            return {"prims": prims}
         attr, attr_type = ctx.value("attribute"), ctx.value("attribute_type")
-        if ctx.is_random("value"):
-            values = sample_port(ctx, "value", len(prims))
-            for prim, v in zip(prims, values):
-                F.attribute(prim, attr, v, attribute_type=attr_type)
-        else:
-            F.attribute(prims, attr, ctx.value("value"), attribute_type=attr_type)
+        values = ctx.per_prim("value", len(prims), _attribute_shapes(prims[0], attr, attr_type))
+        for prim, v in zip(prims, values or [None] * len(prims)):
+            F.attribute(prim, attr, v, attribute_type=attr_type)
         return {"prims": prims}
+
+
+def _attribute_shapes(prim: Usd.Prim, name: str, attribute_type: str | None) -> Any:
+    """The element shape of one value of attribute ``name`` (its type, or ``attribute_type`` when it is new)."""
+    attr = prim.GetAttribute(name)
+    if attr and attr.IsValid():
+        return attribute_shapes(attr.GetTypeName())
+    found = Sdf.ValueTypeNames.Find(attribute_type) if attribute_type else None
+    return attribute_shapes(found) if found else WHOLE
 
 
 @register_node
@@ -197,12 +207,18 @@ class Visibility(Node):
         if not ctx.given("value"):
             values = [bool(v) for v in ctx.rng.integers(0, 2, size=len(prims))]
             ctx.record("value", values)
-        elif ctx.is_random("value"):
-            values = [bool(v) for v in np.asarray(sample_port(ctx, "value", len(prims))).reshape(-1)]
         else:
-            values = ctx.value("value")      # True/False, or one per prim; the functional call checks it
+            values = [_as_bool(v) for v in ctx.per_prim("value", len(prims), SCALAR)]
         F.visibility(prims, values)
         return {"prims": prims}
+
+
+def _as_bool(value: Any) -> Any:
+    """A drawn visibility as a Python bool (numpy draws are 0-d arrays); anything else is left for the
+    functional call to refuse by name."""
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, np.ndarray) and value.dtype == bool):
+        return bool(value)
+    return value
 
 
 @register_node
@@ -218,15 +234,19 @@ class Material(Node):
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
-        if ctx.is_random("value"):
-            for prim, mat in zip(prims, sample_port(ctx, "value", len(prims))):
-                F.material(prim, mat)
+        n = len(prims)
+        value = ctx.value("value")
+        if isinstance(value, Samples):
+            chosen = ctx.per_prim("value", n, SCALAR)
         else:
-            value = ctx.value("value")
-            if isinstance(value, list):
-                if len(value) != 1:
-                    raise ValueError(f"modify.material: value names {len(value)} materials; expected one "
-                                     f"(use rep.randomizer.materials to pick among several)")
-                value = value[0]
-            F.material(prims, value)
+            mats = flatten_prims(value, "modify.material value")
+            if not mats:
+                raise ValueError("modify.material: value names no material")
+            if len(mats) == 1 or len(mats) == n:
+                chosen = spread_value(mats, n, SCALAR, "modify.material value")
+            else:   # several materials, as Replicator's list: one drawn per prim
+                chosen = [mats[int(k)] for k in ctx.rng.integers(0, len(mats), size=n)]
+                ctx.record("value", [str(m.GetPath()) for m in chosen])
+        for prim, mat in zip(prims, chosen):
+            F.material(prim, mat)
         return {"prims": prims}

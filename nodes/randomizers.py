@@ -2,6 +2,7 @@
 with the node's per-execution stream as ``rng``."""
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -12,11 +13,12 @@ from graphsdg.functional import modify as FM
 from graphsdg.functional import randomizer as FR
 from graphsdg.graph.calls import Call
 from graphsdg.graph.graph import REPLICATOR_ROOT
-from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims
+from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims, is_random_value
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
+from graphsdg.graph.value_shapes import SCALAR, value_shape
 
-from .modify import TARGET, sample_port
+from .modify import TARGET
 
 
 class Randomizer(Node):
@@ -38,15 +40,23 @@ class Color(Randomizer):
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
-        colors = sample_port(ctx, "colors", len(prims))
-        applied = FR.color(prims, colors=colors)
+        n = len(prims)
+        value = ctx.value("colors")
+        if isinstance(value, Samples) or value_shape(value) in ((3,), (4,)):
+            colors = ctx.per_prim("colors", n, ((3,), (4,)))    # one colour, or a distribution's draws
+        else:   # a list of colours, as Replicator reads it: one drawn per prim
+            shape = value_shape(value)
+            if shape is None or len(shape) != 2 or shape[1] not in (3, 4) or shape[0] == 0:
+                raise ValueError(f"randomizer.color colors: got {value!r}; expected one (r, g, b), a list of "
+                                 f"colours to draw from, or a distribution")
+            palette = list(value)
+            colors = [palette[int(k)] for k in ctx.rng.integers(0, len(palette), size=n)]
+        applied = FR.color(prims, colors=np.array([np.asarray(c, dtype=np.float64)[:3] for c in colors]))
         ctx.record("colors", applied)
         return {"prims": prims}
 
 
 def _material_prims(value: Any, what: str) -> list[Usd.Prim]:
-    if isinstance(value, Samples):
-        raise TypeError(f"{what}: expected materials (a list, or a material_omnipbr item), got a distribution")
     return flatten_prims(value, what)
 
 
@@ -60,6 +70,11 @@ class Materials(Randomizer):
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
+        if isinstance(ctx.value("materials"), Samples):   # a distribution of materials: its draws, one per prim
+            chosen = ctx.per_prim("materials", len(prims), SCALAR)
+            for prim, mat in zip(prims, chosen):
+                FM.material(prim, mat)
+            return {"prims": prims}
         mats = _material_prims(ctx.value("materials"), "randomizer.materials materials")
         ctx.record("materials", FR.materials(prims, mats, rng=ctx.rng))
         return {"prims": prims}
@@ -78,18 +93,21 @@ class Texture(Randomizer):
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
         n = len(prims)
-        scale = sample_port(ctx, "texture_scale", n)
-        rotate = sample_port(ctx, "texture_rotate", n)
+        scales = ctx.per_prim("texture_scale", n, ((2,), ()))
+        rotates = ctx.per_prim("texture_rotate", n, SCALAR)
         textures = ctx.value("textures")
-        if isinstance(textures, Samples):   # a distribution of paths: one per prim
-            chosen = []
-            for i, (prim, file) in enumerate(zip(prims, textures.take(n))):
-                s_i = None if scale is None else (np.asarray(scale)[i] if np.ndim(scale) == 2 else scale)
-                r_i = None if rotate is None else (np.asarray(rotate).reshape(-1)[i] if np.size(rotate) == n
-                                                   else rotate)
-                chosen += FR.texture([prim], [file], texture_scale=s_i, texture_rotate=r_i, rng=ctx.rng)
-        else:
-            chosen = FR.texture(prims, list(textures), texture_scale=scale, texture_rotate=rotate, rng=ctx.rng)
+        if isinstance(textures, Samples):   # a distribution of paths: its draws, one per prim
+            files = [os.fspath(f) for f in ctx.per_prim("textures", n, SCALAR)]
+        else:                               # a list of paths, as Replicator's: one drawn per prim
+            listed = [textures] if isinstance(textures, (str, os.PathLike)) else list(textures)
+            if not listed:
+                raise ValueError("randomizer.texture textures: got an empty list; give texture files to draw from")
+            files = [os.fspath(listed[int(k)]) for k in ctx.rng.integers(0, len(listed), size=n)]
+        chosen = []
+        for i, prim in enumerate(prims):
+            scale = None if scales is None else np.broadcast_to(np.asarray(scales[i], dtype=np.float64), (2,))
+            rotate = None if rotates is None else float(np.asarray(rotates[i]).reshape(-1)[0])
+            chosen += FR.texture([prim], [files[i]], texture_scale=scale, texture_rotate=rotate, rng=ctx.rng)
         ctx.record("textures", chosen)
         return {"prims": prims}
 
@@ -200,17 +218,21 @@ class Instantiate(Randomizer):
               "use_cache": Port(bool, True), "semantics": Port(list)}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
-        if "paths" in values and not isinstance(values["paths"], str):
+        if isinstance(values.get("paths"), str):
+            values["paths"] = [values["paths"]]
+        elif "paths" in values and not is_random_value(values["paths"]):
             values["paths"] = list(values["paths"])
         super().__init__(name=name, **values)
         paths, size = self.value_of("paths"), self.value_of("size")
-        if isinstance(paths, str) or not paths:
-            raise ValueError(f"instantiate: paths must be a non-empty list of USD files, got {paths!r}")
         if isinstance(size, bool) or not isinstance(size, int) or size < 1:
             raise ValueError(f"instantiate: size must be a positive integer, got {size!r}")
         if self.value_of("mode") not in ("scene_instance", "point_instance", "reference"):
             raise ValueError(f"instantiate: mode must be 'scene_instance', 'point_instance' or 'reference', "
                              f"got {self.value_of('mode')!r}")
+        if is_random_value(paths):   # a distribution of USD files: its draws fill the slots each execution
+            return
+        if not paths:
+            raise ValueError(f"instantiate: paths must be a non-empty list of USD files, got {paths!r}")
         weights = self.value_of("weights")
         if weights is not None and (len(weights) != len(paths) or sum(weights) <= 0 or min(weights) < 0):
             raise ValueError(f"instantiate: weights {weights!r} must be {len(paths)} non-negative numbers "
@@ -230,6 +252,12 @@ class Instantiate(Randomizer):
 
     def compute(self, ctx: ExecContext) -> dict:
         slots = list(self.output_values["prims"])
+        if ctx.is_random("paths"):
+            chosen = [os.fspath(p) for p in ctx.per_prim("paths", len(slots), SCALAR)]
+            FM.reference(slots, chosen)
+            if self.value_of("semantics"):
+                FM.semantics(slots, self.value_of("semantics"))
+            return {"prims": slots}
         paths = list(self.value_of("paths"))
         weights = self.value_of("weights")
         p = None if weights is None else np.asarray(weights, dtype=np.float64) / float(sum(weights))

@@ -82,7 +82,9 @@ def test_choice_of_tuples_without_weights_and_without_replacement():
 def test_sequence_walks_in_order_and_wraps():
     seq = rep.distribution.sequence(["a", "b", "c"])
     assert [draw(seq, 1, execution=k)[0] for k in range(7)] == list("abcabca")
-    assert list(draw(seq, 2, execution=1)) == ["c", "a"]          # two targets take two consecutive items
+    assert list(draw(seq, 2, execution=1)) == ["b", "b"]          # one item per execution, whatever the targets
+    chunks = rep.distribution.sequence(["a", "b", "c"], stride=2)   # stride: that many consecutive items a draw
+    assert [list(draw(chunks, 1, execution=k)[0]) for k in range(3)] == [["a", "b"], ["c", "a"], ["b", "c"]]
     shuffled = rep.distribution.sequence(list(range(6)), ordered=False)
     cycle = [int(draw(shuffled, 1, execution=k)[0]) for k in range(12)]
     assert sorted(cycle[:6]) == list(range(6)) and cycle[6:] == cycle[:6]

@@ -199,13 +199,15 @@ def test_modify_without_target_raises():
             rep.randomizer.color(colors=rep.distribution.uniform((0, 0, 0), (1, 1, 1)))
 
 
-def test_registered_randomizer_returning_nothing_raises():
-    def forgetful():
+def test_registered_randomizer_returning_a_non_item_raises():
+    # returning nothing is Replicator's common form (tests/test_replicator_value_shapes.py); a stray value is not
+    def confused():
         rep.create.light(light_type="Sphere")
+        return 42
 
-    rep.randomizer.register(forgetful)
-    with pytest.raises(GraphBuildError, match="registered randomizer 'forgetful' returned nothing"):
-        rep.randomizer.forgetful()
+    rep.randomizer.register(confused)
+    with pytest.raises(GraphBuildError, match="registered randomizer 'confused' returned 42"):
+        rep.randomizer.confused()
 
 
 def test_no_warning_for_a_listened_event():

@@ -112,7 +112,9 @@ def test_choice_draws_only_choices_and_never_zero_weights(choices, data):
 def test_sequence_steps_through_items_in_order(items, n, execution):
     _fresh_graph()
     x = np.asarray(draw(rep.distribution.sequence(items), n, execution)).tolist()
-    assert x == [items[(execution * n + i) % len(items)] for i in range(n)]
+    assert x == [items[execution % len(items)]] * n                       # one item per execution for all targets
+    y = np.asarray(draw(rep.distribution.sequence(items, stride=n), 1, execution)[0]).tolist()
+    assert y == [items[(execution * n + i) % len(items)] for i in range(n)]   # stride: n consecutive items
 
 
 @FAST

@@ -31,6 +31,7 @@ from graphsdg import rng as rnglib
 from graphsdg.errors import GraphBuildError
 from graphsdg.graph.samples import Samples
 from graphsdg.graph.scopes import scopes
+from graphsdg.graph.value_shapes import Shape, spread
 from graphsdg.stage.prims import resolve_prim
 
 if TYPE_CHECKING:  # type names only: the graph module imports this one
@@ -198,6 +199,20 @@ class ExecContext:
         if isinstance(value, Samples):
             return value.take(n)
         return value
+
+    def per_prim(self, port: str, n: int, shapes: tuple[Shape, ...] | None) -> list[Any] | None:
+        """Input ``port`` as ``n`` per-prim values (None when not given), by Replicator's value shapes.
+
+        One value for every prim, one per prim, or a distribution's draws of either
+        (:mod:`graphsdg.graph.value_shapes`); what a distribution drew is kept as provenance.
+        """
+        if not self.given(port):
+            return None
+        value = self.value(port)
+        values = spread(value, n, shapes, f"{self.node.type_name} {port}")
+        if isinstance(value, Samples):
+            self.record(port, values)
+        return values
 
     def is_random(self, port: str) -> bool:
         """Whether ``port`` is fed by a distribution (re-sampled each execution)."""

@@ -1,5 +1,11 @@
 """``register(fn)`` for the graph-API namespaces: a user function becomes ``rep.<namespace>.<name>``.
 
+Calling the registered name calls ``fn``, which builds nodes with ``rep.*`` calls; they join the graph
+where the call is made (gated by the enclosing ``with rep.trigger...:`` block), so they run each time
+that trigger fires. ``fn`` may return what it built (an item, ``item.node``, or a list of items) or
+nothing at all, as Replicator allows: a function that builds its nodes inside ``with`` blocks and has no
+``return`` still drives its prims on every execution.
+
 Example:
     >>> import graphsdg as rep
     >>> def bright_lights():
@@ -38,9 +44,13 @@ def register_function(namespace: ModuleType, fn: Callable[..., Any], override: b
     @functools.wraps(fn)
     def call(*args: Any, **kwargs: Any) -> Any:
         result = fn(*args, **kwargs)
-        if result is None:
-            raise GraphBuildError(f"registered {short} {name!r} returned nothing; it must return the item (or "
-                                  f"item.node) it built, e.g. 'return lights.node'")
+        if result is None:   # its nodes are already in the graph, gated by the caller's trigger
+            return None
+        if isinstance(result, (list, tuple)):
+            return [as_item(r) for r in result]
+        if not isinstance(result, (Node, ReplicatorItem)):
+            raise GraphBuildError(f"registered {short} {name!r} returned {result!r}; a registered function "
+                                  f"returns the item it built (or item.node), or nothing")
         return as_item(result)
 
     setattr(namespace, name, call)
