@@ -38,3 +38,12 @@ def test_enabling_an_out_of_scope_extension_says_why(compat):
 def test_an_unmapped_name_still_gets_the_generic_answer(compat):
     with pytest.raises(CompatImportError, match="not available in graphsdg's compat mode"):
         importlib.import_module("isaacsim.no_such_module")
+
+
+def test_palletizing_example_imports_from_its_isaac_6_path(compat):
+    from isaacsim.core.utils.extensions import enable_extension
+    assert enable_extension("isaacsim.cortex.examples")
+    from isaacsim.cortex.examples.ur10_palletizing.ur10_palletizing import BinStacking
+    from isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing import BinStacking as older
+    from graphsdg.scenarios.palletizing import BinStacking as scenario
+    assert BinStacking is older is scenario

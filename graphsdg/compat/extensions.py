@@ -51,6 +51,7 @@ KNOWN: dict[str, tuple[str, ...]] = {
     "isaacsim.replicator.writers": (),
     "isaacsim.replicator.examples": (),
     "isaacsim.examples.interactive": ("isaacsim.examples.interactive",),
+    "isaacsim.cortex.examples": ("isaacsim.cortex.examples",),
 }
 # off until enabled, as in Isaac Sim's standalone Python experience
 OFF_AT_START: set[str] = {"isaacsim.test.utils", "omni.simready.explorer"}

@@ -162,7 +162,9 @@ def _add_ancestors(by_name: dict[str, types.ModuleType], name: str) -> None:
 
 
 def _palletizing_module() -> list[types.ModuleType] | None:
-    """``isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing`` when the scenario exists."""
+    """The UR10 palletizing example's modules when the scenario exists: Isaac Sim 6.0.1's
+    ``isaacsim.cortex.examples.ur10_palletizing.ur10_palletizing`` and the older
+    ``isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing``."""
     try:
         from graphsdg.scenarios import palletizing
     except ModuleNotFoundError as exc:   # absent; a scenario that is there but broken raises
@@ -174,7 +176,9 @@ def _palletizing_module() -> list[types.ModuleType] | None:
     pkg = CompatModule("isaacsim.examples.interactive.ur10_palletizing", ur10_palletizing=leaf)
     interactive = CompatModule("isaacsim.examples.interactive", ur10_palletizing=pkg)
     examples = CompatModule("isaacsim.examples", interactive=interactive)
-    return [leaf, pkg, interactive, examples]
+    cortex_leaf = CompatModule("isaacsim.cortex.examples.ur10_palletizing.ur10_palletizing",
+                               BinStacking=palletizing.BinStacking)
+    return [cortex_leaf, leaf, pkg, interactive, examples]
 
 
 def install() -> None:
