@@ -64,6 +64,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                     "num_bins); fewer make CI-sized runs"),
     "/persistent/isaac/asset_root/default": (None, "root that get_assets_root_path() returns instead of the "
                                              "built-in asset pack"),
+    "/graphsdg/assets/nucleusMirror": (None, "local folder holding a Nucleus server's tree (NVIDIA/, Isaac/, ...): "
+                                             "omniverse://<host>/<path> reads <folder>/<path> (graphsdg.assets.nucleus)"),
     "/rtx/rendermode": ("RayTracedLighting", "render mode; with the pbr backend RaytracedLighting is its "
                         "real-time tier and PathTracing its path tier; on the classic rasteriser PathTracing "
                         "enables the highest-quality settings (8x MSAA, shadow maps of 8 texels per image pixel "

@@ -20,6 +20,7 @@ from typing import Any, Sequence
 import numpy as np
 from pxr import Gf, Pcp, Sdf, Usd, UsdGeom, UsdLux
 
+from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.errors import closest, usd_error_text
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
@@ -332,9 +333,10 @@ def reference(usd_path: str, name: str | None = None, parent: PrimLike | None = 
     authored (see :mod:`graphsdg.sim.compiler`).
 
     Raises ``FileNotFoundError`` naming a path that does not exist and
-    ``ValueError`` for a file that does not parse as USD.
+    ``ValueError`` for a file that does not parse as USD. An ``omniverse://`` URL
+    references its local file (:mod:`graphsdg.assets.nucleus`).
     """
-    path_str = os.fspath(usd_path)
+    path_str = resolve_asset_path(usd_path)
     layer = _reference_layer(path_str)
     default = os.path.splitext(os.path.basename(path_str))[0]
     prim = UsdGeom.Xform.Define(get_stage(), _new_path(name, default, parent)).GetPrim()
@@ -363,7 +365,7 @@ def add_reference(prim: Usd.Prim, usd_path: str, layer: Sdf.Layer | None = None,
     Raises ``FileNotFoundError`` naming files that do not exist (the prim is removed
     if ``remove_on_error``, else the reference is taken back).
     """
-    path_str = os.fspath(usd_path)
+    path_str = resolve_asset_path(usd_path)
     layer = layer or _reference_layer(path_str)
     target = _reference_target(layer, path_str)
     stage = prim.GetStage()

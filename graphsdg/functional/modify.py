@@ -19,6 +19,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from graphsdg import settings_store as settings
+from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.errors import closest
 from graphsdg.functional.per_prim import per_prim, per_prim_array
 from graphsdg.runtime import runtime
@@ -307,7 +308,7 @@ def reference(prims: Any, usd_paths: Any) -> None:
     if len(paths) != len(targets):
         raise ValueError(f"reference got {len(paths)} paths for {len(targets)} prims")
     for prim, path in zip(targets, paths):
-        path = os.fspath(path)
+        path = resolve_asset_path(path)   # an omniverse:// URL: its local file
         if "://" not in path and not os.path.isfile(path):
             raise FileNotFoundError(f"reference usd_path {path!r} does not exist")
         refs = prim.GetReferences()

@@ -25,6 +25,7 @@ import numpy as np
 from pxr import Usd, UsdGeom, UsdLux
 
 from graphsdg import settings_store as settings
+from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.imaging import environment_map
 from graphsdg.sim.compile_error import CompileError
 from graphsdg.sim.compiled_scene import CompiledScene, LightBinding
@@ -104,7 +105,7 @@ def light_params(prim: Usd.Prim, world_scale: np.ndarray) -> LightParams:
     texture = None
     if kind == "dome":
         asset = _get(prim, "inputs:texture:file", None)
-        texture = (asset.resolvedPath or asset.path) if asset is not None and asset.path else None
+        texture = resolve_asset_path(asset.resolvedPath or asset.path) if asset is not None and asset.path else None
     return LightParams(kind=kind, color=color * power / k, radius=radius, cast_shadow=cast and kind != "dome",
                        texture=texture)
 

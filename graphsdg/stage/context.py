@@ -15,6 +15,7 @@ from typing import Callable
 
 from pxr import Sdf, Usd, UsdGeom
 
+from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.assets.root import builtin_pack_root
 from graphsdg.errors import usd_error_text
 from graphsdg.stage.changes import ChangeTracker
@@ -65,7 +66,7 @@ class StageContext:
         return self._install(stage)
 
     def open_stage(self, path: str | os.PathLike) -> Usd.Stage:
-        path = os.fspath(path)
+        path = resolve_asset_path(path)   # an omniverse:// URL opens its local file
         if not os.path.isfile(path):
             raise FileNotFoundError(f"cannot open stage: no USD file at {path!r}")
         try:

@@ -13,6 +13,9 @@ from typing import Sequence
 
 from pxr import Gf, Sdf, Usd, UsdShade
 
+from graphsdg.assets.nucleus import is_nucleus_url, resolve_asset_path
+from graphsdg.stage.mdl_modules import instance_arguments
+
 OMNIPBR_TO_PREVIEW = {
     "diffuse_color_constant": "diffuseColor",
     "reflection_roughness_constant": "roughness",
@@ -181,15 +184,21 @@ def describe_omnipbr(path: str, shader: UsdShade.Shader) -> MaterialDesc:
     ``diffuse_texture`` (tinted by ``diffuse_tint``) or ``diffuse_color_constant``,
     ``reflection_roughness_constant``, ``metallic_constant``, ``emissive_color`` when
     ``enable_emission``, and the UV controls ``texture_scale`` (repeats, as graphsdg's
-    own ``texture_scale``), ``texture_rotate`` (degrees) and ``texture_translate``.
+    own ``texture_scale``), ``texture_rotate`` (degrees) and ``texture_translate``. A shader running a
+    material-instance module (an ``.mdl`` file exporting OmniPBR with fixed arguments, see
+    :mod:`graphsdg.stage.mdl_modules`) takes those arguments for the inputs it does not author.
     """
+    fixed = instance_arguments(shader)
+
     def get(name: str, default):
         inp = shader.GetInput(name)
         v = _input_value(inp) if inp else None
+        v = fixed.get(name) if v is None else v
         return default if v is None else v
 
     tex_in = shader.GetInput("diffuse_texture")
     texture = texture_file_path(_interface_input(tex_in)) if tex_in else None
+    texture = fixed.get("diffuse_texture") if texture is None else texture
     colour = get("diffuse_tint", Gf.Vec3f(1, 1, 1)) if texture else get("diffuse_color_constant",
                                                                          Gf.Vec3f(0.2, 0.2, 0.2))
     emissive = get("emissive_color", Gf.Vec3f(0, 0, 0)) if bool(get("enable_emission", False)) else (0, 0, 0)
@@ -217,6 +226,8 @@ def texture_file_path(file_input: UsdShade.Input) -> str | None:
     if asset.resolvedPath:
         return asset.resolvedPath
     path = asset.path
+    if is_nucleus_url(path):
+        return resolve_asset_path(path)   # its local file, or an error naming the URL
     if os.path.isabs(path) or "://" in path:
         return path
     for spec in file_input.GetAttr().GetPropertyStack(Usd.TimeCode.Default()):
@@ -324,14 +335,18 @@ def texture_maps(material: UsdShade.Material) -> dict[str, str]:
 
 
 def _omnipbr_maps(shader: UsdShade.Shader) -> dict[str, str]:
+    fixed = instance_arguments(shader)
+
     def flag(name: str) -> bool:
         inp = shader.GetInput(name)
         value = _input_value(inp) if inp else None
+        value = fixed.get(name) if value is None else value
         return bool(value) if value is not None else False
 
     def file(name: str) -> str | None:
         inp = shader.GetInput(name)
-        return texture_file_path(_interface_input(inp)) if inp else None
+        path = texture_file_path(_interface_input(inp)) if inp else None
+        return fixed.get(name) if path is None else path
 
     maps = {role: f for role, name in OMNIPBR_MAP_INPUTS if (f := file(name))}
     orm = file("ORM_texture")
