@@ -23,6 +23,7 @@ select_gl_platform()   # before anything imports mujoco
 
 from graphsdg import (annotators, backends, functional, orchestrator, rng, settings,  # noqa: E402
                       stage, writers)
+from graphsdg import augmentations_default  # noqa: E402  (rep.augmentations_default; registers RgbToHsv, ...)
 from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry  # noqa: E402
 from graphsdg.io import writers as _builtin_writers  # noqa: E402,F401  (registers BasicWriter)
 from graphsdg.io.backends import BackendDispatch  # noqa: E402
@@ -69,8 +70,8 @@ from graphsdg.graph import ReplicatorItem, new_layer  # noqa: E402
 
 __version__ = "0.1.0"
 
-__all__ = ["annotators", "backends", "create", "functional", "orchestrator", "rng", "settings", "stage",
-           "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
+__all__ = ["annotators", "augmentations_default", "backends", "create", "functional", "orchestrator", "rng",
+           "settings", "stage", "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
            "new_layer", "ReplicatorItem",
            "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
            "get_global_seed", "set_global_seed", "timeline"]

@@ -17,7 +17,14 @@ def register_writer(writer_cls: type[Writer], category: str | None = None) -> No
 
 
 def unregister_writer(name: str) -> None:
+    """Remove writer ``name`` (attached instances detach); an unknown name raises."""
     WriterRegistry.unregister(name)
+
+
+def register_node_writer(name: str, node_type_id: str, annotators: list, category: str | None = None,
+                         **kwargs: Any) -> None:
+    """Replicator's OmniGraph node writers; graphsdg has no OmniGraph nodes, so this raises, saying what to do."""
+    WriterRegistry.register_node_writer(name, node_type_id, annotators, category, **kwargs)
 
 
 def get(name: str, init_params: dict | None = None, render_products: Any = None,
@@ -29,4 +36,5 @@ def get_writers(category: str | None = None) -> dict[str, type[Writer]]:
     return WriterRegistry.get_writers(category)
 
 
-__all__ = ["register_writer", "unregister_writer", "get", "get_writers", "Writer", "WriterRegistry"]
+__all__ = ["register_writer", "unregister_writer", "register_node_writer", "get", "get_writers", "Writer",
+           "WriterRegistry"]

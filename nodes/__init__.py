@@ -5,3 +5,9 @@ Importing this package registers the node types with the runtime's registries;
 """
 from . import annotators  # noqa: F401  (registers annotator types)
 from . import create, distributions, get, modify, randomizers, triggers  # noqa: F401  (register node types)
+
+from graphsdg.annotate.annotator import AnnotatorRegistry as _AnnotatorRegistry  # noqa: E402
+
+# the annotators graphsdg ships (Replicator's DEFAULT_ANNOTATORS list; scripts may append their own)
+_AnnotatorRegistry._default_annotators.extend(
+    n for n in _AnnotatorRegistry.get_registered_annotators() if n not in _AnnotatorRegistry._default_annotators)

@@ -13,12 +13,15 @@ Example:
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+import itertools
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from graphsdg.errors import closest, unknown_name
+from graphsdg.annotate import augmentation as augmentations
+from graphsdg.annotate.augmentation import Augmentation, AugmentationError, as_augmentation
+from graphsdg.errors import UnknownNameError, closest, unknown_name
 from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
 
@@ -50,12 +53,18 @@ class AovSource:
     doc: str = ""
 
 
+class AnnotatorRegistryError(UnknownNameError):
+    """An annotator name the registry does not know, or a bad registry call (Replicator's error type)."""
+
+
 class AnnotatorRegistry:
     """Registry of annotator specs (``rep.AnnotatorRegistry``)."""
 
     _specs: dict[str, AnnotatorSpec] = {}
     _aliases: dict[str, str] = {}
     _aovs: dict[str, AovSource] = {}
+    #: names of the annotators graphsdg ships (Replicator keeps this list for its telemetry; scripts append to it)
+    _default_annotators: list[str] = []
 
     @classmethod
     def register_spec(cls, spec: AnnotatorSpec, aliases: Iterable[str] = ()) -> None:
@@ -69,13 +78,13 @@ class AnnotatorRegistry:
     def resolve(cls, name: str) -> AnnotatorSpec:
         """The spec registered as ``name`` (an alias or a ``_fast`` variant included)."""
         if not isinstance(name, str):
-            raise TypeError(f"annotator name must be a string, got {type(name).__name__}")
+            raise AnnotatorRegistryError(f"annotator name must be a string, got {type(name).__name__} {name!r}")
         key = cls._aliases.get(name, name)
         if key not in cls._specs and key.endswith("_fast"):
             key = cls._aliases.get(key[:-5], key[:-5])
         spec = cls._specs.get(key)
         if spec is None:
-            raise unknown_name("annotator", name, cls.get_registered_annotators())
+            raise AnnotatorRegistryError(str(unknown_name("annotator", name, cls.get_registered_annotators())))
         return spec
 
     @classmethod
@@ -210,9 +219,62 @@ class AnnotatorRegistry:
 
     @classmethod
     def unregister(cls, name: str) -> None:
+        """Remove annotator ``name`` and its aliases (nothing happens for an unknown name)."""
         cls._specs.pop(name, None)
+        cls._aliases.pop(name, None)
         for alias in [a for a, n in cls._aliases.items() if n == name]:
             del cls._aliases[alias]
+
+    @classmethod
+    def unregister_annotator(cls, name: str) -> None:
+        """Remove annotator ``name`` (Replicator's call); an unknown name raises, listing the registered ones."""
+        if not isinstance(name, str):
+            raise AnnotatorRegistryError(f"annotator name must be a string, got {type(name).__name__} {name!r}")
+        if name not in cls._specs and name not in cls._aliases:
+            raise AnnotatorRegistryError(str(unknown_name("annotator", name, cls.get_registered_annotators())))
+        cls.unregister(name)
+
+    @classmethod
+    def register(cls, name: str, annotator: "Annotator | str") -> str:
+        """Register ``annotator`` (an object, augmentations and init params included, or a registered name)
+        under ``name``; ``get_annotator(name)`` then makes annotators like it.
+
+        Example:
+            >>> import graphsdg as rep
+            >>> noisy = rep.annotators.get("distance_to_camera").augment(
+            ...     rep.annotators.Augmentation.from_function(lambda data_in: data_in + 1.0))
+            >>> rep.annotators.register("depth_plus_one", noisy)
+            'depth_plus_one'
+        """
+        if not isinstance(name, str) or not name:
+            raise AnnotatorRegistryError(f"annotator name must be a non-empty string, got {name!r}")
+        if isinstance(annotator, Annotator):
+            spec, params = annotator.spec, dict(annotator.init_params)
+        elif isinstance(annotator, str):
+            spec = cls.resolve(annotator)
+            params = dict(spec.defaults)
+        else:
+            raise AnnotatorRegistryError(f"register({name!r}, ...) needs an annotator or an annotator's name, got "
+                                         f"{type(annotator).__name__}")
+        cls.unregister(name)
+        cls._specs[name] = replace(spec, defaults=params)
+        return name
+
+    # ---- augmentations (graphsdg.annotate.augmentation keeps them) ----
+    @classmethod
+    def register_augmentation(cls, name: str, augmentation: "Augmentation | str") -> None:
+        """Register ``augmentation`` as ``name`` (``annotator.augment(name)`` then applies it)."""
+        augmentations.register_augmentation(name, augmentation)
+
+    @classmethod
+    def unregister_augmentation(cls, name: str) -> None:
+        """Remove the augmentation registered as ``name``."""
+        augmentations.unregister_augmentation(name)
+
+    @classmethod
+    def get_augmentation(cls, name: str) -> Augmentation:
+        """The augmentation registered as ``name``."""
+        return augmentations.get_augmentation(name)
 
 
 def _params(spec: AnnotatorSpec, given: dict) -> dict:
@@ -282,6 +344,47 @@ class Annotator:
         if not self._render_products:
             attachments.annotators.discard(self)
 
+    def augment(self, augmentation: "Augmentation | str | Callable[..., Any]",
+                data_out_shape: tuple[int, ...] | None = None, name: str | None = None, device: str | None = None,
+                **kwargs: Any) -> "Annotator":
+        """Apply ``augmentation`` to this annotator's output from now on; returns the annotator itself.
+
+        ``augmentation`` is an :class:`~graphsdg.annotate.augmentation.Augmentation`, a registered
+        augmentation's name, or a function / Warp kernel taking ``data_in``; ``kwargs`` set its parameters
+        for this use, ``name`` renames the annotator (its key in writers' data).
+
+        Example:
+            >>> import graphsdg as rep
+            >>> def swap_red_blue(data_in):
+            ...     return data_in[..., [2, 1, 0, 3]]
+            >>> rep.annotators.get("rgb").augment(swap_red_blue, name="bgr").name
+            'bgr'
+        """
+        if device not in (None, "cpu"):
+            raise ValueError(f"augmentation device {device!r} is not available; graphsdg runs augmentations on "
+                             f"the CPU (device=None or 'cpu'; Warp kernels run on Warp's CPU device)")
+        aug = as_augmentation(augmentation, data_out_shape, **kwargs)
+        params = aug.bind(**kwargs)
+        self.spec = _augmented_spec(self.spec, aug, params, data_out_shape)
+        if name:
+            self.name = name
+        return self
+
+    def augment_compose(self, augmentations: "Iterable[Augmentation | str]", name: str | None = None) -> "Annotator":
+        """Apply several augmentations in order (each to the previous one's output); returns the annotator."""
+        if isinstance(augmentations, (str, Augmentation)) or not isinstance(augmentations, Iterable):
+            raise AugmentationError(f"augment_compose needs a list of augmentations, got {augmentations!r}")
+        items = list(augmentations)
+        bad = [type(a).__name__ for a in items if not isinstance(a, (str, Augmentation))]
+        if bad or not items:
+            raise AugmentationError(f"augment_compose needs a non-empty list of Augmentations or registered "
+                                    f"augmentation names, got {bad or items}")
+        for aug in items:
+            self.augment(aug)
+        if name:
+            self.name = name
+        return self
+
     def compute_for(self, frame) -> dict:
         out = get_output(frame, self.spec, self.init_params)
         self._latest[frame.render_product.path] = out
@@ -308,6 +411,35 @@ class Annotator:
 
     def __repr__(self) -> str:
         return f"Annotator({self.name!r}, {self.init_params})"
+
+
+_augmented = itertools.count()
+
+
+def _augmented_spec(source: AnnotatorSpec, aug: Augmentation, params: dict,
+                    data_out_shape: tuple[int, ...] | None) -> AnnotatorSpec:
+    """``source`` with ``aug`` applied to its array: a spec of its own name, so frames cache both outputs."""
+    key = f"{source.name}+{aug.name}#{next(_augmented)}"
+
+    def compute(frame, init_params: dict) -> dict:
+        out = get_output(frame, source, init_params)
+        data = out.get("data")
+        if data is None:
+            raise AugmentationError(f"annotator {source.name!r} has no data array for augmentation {aug.name!r} "
+                                    f"to work on (its output holds only {sorted(out.get('info', {}))})")
+        result = aug.run(data, (key, frame.render_product.path, frame.frame_index), params, data_out_shape)
+        info = dict(out.get("info") or {})
+        if isinstance(result, dict):
+            info.update(result["info"])
+            result = result["data"]
+        return {"data": result, "info": info} if info else {"data": result}
+
+    return replace(source, name=key, compute=compute,
+                   doc=f"{source.doc}\n\nAugmented with {aug.name!r} {params}.".strip())
+
+
+# augmentations resolve annotator names through the registry (the augmentation module cannot import this one)
+augmentations.annotator_lookup = AnnotatorRegistry.get_annotator
 
 
 def shape_output(out: dict, legacy: bool = True, copy_arrays: bool = False) -> Any:

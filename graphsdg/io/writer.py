@@ -94,10 +94,39 @@ class Writer:
         return objs
 
     def get_annotators(self) -> dict[str, Annotator]:
+        """The writer's annotators by name (their keys in ``data``)."""
         return {a.name: a for a in self._annotator_objects()}
 
-    def add_annotator(self, annotator: "Annotator | str") -> None:
-        self.annotators = list(self.annotators or []) + [annotator]
+    def get_annotator(self, name: str) -> Annotator | None:
+        """The writer's annotator called ``name``, or None."""
+        return self.get_annotators().get(name)
+
+    def add_annotator(self, annotator: "Annotator | str", name: str | None = None) -> None:
+        """Add ``annotator`` (an object or a name); one of the same name is replaced, as in Replicator.
+
+        ``name`` renames the annotator (its key in ``data``).
+        """
+        if isinstance(annotator, str):
+            annotator = AnnotatorRegistry.get_annotator(annotator)
+        if not isinstance(annotator, Annotator):
+            raise TypeError(f"{type(self).__name__}.add_annotator expects an annotator or an annotator name, got "
+                            f"{type(annotator).__name__} {annotator!r}")
+        if name:
+            annotator.name = name
+        annotators = self.get_annotators()
+        annotators[annotator.name] = annotator
+        self.annotators = list(annotators.values())
+        self._annotator_objs = None
+
+    def augment_annotator(self, annotator_name: str, augmentation: Any, **kwargs: Any) -> None:
+        """Augment the writer's annotator ``annotator_name`` (its data keeps that name); ``augmentation`` as
+        for ``Annotator.augment``, ``kwargs`` its parameters."""
+        annotators = self.get_annotators()
+        if annotator_name not in annotators:
+            raise ValueError(f"{type(self).__name__} has no annotator {annotator_name!r} to augment"
+                             f"{closest(str(annotator_name), annotators)}; its annotators: {sorted(annotators)}")
+        annotators[annotator_name].augment(augmentation, **kwargs)
+        self.annotators = list(annotators.values())
         self._annotator_objs = None
 
     @property
@@ -248,16 +277,38 @@ class WriterRegistry:
     """Registry of writer classes (``rep.WriterRegistry``)."""
 
     _writers: dict[str, tuple[type[Writer], str | None]] = {}
+    #: names of the writers graphsdg ships (those registered in the "default" category); Replicator keeps this
+    #: list for its telemetry and extensions append their writers to it
+    _default_writers: list[str] = []
 
     @classmethod
     def register(cls, writer_cls: type[Writer], category: str | None = None) -> None:
+        """Register a :class:`Writer` subclass under its class name."""
         if not (inspect.isclass(writer_cls) and issubclass(writer_cls, Writer)):
             raise TypeError(f"WriterRegistry.register expects a rep.Writer subclass, got {writer_cls!r}")
         cls._writers[writer_cls.__name__] = (writer_cls, category)
+        if category == "default" and writer_cls.__name__ not in cls._default_writers:
+            cls._default_writers.append(writer_cls.__name__)
 
     @classmethod
     def unregister(cls, name: str) -> None:
-        cls._writers.pop(name, None)
+        """Remove writer ``name``; its attached instances detach first. An unknown name raises, listing the known."""
+        if name not in cls._writers:
+            raise unknown_name("writer", name, cls._writers)
+        for writer in [w for w in attachments.writers if type(w).__name__ == name]:
+            writer.detach()
+        del cls._writers[name]
+
+    unregister_writer = unregister   # Replicator's other name for it
+
+    @classmethod
+    def register_node_writer(cls, name: str, node_type_id: str, annotators: list, category: str | None = None,
+                             **kwargs: Any) -> None:
+        """Replicator registers writers implemented as OmniGraph nodes (ROS 2 publishers, ...); graphsdg has none."""
+        raise NotImplementedError(
+            f"register_node_writer({name!r}, node_type_id={node_type_id!r}, ...) registers a writer implemented as "
+            f"an OmniGraph node, and graphsdg has no OmniGraph nodes. Subclass rep.Writer (write(data) receives the "
+            f"annotators' data each frame) and register it with rep.writers.register_writer(cls)")
 
     @classmethod
     def get(cls, name: str, init_params: dict | None = None, render_products=None,
