@@ -1,7 +1,8 @@
 """Static scan: which ``rep.*`` names and Isaac import statements of Isaac Sim's Replicator-using files resolve.
 
-For every file of an Isaac Sim source tree that imports ``omni.replicator.core``
-(the targets of ``bench/isaac_tree.py``), it collects
+For every target of ``bench/isaac_tree.py`` (the standalone scripts and test
+files of an Isaac Sim source tree that import ``omni.replicator.core``, with the
+helper modules the scripts import beside them), it collects
 
 * every maximal attribute chain rooted at a name bound to Replicator
   (``rep.functional.create.xform``; from-imported names count as chains), and
@@ -28,7 +29,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from isaac_tree import imports_replicator, scope_of   # noqa: E402
+from isaac_tree import find_targets, imports_replicator, scope_of   # noqa: E402
 
 ISAAC_ROOTS = ("omni", "carb", "isaacsim", "pxr", "usdrt", "Semantics", "warp")
 REPLICATOR = "omni.replicator.core"
@@ -130,7 +131,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--missing", action="store_true", help="list the names that do not resolve")
     args = parser.parse_args(argv)
     source = args.isaac / "source"
-    files = sorted(p for p in source.rglob("*.py") if imports_replicator(p))
+    scripts, tests = find_targets(source)
+    helpers = [p for p in (source / "standalone_examples").rglob("*_utils.py") if imports_replicator(p)]
+    files = sorted(set(scripts) | set(tests) | set(helpers))
     per_file = {}
     for path in files:
         tree = ast.parse(path.read_text(errors="replace"))
