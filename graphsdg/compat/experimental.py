@@ -1,6 +1,7 @@
 """Isaac compat area: ``isaacsim.core.experimental`` objects, prims and materials.
 
-The classes live in :mod:`graphsdg.compat.experimental_objects`,
+The classes live in :mod:`graphsdg.compat.experimental_objects` (lights in
+:mod:`graphsdg.compat.experimental_lights`, the camera in :mod:`graphsdg.compat.experimental_camera`),
 :mod:`graphsdg.compat.experimental_prims` and
 :mod:`graphsdg.compat.experimental_materials`; this module maps them to Isaac's
 module names (deformable prims and materials come from
@@ -10,6 +11,8 @@ from __future__ import annotations
 
 import types
 
+from graphsdg.compat import experimental_camera as camera
+from graphsdg.compat import experimental_lights as lights
 from graphsdg.compat import experimental_materials as materials
 from graphsdg.compat import experimental_objects as objects
 from graphsdg.compat import experimental_prims as prims
@@ -21,7 +24,10 @@ def modules() -> list[types.ModuleType]:
     return [
         CompatModule("isaacsim.core.experimental.objects", GroundPlane=objects.GroundPlane, Shape=objects.Shape,
                      Cube=objects.Cube, Sphere=objects.Sphere, Cylinder=objects.Cylinder, Capsule=objects.Capsule,
-                     Cone=objects.Cone, Plane=objects.Plane, Mesh=objects.Mesh),
+                     Cone=objects.Cone, Plane=objects.Plane, Mesh=objects.Mesh, Camera=camera.Camera,
+                     Light=lights.Light, DistantLight=lights.DistantLight, SphereLight=lights.SphereLight,
+                     RectLight=lights.RectLight, DiskLight=lights.DiskLight, CylinderLight=lights.CylinderLight,
+                     DomeLight=lights.DomeLight),
         CompatModule("isaacsim.core.experimental.prims", Prim=prims.Prim, XformPrim=prims.XformPrim,
                      GeomPrim=prims.GeomPrim, RigidPrim=prims.RigidPrim),
         CompatModule("isaacsim.core.experimental.materials", VisualMaterial=materials.VisualMaterial,

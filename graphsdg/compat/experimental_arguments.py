@@ -18,6 +18,7 @@ import warnings
 from typing import Any, Sequence
 
 import numpy as np
+from PIL import ImageColor
 from pxr import Sdf, Usd
 
 _warned: set[str] = set()
@@ -87,3 +88,34 @@ def as_paths(paths: Any) -> list[str]:
     if not out:
         raise ValueError("no prim paths given; expected a path or a non-empty list of paths")
     return out
+
+
+# matplotlib's one-letter base colours (Isaac parses colour strings with matplotlib); names and hex codes go
+# through Pillow's CSS / X11 table
+_BASE_COLORS = {"b": (0.0, 0.0, 1.0), "g": (0.0, 0.5, 0.0), "r": (1.0, 0.0, 0.0), "c": (0.0, 0.75, 0.75),
+                "m": (0.75, 0.0, 0.75), "y": (0.75, 0.75, 0.0), "k": (0.0, 0.0, 0.0), "w": (1.0, 1.0, 1.0)}
+
+
+def parse_color(color: str) -> tuple[float, float, float]:
+    """An RGB triple in [0, 1] from a colour name (CSS4 / X11, any case), a hex code or a base-colour letter."""
+    text = color.strip().lower()
+    if text in _BASE_COLORS:
+        return _BASE_COLORS[text]
+    try:
+        rgb = ImageColor.getrgb(text)
+    except ValueError:
+        raise ValueError(f"invalid colour string {color!r}: expected a CSS4 / X11 colour name ('white', "
+                         f"'darkorange'), a hex code ('#ff8800') or a base colour letter ('r', 'g', 'b', ...)") from None
+    return tuple(c / 255.0 for c in rgb[:3])  # type: ignore[return-value]
+
+
+def color_rows(colors: Any, count: int, name: str = "colors") -> np.ndarray:
+    """Colours (rgb rows in [0, 1] or colour strings) broadcast to ``(count, 3)``."""
+    if isinstance(colors, str):
+        colors = parse_color(colors)
+    elif isinstance(colors, (list, tuple)):
+        colors = [parse_color(c) if isinstance(c, str) else c for c in colors]
+    data = rows(colors, count, 3, name)
+    if data.min() < 0 or data.max() > 1:
+        raise ValueError(f"{name} {colors!r} must be rgb values in [0, 1]")
+    return data

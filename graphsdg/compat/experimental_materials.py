@@ -23,7 +23,7 @@ from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
 from graphsdg.stage import materials as matlib
-from graphsdg.stage.context import get_stage
+from graphsdg.compat.experimental_stage_scope import current_stage as get_stage
 
 # input -> (USD type, width, (low, high) or None, rendered by graphsdg)
 _PREVIEW_INPUTS: dict[str, tuple[Any, int, tuple[float, float] | None, bool]] = {

@@ -25,7 +25,7 @@ from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.experimental_prims import GeomPrim, XformPrim
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
-from graphsdg.stage.context import get_stage
+from graphsdg.compat.experimental_stage_scope import current_stage as get_stage
 
 _AXES = ("X", "Y", "Z")
 

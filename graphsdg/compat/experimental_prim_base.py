@@ -13,7 +13,7 @@ from pxr import Sdf, Usd
 
 from graphsdg.compat.experimental_arguments import as_paths
 from graphsdg.compat.modules import CompatObject
-from graphsdg.stage.context import get_stage
+from graphsdg.compat.experimental_stage_scope import current_stage as get_stage
 
 _REGEX_CHARS = re.compile(r"[\\^$.|?*+()\[\]{}]")
 
