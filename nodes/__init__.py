@@ -5,6 +5,7 @@ Importing this package registers the node types with the runtime's registries;
 """
 from . import annotators  # noqa: F401  (registers annotator types)
 from . import create, distributions, get, modify, randomizers, triggers  # noqa: F401  (register node types)
+from . import domain_randomization  # noqa: F401  (physics domain-randomization node types)
 
 from graphsdg.annotate.annotator import AnnotatorRegistry as _AnnotatorRegistry  # noqa: E402
 

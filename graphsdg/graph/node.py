@@ -37,7 +37,8 @@ from graphsdg.stage.prims import resolve_prim
 if TYPE_CHECKING:  # type names only: the graph module imports this one
     from graphsdg.graph.graph import Graph
 
-FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer")
+# "gate": a node inside a trigger's block that picks which rows (environments) the nodes in its own block change
+FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer", "gate")
 
 
 @dataclass(frozen=True)

@@ -96,6 +96,36 @@ def run_subgraphs(graph: Graph, fired: Iterable[Node], frame: int, dry: bool = F
     return ran
 
 
+def fire_now(triggers: Iterable[TriggerNode]) -> list[Node]:
+    """Fire ``triggers`` now, between orchestrator steps, and run the nodes they gate; returns the nodes run.
+
+    An RL loop's ``step_randomization`` fires its trigger this way, once per call; the graph's frame does
+    not advance (no step was taken).
+    """
+    graph = active_graph()
+    if graph is None:
+        return []
+    fired = list(triggers)
+    for t in fired:
+        t.exec_count += 1
+        t.last_frame = graph.frame
+        t.output_values = {**t.output_values, "execs": t.exec_count}
+    ran = run_subgraphs(graph, fired, graph.frame)
+    _keep_provenance(graph, ran, graph.frame)
+    return ran
+
+
+def evaluate_all(graph: Graph) -> list[Node]:
+    """Run every node of ``graph`` but its triggers once, in order, whatever gates them (a push graph
+    evaluated by hand: OmniGraph's ``evaluate_sync``); returns the nodes run."""
+    ran = [n for n in graph.order if n.family != "trigger"]
+    for node in ran:
+        execute(node, graph.frame)
+    _keep_provenance(graph, ran, graph.frame)
+    graph.frame += 1
+    return ran
+
+
 def graph_step() -> dict[str, Any] | None:
     """The orchestrator hook: one step of the current graph."""
     graph = active_graph()
