@@ -33,6 +33,8 @@ from graphsdg.annotate.augmentation import NODE_TYPES, UNAVAILABLE, Augmentation
 
 HUE_SECTOR = 43   # 8-bit hue steps per sixth of the colour wheel
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+#: the 3x3 pixel transform (row by row) node augmentations report in ``info["xform"]`` when they move nothing
+_IDENTITY = np.eye(3).reshape(-1)
 
 
 def _colour(data_in: np.ndarray, name: str) -> np.ndarray:
@@ -114,12 +116,13 @@ def aug_adjust_sigmoid(data_in: np.ndarray, cutoff: float, gain: float) -> np.nd
     return _with_alpha(_to_uint8(y * np.float32(255.0)), data_in)
 
 
-def contrast(data_in: np.ndarray, contrastFactor: float) -> np.ndarray:  # noqa: N803 (Replicator's node input)
+def contrast(data_in: np.ndarray, contrastFactor: float) -> dict:  # noqa: N803 (Replicator's node input)
     """Scale each colour's distance from the image's mean grey level by ``contrastFactor`` (0 gives flat grey,
     1 the image, 2 twice the contrast); rounded to the nearest level."""
     rgb = _colour(data_in, "contrast")[..., :3].astype(np.float64)
     mean = float((rgb @ np.array([0.299, 0.587, 0.114])).mean())
-    return _with_alpha(np.clip(np.rint(mean + float(contrastFactor) * (rgb - mean)), 0, 255), data_in)
+    scaled = np.clip(np.rint(mean + float(contrastFactor) * (rgb - mean)), 0, 255)
+    return {"data": _with_alpha(scaled, data_in), "info": {"xform": _IDENTITY.copy()}}
 
 
 # ---- noise ---------------------------------------------------------------------------------------------
@@ -201,7 +204,6 @@ def canny(data_in: np.ndarray, thresholdLow: float, thresholdHigh: float) -> dic
 
 
 # ---- filters -------------------------------------------------------------------------------------------
-_IDENTITY = np.eye(3).reshape(-1)
 
 
 def _filtered(data_in: np.ndarray, kernel: np.ndarray, alpha: float, name: str) -> dict:
