@@ -29,6 +29,7 @@ from graphsdg.functional.create import add_reference
 from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.stage import context as stage_context
 from graphsdg.stage import semantics as semlib
+from graphsdg.stage.path_patterns import match_prim_paths
 from graphsdg.maths.rotations import euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.xform import set_local_pose
 
@@ -177,11 +178,10 @@ def is_prim_path_valid(prim_path: str, fabric: bool = False) -> bool:
 
 
 def define_prim(prim_path: str, prim_type: str = "Xform", fabric: bool = False) -> Usd.Prim:
-    """Define a prim; raises ValueError if one with another type is already there."""
+    """Define a prim of ``prim_type``; raises ValueError if a prim already exists there (as Isaac Sim 6)."""
     existing = get_prim_at_path(prim_path)
-    if existing and existing.GetTypeName() != prim_type:
-        raise ValueError(f"a prim already exists at {prim_path!r} with type {existing.GetTypeName()!r}, "
-                         f"not {prim_type!r}")
+    if existing:
+        raise ValueError(f"A prim already exists at prim path: {prim_path} (type {existing.GetTypeName()!r})")
     return get_current_stage().DefinePrim(Sdf.Path(prim_path), prim_type)
 
 
@@ -194,7 +194,11 @@ def create_prim(prim_path: str, prim_type: str = "Xform", position: Sequence[flo
     (``orientation`` is a w, x, y, z quaternion), and label."""
     if position is not None and translation is not None:
         raise ValueError("create_prim takes position (world) or translation (local), not both")
-    prim = define_prim(prim_path, prim_type)
+    existing = get_prim_at_path(prim_path)
+    if existing and existing.GetTypeName() != prim_type:
+        raise ValueError(f"a prim already exists at {prim_path!r} with type {existing.GetTypeName()!r}, "
+                         f"not {prim_type!r}")
+    prim = get_current_stage().DefinePrim(Sdf.Path(prim_path), prim_type)
     for name, value in (attributes or {}).items():
         attr = prim.GetAttribute(name)
         if not attr:
@@ -231,15 +235,16 @@ def get_prim_parent(prim: Usd.Prim) -> Usd.Prim:
     return prim.GetParent()
 
 
-def get_prim_path(prim: Usd.Prim) -> str:
-    return str(prim.GetPath())
+def get_prim_path(prim: Usd.Prim) -> str | None:
+    """The prim's path string (None for an invalid or missing prim)."""
+    return str(prim.GetPath()) if prim else None
 
 
 def find_matching_prim_paths(prim_path_regex: str, prim_type: str | None = None) -> list[str]:
-    """Paths of prims whose full path matches ``prim_path_regex`` (of ``prim_type`` if given)."""
-    pattern = re.compile(f"^{prim_path_regex}$")
-    return [str(p.GetPath()) for p in get_current_stage().Traverse()
-            if pattern.match(str(p.GetPath())) and (prim_type is None or p.GetTypeName() == prim_type)]
+    """Paths of prims matching the pattern segment by segment (Isaac's glob rules, ``.*`` read as ``*``:
+    :func:`graphsdg.stage.path_patterns.match_prim_paths`); ``prim_type`` ``"articulation"`` or ``"rigid_body"``
+    keeps prims with that physics API."""
+    return match_prim_paths(prim_path_regex, api=prim_type or None)
 
 
 def set_prim_visibility(prim: Usd.Prim, visible: bool) -> None:

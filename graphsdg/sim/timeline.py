@@ -56,6 +56,8 @@ if TYPE_CHECKING:
 
 # Kit's timeline reads its sub-stepping from this setting (set_ticks_per_frame writes it)
 TICKS_PER_FRAME_SETTING = "/app/player/timelineSubsampleRate"
+# False: ticks advance time and send tick events without stepping physics (Kit's render-only app updates)
+PLAY_SIMULATIONS_SETTING = "/app/player/playSimulations"
 
 
 class TimelineEventType(enum.IntEnum):
@@ -302,7 +304,8 @@ class Timeline:
                 self.pause()
                 return False
             dt = min(dt, end - self.current_time)   # the last tick lands on the end time
-        if self._simulation is not None:
+        # Kit's /app/player/playSimulations = False: the timeline ticks but physics does not step (a render)
+        if self._simulation is not None and settings.get(PLAY_SIMULATIONS_SETTING, True) is not False:
             sim = self._simulation()
             sim.sync_dirty_prims()
             sim.advance(dt)
