@@ -317,6 +317,11 @@ class Annotator:
     def render_products(self) -> list[RenderProduct]:
         return list(self._render_products)
 
+    def initialize(self, **init_params: Any) -> "Annotator":
+        """Set init params (Replicator's ``annotator.initialize(...)``), checked as ``get(name, init_params)``."""
+        self.init_params = _params(self.spec, {**self.init_params, **init_params})
+        return self
+
     def attach(self, render_products: "RenderProduct | str | Iterable[RenderProduct | str]") -> "Annotator":
         """Attach to one render product or a list of them (objects or paths)."""
         items = render_products if isinstance(render_products, (list, tuple)) else [render_products]

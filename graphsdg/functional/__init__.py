@@ -7,8 +7,8 @@ Example:
     >>> str(cube.GetPath())
     '/Cube'
 """
-from graphsdg.functional import create, create_batch, modify, physics, randomizer
+from graphsdg.functional import create, create_batch, get, modify, physics, randomizer
 from graphsdg.io.io_functions import write_blob, write_image, write_json, write_np
 
-__all__ = ["create", "create_batch", "modify", "randomizer", "physics", "write_image", "write_np", "write_json",
+__all__ = ["create", "create_batch", "get", "modify", "randomizer", "physics", "write_image", "write_np", "write_json",
            "write_blob"]

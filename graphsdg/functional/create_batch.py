@@ -48,3 +48,33 @@ capsule = _batch("capsule")
 plane = _batch("plane")
 disk = _batch("disk")
 torus = _batch("torus")
+
+
+def camera(count: int = 1, position: Any = None, rotation: Any = None, look_at: Any = None,
+           look_at_up_axis: Any = None, focal_length: float = 24.0, focus_distance: float = 400.0, f_stop: float = 0.0,
+           horizontal_aperture: float = 20.955, vertical_aperture: float | None = None,
+           horizontal_aperture_offset: float = 0.0, vertical_aperture_offset: float = 0.0,
+           clipping_range: tuple[float, float] = (0.01, 1000000.0), projection_type: str = "pinhole",
+           name: str | None = None, parent: Any = None, semantics: Any = None) -> list:
+    """Create ``count`` cameras (``rep.functional.create.camera`` each); poses per prim (an ``(N, 3)`` array) or
+    shared, the lens shared by all; returns the list of camera prims.
+
+    Example:
+        >>> import graphsdg as rep
+        >>> _ = rep.stage.new_stage()
+        >>> cams = rep.functional.create_batch.camera(count=2, position=[(0, 0, 5), (0, 0, 9)], name="Camera")
+        >>> [(str(c.GetPath()), c.GetTypeName()) for c in cams]
+        [('/Camera', 'Camera'), ('/Camera_01', 'Camera')]
+    """
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+        raise ValueError(f"count must be a positive integer, got {count!r}")
+    positions = per_prim(position, count, "position")
+    rotations = per_prim(rotation, count, "rotation")
+    targets = per_prim(look_at, count, "look_at")
+    return [create.camera(position=positions[i], rotation=rotations[i], look_at=targets[i],
+                          look_at_up_axis=look_at_up_axis, focal_length=focal_length, focus_distance=focus_distance,
+                          f_stop=f_stop, horizontal_aperture=horizontal_aperture, vertical_aperture=vertical_aperture,
+                          horizontal_aperture_offset=horizontal_aperture_offset,
+                          vertical_aperture_offset=vertical_aperture_offset, clipping_range=clipping_range,
+                          projection_type=projection_type, name=name, parent=parent, semantics=semantics)
+            for i in range(count)]
