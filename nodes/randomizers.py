@@ -57,12 +57,13 @@ class Color(Randomizer):
 
 
 def _material_prims(value: Any, what: str) -> list[Usd.Prim]:
-    return flatten_prims(value, what)
+    return flatten_prims(FR.with_mdl_materials(value), what)   # .mdl files: their materials, made once
 
 
 @register_node
 class Materials(Randomizer):
-    """Bind each prim a material drawn from ``materials`` (a material_omnipbr item, prims or paths)."""
+    """Bind each prim a material drawn from ``materials`` (a material_omnipbr item, prims, paths or ``.mdl``
+    files)."""
 
     type_name = "randomizer.materials"
     inputs = {**TARGET, "materials": Port("materials", required=True), "seed": Port(int),

@@ -180,8 +180,9 @@ def test_image_assets_decode(key):
 
 def test_pack_stays_small():
     total = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(ROOT) for f in fs)
-    # 4.1 MB with the pbr normal and ORM maps (0.44 MB of it); a guard against bloat, not a target
-    assert total < 4.5e6, f"asset pack is {total / 1e6:.1f} MB"
+    # 4.1 MB with the pbr normal and ORM maps (0.44 MB of it), ~5.5 MB with the stand-ins for the further
+    # /Isaac/... paths (warehouses, forklift, Franka, Nova Carter, ...); a guard against bloat, not a target
+    assert total < 6.0e6, f"asset pack is {total / 1e6:.1f} MB"
 
 
 def test_pack_regenerates_identically(tmp_path):
@@ -194,7 +195,7 @@ def test_pack_regenerates_identically(tmp_path):
         if rel.endswith(".usd"):
             a, b = Usd.Stage.Open(new), Usd.Stage.Open(old)      # keep the stages: they own the layers
             assert a.GetRootLayer().ExportToString() == b.GetRootLayer().ExportToString(), rel
-        elif rel.endswith(".json"):
+        elif rel.endswith((".json", ".mdl")):
             with open(new, encoding="utf-8") as fa, open(old, encoding="utf-8") as fb:
                 assert fa.read() == fb.read(), rel
         elif rel.endswith(".hdr"):

@@ -37,21 +37,34 @@ def new_asset_stage(path: str, root_name: str, kind: str = Kind.Tokens.component
     return stage, root
 
 
-def define_mesh(stage: Usd.Stage, path: str, mesh: MeshData) -> UsdGeom.Mesh:
-    """A ``UsdGeom.Mesh`` with face-varying ``primvars:st`` and normals, and its extent."""
+COMPACT_DECIMALS = (5, 3)   # points to 0.01 mm, unit normals to 1e-3: text files about 40 % smaller
+
+
+def define_mesh(stage: Usd.Stage, path: str, mesh: MeshData,
+                decimals: tuple[int, int] | None = None) -> UsdGeom.Mesh:
+    """A ``UsdGeom.Mesh`` with face-varying ``primvars:st`` and normals, and its extent.
+
+    ``decimals`` (points, normals) rounds the values written (and UVs to 1e-4), which
+    keeps text layers small (:data:`COMPACT_DECIMALS`); None writes them at full float
+    precision (UVs to 1e-6).
+    """
+    points, normals = mesh.points, mesh.normals
+    if decimals is not None:
+        points, normals = np.round(points, decimals[0]), np.round(normals, decimals[1])
     g = UsdGeom.Mesh.Define(stage, path)
-    g.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(mesh.points.astype(np.float32)))
+    g.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(points.astype(np.float32)))
     g.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(mesh.counts.astype(np.int32)))
     g.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(mesh.indices.astype(np.int32)))
     g.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
-    g.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(mesh.normals.astype(np.float32)))
+    g.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(normals.astype(np.float32)))
     g.SetNormalsInterpolation(UsdGeom.Tokens.faceVarying)
-    lo, hi = mesh.bounds()
+    lo, hi = points.min(axis=0), points.max(axis=0)
     g.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*lo.astype(float)), Gf.Vec3f(*hi.astype(float))]))
     st = UsdGeom.PrimvarsAPI(g).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray,
                                                UsdGeom.Tokens.faceVarying)
     # Indexed, as exporters write it: unique UVs plus one index per face vertex.
-    uniq, inverse = np.unique(np.round(mesh.st, 6).astype(np.float32), axis=0, return_inverse=True)
+    uv_decimals = 6 if decimals is None else 4
+    uniq, inverse = np.unique(np.round(mesh.st, uv_decimals).astype(np.float32), axis=0, return_inverse=True)
     st.Set(Vt.Vec2fArray.FromNumpy(uniq))
     st.SetIndices(Vt.IntArray.FromNumpy(inverse.ravel().astype(np.int32)))
     return g

@@ -21,7 +21,9 @@ from typing import Callable
 import numpy as np
 from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
 
-from graphsdg.assets import authoring, geometry, outdoor_skies, packing_table, simready, skies, textures, ycb
+from graphsdg.assets import (authoring, forklift, franka, geometry, handling_props, mdl_materials, outdoor_skies,
+                             packing_table, simready, skies, textures, warehouse_props, ycb)
+from graphsdg.assets.entries import ImageAsset, UsdAsset
 from graphsdg.assets.noise import hash01
 
 PROPS = "/Isaac/Environments/Simple_Warehouse/Props"
@@ -33,28 +35,6 @@ GROUND_DIR = "/NVIDIA/Materials/vMaterials_2/Ground/textures"
 
 def _abs(root: str, rel: str) -> str:
     return os.path.join(root, rel.lstrip("/"))
-
-
-@dataclass(frozen=True)
-class UsdAsset:
-    """A USD file of the pack: where it lives, its bounding-box size (m) and how to build it."""
-
-    key: str
-    path: str
-    size: tuple[float, float, float]
-    description: str
-    build: Callable[[str], list[str]]
-
-
-@dataclass(frozen=True)
-class ImageAsset:
-    """A texture or sky image of the pack."""
-
-    key: str
-    path: str
-    shape: tuple[int, int]       # (rows, cols)
-    description: str
-    build: Callable[[str], list[str]]
 
 
 # ---- wood textures ----------------------------------------------------------
@@ -432,11 +412,19 @@ IMAGE_ASSETS.update({
                                       _ground_builder(n))
     for n, (d, _) in GROUND_TEXTURES.items()})
 
+# Stand-ins for the further /Isaac/... paths Isaac's Replicator examples and tests load, module by module
+# (stages that reference props come after the props).
+ISAAC_STAND_IN_MODULES = (warehouse_props, handling_props, forklift, franka)
+ISAAC_ASSETS: dict[str, UsdAsset] = {a.key: a for m in ISAAC_STAND_IN_MODULES for a in m.ASSETS}
+# Material-instance modules (.mdl) at the paths of Isaac's environment materials, with their textures
+MDL_ASSETS: dict[str, ImageAsset] = {a.key: a for a in mdl_materials.ASSETS}
+
 # Images first: the warehouse's rack decks use the plywood texture.
 BUILD_ORDER: list[Callable[[str], list[str]]] = [a.build for a in IMAGE_ASSETS.values()] + \
     [USD_ASSETS[k].build for k in ("pallet", "sm_cardboxc_01", "sm_cardboxd_01", "sm_cardboxd_04", "grid",
                                    "warehouse")] + \
-    [a.build for a in PROP_ASSETS.values()] + [simready.build_catalog]
+    [a.build for a in PROP_ASSETS.values()] + [simready.build_catalog] + \
+    [a.build for a in MDL_ASSETS.values()] + [a.build for a in ISAAC_ASSETS.values()]
 
 
 def build_all(root: str) -> list[str]:

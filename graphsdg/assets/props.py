@@ -70,7 +70,8 @@ def part_texture(color: RGB, seed: int) -> np.ndarray:
 
 def write_prop(root: str, rel: str, prim_name: str, parts: Sequence[Part], *, texture_dir: str,
                texture_prefix: str, seed: int, meters_per_unit: float | None = 1.0,
-               unit_scale: float = 1.0) -> tuple[Usd.Stage, Usd.Prim, list[str]]:
+               unit_scale: float = 1.0, decimals: tuple[int, int] | None = None
+               ) -> tuple[Usd.Stage, Usd.Prim, list[str]]:
     """Write ``parts`` as the prop file ``rel`` (under ``root``) with default prim ``/prim_name``.
 
     Each part is the mesh ``/prim_name/<part.name>`` bound to
@@ -78,7 +79,8 @@ def write_prop(root: str, rel: str, prim_name: str, parts: Sequence[Part], *, te
     ``<texture_dir>/<texture_prefix>_<part.name>.png`` (a path relative to the
     file's folder). Geometry is multiplied by ``unit_scale`` (100 for an asset
     authored in centimetres). ``meters_per_unit`` None leaves the metadata
-    unauthored (USD's fallback is centimetres). Returns the open stage, the root
+    unauthored (USD's fallback is centimetres). ``decimals`` rounds the meshes'
+    values (:func:`graphsdg.assets.authoring.define_mesh`). Returns the open stage, the root
     prim and the relative paths written (textures; the caller saves the stage).
     """
     path = os.path.join(root, rel.lstrip("/"))
@@ -100,7 +102,7 @@ def write_prop(root: str, rel: str, prim_name: str, parts: Sequence[Part], *, te
         mesh = part.mesh
         if unit_scale != 1.0:
             mesh = geometry.transformed(mesh, np.diag([unit_scale] * 3 + [1.0]))
-        geom = authoring.define_mesh(stage, f"/{prim_name}/{part.name}", mesh)
+        geom = authoring.define_mesh(stage, f"/{prim_name}/{part.name}", mesh, decimals)
         authoring.bind_material(geom.GetPrim(), material)
     return stage, prim, written
 

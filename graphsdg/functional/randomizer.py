@@ -26,6 +26,8 @@ from graphsdg.functional.per_prim import per_prim
 from graphsdg.rng import ReplicatorRNG, as_generator
 from graphsdg.sim import bounds, placement
 from graphsdg.stage import materials as matlib
+from graphsdg.stage import mdl_modules
+from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prims, sanitize_name
 from graphsdg.maths.rotations import matrix_to_euler_xyz, quat_wxyz_to_matrix
 from graphsdg.stage.xform import parent_world_matrix, set_local_pose, world_matrix
@@ -92,9 +94,47 @@ def color(prims: Any, colors: Any = None, rng: ReplicatorRNG | np.random.Generat
     return np.asarray(values)
 
 
+def is_mdl_url(value: Any) -> bool:
+    """Whether ``value`` names an ``.mdl`` file (rather than a material prim)."""
+    return isinstance(value, (str, os.PathLike)) and os.fspath(value).lower().endswith(".mdl")
+
+
+def mdl_material(url: str, looks: str = LOOKS) -> Usd.Prim:
+    """The material running the ``.mdl`` file ``url``, made once under ``looks`` (as Replicator does for MDL
+    paths given to its material randomizer) and reused while that prim stands."""
+    path = os.fspath(url)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"MDL material {path!r} does not exist")
+    stage = get_stage()
+    looks_prim = stage.GetPrimAtPath(looks)
+    for child in looks_prim.GetChildren() if looks_prim else []:
+        shader = UsdShade.Shader(child.GetChild("Shader"))
+        asset = shader.GetSourceAsset("mdl") if shader else None
+        if asset is not None and asset.path == path:
+            return child
+    name = mdl_modules.material_name(path)
+    _ensure_scope(stage, Sdf.Path(looks))
+    target = Sdf.Path(looks).AppendChild(sanitize_name(name))
+    k = 1
+    while stage.GetPrimAtPath(target):
+        target = Sdf.Path(looks).AppendChild(sanitize_name(f"{name}_{k:02d}"))
+        k += 1
+    return matlib.define_mdl_material(stage, target, path, name).GetPrim()
+
+
+def with_mdl_materials(value: Any, looks: str = LOOKS) -> Any:
+    """``value`` (a material, path or list of them) with every ``.mdl`` file in it replaced by its material."""
+    if is_mdl_url(value):
+        return mdl_material(value, looks)
+    if isinstance(value, (list, tuple)):
+        return [with_mdl_materials(v, looks) for v in value]
+    return value
+
+
 def materials(prims: Any, materials: Any, rng: ReplicatorRNG | np.random.Generator | None = None) -> list[str]:
-    """Bind each prim a material drawn uniformly from ``materials`` (prims or paths); returns the paths bound."""
-    mats = resolve_prims(materials)
+    """Bind each prim a material drawn uniformly from ``materials`` (prims, paths or ``.mdl`` files, whose
+    materials are made once under ``/Replicator/Looks``); returns the paths bound."""
+    mats = resolve_prims(with_mdl_materials(materials))
     if not mats:
         raise ValueError("materials() needs at least one material to choose from, got none")
     for m in mats:
@@ -344,5 +384,5 @@ def scatter_3d(prims: Any, volume_prims: Any, no_collision_prims: Any = None, vo
     _move_to(targets, positions)
 
 
-__all__ = ["display_color", "color", "materials", "texture", "rotation", "uniform_quaternions", "scatter_2d",
+__all__ = ["display_color", "color", "is_mdl_url", "mdl_material", "with_mdl_materials", "materials", "texture", "rotation", "uniform_quaternions", "scatter_2d",
            "scatter_3d"]

@@ -1,0 +1,277 @@
+"""Stand-ins at the /Isaac/... paths Isaac's Replicator examples and tests load: layout, size, physics, materials.
+
+Each test checks what a script relies on: prim names and paths it looks up, the
+asset's size and origin, the physics it simulates (the Franka's kinematic chain
+against Franka's DH parameters, computed here independently), and the MDL
+materials it randomizes.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import mujoco
+import numpy as np
+import pytest
+from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
+
+import graphsdg as rep
+from graphsdg.assets import builtin_pack_root, catalog, get_assets_root_path
+from graphsdg.physics.articulations import ArticulationView
+from graphsdg.runtime import runtime
+from graphsdg.stage import materials as matlib
+from graphsdg.stage.mdl_modules import MdlModuleError, parse_module, read_module
+
+ROOT = builtin_pack_root()
+ISAAC_KEYS = sorted(catalog.ISAAC_ASSETS)
+
+
+def _open(rel: str) -> Usd.Stage:
+    return Usd.Stage.Open(os.path.join(ROOT, rel.lstrip("/")))
+
+
+def _bounds(prim: Usd.Prim) -> tuple[np.ndarray, np.ndarray]:
+    rng = UsdGeom.BBoxCache(Usd.TimeCode.Default(), ["default", "render"]).ComputeWorldBound(prim) \
+        .ComputeAlignedRange()
+    return np.array(rng.GetMin()), np.array(rng.GetMax())
+
+
+def _run(seconds: float) -> None:
+    tl = rep.timeline.get_timeline_interface()
+    tl.play()
+    for _ in range(int(round(seconds * 60))):
+        rep.orchestrator.update()
+    tl.pause()
+
+
+@pytest.mark.parametrize("key", ISAAC_KEYS)
+def test_stand_in_opens_z_up_in_metres_with_its_catalogued_size(key):
+    asset = catalog.ISAAC_ASSETS[key]
+    stage = _open(asset.path)
+    assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z
+    assert UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    lo, hi = _bounds(stage.GetDefaultPrim())
+    np.testing.assert_allclose(hi - lo, asset.size, atol=1e-3, err_msg=key)
+
+
+def test_every_path_the_examples_load_resolves_in_the_pack():
+    rels = [
+        "/Isaac/Environments/Simple_Warehouse/Props/S_TrafficCone.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/S_WetFloorSign.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/SM_BarelPlastic_B_03.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/SM_PaletteA_02.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/SM_CardBoxA_01.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/SM_CardBoxB_01.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/SM_CardBoxA_01_414.usd",
+        "/Isaac/Environments/Simple_Warehouse/Props/SM_CardBoxD_04_1847.usd",
+        "/Isaac/Environments/Simple_Warehouse/Materials/MI_PaperNotes_01.mdl",
+        "/Isaac/Environments/Simple_Warehouse/Materials/MI_CardBoxB_05.mdl",
+        "/Isaac/Props/Forklift/forklift.usd",
+        "/Isaac/Props/Pallet/pallet.usd",
+        "/Isaac/Props/KLT_Bin/small_KLT_visual.usd",
+        "/Isaac/Props/Dolly/dolly.usd",
+        "/Isaac/Robots/FrankaRobotics/FrankaPanda/franka.usd",
+    ]
+    missing = [r for r in rels if not os.path.isfile(get_assets_root_path() + r)]
+    assert missing == []
+
+
+# ---- props -------------------------------------------------------------------------------
+def test_traffic_cone_stands_on_its_base_centre_and_is_orange_with_white_bands():
+    stage = _open("/Isaac/Environments/Simple_Warehouse/Props/S_TrafficCone.usd")
+    cone = stage.GetDefaultPrim()
+    lo, hi = _bounds(cone)
+    np.testing.assert_allclose(lo, (-0.18, -0.18, 0.0), atol=1e-4)
+    np.testing.assert_allclose(hi, (0.18, 0.18, 0.70), atol=1e-4)
+    # the bands sit within the cone's height and the cone narrows upwards
+    band_lo, band_hi = _bounds(cone.GetChild("Bands"))
+    assert 0.25 < band_lo[2] and band_hi[2] < 0.6
+    assert band_hi[0] - band_lo[0] < 0.3
+    colors = {}
+    for name in ("Cone", "Bands"):
+        mat = matlib.bound_material(cone.GetChild(name))
+        img = __import__("cv2").imread(matlib.describe(mat).texture)[..., ::-1] / 255.0
+        colors[name] = img.reshape(-1, 3).mean(0)
+    assert colors["Cone"][0] > 0.8 and colors["Cone"][2] < 0.15          # orange
+    assert colors["Bands"].min() > 0.8                                    # white
+
+
+def test_forklift_forks_point_along_minus_y_from_an_origin_under_the_driver():
+    stage = _open("/Isaac/Props/Forklift/forklift.usd")
+    fork = stage.GetDefaultPrim()
+    forks_lo, forks_hi = _bounds(fork.GetChild("Forks"))
+    assert forks_lo[1] == pytest.approx(-1.95, abs=1e-3)                  # tips 1.95 m ahead along -Y
+    assert forks_lo[2] == pytest.approx(0.05, abs=1e-3)
+    lo, hi = _bounds(fork)
+    assert lo[2] == pytest.approx(0.0, abs=1e-6) and hi[2] == pytest.approx(2.15, abs=1e-3)
+    assert hi[1] == pytest.approx(1.25, abs=1e-3)                         # counterweight behind
+    assert abs(lo[0] + hi[0]) < 1e-6                                      # centred across
+    # every part is a mesh child of the default prim, as scripts reference and label the whole forklift
+    meshes = [c.GetName() for c in fork.GetChildren() if c.IsA(UsdGeom.Mesh)]
+    assert {"Body", "Forks", "Mast", "Wheels", "OverheadGuard"} <= set(meshes)
+
+
+def test_klt_bin_is_centred_on_its_bounds_and_open_at_the_top():
+    stage = _open("/Isaac/Props/KLT_Bin/small_KLT_visual.usd")
+    lo, hi = _bounds(stage.GetDefaultPrim())
+    np.testing.assert_allclose((lo + hi) / 2, 0.0, atol=1e-6)
+    np.testing.assert_allclose(hi - lo, (0.297, 0.198, 0.147), atol=1e-6)
+    floor_lo, floor_hi = _bounds(stage.GetDefaultPrim().GetChild("Floor"))
+    assert floor_hi[2] < lo[2] + 0.01                                     # nothing but the floor low down
+    assert not any(p.HasAPI(UsdPhysics.RigidBodyAPI) or p.HasAPI(UsdPhysics.CollisionAPI)
+                   for p in Usd.PrimRange(stage.GetDefaultPrim()))        # "visual": no physics
+
+
+def test_dolly_made_a_rigid_body_as_the_amr_example_does_stands_on_the_floor():
+    root = get_assets_root_path()
+    rep.functional.create.reference(usd_path=root + "/Isaac/Environments/Grid/default_environment.usd", name="Env")
+    dolly = rep.functional.create.reference(usd_path=root + "/Isaac/Props/Dolly/dolly.usd", name="Dolly",
+                                            position=(0.0, 0.0, 0.05))
+    gprims = [c for c in dolly.GetChildren() if c.IsA(UsdGeom.Gprim)]
+    assert len(gprims) == 1 and gprims[0].HasAPI(UsdPhysics.CollisionAPI)
+    for g in gprims:                                                      # amr_navigation.py's loop
+        rep.functional.physics.apply_rigid_body(g)
+    _run(1.5)
+    lo, hi = _bounds(dolly)
+    assert lo[2] == pytest.approx(0.0, abs=0.01)                          # fell 5 cm onto the floor
+    assert hi[2] == pytest.approx(0.5, abs=0.01)                          # deck top 0.5 m up
+
+
+# ---- Franka --------------------------------------------------------------------------------
+FRANKA = "/Isaac/Robots/FrankaRobotics/FrankaPanda/franka.usd"
+LINKS = ["panda_link0", "panda_link1", "panda_link2", "panda_link3", "panda_link4", "panda_link5", "panda_link6",
+         "panda_link7", "panda_hand", "panda_leftfinger", "panda_rightfinger"]
+DOFS = ["panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4", "panda_joint5", "panda_joint6",
+        "panda_joint7", "panda_finger_joint1", "panda_finger_joint2"]
+
+
+def panda_flange(q) -> np.ndarray:
+    """The Panda's flange (4x4) from its modified DH parameters (Craig): a, d, alpha per joint."""
+    dh = [(0.0, 0.333, 0.0), (0.0, 0.0, -math.pi / 2), (0.0, 0.316, math.pi / 2), (0.0825, 0.0, math.pi / 2),
+          (-0.0825, 0.384, -math.pi / 2), (0.0, 0.0, math.pi / 2), (0.088, 0.0, math.pi / 2)]
+    t = np.eye(4)
+    for (a, d, alpha), theta in zip(dh, q):
+        ca, sa, ct, st = math.cos(alpha), math.sin(alpha), math.cos(theta), math.sin(theta)
+        t = t @ np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -d * sa], [st * sa, ct * sa, ca, d * ca],
+                          [0, 0, 0, 1]])
+    flange = np.eye(4)
+    flange[2, 3] = 0.107
+    return t @ flange
+
+
+def test_franka_has_isaacs_links_joints_and_articulation_root():
+    stage = _open(FRANKA)
+    root = stage.GetDefaultPrim()
+    assert root.GetName() == "panda" and root.HasAPI(UsdPhysics.ArticulationRootAPI)
+    links = [c.GetName() for c in root.GetChildren() if c.HasAPI(UsdPhysics.RigidBodyAPI)]
+    assert links == LINKS
+    joints = {str(p.GetPath()): p.GetTypeName() for p in Usd.PrimRange(root) if p.IsA(UsdPhysics.Joint)}
+    expected = {f"/panda/panda_link{i}/panda_joint{i + 1}": "PhysicsRevoluteJoint" for i in range(7)}
+    expected.update({"/panda/panda_link7/panda_hand_joint": "PhysicsFixedJoint",
+                     "/panda/panda_hand/panda_finger_joint1": "PhysicsPrismaticJoint",
+                     "/panda/panda_hand/panda_finger_joint2": "PhysicsPrismaticJoint",
+                     "/panda/root_joint": "PhysicsFixedJoint"})
+    assert joints == expected
+    j4 = UsdPhysics.RevoluteJoint(stage.GetPrimAtPath("/panda/panda_link3/panda_joint4"))
+    assert (j4.GetLowerLimitAttr().Get(), j4.GetUpperLimitAttr().Get()) == pytest.approx(
+        (math.degrees(-3.0718), math.degrees(-0.0698)), abs=1e-3)
+    fingers = UsdPhysics.PrismaticJoint(stage.GetPrimAtPath("/panda/panda_hand/panda_finger_joint1"))
+    assert (fingers.GetLowerLimitAttr().Get(), fingers.GetUpperLimitAttr().Get()) == pytest.approx((0.0, 0.04))
+    assert all(UsdPhysics.MassAPI(stage.GetPrimAtPath(f"/panda/{n}")).GetMassAttr().Get() > 0 for n in LINKS)
+
+
+def test_franka_compiles_to_mujoco_with_franka_kinematics_where_it_is_placed():
+    franka = rep.functional.create.reference(usd_path=get_assets_root_path() + FRANKA, name="Franka",
+                                             position=(1.0, 2.0, 0.0), rotation=(0.0, 0.0, 90.0))
+    view = ArticulationView(str(franka.GetPath()))
+    assert view.dof_names == DOFS
+    q = view.get_joint_positions()
+    np.testing.assert_allclose(q, (0, -math.pi / 4, 0, -3 * math.pi / 4, 0, math.pi / 2, math.pi / 4, 0.04, 0.04),
+                               atol=1e-6)
+    s = runtime().sim
+    m = s.model
+    ids = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"/Franka/{n}") for n in LINKS}
+    parents = {n: mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, int(m.body_parentid[i])) for n, i in ids.items()}
+    assert parents["panda_link0"] == "world"
+    chain = ["panda_link0", *[f"panda_link{i}" for i in range(1, 8)], "panda_hand"]
+    for parent, child in zip(chain, chain[1:]):
+        assert parents[child] == f"/Franka/{parent}"
+    assert parents["panda_leftfinger"] == parents["panda_rightfinger"] == "/Franka/panda_hand"
+    # the hand (the flange) where Franka's DH parameters put it, in the placed robot's frame
+    place = np.eye(4)
+    place[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    place[:3, 3] = (1.0, 2.0, 0.0)
+    for pose in ((0.0,) * 7, (0.3, -0.5, 0.2, -2.0, 0.4, 1.8, -0.6)):
+        view.set_joint_positions([*pose, 0.02, 0.02])
+        mujoco.mj_kinematics(m, s.data)
+        expected = place @ panda_flange(pose)
+        np.testing.assert_allclose(s.data.xpos[ids["panda_hand"]], expected[:3, 3], atol=1e-5)
+        # the hand is turned -45 degrees about the flange axis
+        hand_x = s.data.xmat[ids["panda_hand"]].reshape(3, 3)[:, 0]
+        np.testing.assert_allclose(hand_x, expected[:3, :3] @ (math.cos(-math.pi / 4), math.sin(-math.pi / 4), 0),
+                                   atol=1e-5)
+        gap = np.linalg.norm(s.data.xpos[ids["panda_leftfinger"]] - s.data.xpos[ids["panda_rightfinger"]])
+        assert gap == pytest.approx(0.04, abs=1e-6)
+
+
+def test_franka_drives_hold_the_ready_pose_against_gravity_and_follow_targets():
+    franka = rep.functional.create.reference(usd_path=get_assets_root_path() + FRANKA, name="Franka")
+    view = ArticulationView(str(franka.GetPath()))
+    ready = view.get_joint_positions()
+    _run(1.0)
+    assert np.abs(view.get_joint_positions() - ready).max() < 0.01
+    target = ready + np.array([0.3, 0.2, -0.2, 0.3, 0.3, -0.3, 0.4, -0.02, -0.02])
+    view.set_joint_position_targets(target)
+    _run(2.0)
+    assert np.abs(view.get_joint_positions() - target).max() < 0.02
+
+
+# ---- MDL materials ---------------------------------------------------------------------------
+MATERIALS = "/Isaac/Environments/Simple_Warehouse/Materials"
+
+
+def test_mdl_stand_ins_are_omnipbr_instances_with_textures_beside_them():
+    for name, roughness in (("MI_PaperNotes_01", 0.75), ("MI_CardBoxB_05", 0.9)):
+        path = get_assets_root_path() + f"{MATERIALS}/{name}.mdl"
+        inst = read_module(path)[name]
+        assert inst.base == "OmniPBR"
+        assert inst.arguments["reflection_roughness_constant"] == pytest.approx(roughness)
+        tex = inst.arguments["diffuse_texture"]
+        assert tex == os.path.join(os.path.dirname(path), "Textures", f"{name}_BaseColor.png")
+        assert os.path.isfile(tex)
+
+
+def test_randomizing_card_box_materials_with_mdl_urls_renders_their_textures():
+    """scene_based_sdg.py: rep.randomizer.materials([...mdl urls]) on a group of card-box meshes."""
+    root = get_assets_root_path()
+    urls = [f"{root}{MATERIALS}/MI_PaperNotes_01.mdl", f"{root}{MATERIALS}/MI_CardBoxB_05.mdl"]
+    boxes = [rep.functional.create.reference(usd_path=root + "/Isaac/Environments/Simple_Warehouse/Props/"
+                                             "SM_CardBoxD_04.usd", name=f"CardBox_{i}") for i in range(4)]
+    meshes = [c.GetPath() for b in boxes for c in b.GetChildren() if c.IsA(UsdGeom.Mesh)]
+    assert len(meshes) == 4
+    with rep.trigger.on_custom_event("randomize_cardboxes_materials"):
+        with rep.create.group(meshes):
+            rep.randomizer.materials(urls)
+    for _ in range(3):
+        rep.utils.send_og_event(event_name="randomize_cardboxes_materials")
+        rep.orchestrator.step()
+    stage = rep.stage.get_stage()
+    looks = stage.GetPrimAtPath("/Replicator/Looks")
+    made = sorted(c.GetName() for c in looks.GetChildren() if c.IsA(UsdShade.Material))
+    assert made == ["MI_CardBoxB_05", "MI_PaperNotes_01"]                  # one material per file, reused
+    for path in meshes:
+        desc = matlib.describe(matlib.bound_material(stage.GetPrimAtPath(path)))
+        name = desc.path.rsplit("/", 1)[1]
+        assert desc.texture == f"{root}{MATERIALS}/Textures/{name}_BaseColor.png"
+        assert desc.roughness == pytest.approx(0.75 if name == "MI_PaperNotes_01" else 0.9)
+
+
+def test_mdl_module_reader_names_what_it_cannot_read():
+    with pytest.raises(MdlModuleError, match="not an MDL module"):
+        parse_module("export material M(*) = OmniPBR();", "/x/M.mdl")
+    with pytest.raises(MdlModuleError, match="cannot read the argument value 'foo"):
+        parse_module("mdl 1.6; export material M(*) = OmniPBR(metallic_constant: foo(1));", "/x/M.mdl")
+    with pytest.raises(MdlModuleError, match="exports no material"):
+        parse_module("mdl 1.6; import ::OmniPBR::OmniPBR;", "/x/M.mdl")
+    with pytest.raises(FileNotFoundError, match="nope.mdl"):
+        rep.functional.randomizer.mdl_material("/no/such/nope.mdl")
