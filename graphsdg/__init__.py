@@ -65,13 +65,14 @@ nodes = _import_node_library()
 
 # the graph-API calls are made from the node types registered above
 from graphsdg import create, distribution, events, get, graph, modify, randomizer, trigger  # noqa: E402
-from graphsdg import events as utils  # noqa: E402  (rep.utils.send_og_event)
+from graphsdg import example, tools, utils  # noqa: E402  (rep.example, rep.tools, rep.utils)
 from graphsdg.graph import ReplicatorItem, new_layer  # noqa: E402
 
 __version__ = "0.1.0"
 
 __all__ = ["annotators", "augmentations_default", "backends", "create", "functional", "orchestrator", "rng",
            "settings", "stage", "writers", "distribution", "get", "graph", "modify", "randomizer", "trigger", "utils", "events",
+           "example", "tools",
            "new_layer", "ReplicatorItem",
            "Annotator", "AnnotatorRegistry", "BackendDispatch", "Writer", "WriterRegistry",
            "get_global_seed", "set_global_seed", "timeline"]

@@ -49,6 +49,14 @@ curve = _typed(("BasisCurves",), "curve")
 geomsubset = _typed(("GeomSubset",), "geomsubset")
 skeleton = _typed(("Skeleton",), "skeleton")
 shape = _typed(("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh"), "shape")
+scope = _typed(("Scope",), "scope")
+graph = _typed(("OmniGraph",), "graph")
+physics = _typed(("PhysicsScene",), "physics")
+renderproduct = _typed(("RenderProduct",), "renderproduct")
+rendervar = _typed(("RenderVar",), "rendervar")
+listener = _typed(("Listener", "OmniListener"), "listener")
+sound = _typed(("Sound", "OmniSound"), "sound")
+skelanimation = _typed(("SkelAnimation",), "skelanimation")
 
 
 def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None = None) -> None:
@@ -57,4 +65,5 @@ def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None 
 
 
 __all__ = [*_calls, "camera", "light", "material", "mesh", "xform", "shader", "curve", "geomsubset",
-           "skeleton", "shape", "register"]
+           "skeleton", "shape", "scope", "graph", "physics", "renderproduct", "rendervar", "listener", "sound",
+           "skelanimation", "register"]

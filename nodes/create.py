@@ -9,10 +9,11 @@ fires. Prim creation itself goes through ``graphsdg.functional.create``.
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any, Callable
 
 import numpy as np
-from pxr import Sdf, Usd
+from pxr import Sdf, Usd, UsdShade
 
 from graphsdg.functional import create as FC
 from graphsdg.functional import modify as FM
@@ -22,6 +23,7 @@ from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims, is_rando
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.value_shapes import SCALAR, VEC3, attribute_shapes
 from graphsdg.stage.context import get_stage
+from graphsdg.stage.materials import surface_shader
 
 from .modify import POSE_PORTS, apply_pose
 
@@ -229,7 +231,10 @@ class CreateCamera(CreateNode):
 MDL_INPUTS = {"diffuse": "diffuse_color_constant", "diffuse_texture": "diffuse_texture",
               "roughness": "reflection_roughness_constant", "metallic": "metallic_constant",
               "emissive_color": "emissive_color", "emissive_intensity": "emissive_intensity"}
-UNRENDERED_INPUTS = ("roughness_texture", "metallic_texture", "emissive_texture")
+# OmniPBR inputs kept on the material's shader for readers of the stage; the classic renderer draws none of them
+UNRENDERED_INPUTS = {"roughness_texture": "reflectionroughness_texture", "metallic_texture": "metallic_texture",
+                     "emissive_texture": "emissive_color_texture", "specular": "specular_level"}
+_warned_unrendered: set[str] = set()
 
 
 @register_node
@@ -247,10 +252,12 @@ class CreateMaterialOmniPBR(CreateNode):
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
         super().__init__(name=name, **values)
-        given = [k for k in UNRENDERED_INPUTS if values.get(k) is not None]
+        given = [k for k in UNRENDERED_INPUTS if values.get(k) is not None and k not in _warned_unrendered]
         if given:
-            raise ValueError(f"material_omnipbr: {given} are not rendered by graphsdg (only diffuse_texture "
-                             f"is); remove them")
+            _warned_unrendered.update(given)
+            warnings.warn(f"material_omnipbr: {given} are authored on the material's shader but not rendered "
+                          f"(graphsdg draws diffuse, diffuse_texture, roughness, metallic and emission)",
+                          stacklevel=4)
 
     def setup(self, ctx: ExecContext) -> None:
         stage = get_stage()
@@ -263,6 +270,9 @@ class CreateMaterialOmniPBR(CreateNode):
             if self.value_of("emissive_intensity") and "emissive_color" not in inputs:
                 inputs["emissive_color"] = (1.0, 1.0, 1.0)
             prim = FC.material(mdl="OmniPBR.mdl", name=self.user_name or "OmniPBR", parent=LOOKS, **inputs)
+            for port, mdl in UNRENDERED_INPUTS.items():
+                if _plain(self, port) is not None:
+                    _author_unrendered(prim, mdl, _plain(self, port))
             if self.value_of("semantics"):
                 FM.semantics(prim, self.value_of("semantics"))
             mats.append(prim)
@@ -278,7 +288,22 @@ class CreateMaterialOmniPBR(CreateNode):
                 inputs[mdl] = values if port == "diffuse_texture" else np.array(values, dtype=np.float64)
         if inputs:
             FM.material_inputs(mats, **inputs)
+        for port, mdl in UNRENDERED_INPUTS.items():
+            if ctx.is_random(port):
+                for mat, value in zip(mats, ctx.per_prim(port, len(mats), SCALAR)):
+                    _author_unrendered(mat, mdl, value)
         return {"prims": mats}
+
+
+def _author_unrendered(material: Usd.Prim, mdl_input: str, value: Any) -> None:
+    """Keep an OmniPBR input graphsdg does not render on the material's surface shader (``inputs:<name>``)."""
+    shader = surface_shader(UsdShade.Material(material))
+    target = shader.GetPrim() if shader is not None else material
+    if mdl_input.endswith("_texture"):
+        target.CreateAttribute(f"inputs:{mdl_input}", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(os.fspath(value)))
+    else:
+        target.CreateAttribute(f"inputs:{mdl_input}", Sdf.ValueTypeNames.Float).Set(
+            float(np.asarray(value).reshape(-1)[0]))
 
 
 @register_node

@@ -13,8 +13,10 @@ from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
 from graphsdg.graph.value_shapes import SCALAR, SCALAR_OR_VEC3, WHOLE, attribute_shapes, spread_value
 from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
+from graphsdg.physics.timeline import get_timeline_interface
+from graphsdg.render.render_product import registry as render_products
 from graphsdg.stage.prims import resolve_prim
-from graphsdg.stage.xform import world_matrix
+from graphsdg.stage.xform import up_axis_vector, world_matrix
 
 TARGET = {"input_prims": Port("prims", required=True)}
 POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
@@ -249,4 +251,184 @@ class Material(Node):
                 ctx.record("value", [str(m.GetPath()) for m in chosen])
         for prim, mat in zip(prims, chosen):
             F.material(prim, mat)
+        return {"prims": prims}
+
+
+@register_node
+class Variant(Node):
+    """Select variant ``value`` of variant set ``name`` on each prim (a list of variants, or a distribution of
+    them: one drawn per prim)."""
+
+    type_name = "modify.variant"
+    family = "modify"
+    call = Call(named=False, renamed={"variant_set": "name"}, required=("value",))
+    inputs = {**TARGET, "variant_set": Port(str, required=True), "value": Port(object)}
+    outputs = {"prims": Port("prims")}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        if not isinstance(self.value_of("variant_set"), str) or not self.value_of("variant_set"):
+            raise ValueError(f"modify.variant: name must be a variant set's name, got "
+                             f"{self.value_of('variant_set')!r}")
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        n = len(prims)
+        value = ctx.value("value")
+        if isinstance(value, Samples):
+            chosen = ctx.per_prim("value", n, SCALAR)
+        else:   # one variant for all, or a list to draw from (Replicator wraps a list in a choice)
+            listed = [value] if isinstance(value, str) else list(value)
+            if not listed:
+                raise ValueError("modify.variant: value is an empty list; give the variant(s) to select")
+            chosen = [listed[int(k)] for k in ctx.rng.integers(0, len(listed), size=n)] if len(listed) > 1 \
+                else listed * n
+            ctx.record("value", chosen)
+        set_name = ctx.value("variant_set")
+        for prim, selection in zip(prims, chosen):
+            _select_variant(prim, set_name, str(selection))
+        return {"prims": prims}
+
+
+def _select_variant(prim: Usd.Prim, set_name: str, selection: str) -> None:
+    sets = prim.GetVariantSets()
+    if not sets.HasVariantSet(set_name):
+        raise ValueError(f"modify.variant: {prim.GetPath()} has no variant set {set_name!r}; its variant sets: "
+                         f"{sets.GetNames()}")
+    variant_set = sets.GetVariantSet(set_name)
+    names = variant_set.GetVariantNames()
+    if selection not in names:
+        raise ValueError(f"modify.variant: variant set {set_name!r} of {prim.GetPath()} has no variant "
+                         f"{selection!r}; its variants: {names}")
+    variant_set.SetVariantSelection(selection)
+
+
+TIMELINE_TYPES = ("time", "start_time", "end_time", "frame", "start_frame", "end_frame")
+
+
+@register_node
+class Timeline(Node):
+    """Set the timeline's current, start or end time (seconds) or frame (``modify_type``)."""
+
+    type_name = "modify.timeline"
+    family = "modify"
+    call = Call(named=False, required=("value",))
+    inputs = {"value": Port(float), "modify_type": Port(str)}
+    outputs = {"value": Port(float)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        kind = self.value_of("modify_type")
+        if not isinstance(kind, str) or kind.lower() not in TIMELINE_TYPES:
+            raise ValueError(f"modify.timeline: modify_type must be one of {list(TIMELINE_TYPES)}, got {kind!r}")
+
+    def compute(self, ctx: ExecContext) -> dict:
+        value = ctx.per_prim("value", 1, SCALAR)[0]
+        seconds = float(np.asarray(value, dtype=np.float64).reshape(-1)[0])
+        timeline = get_timeline_interface()
+        kind = ctx.value("modify_type").lower()
+        if kind.endswith("frame"):
+            seconds /= timeline.get_time_codes_per_seconds()
+        setter = {"time": timeline.set_current_time, "frame": timeline.set_current_time,
+                  "start_time": timeline.set_start_time, "start_frame": timeline.set_start_time,
+                  "end_time": timeline.set_end_time, "end_frame": timeline.set_end_time}[kind]
+        setter(seconds)
+        return {"value": seconds}
+
+
+@register_node
+class PoseCameraRelative(Node):
+    """Place the prims in front of ``camera``: ``distance`` along its view axis, at normalised image coordinates
+    ``horizontal_location`` / ``vertical_location`` in [-1, 1] of ``render_product``'s frame (+1: right, top)."""
+
+    type_name = "modify.pose_camera_relative"
+    family = "modify"
+    call = Call(named=False)
+    inputs = {"camera": Port("prim", required=True), "render_product": Port(object, required=True),
+              "distance": Port(float, required=True), "horizontal_location": Port(float, 0),
+              "vertical_location": Port(float, 0), **TARGET}
+    outputs = {"prims": Port("prims")}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        n = len(prims)
+        cameras = [p for p in flatten_prims(ctx.value("camera"), "modify.pose_camera_relative camera")]
+        if not cameras or not cameras[0].IsA(UsdGeom.Camera):
+            raise ValueError(f"modify.pose_camera_relative: camera must name a camera prim, got "
+                             f"{[str(c.GetPath()) for c in cameras]}")
+        width, height = _resolution(ctx.value("render_product"))
+        cam = UsdGeom.Camera(cameras[0]).GetCamera(Usd.TimeCode.Default())
+        half_w = 0.5 * cam.horizontalAperture / cam.focalLength
+        half_h = half_w * height / width   # square pixels: the vertical aperture follows the frame
+        distance = ctx.per_prim("distance", n, SCALAR)
+        horizontal = ctx.per_prim("horizontal_location", n, SCALAR)
+        vertical = ctx.per_prim("vertical_location", n, SCALAR)
+        matrix = world_matrix(cameras[0])
+        rows = []
+        for d, h, v in zip(distance, horizontal, vertical):
+            d, h, v = float(np.asarray(d).reshape(-1)[0]), float(np.asarray(h).reshape(-1)[0]), \
+                float(np.asarray(v).reshape(-1)[0])
+            local = np.array([h * d * half_w, v * d * half_h, -d, 1.0])
+            rows.append((local @ matrix)[:3])
+        F.pose(prims, position_value=_to_parent_frames(prims, np.array(rows)))
+        return {"prims": prims}
+
+
+def _resolution(render_product: Any) -> tuple[int, int]:
+    """(width, height) of a render product object or path."""
+    if isinstance(render_product, list) and render_product:
+        render_product = render_product[0]
+    resolution = getattr(render_product, "resolution", None)
+    if resolution is None and isinstance(render_product, (str, Sdf.Path)):
+        resolution = render_products.find(str(render_product)).resolution
+    if resolution is None:
+        raise ValueError(f"modify.pose_camera_relative: render_product must be a render product (or its path), "
+                         f"got {render_product!r}")
+    return int(resolution[0]), int(resolution[1])
+
+
+def _to_parent_frames(prims: list[Usd.Prim], world_points: np.ndarray) -> np.ndarray:
+    """World points as local translations of each prim (its parent's frame)."""
+    out = []
+    for prim, point in zip(prims, world_points):
+        parent = prim.GetParent()
+        if parent and not parent.IsPseudoRoot():
+            inverse = np.linalg.inv(world_matrix(parent))
+            point = (np.append(point, 1.0) @ inverse)[:3]
+        out.append(point)
+    return np.array(out)
+
+
+@register_node
+class PoseOrbit(Node):
+    """Place the prims on a sphere around ``barycentre`` (a point, or prims: their mean position):
+    ``distance`` away, at ``azimuth`` degrees round the up axis (from +X) and ``elevation`` degrees above
+    the horizontal plane; aimed at the barycentre unless ``look_at_barycentre=False``."""
+
+    type_name = "modify.pose_orbit"
+    family = "modify"
+    call = Call(named=False)
+    inputs = {"barycentre": Port("vec3|prim", required=True), "distance": Port(float, required=True),
+              "azimuth": Port(float, required=True), "elevation": Port(float, required=True),
+              "look_at_barycentre": Port(bool, True), **TARGET}
+    outputs = {"prims": Port("prims")}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        prims = ctx.prims()
+        n = len(prims)
+        centre = look_at_points(ctx.value("barycentre"), n)
+        if np.shape(centre) != (3,):
+            raise ValueError(f"modify.pose_orbit: barycentre must be (x, y, z) or prims, got "
+                             f"{ctx.value('barycentre')!r}")
+        up = up_axis_vector(prims[0].GetStage()) if prims else np.array([0.0, 0.0, 1.0])
+        first = np.array([1.0, 0.0, 0.0])
+        second = np.cross(up, first)
+        points = []
+        for d, az, el in zip(*(ctx.per_prim(p, n, SCALAR) for p in ("distance", "azimuth", "elevation"))):
+            d, az, el = (float(np.asarray(x).reshape(-1)[0]) for x in (d, az, el))
+            a, e = np.radians(az), np.radians(el)
+            points.append(centre + d * (np.cos(e) * (np.cos(a) * first + np.sin(a) * second) + np.sin(e) * up))
+        F.pose(prims, position_value=_to_parent_frames(prims, np.array(points)))
+        if ctx.value("look_at_barycentre"):
+            F.pose(prims, look_at_value=centre)
         return {"prims": prims}

@@ -1,4 +1,4 @@
-"""Trigger nodes: ``on_frame``, ``on_time``, ``on_custom_event``.
+"""Trigger nodes: ``on_frame``, ``on_time``, ``on_time_end``, ``on_custom_event``, ``on_condition``.
 
 Each polls once per ``orchestrator.step()``; when it fires, the nodes built in
 its ``with`` block run.
@@ -8,10 +8,13 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from graphsdg import settings_store as settings
 from graphsdg.graph.calls import Call
 from graphsdg.graph.node import Port, TriggerNode
 from graphsdg.graph.registry import register_node
+from graphsdg.physics.timeline import get_timeline_interface
 
 
 def _positive_int(value: Any, what: str, minimum: int = 1) -> int:
@@ -112,3 +115,66 @@ class OnCustomEvent(TriggerNode):
 
     def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
         return self.value_of("event_name") in events
+
+
+@register_node
+class OnTimeEnd(TriggerNode):
+    """Fire on the last step before each ``interval`` seconds of simulated time is reached (the frame that ends
+    the interval: a writer attached to it captures a simulation's end state)."""
+
+    type_name = "trigger.on_time_end"
+    call = Call(params=("interval", "name", "rt_subframes", "enable_capture_on_play", "max_execs"),
+                name_default="on_time_end")
+    inputs = {"interval": Port(float, 1), "max_execs": Port(int, 0), "rt_subframes": Port(int, 32),
+              "enable_capture_on_play": Port(bool, True)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        interval = self.value_of("interval")
+        if isinstance(interval, bool) or not isinstance(interval, (int, float)) or not interval > 0:
+            raise ValueError(f"on_time_end interval must be a positive number of seconds, got {interval!r}")
+        _positive_int(self.value_of("max_execs"), "on_time_end max_execs", 0)
+        _positive_int(self.value_of("rt_subframes"), "on_time_end rt_subframes")
+        self.boundary: float | None = None
+
+    def setup(self, ctx) -> None:
+        if self.value_of("enable_capture_on_play"):
+            settings.set("/omni/replicator/captureOnPlay", True)
+
+    def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
+        interval = float(self.value_of("interval"))
+        if self.boundary is None:
+            self.boundary = sim_time + interval
+        step = get_timeline_interface().frame_duration
+        if sim_time + step + 1e-9 < self.boundary:
+            return False
+        while self.boundary <= sim_time + step + 1e-9:   # the next interval ends after this step
+            self.boundary += interval
+        return not self.exhausted()
+
+
+@register_node
+class OnCondition(TriggerNode):
+    """Fire on each step where ``condition()`` returns true (a function, or a ``functools.partial`` holding its
+    arguments), at most ``max_execs`` times (0: no limit)."""
+
+    type_name = "trigger.on_condition"
+    call = Call(named=False)
+    inputs = {"condition": Port(object, required=True), "max_execs": Port(int, 0), "rt_subframes": Port(int, 1)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        if not callable(self.value_of("condition")):
+            raise TypeError(f"on_condition condition must be a function or functools.partial returning a bool, "
+                            f"got {self.value_of('condition')!r}")
+        _positive_int(self.value_of("max_execs"), "on_condition max_execs", 0)
+        _positive_int(self.value_of("rt_subframes"), "on_condition rt_subframes")
+
+    def poll(self, frame: int, sim_time: float, events: set[str]) -> bool:
+        if self.exhausted():
+            return False
+        met = self.value_of("condition")()
+        if not isinstance(met, (bool, np.bool_)):
+            raise TypeError(f"on_condition: condition {self.value_of('condition')!r} returned {met!r}; it must "
+                            f"return True or False")
+        return bool(met)

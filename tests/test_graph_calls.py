@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import doctest
 import inspect
-import os
 
 import numpy as np
 import pytest
@@ -16,7 +15,7 @@ from graphsdg.graph.node import Node, Port
 from graphsdg.graph.registry import NodeRegistry
 
 NAMESPACES = {"create": rep.create, "modify": rep.modify, "randomizer": rep.randomizer, "get": rep.get,
-              "distribution": rep.distribution, "trigger": rep.trigger}
+              "distribution": rep.distribution, "trigger": rep.trigger, "physics": rep.physics}
 
 # every call's parameters and defaults, as the hand-written faces had them before they were derived
 SIGNATURES = {
@@ -97,6 +96,22 @@ SIGNATURES = {
     "distribution.sequence": "(items, ordered=True, seed=-1, name=None, stride=None)",
     "distribution.uniform": "(lower, upper, num_samples=1, seed=None, name=None)",
     "trigger.on_custom_event": "(event_name)",
+    "trigger.on_time_end": "(interval=1, name='on_time_end', rt_subframes=32, enable_capture_on_play=True, "
+                           "max_execs=0)",
+    "trigger.on_condition": "(condition, max_execs=0, rt_subframes=1)",
+    "modify.variant": "(name, value, input_prims=None)",
+    "modify.timeline": "(value, modify_type=None)",
+    "modify.pose_camera_relative": "(camera, render_product, distance, horizontal_location=0, vertical_location=0, "
+                                   "input_prims=None)",
+    "modify.pose_orbit": "(barycentre, distance, azimuth, elevation, look_at_barycentre=True, input_prims=None)",
+    "physics.rigid_body": "(velocity=(0.0, 0.0, 0.0), angular_velocity=None, contact_offset=None, "
+                          "rest_offset=None, overwrite=False, physics_scene=None, input_prims=None)",
+    "physics.collider": "(approximation_shape='convexHull', contact_offset=None, rest_offset=None, "
+                        "physics_scene=None, input_prims=None)",
+    "physics.mass": "(mass=None, density=None, center_of_mass=None, diagonal_inertia=None, principal_axes=None, "
+                    "input_prims=None)",
+    "physics.physics_material": "(static_friction=None, dynamic_friction=None, restitution=None, input_prims=None)",
+    "physics.drive_properties": "(stiffness=0.0, damping=0.0, input_prims=None)",
     "trigger.on_frame": "(interval=1, num_frames=0, name='on_frame', rt_subframes=1, max_execs=0)",
     "trigger.on_time": "(interval=1, num=0, name='on_time', rt_subframes=32, enable_capture_on_play=True,"
                        " reset_physics=True, max_execs=0)",
@@ -137,9 +152,8 @@ def test_call_defaults_are_the_node_ports_defaults():
 
 def test_the_faces_name_no_node_type():
     """The rep.<family> modules reach their node classes through the registry, never by a type-name string."""
-    root = os.path.dirname(rep.__file__)
-    for family in NAMESPACES:
-        with open(os.path.join(root, f"{family}.py")) as f:
+    for family, namespace in NAMESPACES.items():
+        with open(namespace.__file__) as f:
             text = f.read()
         assert "NodeRegistry" not in text and f'"{family}.' not in text, family
 

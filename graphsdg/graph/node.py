@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # type names only: the graph module imports this one
     from graphsdg.graph.graph import Graph
 
 # "gate": a node inside a trigger's block that picks which rows (environments) the nodes in its own block change
-FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer", "gate")
+FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer", "gate", "physics")
 
 
 @dataclass(frozen=True)

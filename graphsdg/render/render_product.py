@@ -189,6 +189,20 @@ def _camera_path(camera: object) -> str:
     return str(prim.GetPath())
 
 
+def _item_cameras(item: object) -> list[Usd.Prim]:
+    """The cameras of a graph item: each prim that is a camera, else the cameras below it (Replicator's Xform
+    wrappers and stereo rigs)."""
+    cameras: list[Usd.Prim] = []
+    for prim in item.get_output_prims()["prims"]:  # type: ignore[attr-defined]
+        if prim.IsA(UsdGeom.Camera):
+            cameras.append(prim)
+        else:
+            cameras += [p for p in Usd.PrimRange(prim) if p.IsA(UsdGeom.Camera)]
+    if not cameras:
+        raise InvalidPrimError(f"render product camera item {item!r} holds no UsdGeom.Camera prim")
+    return cameras
+
+
 def create_render_product(camera: object, resolution: Sequence[int], force_new: bool = False,
                           name: str | None = None, render_vars: Iterable[str] | None = None
                           ) -> RenderProduct | list[RenderProduct]:
@@ -203,6 +217,9 @@ def create_render_product(camera: object, resolution: Sequence[int], force_new: 
         (64, 48)
     """
     res = _validate_resolution(resolution)
+    if hasattr(camera, "get_output_prims"):   # a graph item: each camera it made (a stereo rig: both), as Replicator
+        cameras = _item_cameras(camera)
+        camera = cameras[0] if len(cameras) == 1 else cameras
     if isinstance(camera, (list, tuple)) and not (len(camera) == 3 and all(isinstance(c, (int, float))
                                                                            for c in camera)):
         return [create_render_product(c, res, force_new, name, render_vars) for c in camera]  # type: ignore
