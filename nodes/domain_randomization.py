@@ -88,14 +88,15 @@ class ViewWriter(Node):
     kind: ClassVar[str] = ""
     inputs = {"view": Port(str), "attribute": Port(str, required=True), "operation": Port(str, "direct"),
               "values": Port("samples", required=True), "indices": Port("indices", required=True),
-              "on_reset": Port(bool, False), "num_buckets": Port(int)}
+              "on_reset": Port(bool, False), "num_buckets": Port(int),
+              "bucket_lower": Port("number|tuple"), "bucket_upper": Port("number|tuple")}
     outputs = {"values": Port("array")}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:
         super().__init__(name=name, **values)
         check_attribute(self.kind, self.value_of("attribute"), self.value_of("operation"))
         buckets = self.value_of("num_buckets")
-        if buckets is not None and (isinstance(buckets, bool) or not isinstance(buckets, int) or buckets < 1):
+        if buckets and (isinstance(buckets, bool) or not isinstance(buckets, int) or buckets < 1):
             raise ValueError(f"num_buckets must be a positive integer, got {buckets!r}")
 
     def _samples(self, ctx: ExecContext, n: int) -> np.ndarray:
@@ -106,10 +107,14 @@ class ViewWriter(Node):
         return np.repeat(row, n, axis=0)
 
     def _buckets(self) -> tuple[np.ndarray, np.ndarray, int] | None:
-        """(lower, upper, count) of material buckets: from the distribution feeding ``values``."""
+        """(lower, upper, count) of material buckets: the ``bucket_lower`` / ``bucket_upper`` given, else the bounds
+        of the distribution feeding ``values``."""
         count = self.value_of("num_buckets")
-        if count is None:
+        if not count:
             return None
+        if self.value_of("bucket_lower") is not None and self.value_of("bucket_upper") is not None:
+            return (np.asarray(self.value_of("bucket_lower"), dtype=np.float64),
+                    np.asarray(self.value_of("bucket_upper"), dtype=np.float64), int(count))
         source = getattr(self.values.get("values"), "node", None)
         kind = getattr(source, "type_name", "")
         if kind in ("distribution.uniform", "distribution.log_uniform"):

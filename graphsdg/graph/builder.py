@@ -45,8 +45,9 @@ def ensure_root(graph: Graph) -> Sdf.Path:
 
 
 # ---- adding nodes --------------------------------------------------------
-def add_node(node: Node, gated: bool = True) -> ReplicatorItem:
-    """Add ``node`` to the current graph with its data edges, run its setup, and run it now if ungated."""
+def add_node(node: Node, gated: bool = True, run_ungated: bool = True) -> ReplicatorItem:
+    """Add ``node`` to the current graph with its data edges, run its setup, and run it now if ungated (unless
+    ``run_ungated`` is False: a node whose inputs are set after it is made runs later)."""
     graph = current_graph()
     assert graph is not None
     if node.family != "trigger" and gated:
@@ -57,7 +58,7 @@ def add_node(node: Node, gated: bool = True) -> ReplicatorItem:
         ensure_root(graph)
         graph.add(node, upstream)
         node.setup(ExecContext(node, 0, graph.frame))
-    if node.trigger is None and node.family not in ("distribution", "trigger"):
+    if run_ungated and node.trigger is None and node.family not in ("distribution", "trigger"):
         scheduler.run_now(graph, node)
     return ReplicatorItem(node)
 

@@ -23,6 +23,7 @@ from graphsdg.graph.node import Node, describe_value
 from graphsdg.rng import stable_key
 
 REPLICATOR_ROOT = "/Replicator"
+REPLICATOR_GRAPH_PATH = "/Replicator/SDGPipeline"    # Replicator's graph, as OmniGraph names it
 
 
 class Graph:
@@ -38,6 +39,7 @@ class Graph:
         self.pending_events: set[str] = set()
         self.frame = 0                           # graph executions (steps) so far
         self.owns_root = False                   # the graph made /Replicator
+        self.path = REPLICATOR_GRAPH_PATH         # where OmniGraph keeps it (graphs made by path keep theirs)
 
     # ---- structure -----------------------------------------------------
     def __len__(self) -> int:
@@ -82,6 +84,21 @@ class Graph:
         if not nx.is_directed_acyclic_graph(self.dag):
             self.dag.remove_edge(up.name, down.name)
             raise ValueError(f"connecting {up.name!r} -> {down.name!r} would make a cycle")
+        self._order = None
+
+    def remove(self, node: Node) -> None:
+        """Take ``node`` out of the graph; nodes reading its outputs must be disconnected first."""
+        readers = self.downstream(node)
+        if readers:
+            raise ValueError(f"cannot remove {node.name!r}: {[d.name for d in readers]} read its outputs")
+        self.dag.remove_node(node.name)
+        self._nodes.remove(node)
+        self._names.discard(node.name)
+        self._order = None
+        node.graph = None
+
+    def invalidate(self) -> None:
+        """Recompute the order and stable ids before the next run (a node's inputs or gating changed)."""
         self._order = None
 
     def _unique_name(self, base: str) -> str:

@@ -29,6 +29,7 @@ from pxr import Sdf, Usd
 
 from graphsdg import rng as rnglib
 from graphsdg.errors import GraphBuildError
+from graphsdg.graph.attributes import EXEC_IN, EXEC_OUT, Attribute, NodeType, attribute_names, graph_path
 from graphsdg.graph.samples import Samples
 from graphsdg.graph.scopes import scopes
 from graphsdg.graph.value_shapes import Shape, spread
@@ -109,6 +110,85 @@ class Node:
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name or self.type_name}>"
 
+    # ---- OmniGraph's view of a node: attributes, type, path (graphsdg.graph.attributes) -----------------------
+    def get_attribute(self, name: str) -> Attribute:
+        """Port ``name`` (``"inputs:x"`` / ``"outputs:y"``) as an attribute to get, set and connect."""
+        return Attribute(self, name)
+
+    def get_attribute_exists(self, name: str) -> bool:
+        try:
+            Attribute(self, name)
+        except KeyError:
+            return False
+        return True
+
+    def get_attributes(self) -> list[Attribute]:
+        return [Attribute(self, n) for n in attribute_names(self)]
+
+    def get_node_type(self) -> NodeType:
+        return NodeType(self)
+
+    def get_type_name(self) -> str:
+        return NodeType(self).get_node_type()
+
+    def get_prim_path(self) -> str:
+        """Where OmniGraph would keep the node: its graph's path and its name."""
+        return f"{graph_path(self)}/{self.name}"
+
+    def is_valid(self) -> bool:
+        return self.graph is not None
+
+    def input_value(self, port: str) -> Any:
+        """Input ``port`` with its connections resolved (None while an upstream node has not computed)."""
+        try:
+            return resolve_refs(self.value_of(port))
+        except GraphBuildError:
+            return None
+
+    def set_input(self, port: str, value: Any) -> None:
+        """Give input ``port`` a plain value (the node's identity changes: the graph recomputes its order)."""
+        self.values[port] = value
+        if self.graph is not None:
+            self.graph.invalidate()
+
+    def input_sources(self, port: str) -> list[tuple["Node", str]]:
+        """(node, output port) pairs feeding input ``port``."""
+        found = [(ref.node, ref.output) for ref in iter_refs(self.values.get(port))]
+        return found + [src for src in self.__dict__.get("exec_sources", []) if port == EXEC_IN]
+
+    def connect_output(self, port: str, dest: "Node", dest_port: str) -> None:
+        """Feed ``dest``'s input ``dest_port`` from output ``port``: a data edge of the graph. A trigger's
+        ``execOut`` into ``execIn`` gates ``dest`` by the trigger instead."""
+        if self.graph is None or dest.graph is not self.graph:
+            raise GraphBuildError(f"cannot connect {self.name!r} to {dest.name!r}: they are not in one graph")
+        if port == EXEC_OUT and dest_port == EXEC_IN and self.family == "trigger":
+            dest.trigger = self
+            self.graph.dag.add_edge(self.name, dest.name, kind="exec", ports=[])
+            self.graph.invalidate()
+            return
+        if dest_port in dest.inputs:
+            dest.values[dest_port] = ReplicatorItem(self, port)
+        else:      # an exec pin graphsdg's node has no port for: it orders the two nodes
+            dest.__dict__.setdefault("exec_sources", []).append((self, port))
+        self.graph.connect(self, dest, port, dest_port)
+
+    def disconnect_input(self, port: str, up: "Node", up_port: str) -> bool:
+        """Undo ``up.connect_output(up_port, self, port)``; False when they were not connected."""
+        if port == EXEC_IN and up.family == "trigger" and self.trigger is up:
+            self.trigger = None
+        elif port in self.inputs and any(r.node is up and r.output == up_port for r in iter_refs(self.values.get(port))):
+            self.values[port] = None
+        elif (up, up_port) in self.__dict__.get("exec_sources", []):
+            self.exec_sources.remove((up, up_port))
+        else:
+            return False
+        if self.graph is not None:
+            still = any(r.node is up for v in self.values.values() for r in iter_refs(v)) or self.trigger is up
+            if not still and self.graph.dag.has_edge(up.name, self.name):
+                self.graph.dag.remove_edge(up.name, self.name)
+            self.graph.invalidate()
+        return True
+
 
 class ReplicatorItem:
     """What every graph-API call returns: a handle on one node's output (``rep.ReplicatorItem``).
@@ -118,9 +198,29 @@ class ReplicatorItem:
     :meth:`get_output_prims`.
     """
 
-    def __init__(self, node: Node, output: str | None = None) -> None:
+    def __init__(self, node: Any, *args: Any, **kwargs: Any) -> None:
+        """``ReplicatorItem(node, output=None)``; or Replicator's ``ReplicatorItem(fn, *args, **kwargs)``: the
+        item of the node ``fn(*args, **kwargs)`` returns."""
+        if isinstance(node, Node):
+            if len(args) + len(kwargs) > 1 or set(kwargs) - {"output"}:
+                raise TypeError(f"ReplicatorItem(node, output=None) got extra arguments {args!r} {kwargs!r}")
+            output = args[0] if args else kwargs.get("output")
+        elif callable(node):
+            made = node(*args, **kwargs)
+            node, output = (made.node, made.output) if isinstance(made, ReplicatorItem) else (made, None)
+            if not isinstance(node, Node):
+                raise TypeError(f"ReplicatorItem(fn, ...): fn returned {made!r}, not a graph node")
+        else:
+            raise TypeError(f"ReplicatorItem expects a graph node (or a function making one), got {node!r}")
         self.node = node
         self.output = output or next(iter(node.outputs), "")
+
+    @staticmethod
+    def _get_context() -> "Node | None":
+        """The node of the innermost open ``with`` block: its item's, else its trigger's (None outside any)."""
+        if scopes.targets:
+            return scopes.targets[-1].node
+        return scopes.trigger
 
     @property
     def name(self) -> str:
