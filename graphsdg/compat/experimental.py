@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import types
 
+from graphsdg.compat import experimental_articulation as articulation
 from graphsdg.compat import experimental_camera as camera
 from graphsdg.compat import experimental_lights as lights
 from graphsdg.compat import experimental_materials as materials
+from graphsdg.compat import experimental_nonvisual_material as nonvisual
 from graphsdg.compat import experimental_objects as objects
 from graphsdg.compat import experimental_prims as prims
 from graphsdg.compat.modules import CompatModule
@@ -29,9 +31,11 @@ def modules() -> list[types.ModuleType]:
                      RectLight=lights.RectLight, DiskLight=lights.DiskLight, CylinderLight=lights.CylinderLight,
                      DomeLight=lights.DomeLight),
         CompatModule("isaacsim.core.experimental.prims", Prim=prims.Prim, XformPrim=prims.XformPrim,
-                     GeomPrim=prims.GeomPrim, RigidPrim=prims.RigidPrim),
+                     GeomPrim=prims.GeomPrim, RigidPrim=prims.RigidPrim,
+                     Articulation=articulation.Articulation),
         CompatModule("isaacsim.core.experimental.materials", VisualMaterial=materials.VisualMaterial,
                      PreviewSurfaceMaterial=materials.PreviewSurfaceMaterial,
                      OmniPbrMaterial=materials.OmniPbrMaterial, PhysicsMaterial=materials.PhysicsMaterial,
-                     RigidBodyMaterial=materials.RigidBodyMaterial),
+                     RigidBodyMaterial=materials.RigidBodyMaterial,
+                     NonVisualMaterial=nonvisual.NonVisualMaterial),
     ]
