@@ -65,7 +65,8 @@ def test_every_vendored_script_parses_and_only_uses_names_the_layer_maps():
 
 # ---- unsupported names fail clearly -------------------------------------------------------------
 UNSUPPORTED = [
-    ("import omni.isaac.core", CompatImportError, "omni.isaac is not available in graphsdg's compat mode"),
+    ("import omni.isaac.no_such_extension", CompatImportError,
+     "omni.isaac.no_such_extension is not one of Isaac's pre-4.5 module names"),
     ("from isaacsim.core.api import World", CompatImportError, "isaacsim.core.api is not available"),
     ("from omni.replicator.core import no_such_thing", CompatImportError,
      "omni.replicator.core.no_such_thing is not available"),

@@ -55,6 +55,9 @@ KNOWN: dict[str, tuple[str, ...]] = {
 }
 # off until enabled, as in Isaac Sim's standalone Python experience
 OFF_AT_START: set[str] = {"isaacsim.test.utils", "omni.simready.explorer"}
+# Isaac's pre-4.5 extension name -> the extensions replacing it (graphsdg.compat.legacy_names fills it); an old name
+# is known once a replacement is, and otherwise its error names the replacements
+RENAMED: dict[str, tuple[str, ...]] = {}
 
 
 def declare(provided: dict[str, tuple[str, ...]], off_at_start=()) -> None:
@@ -75,6 +78,9 @@ def _check(name: str) -> str:
     if why is not None:
         raise UnknownExtensionError(f"extension {name!r} is out of scope for graphsdg's compat mode: {why}. "
                                     f"{PORTING}", name=str(name))
+    if ext not in KNOWN and ext in RENAMED:
+        raise UnknownExtensionError(f"extension {name!r} is Isaac's pre-4.5 name of {', '.join(RENAMED[ext])}, which "
+                                    f"graphsdg's compat mode does not provide. {PORTING}", name=str(name))
     if ext not in KNOWN:
         raise UnknownExtensionError(
             f"extension {name!r} is not available in graphsdg's compat mode; known extensions: "
