@@ -1,5 +1,10 @@
 """isaacsim.test.utils: checks Isaac's example scripts run on their own output (file counts by extension).
 
+This area also makes the package ``isaacsim.test.utils`` itself and the submodules of UI
+helpers graphsdg cannot provide; the image comparison, image files, capture, timing and
+stage polling helpers come from :mod:`graphsdg.compat.test_utils_images` and
+:mod:`graphsdg.compat.test_utils_capture`.
+
 The functions follow the contracts of Isaac Sim's ``isaacsim.test.utils.file_validation``:
 
 * :func:`validate_folder_contents` - True when a folder holds the expected number
@@ -119,9 +124,21 @@ def validate_file_list(file_paths: list[str | Path], *, fail_on_missing: bool = 
     return {"passed": passed, "missing_files": missing, "empty_files": empty, "undersized_files": undersized}
 
 
+NO_UI = ("graphsdg has no Kit UI (omni.ui windows, menus, omni.kit.ui_test mouse emulation), so the UI test "
+         "helpers (MenuUITestCase, menu_utils, button_utils, layout_utils, viewport_utils.project_world_to_screen) "
+         "are not provided")
+NO_ARTICULATION_COMPARE = ("usd_utils.compare_usd_files compares PhysX articulation properties of loaded robots, "
+                           "which graphsdg does not provide")
+UI_MODULES = ("menu_utils", "menu_ui_test", "button_utils", "layout_utils", "viewport_utils")
+
+
 def modules() -> list[types.ModuleType]:
-    """``isaacsim.test.utils`` and its ``file_validation`` submodule."""
+    """``isaacsim.test.utils``, its ``file_validation`` submodule, and the UI and USD-comparison submodules (which
+    name what they lack)."""
     names = dict(validate_folder_contents=validate_folder_contents, get_folder_file_summary=get_folder_file_summary,
                  validate_file_list=validate_file_list)
-    return [CompatModule("isaacsim.test.utils", **names),
-            CompatModule("isaacsim.test.utils.file_validation", **names)]
+    found = [CompatModule("isaacsim.test.utils", hint=f"{NO_UI}; {NO_ARTICULATION_COMPARE}.", **names),
+             CompatModule("isaacsim.test.utils.file_validation", **names),
+             CompatModule("isaacsim.test.utils.usd_utils", hint=f"{NO_ARTICULATION_COMPARE}.")]
+    found += [CompatModule(f"isaacsim.test.utils.{name}", hint=f"{NO_UI}.") for name in UI_MODULES]
+    return found
