@@ -274,6 +274,30 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
     return frames
 
 
+def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -> list:
+    """Render ``render_products`` now, outside a capture: no annotators, no writers, no time advance (Kit's
+    viewport redraw on an app update). The render observers hear of it as of a capture's renders.
+
+    Returns each product's :class:`~graphsdg.render.rasterizer.RenderOutputs` (``.get("color")``).
+    """
+    rt = runtime()
+    rt.complete_capture()   # a pipelined step's pixels first: one GL context, one pass at a time
+    sim = rt.sim
+    sim.sync_dirty_prims()
+    requests = []
+    for rp in render_products:
+        rp.check_alive()
+        sim.require_offscreen(rp.width, rp.height)
+        requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None))
+    outputs = list(rt.renderer.render_batch(sim, requests)) if requests else []
+    for out in outputs:
+        out.finish()   # hand the pixel buffers back once the colour is read
+    if render_products:
+        for observer in list(rt.render_observers):
+            observer([rp.path for rp in render_products])
+    return outputs
+
+
 class _Capture:
     """One step's rendered products, and what :meth:`finish` needs to annotate and write them."""
 

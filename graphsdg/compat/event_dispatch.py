@@ -22,8 +22,11 @@ time anything observes or waits for an event:
 * stage events (``omni.usd.get_context().stage_event_name(StageEventType.X)``):
   the USD context's CLOSING / OPENED / CLOSED / SAVED;
 * rendering (``stage_rendering_event_name(StageRenderingEventType.NEW_FRAME,
-  immediate)``): once per capture that rendered, payload ``render_products``
-  (graphsdg renders only when it captures, never on a plain app update).
+  immediate)``): once per capture that rendered, payload ``render_products``; and,
+  as Kit's viewport draws a frame on every app update, an app update that
+  captured nothing while someone observes these events draws the active
+  viewport's camera (a real render) and sends them for it. Unobserved, plain app
+  updates render nothing.
 
 Example:
     >>> from graphsdg.compat import event_dispatch
@@ -48,12 +51,15 @@ import types
 import weakref
 from typing import Any, Callable
 
-from graphsdg.compat import kit
+from graphsdg import orchestrator
+from graphsdg.compat import kit, viewport
 from graphsdg.compat.event_names import (APP_POST_UPDATE, APP_PRE_UPDATE, APP_UPDATE, TIMELINE_EVENT_NAMES,
                                          StageRenderingEventType, stage_event_name, stage_rendering_event_name)
 from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.render.render_product import registry as product_registry
 from graphsdg.runtime import runtime
 from graphsdg.sim.timeline import TimelineEvent, TimelineEventType
+from graphsdg.stage.context import get_stage
 
 log = logging.getLogger("carb")
 
@@ -267,6 +273,7 @@ class _KitEventSources:
         self._app_subscription: Any = None
         self._app_pre_subscription: Any = None
         self._stage_subscription: Any = None
+        self._rendered = False   # whether something rendered since the app update began
 
     def connect(self) -> None:
         rt = runtime()
@@ -293,16 +300,32 @@ class _KitEventSources:
 
     def _on_app_update(self, event: Any) -> None:
         payload = {"dt": float(event.payload.get("dt", 0.0))}
+        if not self._rendered and self._new_frames_observed():
+            self._draw_viewport()
+        self._rendered = False
         self._dispatcher.dispatch_event(APP_UPDATE, payload)
         self._dispatcher.dispatch_event(APP_POST_UPDATE, payload)
 
     def _on_app_pre_update(self, event: Any) -> None:
+        self._rendered = False
         self._dispatcher.dispatch_event(APP_PRE_UPDATE, {"dt": float(event.payload.get("dt", 0.0))})
+
+    def _new_frames_observed(self) -> bool:
+        return any(self._dispatcher.has_observers(stage_rendering_event_name(StageRenderingEventType.NEW_FRAME, now))
+                   for now in (True, False))
+
+    def _draw_viewport(self) -> None:
+        """Kit's per-update viewport frame: render the active viewport's camera (its render product)."""
+        active = viewport.get_active_viewport()
+        if not get_stage().GetPrimAtPath(str(active.camera_path)):
+            return   # a stage the USD context did not open has no viewport camera: no viewport frame to draw
+        orchestrator.draw([product_registry.find(active.render_product_path)])
 
     def _on_stage_event(self, event: Any) -> None:
         self._dispatcher.dispatch_event(stage_event_name(event.type), dict(event.payload))
 
     def _on_render(self, render_products: list[str]) -> None:
+        self._rendered = True
         payload = {"render_products": list(render_products)}
         # Kit sends the immediate event when the frame is ready and the deferred one later in the update;
         # graphsdg's frame is ready at once, so both go out now, immediate first

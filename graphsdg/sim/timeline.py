@@ -213,7 +213,13 @@ class Timeline:
         return float("inf") if self.end_time is None else self.end_time
 
     def set_end_time(self, seconds: float) -> None:
-        """Set where playback ends (not looping) or wraps to the start time (looping)."""
+        """Set where playback ends (not looping) or wraps to the start time (looping); ``inf`` (what
+        :meth:`get_end_time` answers when none is set) removes the end time again."""
+        if isinstance(seconds, (int, float)) and not isinstance(seconds, bool) and seconds == math.inf:
+            if self.end_time is not None:
+                self.end_time = None
+                self._emit(TimelineEventType.END_TIME_CHANGED, endTime=math.inf)
+            return
         value = _seconds(seconds, "end time")
         if value < self.start_time:
             raise ValueError(f"end time {value!r} s is before the start time {self.start_time!r} s")
