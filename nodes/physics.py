@@ -1,8 +1,9 @@
 """Physics nodes (``rep.physics``): author the UsdPhysics schemas the MuJoCo compiler maps, each execution.
 
 ``rigid_body`` (RigidBodyAPI with a starting velocity), ``collider`` (CollisionAPI, mesh approximation),
-``mass`` (MassAPI), ``physics_material`` (a physics material's friction and restitution) and
-``drive_properties`` (a joint drive's stiffness and damping). Every value may be one for all prims, one per
+``mass`` (MassAPI), ``physics_material`` (a physics material's friction and restitution),
+``drive_properties`` (a joint drive's stiffness and damping); ``simulate`` runs the simulation forward and
+``reset`` restarts it from the stage. Every value may be one for all prims, one per
 prim, or a distribution (:mod:`graphsdg.graph.value_shapes`); the schemas go through
 ``graphsdg.functional.physics`` where it has a call.
 """
@@ -19,6 +20,7 @@ from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.value_shapes import SCALAR, VEC3
+from graphsdg.runtime import runtime
 from graphsdg.sim.colliders import check_approximation
 
 from .modify import TARGET
@@ -203,3 +205,51 @@ class DriveProperties(PhysicsNode):
             drive.CreateStiffnessAttr().Set(_number(k))
             drive.CreateDampingAttr().Set(_number(d))
         return {"prims": prims}
+
+
+@register_node
+class Simulate(PhysicsNode):
+    """Run the physics simulation for ``time`` seconds now (in steps of ``step_dt`` when given), writing the
+    rigid bodies' poses back to the stage: objects dropped by a randomizer settle before the capture."""
+
+    type_name = "physics.simulate"
+    inputs = {"time": Port(float, required=True), "step_dt": Port(float), "physics_scene": Port(str)}
+    outputs = {"time": Port(float)}
+
+    def __init__(self, name: str | None = None, **values: Any) -> None:
+        super().__init__(name=name, **values)
+        for port in ("time", "step_dt"):
+            value = self.value_of(port)
+            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0):
+                raise ValueError(f"physics.simulate: {port} must be a positive number of seconds, got {value!r}")
+
+    def compute(self, ctx: ExecContext) -> dict:
+        if ctx.dry:
+            return {"time": 0.0}
+        sim = runtime().sim
+        sim.sync_dirty_prims()
+        total = float(ctx.value("time"))
+        chunk = float(ctx.value("step_dt") or total)
+        done = 0.0
+        while done < total - 1e-12:
+            step = min(chunk, total - done)
+            sim.advance(step)
+            done += step
+        return {"time": done}
+
+
+@register_node
+class Reset(PhysicsNode):
+    """Restart the physics simulation from the stage as it is authored now: rigid bodies at their authored
+    poses and velocities, the physics clock at zero."""
+
+    type_name = "physics.reset"
+    inputs = {"physics_scene": Port(str)}
+    outputs = {"time": Port(float)}
+
+    def compute(self, ctx: ExecContext) -> dict:
+        if not ctx.dry:
+            sim = runtime().sim
+            sim.sync_dirty_prims()
+            sim.recompile(keep_state=False)
+        return {"time": 0.0}

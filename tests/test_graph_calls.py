@@ -112,6 +112,8 @@ SIGNATURES = {
                     "input_prims=None)",
     "physics.physics_material": "(static_friction=None, dynamic_friction=None, restitution=None, input_prims=None)",
     "physics.drive_properties": "(stiffness=0.0, damping=0.0, input_prims=None)",
+    "physics.simulate": "(time, step_dt=None, physics_scene=None)",
+    "physics.reset": "(physics_scene=None)",
     "trigger.on_frame": "(interval=1, num_frames=0, name='on_frame', rt_subframes=1, max_execs=0)",
     "trigger.on_time": "(interval=1, num=0, name='on_time', rt_subframes=32, enable_capture_on_play=True,"
                        " reset_physics=True, max_execs=0)",

@@ -7,7 +7,7 @@
 * :mod:`~graphsdg.physics.timeline`: the timeline interface (``omni.timeline``, ``rep.timeline``).
 
 The package is also Replicator's ``rep.physics``: its graph calls (``rigid_body``, ``collider``, ``mass``,
-``physics_material``, ``drive_properties``) are the node types of ``nodes/physics.py``, looked up in the
+``physics_material``, ``drive_properties``, ``simulate``, ``reset``) are the node types of ``nodes/physics.py``, looked up in the
 node registry when first asked for (the node library registers after this package is imported).
 """
 from __future__ import annotations
@@ -16,7 +16,8 @@ from typing import Any
 
 from graphsdg.graph.calls import family_calls
 
-__all__ = ["rigid_body", "collider", "mass", "physics_material", "drive_properties"]   # Replicator's graph calls
+__all__ = ["rigid_body", "collider", "mass", "physics_material", "drive_properties", "simulate",
+           "reset"]   # Replicator's graph calls
 
 
 def __getattr__(name: str) -> Any:

@@ -1,0 +1,137 @@
+"""Replicator's public API in compat mode: the documented names graphsdg answers beyond ``graphsdg`` itself.
+
+``omni.replicator.core`` forwards to ``graphsdg`` (``graphsdg.compat.isaac``); this area adds, to the
+forwarding modules of its submodules, what Replicator documents and graphsdg has no module name for:
+
+* the names that cannot work here, each a function raising :class:`CompatError` that names it and says why
+  (RTX projection materials and decals, MDL shader graphs, keyboard triggers, skeletal animation,
+  RTX-sensor tiling); a name stays importable, so only a script that calls it stops;
+* ``rep.orchestrator.set_next_rt_subframes`` / ``set_minimum_next_rt_subframes`` (the next capture's
+  subframes, through the runtime's graph hooks) and ``get_sim_times_to_write`` (always empty: graphsdg
+  writes each capture in its own step, nothing waits);
+* ``omni.replicator.core.scripts.writers_default.tools``, the module path of ``rep.tools``.
+
+A refusal is added only where graphsdg has no such name, so an area or a room that implements one later
+(``render_product_tiled``, ``omni_lidar``) is not hidden. ``docs/porting.md`` ("Replicator's public API")
+lists every documented name and what it maps to.
+"""
+from __future__ import annotations
+
+import types
+from typing import Any, Callable
+
+import graphsdg
+from graphsdg import tools
+from graphsdg.compat.modules import CompatError, CompatModule, ForwardingModule
+from graphsdg.runtime import runtime
+
+# documented names graphsdg cannot honour: module -> name -> why (the error says it)
+REFUSED: dict[str, dict[str, str]] = {
+    "create": {
+        "mdl_from_json": "it builds an MDL shader graph, and graphsdg renders UsdPreviewSurface-style materials "
+                         "(use rep.create.material_omnipbr)",
+        "projection_material": "RTX projection materials (a copy of the mesh pushed out along its normals, "
+                               "textured by projection) are not rendered by MuJoCo's rasteriser",
+        "mesh_decal": "RTX mesh decals are not rendered by MuJoCo's rasteriser",
+        "tiled_sensor": "it is Replicator's deprecated RTX-sensor tiling (RTX sensors do not exist here); use "
+                        "one render product per camera",
+        "omni_lidar": "RTX lidar sensors are not available in graphsdg (no RTX sensor models)",
+        "omni_radar": "RTX radar sensors are not available in graphsdg (no RTX sensor models)",
+        "render_product_tiled": "tiled render products are not available in this build",
+    },
+    "get": {
+        "normalized_decal_position": "it places RTX mesh decals, which graphsdg does not render",
+    },
+    "modify": {
+        "projection_material": "RTX projection materials are not rendered by MuJoCo's rasteriser",
+        "animation": "skeletal animation clips are not played (graphsdg has no skeleton animation runtime)",
+    },
+    "trigger": {
+        "on_key_press": "graphsdg runs headless: there is no keyboard to press (use "
+                        "rep.trigger.on_custom_event with rep.utils.send_og_event)",
+    },
+}
+
+
+def refusal(qualified: str, why: str) -> Callable[..., Any]:
+    """A stand-in for ``qualified`` that raises :class:`CompatError` naming it and saying ``why`` when called."""
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise CompatError(f"{qualified} is not available in graphsdg's compat mode: {why}. See docs/porting.md "
+                          f"(Replicator's public API).")
+
+    refuse.__name__ = refuse.__qualname__ = qualified.rsplit(".", 1)[-1]
+    refuse.__doc__ = f"Not available in graphsdg: {why}."
+    return refuse
+
+
+class _SubframeRequests:
+    """The subframes asked for the next capture (``set_next_rt_subframes``), handed to the orchestrator through
+    the runtime's graph hooks (the largest request wins; the capture never takes fewer than its setting)."""
+
+    def __init__(self) -> None:
+        self.pending = 0
+
+    def __call__(self) -> dict[str, int] | None:
+        if not self.pending:
+            return None
+        requested, self.pending = self.pending, 0
+        return {"rt_subframes": requested}
+
+    def request(self, value: int, minimum: bool) -> None:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ValueError(f"rt_subframes must be a positive integer, got {value!r}")
+        self.pending = max(self.pending, value) if minimum else value
+
+
+_requests = _SubframeRequests()
+
+
+def set_next_rt_subframes(value: int) -> None:
+    """Render the next capture with ``value`` subframes (at least ``/omni/replicator/RTSubframes``)."""
+    _requests.request(value, minimum=False)
+
+
+def set_minimum_next_rt_subframes(value: int) -> None:
+    """Render the next capture with at least ``value`` subframes."""
+    _requests.request(value, minimum=True)
+
+
+def get_sim_times_to_write() -> list:
+    """The simulation times still waiting to be written: none (each ``step()`` writes its own capture)."""
+    return []
+
+
+def _family_module(family: str, target: types.ModuleType) -> ForwardingModule:
+    """``omni.replicator.core.<family>`` forwarding to graphsdg's module, with the refusals graphsdg lacks."""
+    extra = {name: refusal(f"omni.replicator.core.{family}.{name}", why)
+             for name, why in REFUSED.get(family, {}).items() if not hasattr(target, name)}
+    return ForwardingModule(f"omni.replicator.core.{family}", target, **extra)
+
+
+def modules() -> list[types.ModuleType]:
+    """The compat modules of this area (see the module docstring)."""
+    out: list[types.ModuleType] = [_family_module(f, getattr(graphsdg, f)) for f in REFUSED]
+    orchestrator_extra = {name: fn for name, fn in (
+        ("set_next_rt_subframes", set_next_rt_subframes),
+        ("set_minimum_next_rt_subframes", set_minimum_next_rt_subframes),
+        ("get_sim_times_to_write", get_sim_times_to_write)) if not hasattr(graphsdg.orchestrator, name)}
+    out.append(ForwardingModule("omni.replicator.core.orchestrator", graphsdg.orchestrator, **orchestrator_extra))
+    writers_tools = ForwardingModule("omni.replicator.core.scripts.writers_default.tools", tools)
+    out.append(writers_tools)
+    out.append(CompatModule("omni.replicator.core.scripts.writers_default", tools=writers_tools))
+    return out
+
+
+def install() -> None:
+    """Let the next capture's subframe requests reach the orchestrator."""
+    hooks = runtime().graph_hooks
+    if _requests not in hooks:
+        hooks.append(_requests)
+
+
+def uninstall() -> None:
+    """Stop answering subframe requests (compat mode removed)."""
+    _requests.pending = 0
+    hooks = runtime().graph_hooks
+    if _requests in hooks:
+        hooks.remove(_requests)
