@@ -70,6 +70,20 @@ def stereo_camera(stereo_baseline: float, position: Any = None, rotation: Any = 
     return rigs
 
 
+def render_product_tiled(cameras: Any, tile_resolution: Any, force_new: bool = False,
+                         name: str | None = None) -> Any:
+    """Replicator's one render product holding a grid of camera tiles; graphsdg does not render tiles.
+
+    Raises, saying to make one render product per camera (``rep.create.render_product(cameras, tile_resolution)``
+    returns one per camera of a list), which renders the same images, each as its own array.
+    """
+    raise NotImplementedError(
+        f"rep.create.render_product_tiled(cameras={cameras!r}, tile_resolution={tile_resolution!r}) renders several "
+        f"cameras into one tiled image, which graphsdg's renderer does not do (its annotators and writers work on "
+        f"one camera per render product). Make one render product per camera instead: "
+        f"rep.create.render_product(cameras, tile_resolution) returns one per camera of a list")
+
+
 def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None = None) -> None:
     """Add ``fn`` as ``rep.create.<fn_name>``."""
     register_function(sys.modules[__name__], fn, override, fn_name)

@@ -172,3 +172,11 @@ def test_isaac_time_and_noop_annotators():
         rep.annotators.get("IsaacReadSimulationTime").initialize(resetOnStop=False)
     with pytest.raises(ValueError, match="no init param"):
         rep.annotators.get("IsaacNoop").initialize(colorize=True)
+
+
+def test_render_product_tiled_says_what_to_do_instead():
+    cams = rep.functional.create_batch.camera(count=2, position=[(0, 0, 5), (0, 0, 9)])
+    with pytest.raises(NotImplementedError, match="one render product per camera"):
+        rep.create.render_product_tiled(cameras=[str(c.GetPath()) for c in cams], tile_resolution=(32, 32))
+    products = rep.create.render_product([str(c.GetPath()) for c in cams], (32, 32))   # the suggested form
+    assert [p.camera for p in products] == [str(c.GetPath()) for c in cams]
