@@ -25,12 +25,13 @@ Example:
     >>> import omni.usd
     >>> from pxr import UsdGeom, UsdPhysics
     >>> from isaacsim.core.experimental.prims import Articulation
-    >>> omni.usd.get_context().new_stage()
+    >>> _ = omni.usd.get_context().new_stage()
     >>> stage = omni.usd.get_context().get_stage()
+    >>> robot_prim = UsdGeom.Xform.Define(stage, "/Robot").GetPrim()
     >>> link = UsdGeom.Cube.Define(stage, "/Robot/Link").GetPrim()
     >>> UsdPhysics.RigidBodyAPI.Apply(link); UsdPhysics.CollisionAPI.Apply(link)  # doctest: +ELLIPSIS
     UsdPhysics...
-    >>> UsdPhysics.ArticulationRootAPI.Apply(stage.GetPrimAtPath("/Robot"))  # doctest: +ELLIPSIS
+    >>> UsdPhysics.ArticulationRootAPI.Apply(robot_prim)  # doctest: +ELLIPSIS
     UsdPhysics.ArticulationRootAPI(...)
     >>> _ = UsdPhysics.RevoluteJoint.Define(stage, "/Robot/Hinge").CreateBody1Rel().SetTargets(["/Robot/Link"])
     >>> robot = Articulation("/Robot")

@@ -13,7 +13,7 @@ Example:
     >>> isaac.install()
     >>> import omni.usd
     >>> import isaacsim.core.experimental.utils.bounds as bounds_utils
-    >>> omni.usd.get_context().new_stage()
+    >>> _ = omni.usd.get_context().new_stage()
     >>> cube = omni.usd.get_context().get_stage().DefinePrim("/Cube", "Cube")   # size 2
     >>> bounds_utils.compute_aabb("/Cube").tolist()
     [-1.0, -1.0, -1.0, 1.0, 1.0, 1.0]

@@ -14,7 +14,7 @@ Example:
     >>> isaac.install()
     >>> import omni.usd
     >>> from isaacsim.core.experimental.objects import Camera
-    >>> omni.usd.get_context().new_stage()
+    >>> _ = omni.usd.get_context().new_stage()
     >>> camera = Camera("/World/Camera")
     >>> camera.set_focal_lengths(2.4)
     >>> camera.get_focal_lengths().tolist(), camera.geoms[0].GetFocalLengthAttr().Get()

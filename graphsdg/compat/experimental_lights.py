@@ -15,7 +15,7 @@ Example:
     >>> isaac.install()
     >>> import omni.usd
     >>> from isaacsim.core.experimental.objects import SphereLight
-    >>> omni.usd.get_context().new_stage()
+    >>> _ = omni.usd.get_context().new_stage()
     >>> light = SphereLight("/World/Light", radii=0.25, positions=(0, 0, 2.5))
     >>> light.set_intensities(30000); light.get_intensities().tolist()
     [[30000.0]]

@@ -15,7 +15,7 @@ Example:
     >>> isaac.install()
     >>> import omni.usd
     >>> from isaacsim.core.experimental.materials import NonVisualMaterial
-    >>> omni.usd.get_context().new_stage()
+    >>> _ = omni.usd.get_context().new_stage()
     >>> material = NonVisualMaterial("/World/Looks/Sign", bases="aluminum", coatings="paint", attributes="emissive")
     >>> int(NonVisualMaterial.encode_material_ids(material)[0, 0])
     2305

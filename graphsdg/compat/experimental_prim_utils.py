@@ -10,7 +10,7 @@ Example:
     >>> isaac.install()
     >>> import omni.usd
     >>> import isaacsim.core.experimental.utils.prim as prim_utils
-    >>> omni.usd.get_context().new_stage()
+    >>> _ = omni.usd.get_context().new_stage()
     >>> stage = omni.usd.get_context().get_stage()
     >>> for name in ("prim_0", "prim_1", "other"):
     ...     _ = stage.DefinePrim(f"/World/{name}", "Xform")
