@@ -42,7 +42,8 @@ from graphsdg.graph.registry import NodeRegistry
 from graphsdg.graph.scopes import current_trigger, implicit_targets
 from graphsdg.physics.articulation_tensor_view import ArticulationTensorView
 from graphsdg.physics.domain_randomization import (ARTICULATION_ATTRIBUTES, OPERATIONS, RIGID_BODY_ATTRIBUTES,
-                                                   SIMULATION_ATTRIBUTES, Target, randomization_targets)
+                                                   SIMULATION_ATTRIBUTES, TENDON_ATTRIBUTES, Target,
+                                                   randomization_targets)
 from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
 
 
@@ -124,6 +125,10 @@ def _writers(call: str, type_name: str, allowed: Sequence[str], view: str, opera
     unknown = sorted(set(attributes) - set(allowed))
     if unknown:
         raise TypeError(f"{call}() got unknown attribute(s) {unknown}; randomizable attributes: {list(allowed)}")
+    tendons = sorted(a for a in TENDON_ATTRIBUTES if attributes.get(a) is not None)
+    if tendons:
+        raise ValueError(f"{call}(): cannot randomize {tendons} of {view!r}: graphsdg compiles no fixed tendons "
+                         f"(MuJoCo's model of the articulation has none)")
     items = []
     for attribute in allowed:          # Isaac's order, whatever the keyword order
         value = attributes.get(attribute)

@@ -172,11 +172,11 @@ class ArticulationTensorView:
                 out[i, k] = read(compiled, j)
         return out
 
-    def _write_dofs(self, data: np.ndarray, indices, what: str, write) -> None:
+    def _write_dofs(self, data: np.ndarray, indices, what: str, write, finite: bool = True) -> None:
         """Call ``write(sim, joint, value)`` for every dof of the selected rows."""
         rows = self._resolve()
         idx = row_indices(indices, len(rows))
-        values = selected_rows(data, idx, len(rows), self.max_dofs, what)
+        values = selected_rows(data, idx, len(rows), self.max_dofs, what, finite)
         sim = self.sim
         for row, vals in zip(idx, values):
             for j, v in zip(rows[int(row)].joints, vals):
@@ -294,7 +294,7 @@ class ArticulationTensorView:
                 c.model.actuator_forcelimited[a] = int(np.isfinite(v))
                 c.model.actuator_forcerange[a] = [-v, v] if np.isfinite(v) else [0.0, 0.0]
             self._model_write(sim, ("dof_max_force", j.path), apply)
-        self._write_dofs(data, indices, "dof max forces", write)
+        self._write_dofs(data, indices, "dof max forces", write, finite=False)
 
     def get_dof_armatures(self) -> np.ndarray:
         return self._dof_table(lambda c, j: c.model.dof_armature[j.dof_adr])

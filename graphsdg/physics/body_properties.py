@@ -73,7 +73,14 @@ def set_inertia(sim: SimScene, path: str, matrix: np.ndarray) -> None:
     moments, quat = principal_inertia(matrix, f"inertia of {path}")
 
     def apply(c: CompiledScene) -> None:
+        m = c.model
         bid = body_id(c, path)
-        c.model.body_inertia[bid] = moments
-        c.model.body_iquat[bid] = quat
+        m.body_inertia[bid] = moments
+        m.body_iquat[bid] = quat
+        # the compiler's shortcuts for a body whose inertial frame is its own frame no longer hold
+        m.body_sameframe[bid] = 0
+        m.body_simple[bid] = 0
+        adr, num = int(m.body_dofadr[bid]), int(m.body_dofnum[bid])
+        if adr >= 0:
+            m.dof_simplenum[adr:adr + num] = 0
     overrides_for(sim).write(("inertia", path), apply, constants=True)

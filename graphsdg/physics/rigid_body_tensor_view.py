@@ -48,9 +48,10 @@ def row_indices(indices: Sequence[int] | np.ndarray | None, count: int) -> np.nd
     return idx
 
 
-def selected_rows(data: np.ndarray, idx: np.ndarray, count: int, width: int, what: str) -> np.ndarray:
+def selected_rows(data: np.ndarray, idx: np.ndarray, count: int, width: int, what: str,
+                  finite: bool = True) -> np.ndarray:
     """The rows of ``data`` for the selected ``idx``: (len(idx), width) from a full (count, ...) table or from
-    one of only the selected rows."""
+    one of only the selected rows; ``finite`` False lets infinities through (limits), never NaN."""
     arr = np.asarray(data, dtype=np.float64)
     flat = arr.reshape(-1, width) if arr.size % width == 0 else None
     if flat is None:
@@ -60,8 +61,8 @@ def selected_rows(data: np.ndarray, idx: np.ndarray, count: int, width: int, wha
     elif flat.shape[0] != len(idx):
         raise ValueError(f"{what}: expected {count} rows (every row) or {len(idx)} (the selected ones), got "
                          f"{flat.shape[0]}")
-    if not np.all(np.isfinite(flat)):
-        raise ValueError(f"{what}: values must be finite, got {arr.tolist()}")
+    if np.any(np.isnan(flat)) or (finite and not np.all(np.isfinite(flat))):
+        raise ValueError(f"{what}: values must be {'finite' if finite else 'numbers'}, got {arr.tolist()}")
     return flat
 
 
