@@ -158,7 +158,13 @@ class LogUniform(Distribution):
 
 
 def _stack(values: list) -> Any:
-    """An array when every value is numeric and of one shape, else the list."""
+    """An array when every value is numeric (or every one boolean: kept boolean) and of one shape, else the list."""
+    try:
+        kept = np.asarray(values)
+    except (TypeError, ValueError):
+        return values
+    if kept.dtype == bool:
+        return kept
     try:
         arr = np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):

@@ -11,7 +11,7 @@ from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
-from graphsdg.graph.value_shapes import SCALAR, SCALAR_OR_VEC3, WHOLE, attribute_shapes, spread_value
+from graphsdg.graph.value_shapes import SCALAR, SCALAR_OR_VEC3, WHOLE, attribute_shapes
 from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
 from graphsdg.physics.timeline import get_timeline_interface
 from graphsdg.render.render_product import registry as render_products
@@ -225,9 +225,9 @@ def _as_bool(value: Any) -> Any:
 
 @register_node
 class Material(Node):
-    """Bind material ``value`` (an item, prim or path)."""
+    """Bind material ``value`` (an item, prim or path) to every prim; given several (a list, a ``count > 1``
+    material item), one drawn per prim; given a distribution, its draws (one per prim, or a per-prim list)."""
 
-    # a distribution of materials picks one per prim each execution
     type_name = "modify.material"
     family = "modify"
     call = Call()
@@ -244,9 +244,9 @@ class Material(Node):
             mats = flatten_prims(value, "modify.material value")
             if not mats:
                 raise ValueError("modify.material: value names no material")
-            if len(mats) == 1 or len(mats) == n:
-                chosen = spread_value(mats, n, SCALAR, "modify.material value")
-            else:   # several materials, as Replicator's list: one drawn per prim
+            if len(mats) == 1:
+                chosen = mats * n
+            else:   # several materials: one drawn per prim, as Replicator wraps a list in a choice
                 chosen = [mats[int(k)] for k in ctx.rng.integers(0, len(mats), size=n)]
                 ctx.record("value", [str(m.GetPath()) for m in chosen])
         for prim, mat in zip(prims, chosen):
