@@ -275,3 +275,77 @@ def test_mdl_module_reader_names_what_it_cannot_read():
         parse_module("mdl 1.6; import ::OmniPBR::OmniPBR;", "/x/M.mdl")
     with pytest.raises(FileNotFoundError, match="nope.mdl"):
         rep.functional.randomizer.mdl_material("/no/such/nope.mdl")
+
+
+# ---- warehouses ------------------------------------------------------------------------------
+WAREHOUSE_DIR = "/Isaac/Environments/Simple_Warehouse"
+
+
+def _mesh_boxes(stage: Usd.Stage) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    cache = UsdGeom.BBoxCache(Usd.TimeCode.Default(), ["default", "render"])
+    out = []
+    for p in stage.Traverse():
+        if p.IsA(UsdGeom.Mesh):
+            r = cache.ComputeWorldBound(p).ComputeAlignedRange()
+            out.append((str(p.GetPath()), np.array(r.GetMin()), np.array(r.GetMax())))
+    return out
+
+
+def _blocking(boxes, lo, hi, skip=("/Floor", "FloorMarkings", "/Roof")) -> list[str]:
+    """Meshes whose bounds overlap the box [lo, hi] (floor, paint and roof excluded)."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    return [p for p, a, b in boxes if not any(s in p for s in skip) and np.all(a < hi) and np.all(b > lo)]
+
+
+def test_small_warehouse_keeps_the_spots_the_examples_use_free():
+    stage = _open(f"{WAREHOUSE_DIR}/warehouse.usd")
+    boxes = _mesh_boxes(stage)
+    floor = stage.GetPrimAtPath("/Warehouse/Floor")
+    assert floor.HasAPI(UsdPhysics.CollisionAPI) and _bounds(floor)[1][2] == pytest.approx(0.0)
+    assert _blocking(boxes, (-7, -7, 0.01), (7, 7, 3)) == []             # AMR dolly / SDG workflow 2 floor
+    assert _blocking(boxes, (-7.2, -0.5, 0.01), (-5.8, 9.2, 1.5)) == []   # box stacking: (-6.5, i * 1.75, 0)
+    # the box-stacking snippet's shelf spots (-9.3, y, 1.3): a deck top at 1.30 m there and nothing above it
+    cache = UsdGeom.XformCache()
+    deck_boxes = []                    # each deck board of the west racks: its world corners' bounds
+    for prim in Usd.PrimRange(stage.GetPrimAtPath("/Warehouse/Shelves/Rack_West")):
+        if prim.GetName() == "Decks":
+            m = np.array(cache.GetLocalToWorldTransform(prim))
+            pts = np.array(UsdGeom.Mesh(prim).GetPointsAttr().Get(), dtype=float)
+            world = (np.c_[pts, np.ones(len(pts))] @ m)[:, :3].reshape(-1, 8, 3)    # the decks are boxes
+            deck_boxes += [(w.min(0), w.max(0)) for w in world]
+    for y in (5.3, 7.3, -0.6):
+        tops = [b[2] for a, b in deck_boxes if a[0] < -9.3 < b[0] and a[1] < y < b[1]]
+        assert min(tops) == pytest.approx(1.3, abs=1e-4)
+        assert _blocking(boxes, (-9.8, y - 0.5, 1.31), (-8.8, y + 0.5, 2.4), skip=("/Frame/",)) == []   # no stock
+
+
+def test_full_warehouse_layout_fits_the_sdg_and_sensor_examples():
+    stage = _open(f"{WAREHOUSE_DIR}/full_warehouse.usd")
+    boxes = _mesh_boxes(stage)
+    # scene-based SDG: forklift at (-20..-2, -1..3), its pallets up to ~5 m away
+    assert _blocking(boxes, (-26, -6, 0.01), (4, 8, 3)) == []
+    # RTX lidar / camera benchmarks: sensors at (-8, 13 + 2 i, 2); radar at (-0.937, -2 + 2 i, 0.894)
+    for i in range(6):
+        assert _blocking(boxes, (-8.3, 12.7 + 2 * i, 1.7), (-7.7, 13.3 + 2 * i, 2.3)) == []
+        assert _blocking(boxes, (-1.2, -2.3 + 2 * i, 0.6), (-0.7, -1.7 + 2 * i, 1.2)) == []
+    # a roof at 8 m: a top camera at 9-11 m with a 6 m near clip sees through it
+    roof_lo, roof_hi = _bounds(stage.GetPrimAtPath("/Warehouse/Roof"))
+    assert roof_lo[2] == pytest.approx(8.0) and roof_hi[2] < 9.0
+    lights = [p for p in stage.Traverse() if p.GetTypeName() in ("RectLight", "DomeLight")]
+    assert len(lights) >= 4
+    assert stage.GetPrimAtPath("/Warehouse/Floor").HasAPI(UsdPhysics.CollisionAPI)
+    # racks are stocked: every rack bay holds goods somewhere
+    bays = [p for p in stage.Traverse() if p.GetName().startswith("Bay_")]
+    assert len(bays) == 43 and all(any(c.GetName().startswith("Stock_") for c in b.GetChildren()) for b in bays)
+
+
+def test_warehouse_with_forklifts_is_the_warehouse_plus_forklifts():
+    stage = _open(f"{WAREHOUSE_DIR}/warehouse_with_forklifts.usd")
+    forklifts = stage.GetPrimAtPath("/Warehouse/Forklifts").GetChildren()
+    assert len(forklifts) == 3
+    for f in forklifts:
+        lo, hi = _bounds(f)
+        assert hi[2] == pytest.approx(2.15, abs=1e-3) and lo[2] == pytest.approx(0.0, abs=1e-6)
+    assert stage.GetPrimAtPath("/Warehouse/Shelves/Rack_West").IsValid()
+    # camera_noise.py's camera at (-1, 5, 1) is inside and free
+    assert _blocking(_mesh_boxes(stage), (-1.3, 4.7, 0.7), (-0.7, 5.3, 1.3)) == []

@@ -19,11 +19,13 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
+from pxr import Gf, Kind, UsdGeom, UsdLux, UsdPhysics
 
 from graphsdg.assets import (authoring, forklift, franka, geometry, handling_props, mdl_materials, outdoor_skies,
-                             packing_table, simready, skies, textures, warehouse_props, ycb)
+                             packing_table, simready, skies, textures, warehouse_props, warehouse_stages, ycb)
 from graphsdg.assets.entries import ImageAsset, UsdAsset
+from graphsdg.assets.pallets import (BLOCK_H, BLOCK_W, BOARD_T, PALLET_HEIGHT, PALLET_LENGTH,  # noqa: F401
+                                    PALLET_WIDTH, pallet_parts)
 from graphsdg.assets.noise import hash01
 
 PROPS = "/Isaac/Environments/Simple_Warehouse/Props"
@@ -63,55 +65,7 @@ def _sky_builder(name: str) -> Callable[[str], list[str]]:
 
 
 # ---- pallet ---------------------------------------------------------------------
-PALLET_LENGTH, PALLET_WIDTH, PALLET_HEIGHT = 1.2, 0.8, 0.14
-BOARD_T = 0.022          # deck and bottom board thickness
-BLOCK_H = 0.074          # block height: 0.022 + 0.022 + 0.074 + 0.022 = 0.14
-BLOCK_W = 0.145
-
-
-def pallet_parts() -> list[tuple[str, tuple[float, float, float], tuple[float, float, float], int]]:
-    """(name, lo, hi, grain axis) of every board and block of the pallet, origin at the bottom centre.
-
-    A block pallet after the EUR pattern: three bottom boards along X, nine blocks,
-    three cross boards along Y, and five top deck boards along X (wide at the
-    edges and centre, narrow between).
-    """
-    L, W = PALLET_LENGTH, PALLET_WIDTH
-    xs = (-L / 2 + BLOCK_W / 2, 0.0, L / 2 - BLOCK_W / 2)
-    ys = (-W / 2 + BLOCK_W / 2, 0.0, W / 2 - BLOCK_W / 2)
-    parts = []
-    z0 = 0.0
-    for i, y in enumerate(ys):
-        parts.append((f"BottomBoard_{i:02d}", (-L / 2, y - BLOCK_W / 2, z0), (L / 2, y + BLOCK_W / 2, z0 + BOARD_T), 0))
-    z1 = z0 + BOARD_T
-    k = 0
-    for x in xs:
-        for y in ys:
-            parts.append((f"Block_{k:02d}", (x - BLOCK_W / 2, y - BLOCK_W / 2, z1),
-                          (x + BLOCK_W / 2, y + BLOCK_W / 2, z1 + BLOCK_H), 2))
-            k += 1
-    z2 = z1 + BLOCK_H
-    for i, x in enumerate(xs):
-        parts.append((f"CrossBoard_{i:02d}", (x - BLOCK_W / 2, -W / 2, z2), (x + BLOCK_W / 2, W / 2, z2 + BOARD_T), 1))
-    z3 = z2 + BOARD_T
-    widths = (0.145, 0.100, 0.145, 0.100, 0.145)
-    gap = (W - sum(widths)) / (len(widths) - 1)
-    y = -W / 2
-    for i, w in enumerate(widths):
-        parts.append((f"DeckBoard_{i:02d}", (-L / 2, y, z3), (L / 2, y + w, z3 + BOARD_T), 0))
-        y += w + gap
-    return parts
-
-
-def write_pbr_maps(root: str, colour_rel: str, rgb: np.ndarray, roughness: float,
-                   metallic: float = 0.0) -> tuple[str, str]:
-    """Write the normal and ORM maps of colour texture ``colour_rel`` (``*_BaseColor.png`` -> ``*_Normal.png``,
-    ``*_ORM.png`` beside it); returns their pack-relative paths."""
-    stem = colour_rel.rsplit("_BaseColor.png", 1)[0]
-    normal_rel, orm_rel = f"{stem}_Normal.png", f"{stem}_ORM.png"
-    textures.write_png(_abs(root, normal_rel), textures.normal_map(rgb))
-    textures.write_png(_abs(root, orm_rel), textures.orm_map(rgb, roughness, metallic))
-    return normal_rel, orm_rel
+write_pbr_maps = textures.write_pbr_maps
 
 
 def build_pallet(root: str) -> list[str]:
@@ -177,120 +131,6 @@ def _card_box_builder(box: CardBox) -> Callable[[str], list[str]]:
     return build
 
 
-# ---- warehouse ------------------------------------------------------------------------
-WAREHOUSE_X, WAREHOUSE_Y, WAREHOUSE_H = 24.0, 16.0, 6.0      # interior floor and wall height
-WALL_T, FLOOR_T = 0.3, 0.2
-RACK_DEPTH, RACK_BAY, RACK_LEVELS = 1.1, 2.7, (1.5, 3.0, 4.4)
-RACK_POST, RACK_HEIGHT = 0.08, 4.5
-
-
-def _collider(prim: Usd.Prim) -> None:
-    UsdPhysics.CollisionAPI.Apply(prim)
-
-
-def _rack_row(y_front: float, y_back: float, bays: int) -> tuple[geometry.MeshData, geometry.MeshData,
-                                                                   geometry.MeshData, list[tuple[float, float, float]]]:
-    """Uprights, beams and decks of one pallet-rack row between ``y_front`` and ``y_back``; shelf spots."""
-    x_start = -bays * RACK_BAY / 2
-    posts, beams, decks, spots = [], [], [], []
-    y_lo, y_hi = min(y_front, y_back), max(y_front, y_back)
-    for i in range(bays + 1):
-        x = x_start + i * RACK_BAY
-        for y in (y_lo, y_hi - RACK_POST):
-            posts.append(geometry.box((x - RACK_POST / 2, y, 0.0), (x + RACK_POST / 2, y + RACK_POST, RACK_HEIGHT),
-                                      geometry.planar_uv(tile=0.5)))
-    for b in range(bays):
-        x0, x1 = x_start + b * RACK_BAY + RACK_POST / 2, x_start + (b + 1) * RACK_BAY - RACK_POST / 2
-        spots.append(((x0 + x1) / 2, (y_lo + y_hi) / 2, 0.0))
-        for z in RACK_LEVELS:
-            for y in (y_lo, y_hi - 0.05):
-                beams.append(geometry.box((x0, y, z - 0.12), (x1, y + 0.05, z), geometry.planar_uv(tile=0.5)))
-            decks.append(geometry.box((x0, y_lo + 0.05, z), (x1, y_hi - 0.05, z + 0.02),
-                                      geometry.planar_uv(tile=1.2, grain_axis=0)))
-            spots.append(((x0 + x1) / 2, (y_lo + y_hi) / 2, z + 0.02))
-    return geometry.merge(posts), geometry.merge(beams), geometry.merge(decks), spots
-
-
-def build_warehouse(root: str) -> list[str]:
-    rel = f"{WAREHOUSE_DIR}/warehouse.usd"
-    tex_dir = f"{WAREHOUSE_DIR}/Materials/Textures"
-    tex = {
-        "Concrete": (textures.concrete((512, 512), seed=301), 0.6),
-        "BlockWall": (textures.block_wall((512, 512), seed=302, blocks=(10, 5)), 0.9),
-        "RackUpright": (textures.painted_metal((64, 64), seed=303, paint=(0.10, 0.24, 0.55)), 0.45),
-        "RackBeam": (textures.painted_metal((64, 64), seed=304, paint=(0.90, 0.42, 0.08)), 0.45),
-        "FloorMarking": (textures.safety_paint((128, 128), seed=305), 0.5),
-    }
-    written = [rel]
-    for name, (img, r) in tex.items():
-        textures.write_png(_abs(root, f"{tex_dir}/{name}_BaseColor.png"), img)
-        written += [f"{tex_dir}/{name}_BaseColor.png", *write_pbr_maps(root, f"{tex_dir}/{name}_BaseColor.png", img, r)]
-    stage, prim = authoring.new_asset_stage(_abs(root, rel), "Warehouse", kind=Kind.Tokens.assembly)
-    looks = {name: authoring.define_textured_material(stage, f"/Warehouse/Looks/{name}",
-                                                      f"./Materials/Textures/{name}_BaseColor.png", roughness=r,
-                                                      normal_texture=f"./Materials/Textures/{name}_Normal.png",
-                                                      orm_texture=f"./Materials/Textures/{name}_ORM.png")
-             for name, (_, r) in tex.items()}
-    looks["Plywood"] = authoring.define_textured_material(
-        stage, "/Warehouse/Looks/Plywood", "../../../NVIDIA/Materials/Base/Wood/Plywood/Plywood_BaseColor.png",
-        roughness=0.8)
-    hx, hy = WAREHOUSE_X / 2, WAREHOUSE_Y / 2
-    floor = authoring.define_mesh(stage, "/Warehouse/Floor", geometry.box(
-        (-hx - WALL_T, -hy - WALL_T, -FLOOR_T), (hx + WALL_T, hy + WALL_T, 0.0), geometry.planar_uv(tile=4.0)))
-    authoring.bind_material(floor.GetPrim(), looks["Concrete"])
-    _collider(floor.GetPrim())
-    UsdGeom.Scope.Define(stage, "/Warehouse/Walls")
-    walls = {
-        "Wall_North": ((-hx - WALL_T, hy, 0.0), (hx + WALL_T, hy + WALL_T, WAREHOUSE_H)),
-        "Wall_South": ((-hx - WALL_T, -hy - WALL_T, 0.0), (hx + WALL_T, -hy, WAREHOUSE_H)),
-        "Wall_East": ((hx, -hy, 0.0), (hx + WALL_T, hy, WAREHOUSE_H)),
-        "Wall_West": ((-hx - WALL_T, -hy, 0.0), (-hx, hy, WAREHOUSE_H)),
-    }
-    for name, (lo, hi) in walls.items():
-        wall = authoring.define_mesh(stage, f"/Warehouse/Walls/{name}", geometry.box(lo, hi, geometry.planar_uv(2.0)))
-        authoring.bind_material(wall.GetPrim(), looks["BlockWall"])
-        _collider(wall.GetPrim())
-    # a painted lane around the open working area in the middle of the floor
-    lane_w, lane_h, half = 0.10, 0.002, 4.0
-    strips = [geometry.box((-half, s * half - lane_w / 2, 0.0), (half, s * half + lane_w / 2, lane_h),
-                           geometry.planar_uv(0.5)) for s in (-1, 1)]
-    strips += [geometry.box((s * half - lane_w / 2, -half + lane_w / 2, 0.0),
-                            (s * half + lane_w / 2, half - lane_w / 2, lane_h), geometry.planar_uv(0.5))
-               for s in (-1, 1)]
-    lanes = authoring.define_mesh(stage, "/Warehouse/FloorMarkings", geometry.merge(strips))
-    authoring.bind_material(lanes.GetPrim(), looks["FloorMarking"])
-    UsdGeom.Scope.Define(stage, "/Warehouse/Shelves")
-    box_names = sorted(CARD_BOXES)
-    spot_index = 0
-    for r, (name, y_front, y_back) in enumerate((("Rack_North", hy - 1.5 - RACK_DEPTH, hy - 1.5),
-                                                 ("Rack_South", -hy + 1.5 + RACK_DEPTH, -hy + 1.5))):
-        rack = UsdGeom.Xform.Define(stage, f"/Warehouse/Shelves/{name}")
-        posts, beams, decks, spots = _rack_row(y_front, y_back, bays=3)
-        for part, mesh, look in (("Uprights", posts, "RackUpright"), ("Beams", beams, "RackBeam"),
-                                 ("Decks", decks, "Plywood")):
-            m = authoring.define_mesh(stage, f"{rack.GetPath()}/{part}", mesh)
-            authoring.bind_material(m.GetPrim(), looks[look])
-        for k, (x, y, z) in enumerate(spots):
-            for j, dx in enumerate((-0.6, 0.6)):
-                spot_index += 1
-                pick = box_names[int(hash01(spot_index, 0, 91) * len(box_names))]
-                if hash01(spot_index, 1, 91) < 0.2:
-                    continue      # leave some gaps on the shelves
-                item = UsdGeom.Xform.Define(stage, f"{rack.GetPath()}/Stock_{k:02d}_{j}")
-                item.GetPrim().GetReferences().AddReference(f"./Props/{pick}.usd")
-                angle = float(hash01(spot_index, 2, 91) * 16.0 - 8.0)
-                item.AddTranslateOp().Set(Gf.Vec3d(x + dx, y, z))
-                item.AddRotateZOp().Set(angle)
-    # a stack of spare pallets by the east wall
-    for i in range(3):
-        spare = UsdGeom.Xform.Define(stage, f"/Warehouse/SparePallets/Pallet_{i:02d}")
-        spare.GetPrim().GetReferences().AddReference("./Props/SM_PaletteA_01.usd")
-        spare.AddTranslateOp().Set(Gf.Vec3d(hx - 1.2, 0.0, i * PALLET_HEIGHT))
-        spare.AddRotateZOp().Set(90.0 + 3.0 * i)
-    authoring.save(stage)
-    return written
-
-
 # ---- grid environment -------------------------------------------------------------------
 GRID_SIZE, GRID_T = 20.0, 0.1
 
@@ -306,7 +146,7 @@ def build_grid_environment(root: str) -> list[str]:
     ground = authoring.define_mesh(stage, "/Environment/GroundPlane", geometry.box(
         (-half, -half, -GRID_T), (half, half, 0.0), geometry.planar_uv(tile=1.0)))
     authoring.bind_material(ground.GetPrim(), look)
-    _collider(ground.GetPrim())
+    UsdPhysics.CollisionAPI.Apply(ground.GetPrim())
     light = UsdLux.DistantLight.Define(stage, "/Environment/defaultLight")
     light.CreateIntensityAttr(300.0)
     light.CreateAngleAttr(1.0)
@@ -325,11 +165,10 @@ USD_ASSETS: dict[str, UsdAsset] = {
                               f"shipping box {b.length:.2f} x {b.width:.2f} x {b.height:.2f} m, printed dieline "
                               f"texture; origin at the bottom centre", _card_box_builder(b))
        for name, b in CARD_BOXES.items()},
-    "warehouse": UsdAsset("warehouse", f"{WAREHOUSE_DIR}/warehouse.usd",
-                          (WAREHOUSE_X + 2 * WALL_T, WAREHOUSE_Y + 2 * WALL_T, WAREHOUSE_H + FLOOR_T),
-                          "warehouse hall: concrete floor (top at z = 0) with a painted lane, block walls, two "
-                          "pallet-rack rows stocked with card boxes, spare pallets; floor and walls collide",
-                          build_warehouse),
+    "warehouse": UsdAsset("warehouse", f"{WAREHOUSE_DIR}/warehouse.usd", warehouse_stages.WAREHOUSE_SIZE,
+                          "warehouse hall: concrete floor (top at z = 0) with a painted lane round an open 14 x 14 m "
+                          "middle, block walls, stocked pallet racks along the west, east and south walls, spare "
+                          "pallets; floor and walls collide", warehouse_stages.build_warehouse),
     "grid": UsdAsset("grid", "/Isaac/Environments/Grid/default_environment.usd", (GRID_SIZE, GRID_SIZE, GRID_T),
                      "20 x 20 m ground with a 1 m grid (top at z = 0, collides) and a distant light",
                      build_grid_environment),
@@ -414,15 +253,15 @@ IMAGE_ASSETS.update({
 
 # Stand-ins for the further /Isaac/... paths Isaac's Replicator examples and tests load, module by module
 # (stages that reference props come after the props).
-ISAAC_STAND_IN_MODULES = (warehouse_props, handling_props, forklift, franka)
+ISAAC_STAND_IN_MODULES = (warehouse_props, handling_props, forklift, franka, warehouse_stages)
 ISAAC_ASSETS: dict[str, UsdAsset] = {a.key: a for m in ISAAC_STAND_IN_MODULES for a in m.ASSETS}
 # Material-instance modules (.mdl) at the paths of Isaac's environment materials, with their textures
 MDL_ASSETS: dict[str, ImageAsset] = {a.key: a for a in mdl_materials.ASSETS}
 
 # Images first: the warehouse's rack decks use the plywood texture.
 BUILD_ORDER: list[Callable[[str], list[str]]] = [a.build for a in IMAGE_ASSETS.values()] + \
-    [USD_ASSETS[k].build for k in ("pallet", "sm_cardboxc_01", "sm_cardboxd_01", "sm_cardboxd_04", "grid",
-                                   "warehouse")] + \
+    [USD_ASSETS[k].build for k in ("pallet", "sm_cardboxc_01", "sm_cardboxd_01", "sm_cardboxd_04", "grid")] + \
+    [warehouse_stages.write_surface_textures, warehouse_stages.build_parts, USD_ASSETS["warehouse"].build] + \
     [a.build for a in PROP_ASSETS.values()] + [simready.build_catalog] + \
     [a.build for a in MDL_ASSETS.values()] + [a.build for a in ISAAC_ASSETS.values()]
 

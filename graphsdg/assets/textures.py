@@ -413,6 +413,17 @@ def orm_map(rgb: np.ndarray, roughness: float, metallic: float = 0.0, roughness_
     return np.stack([1.0 - occlusion_depth * cavity, rough, np.full_like(lum, float(metallic))], axis=-1)
 
 
+def write_pbr_maps(root: str, colour_rel: str, rgb: np.ndarray, roughness: float,
+                   metallic: float = 0.0) -> tuple[str, str]:
+    """Write the normal and ORM maps of the pack's colour texture ``colour_rel`` (``*_BaseColor.png`` ->
+    ``*_Normal.png``, ``*_ORM.png`` beside it, under pack root ``root``); returns their pack-relative paths."""
+    stem = colour_rel.rsplit("_BaseColor.png", 1)[0]
+    normal_rel, orm_rel = f"{stem}_Normal.png", f"{stem}_ORM.png"
+    write_png(os.path.join(root, normal_rel.lstrip("/")), normal_map(rgb))
+    write_png(os.path.join(root, orm_rel.lstrip("/")), orm_map(rgb, roughness, metallic))
+    return normal_rel, orm_rel
+
+
 def write_jpg(path: str, rgb: np.ndarray, quality: int = 92) -> None:
     """Write a float RGB image in [0, 1] as a JPEG (parent folders are created)."""
     os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
