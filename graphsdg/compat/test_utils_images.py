@@ -224,7 +224,7 @@ def save_rgb_image(rgb_data: np.ndarray, out_dir: str, file_name: str) -> None:
     has_alpha = rgb_data.ndim == 3 and rgb_data.shape[2] == 4
     ext = os.path.splitext(file_name)[1].lower()
     if has_alpha and ext in (".jpg", ".jpeg"):
-        raise ValueError(f"Cannot save RGBA data (4 channels) as {ext.upper()} format: JPEG has no "
+        raise ValueError(f"Cannot save RGBA data (4 channels) as {ext.upper()}: JPEG format doesn't support "
                          f"transparency. Use PNG format instead.")
     image = Image.fromarray(rgb_data, mode="RGBA") if has_alpha else Image.fromarray(rgb_data)
     if not has_alpha and ext == ".png":
@@ -264,7 +264,8 @@ def save_depth_image(depth_data: np.ndarray, out_dir: str, file_name: str, norma
     path = os.path.join(out_dir, file_name)
     if os.path.splitext(file_name)[1].lower() in (".tif", ".tiff"):
         if normalize:
-            print("Warning: TIFF keeps metric float32 depth; normalize=True is ignored.")
+            print("Warning: TIFF format requested with normalize=True; TIFF keeps metric float32 depth, so "
+                  "normalize is ignored.")
         image = Image.fromarray(depth.astype(np.float32), mode="F")
         try:
             image.save(path, compression="tiff_deflate")

@@ -109,7 +109,7 @@ class ViewportAPI(CompatObject):
     @property
     def render_product_path(self) -> str:
         """A render product of the viewport's camera at its resolution (made on first use)."""
-        if self._render_product is None:
+        if self._render_product is None or self._render_product.destroyed:   # a script may destroy it
             self._render_product = create.render_product(self._camera_path, self._resolution,
                                                                   name="Viewport")
         return self._render_product.path

@@ -168,6 +168,15 @@ def pbr_device() -> str:
     return device
 
 
+def _installed(name: str) -> bool:
+    """Whether module ``name`` can be imported (a finder that refuses it, as compat mode's for a missing Warp
+    does, counts as not installed)."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except ImportError:
+        return False
+
+
 def pbr_missing(has_module: Callable[[str], bool] | None = None,
                 cuda_devices: Callable[[], int] | None = None,
                 python: tuple[int, int] | None = None, device: str = "cuda:0") -> list[str]:
@@ -177,7 +186,7 @@ def pbr_missing(has_module: Callable[[str], bool] | None = None,
     without the extra never imports Warp (which initialises CUDA). The arguments
     replace the real probes in tests.
     """
-    has_module = has_module or (lambda name: importlib.util.find_spec(name) is not None)
+    has_module = has_module or _installed
     python = python or (sys.version_info.major, sys.version_info.minor)
     if tuple(python) < PBR_MIN_PYTHON:
         return [f"Python >= {PBR_MIN_PYTHON[0]}.{PBR_MIN_PYTHON[1]} (this is {python[0]}.{python[1]}; "
