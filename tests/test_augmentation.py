@@ -89,6 +89,20 @@ def test_seed_parameter_gets_a_new_reproducible_integer_each_frame():
     assert frame_seed(None, ("a", "/rp", 5)) != global_one
 
 
+def test_an_explicit_seed_gives_the_same_noise_to_alike_annotators_the_global_seed_does_not():
+    rp = _scene()
+
+    def noise(data_in, seed):
+        return data_in + np.random.default_rng(seed).standard_normal(data_in.shape).astype(np.float32)
+
+    pair = [rep.annotators.get("distance_to_camera").augment(noise, seed=5).attach(rp) for _ in range(2)]
+    free = [rep.annotators.get("distance_to_camera").augment(noise, seed=None).attach(rp) for _ in range(2)]
+    rep.orchestrator.step()
+    finite = np.isfinite(pair[0].get_data())
+    assert np.array_equal(pair[0].get_data()[finite], pair[1].get_data()[finite])
+    assert not np.array_equal(free[0].get_data()[finite], free[1].get_data()[finite])
+
+
 def test_registered_augmentation_with_per_use_parameters():
     rp = _scene()
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import re
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Iterable
 
@@ -425,6 +426,9 @@ def _augmented_spec(source: AnnotatorSpec, aug: Augmentation, params: dict,
                     data_out_shape: tuple[int, ...] | None) -> AnnotatorSpec:
     """``source`` with ``aug`` applied to its array: a spec of its own name, so frames cache both outputs."""
     key = f"{source.name}+{aug.name}#{next(_augmented)}"
+    # what is augmented, without the counters that make names unique: seeds keyed on it do not depend on how
+    # many augmentations the process made before
+    recipe = f"{re.sub(r'#[0-9]+', '', source.name)}+{aug.name}{sorted(params.items())!r}"
 
     def compute(frame, init_params: dict) -> dict:
         out = get_output(frame, source, init_params)
@@ -432,7 +436,8 @@ def _augmented_spec(source: AnnotatorSpec, aug: Augmentation, params: dict,
         if data is None:
             raise AugmentationError(f"annotator {source.name!r} has no data array for augmentation {aug.name!r} "
                                     f"to work on (its output holds only {sorted(out.get('info', {}))})")
-        result = aug.run(data, (key, frame.render_product.path, frame.frame_index), params, data_out_shape)
+        result = aug.run(data, (recipe, frame.render_product.path, frame.frame_index), params, data_out_shape,
+                         instance=key)
         info = dict(out.get("info") or {})
         if isinstance(result, dict):
             info.update(result["info"])

@@ -181,8 +181,10 @@ class Augmentation:
         return params
 
     def run(self, data: np.ndarray, seed_key: tuple[Hashable, ...], params: dict[str, Any] | None = None,
-            data_out_shape: tuple[int, ...] | None = None) -> Any:
-        """Apply the augmentation to ``data``; ``seed_key`` identifies the annotator, product and frame.
+            data_out_shape: tuple[int, ...] | None = None, instance: Hashable = None) -> Any:
+        """Apply the augmentation to ``data``; ``seed_key`` names what is augmented, the product and the frame,
+        ``instance`` the augmented annotator (it keys the seed only when the seed is the global one, so two
+        annotators augmented alike with one explicit seed get the same noise, as that seed says).
 
         Returns the new array, or ``{"data": array, "info": {...}}`` where the function returned one.
         """
@@ -191,7 +193,10 @@ class Augmentation:
             raise AugmentationError(f"augmentation {self.name!r} needs an array to augment, got "
                                     f"{type(data).__name__}")
         if "seed" in self.parameters:
-            params["seed"] = frame_seed(params.get("seed"), seed_key)
+            seed = params.get("seed")
+            explicit = seed is not None and not isinstance(seed, bool) and isinstance(seed, (int, np.integer)) \
+                and seed >= 0
+            params["seed"] = frame_seed(seed, seed_key if explicit else seed_key + (instance,))
         shape = _check_shape(data_out_shape) or self.data_out_shape
         if self.is_kernel:
             return _run_kernel(self, data, params, shape)
