@@ -84,6 +84,8 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                  "launch per product"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
+    "/app/player/playSimulations": (True, "physics steps with the timeline's ticks; False: ticks advance time and "
+                                          "send their events without stepping physics (Kit's render-only updates)"),
     "/app/player/timelineSubsampleRate": (1, "timeline ticks per frame: each app update's frame is split into this "
                                               "many ticks, each with its physics and tick events "
                                               "(omni.timeline set_ticks_per_frame)"),
@@ -191,6 +193,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/rtx/post/motionblur/exposureFraction": _non_negative_number,
     "/rtx/post/motionblur/maxBlurDiameterFraction": _fraction,
     "/app/player/timelineSubsampleRate": _integer(1),
+    "/app/player/playSimulations": _boolean,
     "/syntheticdata/sensors/perSubsetSegmentation": _boolean,
 }
 

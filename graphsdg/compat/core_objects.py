@@ -127,7 +127,7 @@ class _FixedMixin:
             self.set_collision_approximation(self._approximation)
         if physics_material is not None:
             self.apply_physics_material(physics_material)
-        if new:   # Isaac's PhysX defaults for a new fixed collider, authored without warnings (docs/porting.md)
+        if new:   # Isaac's PhysX defaults for a new fixed collider that MuJoCo uses (docs/porting.md)
             for name, value in self._collider_offsets.items():
                 self.prim.CreateAttribute(name, Sdf.ValueTypeNames.Float).Set(value)
 
@@ -172,8 +172,9 @@ class FixedCuboid(_FixedMixin, VisualCuboid):
 
     _compat_name = "isaacsim.core.api.objects.FixedCuboid"
     _approximation = "boundingCube"
-    _collider_offsets = {"physxCollision:restOffset": 0.0, "physxCollision:contactOffset": 0.1,
-                         "physxCollision:torsionalPatchRadius": 1.0, "physxCollision:minTorsionalPatchRadius": 0.8}
+    # Isaac also authors a 0.1 m contact offset and torsional patch radii 1.0 / 0.8, which MuJoCo has no use for
+    # (the compiler would warn about them); the rest offset is MuJoCo's geom margin
+    _collider_offsets = {"physxCollision:restOffset": 0.0}
 
     def __init__(self, prim_path: str, name: str = "fixed_cube", position: Any = None, translation: Any = None,
                  orientation: Any = None, scale: Any = None, visible: bool | None = None, color: Any = None,

@@ -13,7 +13,7 @@ quaternions w, x, y, z). ``indices`` select a subset.
 * :class:`RigidPrim`: also velocities, masses, inertias, centres of mass,
   densities, forces. While physics runs (``SimulationManager.is_simulating()``:
   the timeline played or ``initialize_physics()``) poses and velocities go
-  through the simulation (:class:`graphsdg.physics.bodies.RigidBodyView`);
+  through the simulation (``_physics_view``: :class:`graphsdg.physics.rigid_body_tensor_view.RigidBodyTensorView`);
   before that, through the USD attributes, as Isaac's views do before their
   physics handles exist (``physics:angularVelocity`` is then in degrees per
   second, as authored). Forces act during the next physics step only.
@@ -37,7 +37,6 @@ import logging
 import types
 from typing import Any, Sequence
 
-import mujoco
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 
@@ -49,10 +48,10 @@ from graphsdg.compat.experimental_arguments import warn_once
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from graphsdg.physics.bodies import RigidBodyView
+from graphsdg.physics.one_step_forces import apply_for_one_step
+from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
 from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.runtime import runtime
-from graphsdg.sim import physics_steps
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.path_patterns import match_prim_paths
 from graphsdg.stage.xform import set_local_pose
@@ -412,49 +411,6 @@ def _wrap_bound_material(prim: Usd.Prim) -> VisualMaterial | None:
     return None
 
 
-class _NextStepForces:
-    """Forces and torques that act on bodies during the next physics step only (PhysX's tensor-API semantics):
-    written into MuJoCo's ``xfrc_applied`` before the step and cleared after it."""
-
-    def __init__(self) -> None:
-        self._pending: dict[str, np.ndarray] = {}
-        self._applied: list[int] = []
-        self._handles: tuple[int, int] | None = None
-
-    def add(self, body_path: str, wrench: np.ndarray) -> None:
-        """Add a world-frame (force (3,), torque about the centre of mass (3,)) for the next step."""
-        self._pending[body_path] = self._pending.get(body_path, np.zeros(6)) + wrench
-        if self._handles is None:
-            self._handles = (physics_steps.subscribe(True, 2 ** 30, self._before),
-                             physics_steps.subscribe(False, -(2 ** 30), self._after))
-
-    def _before(self, step_size: float) -> None:
-        sim = runtime().sim
-        compiled = sim.compiled
-        if compiled is None:
-            return
-        for path, wrench in self._pending.items():
-            binding = compiled.bodies.get(path)
-            if binding is not None:
-                compiled.data.xfrc_applied[binding.body_id] += wrench
-                self._applied.append(binding.body_id)
-        self._pending.clear()
-
-    def _after(self, step_size: float) -> None:
-        compiled = runtime().sim.compiled
-        if compiled is not None:
-            for body_id in self._applied:
-                compiled.data.xfrc_applied[body_id] = 0.0
-        self._applied.clear()
-        if not self._pending and self._handles is not None:
-            for handle in self._handles:
-                physics_steps.unsubscribe(handle)
-            self._handles = None
-
-
-_next_step_forces = _NextStepForces()
-
-
 class RigidPrim(XFormPrim):
     """``isaacsim.core.prims.RigidPrim``: a view of rigid bodies (``RigidBodyAPI`` is applied where missing)."""
 
@@ -470,7 +426,7 @@ class RigidPrim(XFormPrim):
             raise CompatNotSupported("RigidPrim(track_contact_forces=True / contact_filter_prim_paths_expr)",
                                      "graphsdg has no PhysX contact-report views; read contacts through "
                                      "omni.physx scene queries instead")
-        self._physics_view: RigidBodyView | None = None
+        self._physics_view: RigidBodyTensorView | None = None
         super().__init__(prim_paths_expr, name, positions, translations, orientations, scales, visibilities,
                          reset_xform_properties)
         for prim in self._prims:
@@ -492,13 +448,13 @@ class RigidPrim(XFormPrim):
         """Whether physics runs (then reads and writes go through the simulation)."""
         return SimulationManager.is_simulating()
 
-    def _view(self) -> RigidBodyView | None:
-        """The simulation's view of the bodies while physics runs, else None."""
+    def _view(self) -> RigidBodyTensorView | None:
+        """The simulation's tensor view of the bodies while physics runs (``_physics_view``), else None."""
         if not self.is_physics_handle_valid():
             self._physics_view = None
             return None
         if self._physics_view is None:
-            self._physics_view = RigidBodyView(self._prim_paths)
+            self._physics_view = RigidBodyTensorView(self._prim_paths)
         return self._physics_view
 
     def initialize(self, physics_sim_view: Any = None) -> None:
@@ -528,7 +484,7 @@ class RigidPrim(XFormPrim):
         view = self._view()
         if view is None:
             return XFormPrim.get_world_poses(self, indices)
-        pos, quat = view.get_world_poses(self._indices(indices))
+        pos, quat = view.bodies.get_world_poses(self._indices(indices))
         return pos.astype(np.float32), quat.astype(np.float32)
 
     def set_world_poses(self, positions: Any = None, orientations: Any = None, indices: Any = None,
@@ -540,7 +496,7 @@ class RigidPrim(XFormPrim):
         idx = self._indices(indices)
         pos = None if positions is None else _array(positions, len(idx), 3, "positions")
         quat = None if orientations is None else _unit_quats(orientations, len(idx))
-        view.set_world_poses(pos, quat, idx)
+        view.bodies.set_world_poses(pos, quat, idx)
 
     # ---- velocities -------------------------------------------------------------------------------------
     def _usd_velocities(self, idx: np.ndarray, angular: bool) -> np.ndarray:
@@ -557,7 +513,7 @@ class RigidPrim(XFormPrim):
         idx = self._indices(indices)
         view = self._view()
         return self._usd_velocities(idx, False) if view is None else \
-            view.get_velocities(idx)[0].astype(np.float32)
+            view.get_velocities()[idx, :3].astype(np.float32)
 
     def get_angular_velocities(self, indices: Any = None, clone: bool = True) -> np.ndarray:
         """World-frame angular velocities (M, 3): rad/s from the simulation, deg/s as authored before it runs."""
@@ -565,7 +521,7 @@ class RigidPrim(XFormPrim):
         idx = self._indices(indices)
         view = self._view()
         return self._usd_velocities(idx, True) if view is None else \
-            view.get_velocities(idx)[1].astype(np.float32)
+            view.get_velocities()[idx, 3:].astype(np.float32)
 
     def get_velocities(self, indices: Any = None, clone: bool = True) -> np.ndarray:
         """(M, 6): linear then angular velocities."""
@@ -578,7 +534,7 @@ class RigidPrim(XFormPrim):
         ang = None if angular is None else _array(angular, len(idx), 3, "angular velocities")
         view = self._view()
         if view is not None:
-            view.set_velocities(lin, ang, idx)
+            view.bodies.set_velocities(lin, ang, idx)
             return
         for k, i in enumerate(idx):
             api = UsdPhysics.RigidBodyAPI(self._prims[i])
@@ -624,10 +580,10 @@ class RigidPrim(XFormPrim):
             rot = data.xmat[body.body_id].reshape(3, 3)
             origin = data.xpos[body.body_id]
             force, torque = (f[k], tau[k]) if is_global else (rot @ f[k], rot @ tau[k])
-            if at is not None:
+            if at is not None:   # MuJoCo applies xfrc_applied at the centre of mass: add the force's moment about it
                 point = at[k] if is_global else origin + rot @ at[k]
                 torque = torque + np.cross(point - data.xipos[body.body_id], force)
-            _next_step_forces.add(body.path, np.concatenate([force, torque]))
+            apply_for_one_step(sim, body.body_id, force, torque)
 
     # ---- mass properties --------------------------------------------------------------------------------
     def get_masses(self, indices: Any = None, clone: bool = True) -> np.ndarray:
@@ -636,7 +592,7 @@ class RigidPrim(XFormPrim):
         idx = self._indices(indices)
         view = self._view()
         if view is not None:
-            return view.get_masses(idx).astype(np.float32)
+            return view.get_masses()[idx, 0].astype(np.float32)
         return np.array([UsdPhysics.MassAPI(self._prims[i]).GetMassAttr().Get() or 0.0 for i in idx],
                         dtype=np.float32)
 
@@ -646,12 +602,16 @@ class RigidPrim(XFormPrim):
         return np.where(masses > 0, 1.0 / np.where(masses > 0, masses, 1.0), 0.0).astype(np.float32)
 
     def set_masses(self, masses: Any, indices: Any = None) -> None:
-        """Author ``physics:mass`` (the simulation recompiles with it, keeping the bodies' state)."""
+        """Set masses (kg): in the running simulation (inertias kept), else authored as ``physics:mass``."""
         self._check()
         idx = self._indices(indices)
         m = _column(masses, len(idx), "masses")
         if np.any(m < 0):
             raise ValueError(f"masses must be >= 0 kg, got {masses!r}")
+        view = self._view()
+        if view is not None:
+            view.set_masses(m.reshape(-1, 1), idx)
+            return
         for value, i in zip(m, idx):
             UsdPhysics.MassAPI.Apply(self._prims[i]).CreateMassAttr().Set(float(value))
 
@@ -980,3 +940,6 @@ class GeometryPrim(XFormPrim):
 def modules() -> list[types.ModuleType]:
     """``isaacsim.core.prims``' views (the single-prim wrappers and articulations come from their own areas)."""
     return [CompatModule("isaacsim.core.prims", XFormPrim=XFormPrim, RigidPrim=RigidPrim, GeometryPrim=GeometryPrim)]
+
+
+EXTENSIONS = {"isaacsim.core.prims": ("isaacsim.core.prims",)}

@@ -16,15 +16,19 @@ Example:
 """
 from __future__ import annotations
 
+import contextlib
+import logging
 import re
 import types
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom, UsdUtils
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdUtils
 
+from graphsdg.compat.experimental_stage_scope import current_stage, stage_scope
 from graphsdg.compat.kit import get_app
-from graphsdg.compat.modules import CompatModule
+from graphsdg.compat.modules import CompatError, CompatModule
+from graphsdg.compat.simready import upgrade_prim_semantics_to_labels
 from graphsdg.functional.create import add_reference
 from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.stage import context as stage_context
@@ -33,11 +37,51 @@ from graphsdg.stage.path_patterns import match_prim_paths
 from graphsdg.maths.rotations import euler_to_matrix, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.xform import set_local_pose
 
+log = logging.getLogger("carb")
+
 
 # ---- isaacsim.core.utils.stage -------------------------------------------------------------------
 def get_current_stage(fabric: bool = False) -> Usd.Stage:
-    """The current stage (graphsdg has no Fabric stage: ``fabric=True`` returns the same USD stage)."""
-    return stage_context.get_stage()
+    """The ``use_stage`` block's stage on this thread, else the current stage (graphsdg has no Fabric stage:
+    ``fabric=True`` returns the same USD stage)."""
+    return current_stage()
+
+
+@contextlib.contextmanager
+def use_stage(stage: Usd.Stage) -> Iterator[None]:
+    """Make ``stage`` what :func:`get_current_stage` answers on this thread until the block ends (blocks nest)."""
+    with stage_scope(stage):
+        yield
+
+
+def create_new_stage_in_memory() -> Usd.Stage:
+    """A new in-memory stage (not made current)."""
+    return Usd.Stage.CreateInMemory()
+
+
+def set_livesync_stage(usd_path: str, enable: bool) -> bool:
+    """Not mapped: Nucleus live sessions (raises naming it)."""
+    raise CompatError("isaacsim.core.utils.stage.set_livesync_stage is not available in graphsdg's compat mode: "
+                      "there is no Nucleus live-sync session; save the stage with save_stage. See docs/porting.md.")
+
+
+def remove_deleted_references() -> None:
+    """Drop the deleted items of every root-layer prim's reference and payload lists (printing what went)."""
+    stage = get_current_stage()
+    removed = 0
+    for prim in stage.Traverse():
+        spec = stage.GetRootLayer().GetPrimAtPath(prim.GetPath())
+        if not spec:
+            continue
+        for key, what in (("payload", "payload"), ("references", "reference")):
+            items = spec.GetInfo(key)
+            if items.deletedItems:
+                print(f"Removed {len(items.deletedItems)} deleted {what} items from {prim.GetPath()}")
+                removed += len(items.deletedItems)
+                items.deletedItems = []
+                spec.SetInfo(key, items)
+    if removed == 0:
+        print("No deleted references or payloads found in the stage.")
 
 
 def get_current_stage_id() -> int:
@@ -280,6 +324,49 @@ def remove_labels(prim: Usd.Prim, instance_name: str | None = None, include_desc
             semlib.apply(p, kept, mode="clear")
 
 
+def _meshes(prim_path: str | None) -> list[Usd.Prim]:
+    stage = get_current_stage()
+    start = stage.GetPrimAtPath(prim_path) if prim_path else stage.GetPseudoRoot()
+    if not start:
+        log.warning(f"Prim path not found: {prim_path}")
+        return []
+    return [p for p in Usd.PrimRange(start) if p.IsA(UsdGeom.Mesh)]
+
+
+def check_missing_labels(prim_path: str | None = None) -> list[str]:
+    """Paths of the meshes (under ``prim_path``, else on the whole stage) without any ``LabelsAPI`` label set."""
+    return [str(p.GetPath()) for p in _meshes(prim_path) if not semlib.direct_labels(p)]
+
+
+def check_incorrect_labels(prim_path: str | None = None, validate_against_prim_path: bool = False) -> list[list[str]]:
+    """``[mesh path, label]`` for labelled meshes whose first label does not appear in their path (only with
+    ``validate_against_prim_path``; otherwise nothing is reported, as in Isaac Sim 6)."""
+    if not validate_against_prim_path:
+        return []
+    out = []
+    for prim in _meshes(prim_path):
+        path = str(prim.GetPath()).lower()
+        for label in (lab for labels in semlib.direct_labels(prim).values() for lab in labels if lab):
+            low = label.lower()
+            if low not in path and low.replace("_", "") not in path and low.replace("-", "") not in path:
+                out.append([str(prim.GetPath()), label])
+                break
+    return out
+
+
+def count_labels_in_scene(prim_path: str | None = None) -> dict[str, int]:
+    """How many meshes carry each label, plus ``missing_labels`` (meshes without any)."""
+    counts = {"missing_labels": 0}
+    for prim in _meshes(prim_path):
+        labels = [lab for values in semlib.direct_labels(prim).values() for lab in values if lab]
+        if not labels:
+            counts["missing_labels"] += 1
+        for label in labels:
+            counts[label] = counts.get(label, 0) + 1
+    return counts
+
+
+
 # ---- isaacsim.core.utils.rotations -------------------------------------------------------------------
 def euler_to_rot_matrix(euler_angles: Sequence[float], degrees: bool = False, extrinsic: bool = True) -> np.ndarray:
     """Rotation matrix of X, Y, Z angles: extrinsic (fixed axes, R = Rz Ry Rx) or intrinsic (R = Rx Ry Rz)."""
@@ -323,6 +410,24 @@ def gf_quat_to_np_array(orientation: Any) -> np.ndarray:
     return np.array([orientation.GetReal(), *imaginary], dtype=np.float64)
 
 
+def gf_rotation_to_np_array(orientation: Gf.Rotation) -> np.ndarray:
+    """(w, x, y, z) of a ``Gf.Rotation``."""
+    return gf_quat_to_np_array(orientation.GetQuat())
+
+
+def lookat_to_quatf(camera: Gf.Vec3f, target: Gf.Vec3f, up: Gf.Vec3f) -> Gf.Quatf:
+    """The rotation taking +X to ``up x forward``, +Y to ``forward x right`` and +Z to ``forward`` (the unit
+    direction from ``camera`` to ``target``); identity when they coincide."""
+    forward = np.array(target, dtype=np.float64) - np.array(camera, dtype=np.float64)
+    if np.linalg.norm(forward) < 1e-10:
+        return Gf.Quatf(1.0, Gf.Vec3f(0.0, 0.0, 0.0))
+    forward /= np.linalg.norm(forward)
+    right = np.cross(np.array(up, dtype=np.float64), forward)
+    right /= np.linalg.norm(right)
+    w, x, y, z = matrix_to_quat_wxyz(np.column_stack([right, np.cross(forward, right), forward]))
+    return Gf.Quatf(float(w), Gf.Vec3f(float(x), float(y), float(z)))
+
+
 def modules() -> list[types.ModuleType]:
     """``isaacsim.core.utils.stage``, ``.prims``, ``.semantics`` and ``.rotations``."""
     stage_names = dict(
@@ -333,7 +438,9 @@ def modules() -> list[types.ModuleType]:
         clear_stage=clear_stage, add_reference_to_stage=add_reference_to_stage, get_stage_units=get_stage_units,
         set_stage_units=set_stage_units, get_stage_up_axis=get_stage_up_axis, set_stage_up_axis=set_stage_up_axis,
         traverse_stage=traverse_stage, print_stage_prim_paths=print_stage_prim_paths,
-        get_next_free_path=get_next_free_path)
+        get_next_free_path=get_next_free_path, use_stage=use_stage,
+        create_new_stage_in_memory=create_new_stage_in_memory, set_livesync_stage=set_livesync_stage,
+        remove_deleted_references=remove_deleted_references)
     prim_names = dict(
         get_prim_at_path=get_prim_at_path, is_prim_path_valid=is_prim_path_valid, define_prim=define_prim,
         create_prim=create_prim, delete_prim=delete_prim, get_prim_type_name=get_prim_type_name,
@@ -342,8 +449,11 @@ def modules() -> list[types.ModuleType]:
     return [CompatModule("isaacsim.core.utils.stage", **stage_names),
             CompatModule("isaacsim.core.utils.prims", **prim_names),
             CompatModule("isaacsim.core.utils.semantics", add_labels=add_labels, get_labels=get_labels,
-                         remove_labels=remove_labels),
+                         remove_labels=remove_labels, check_missing_labels=check_missing_labels,
+                         check_incorrect_labels=check_incorrect_labels, count_labels_in_scene=count_labels_in_scene,
+                         upgrade_prim_semantics_to_labels=upgrade_prim_semantics_to_labels),
             CompatModule("isaacsim.core.utils.rotations", euler_angles_to_quat=euler_angles_to_quat,
                          euler_to_rot_matrix=euler_to_rot_matrix, quat_to_euler_angles=quat_to_euler_angles,
                          quat_to_rot_matrix=quat_to_rot_matrix, rot_matrix_to_quat=rot_matrix_to_quat,
-                         matrix_to_euler_angles=matrix_to_euler_angles, gf_quat_to_np_array=gf_quat_to_np_array)]
+                         matrix_to_euler_angles=matrix_to_euler_angles, gf_quat_to_np_array=gf_quat_to_np_array,
+                         gf_rotation_to_np_array=gf_rotation_to_np_array, lookat_to_quatf=lookat_to_quatf)]
