@@ -72,7 +72,7 @@ UNSUPPORTED = [
      "omni.replicator.core.no_such_thing is not available"),
     ("import omni.replicator.core as rep\nrep.functional.create.no_such_shape()", CompatError,
      "omni.replicator.core.functional.create.no_such_shape is not available"),
-    ("import carb\ncarb.tokens.get_tokens_interface()", CompatError, "carb.tokens is not available"),
+    ("import carb\ncarb.input.acquire_input_interface()", CompatError, "carb.input is not available"),
     ("import omni.usd\nomni.usd.get_context().get_selection()", CompatError,
      "omni.usd.UsdContext.get_selection is not available"),
     ("import omni.timeline\nomni.timeline.get_timeline_interface().get_director()", CompatError,
