@@ -349,3 +349,61 @@ def test_warehouse_with_forklifts_is_the_warehouse_plus_forklifts():
     assert stage.GetPrimAtPath("/Warehouse/Shelves/Rack_West").IsValid()
     # camera_noise.py's camera at (-1, 5, 1) is inside and free
     assert _blocking(_mesh_boxes(stage), (-1.3, 4.7, 0.7), (-0.7, 5.3, 1.3)) == []
+
+
+# ---- Nova Carter -------------------------------------------------------------------------------
+CARTER = "/Isaac/Robots/NVIDIA/NovaCarter/nova_carter.usd"
+NAV_ONLY = "/Isaac/Samples/Replicator/OmniGraph/nova_carter_nav_only.usd"
+
+
+def test_nova_carter_nav_sample_has_the_children_and_cameras_the_scripts_look_up():
+    rep.functional.create.scope(name="NavWorld")
+    carter = rep.functional.create.reference(usd_path=get_assets_root_path() + NAV_ONLY, parent="/NavWorld",
+                                             name="CarterNav", position=(-6.0, 4.0, 0.0))
+    names = [c.GetName() for c in carter.GetChildren()]
+    assert "targetXform" in names and "chassis_link" in names           # amr_navigation.py's lookups
+    stage = rep.stage.get_stage()
+    chassis = stage.GetPrimAtPath("/NavWorld/CarterNav/chassis_link")
+    assert chassis.HasAPI(UsdPhysics.ArticulationRootAPI)
+    assert chassis.GetAttribute("xformOp:translate").Get() is not None
+    assert stage.GetPrimAtPath("/NavWorld/CarterNav/targetXform").GetAttribute("xformOp:translate").Get() is not None
+    for side in ("left", "right"):
+        cam = stage.GetPrimAtPath(f"/NavWorld/CarterNav/chassis_link/sensors/front_hawk/{side}/camera_{side}")
+        assert cam.IsA(UsdGeom.Camera) and cam.GetAttribute("fStop").IsValid()
+        m = np.array(UsdGeom.Xformable(cam).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
+        np.testing.assert_allclose(-m[2, :3], (1, 0, 0), atol=1e-6)     # looks along the robot's +X
+        np.testing.assert_allclose(m[1, :3], (0, 0, 1), atol=1e-6)      # image up is world up
+        assert m[3, 0] == pytest.approx(-6.0 + 0.31) and m[3, 2] == pytest.approx(0.36)
+    left = stage.GetPrimAtPath("/NavWorld/CarterNav/chassis_link/sensors/front_hawk/left/camera_left")
+    right = stage.GetPrimAtPath("/NavWorld/CarterNav/chassis_link/sensors/front_hawk/right/camera_right")
+    gap = (np.array(UsdGeom.Xformable(left).ComputeLocalToWorldTransform(0).ExtractTranslation())
+           - np.array(UsdGeom.Xformable(right).ComputeLocalToWorldTransform(0).ExtractTranslation()))
+    np.testing.assert_allclose(gap, (0, 0.15, 0), atol=1e-6)             # 0.15 m stereo baseline, left at +Y
+
+
+def test_nova_carter_drives_on_its_wheel_dofs_and_turns_in_place():
+    root = get_assets_root_path()
+    rep.functional.create.reference(usd_path=root + "/Isaac/Environments/Grid/default_environment.usd", name="Env")
+    rep.functional.create.reference(usd_path=root + CARTER, name="Carter")
+    view = ArticulationView("/Carter/chassis_link")
+    assert view.dof_names == ["joint_wheel_left", "joint_wheel_right"]
+    chassis = rep.stage.get_stage().GetPrimAtPath("/Carter/chassis_link")
+    _run(0.5)
+    start = np.array(chassis.GetAttribute("xformOp:translate").Get())
+    assert abs(start[2]) < 0.005                                          # resting on wheels and casters
+    view.set_joint_velocity_targets([4.0, 4.0])                           # 4 rad/s x 0.14 m = 0.56 m/s
+    _run(2.0)
+    moved = np.array(chassis.GetAttribute("xformOp:translate").Get()) - start
+    assert 0.9 < moved[0] < 1.12 and abs(moved[1]) < 0.01 and abs(moved[2]) < 0.01
+    view.set_joint_velocity_targets([-1.5, 1.5])                          # spin left about the axle's middle
+
+    def yaw() -> float:
+        q = chassis.GetAttribute("xformOp:orient").Get()
+        return 2 * math.atan2(q.GetImaginary()[2], q.GetReal())
+
+    _run(1.0)                                                             # up to speed
+    before, centre = yaw(), np.array(chassis.GetAttribute("xformOp:translate").Get())
+    _run(0.5)
+    # 1.5 rad/s x 0.14 m on each wheel, 0.413 m apart: 1.02 rad/s about the axle's middle
+    assert (yaw() - before) / 0.5 == pytest.approx(2 * 1.5 * 0.14 / 0.413, rel=0.1)
+    assert np.linalg.norm(np.array(chassis.GetAttribute("xformOp:translate").Get()) - centre) < 0.02
