@@ -420,7 +420,7 @@ class PoseOrbit(Node):
         if np.shape(centre) != (3,):
             raise ValueError(f"modify.pose_orbit: barycentre must be (x, y, z) or prims, got "
                              f"{ctx.value('barycentre')!r}")
-        up = up_axis_vector(prims[0].GetStage()) if prims else np.array([0.0, 0.0, 1.0])
+        up = np.asarray(up_axis_vector(prims[0].GetStage()) if prims else (0.0, 0.0, 1.0), dtype=np.float64)
         first = np.array([1.0, 0.0, 0.0])
         second = np.cross(up, first)
         points = []

@@ -3,12 +3,16 @@
 :class:`PoseWriter` writes one body's pose into its translate / orient (or
 rotateXYZ) ops each step, and its world-frame ``physics:velocity`` /
 ``physics:angularVelocity``; :func:`set_world_pose_sdf` is the general path for
-any xform op stack.
+any xform op stack. A body whose pose is authored in a layer stronger than the
+stage's edit target (a graph's ``rep.new_layer()`` sublayer) is written there, or
+the stronger opinion would hide every simulated pose.
 """
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
-from pxr import Gf, Usd, UsdGeom, UsdPhysics
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.maths.rotations import (decompose, matrix_to_euler_xyz, matrix_to_quat_wxyz, quat_wxyz_to_euler_xyz,
                                       quat_wxyz_to_matrix)
@@ -34,7 +38,13 @@ class PoseWriter:
         self._last_velocity: np.ndarray | None = None
         self._velocity: Usd.Attribute | None = None
         self._angular: Usd.Attribute | None = None
+        self._layer = _stronger_layer(prim)
         self._read_ops()
+
+    def _edits(self):
+        """Where this body's writes go: its pose's own layer when that is stronger than the edit target."""
+        return Usd.EditContext(self.prim.GetStage(), self._layer) if self._layer is not None \
+            else contextlib.nullcontext()
 
     def _read_ops(self) -> None:
         order = self._order_attr.Get() if self._order_attr else None
@@ -61,17 +71,22 @@ class PoseWriter:
         if self._last_velocity is not None and np.array_equal(values, self._last_velocity):
             return
         self._last_velocity = values
-        if self._velocity is None:
-            body = UsdPhysics.RigidBodyAPI(self.prim)
-            self._velocity, self._angular = body.CreateVelocityAttr(), body.CreateAngularVelocityAttr()
-        self._velocity.Set(Gf.Vec3f(*(float(x) for x in values[:3])))
-        self._angular.Set(Gf.Vec3f(*(float(x) for x in values[3:])))
+        with self._edits():
+            if self._velocity is None:
+                body = UsdPhysics.RigidBodyAPI(self.prim)
+                self._velocity, self._angular = body.CreateVelocityAttr(), body.CreateAngularVelocityAttr()
+            self._velocity.Set(Gf.Vec3f(*(float(x) for x in values[:3])))
+            self._angular.Set(Gf.Vec3f(*(float(x) for x in values[3:])))
 
     def write(self, qpos7: np.ndarray, cache: UsdGeom.XformCache) -> None:
         """Author ``qpos7`` (position, quaternion w, x, y, z) as the prim's world pose."""
         if self._last is not None and np.array_equal(qpos7, self._last):
             return      # unchanged since the last write (a body at rest)
         self._last = np.array(qpos7, dtype=np.float64)
+        with self._edits():
+            self._write(qpos7, cache)
+
+    def _write(self, qpos7: np.ndarray, cache: UsdGeom.XformCache) -> None:
         order = self._order_attr.Get() if self._order_attr else None
         if (tuple(order) if order is not None else ()) != self._order:
             self._read_ops()
@@ -91,6 +106,22 @@ class PoseWriter:
         else:
             euler = quat_wxyz_to_euler_xyz((w, qx, qy, qz))
             self._rotate.Set(Gf.Vec3d(*euler) if self._rotate_kind == "eulerd" else Gf.Vec3f(*euler))
+
+
+def _stronger_layer(prim: Usd.Prim) -> Sdf.Layer | None:
+    """The layer of the strongest opinion on ``prim``'s transform when it is stronger than the edit target's
+    layer (None otherwise: writes go to the edit target as usual)."""
+    attr = prim.GetAttribute("xformOp:translate") or prim.GetAttribute("xformOpOrder")
+    stack = attr.GetPropertyStack(Usd.TimeCode.Default()) if attr else []
+    if not stack:
+        return None
+    stage = prim.GetStage()
+    target = stage.GetEditTarget().GetLayer()
+    layers = stage.GetLayerStack(includeSessionLayers=True)
+    strongest = stack[0].layer
+    if strongest == target or strongest not in layers or target not in layers:
+        return None
+    return strongest if layers.index(strongest) < layers.index(target) else None
 
 
 def set_world_pose_sdf(prim: Usd.Prim, pos: np.ndarray, quat_wxyz: np.ndarray,
