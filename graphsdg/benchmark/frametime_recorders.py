@@ -21,7 +21,8 @@ measurement names, so their metrics files compare key for key:
 * ``rtf_stability``: the real-time factor over windows of wall time.
 
 As in Isaac Sim, the first sample of a phase (from the phase's start to the first
-event) is dropped when collection stops, so N frames give N - 1 app frame times.
+event) is dropped when collection stops, so N frames give N - 1 app frame times
+(and N render times: the last frame's is taken when collection stops).
 
 Example:
     >>> import graphsdg as rep

@@ -35,7 +35,6 @@ Example:
 from __future__ import annotations
 
 import copy
-import importlib.metadata
 import json
 import logging
 import os
@@ -50,11 +49,9 @@ log = logging.getLogger("graphsdg.benchmark")
 
 
 def app_version() -> str:
-    """graphsdg's version."""
-    try:
-        return importlib.metadata.version("graphsdg")
-    except importlib.metadata.PackageNotFoundError:
-        return "0+unknown"
+    """graphsdg's version (the package's own, also when run from a source checkout that was not installed)."""
+    import graphsdg
+    return str(graphsdg.__version__)
 
 
 def version_branch() -> tuple[str, str, str]:
