@@ -180,3 +180,17 @@ def test_every_table_entry_imports_or_names_its_replacement(compat):
                     assert f"{old}.{name}" in str(exc) and f"{new_module}.{new_name}" in str(exc)
                 else:
                     assert value is getattr(importlib.import_module(new_module), new_name)
+
+
+def test_warning_shows_for_imports_outside_main(tmp_path):
+    """Python hides DeprecationWarnings raised outside __main__; the old names' warning shows (as Isaac's log line
+    does), once for the module however many modules import it."""
+    import subprocess
+    for name in ("helper_one", "helper_two"):
+        (tmp_path / f"{name}.py").write_text("from omni.isaac.core.utils.prims import get_prim_at_path\n")
+    code = (f"import sys; sys.path.insert(0, {str(tmp_path)!r}); from graphsdg.compat import isaac; isaac.install(); "
+            "import helper_one, helper_two; isaac.uninstall()")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    lines = [line for line in done.stderr.splitlines() if "IsaacDeprecationWarning: omni.isaac.core.utils.prims " in line]
+    assert len(lines) == 1 and "helper_one.py:1" in lines[0] and "isaacsim.core.utils.prims" in lines[0]

@@ -5,8 +5,8 @@ A large share of published Isaac code predates Isaac Sim 4.5's rename
 ``from omni.isaac.core.utils.prims import get_prim_at_path``). In compat mode
 those imports work as Isaac's own shims did until 5.0: each old module stands
 for its new one (:mod:`graphsdg.compat.legacy_table` has the table), warns once
-with a :class:`DeprecationWarning` (and a ``carb`` log line, as Isaac logs it)
-naming the new name, and answers every attribute *when it is asked for* from the
+with a :class:`DeprecationWarning` naming the new name (shown wherever the import
+is, as Isaac's log line is), and answers every attribute *when it is asked for* from the
 new module as it is then, so names other areas add later are found.
 
 * an old module that moved whole (``omni.isaac.core.utils.prims``) gives the new
@@ -47,6 +47,13 @@ from graphsdg.compat.legacy_table import EXTENSIONS as RENAMED_EXTENSIONS
 from graphsdg.compat.modules import PORTING, CompatImportError, CompatModule, available_names, missing
 
 log = logging.getLogger("carb")
+
+
+class IsaacDeprecationWarning(DeprecationWarning):
+    """The warning an old Isaac name gives when imported (shown wherever the import is, while compat mode is
+    installed, as Isaac's log line is: Python would hide a plain DeprecationWarning outside ``__main__``)."""
+
+
 _TABLED = set(MOVED) | set(NAMES) | set(REMOVED)
 # packages that only hold old names (omni.isaac, omni.isaac.core.prims.soft, ...): strict ancestors of table keys
 _NAMESPACES = {key.rsplit(".", i)[0] for key in _TABLED for i in range(1, key.count("."))} - _TABLED - {"omni"}
@@ -208,8 +215,8 @@ class _LegacyLoader(importlib.abc.Loader):
         if self.kind != "namespace":
             message = (f"{module.__name__} has been deprecated since Isaac Sim 4.5 in favor of "
                        f"{_new_names(self.kind, self.data)}; graphsdg's compat mode maps the old name")
-            log.warning(message)
-            warnings.warn(message, DeprecationWarning, stacklevel=_warning_stacklevel())
+            log.debug(message)   # for carb.logging's loggers; the warning is what people see
+            warnings.warn(message, IsaacDeprecationWarning, stacklevel=_warning_stacklevel())
 
 
 class LegacyNameFinder(importlib.abc.MetaPathFinder):
@@ -251,6 +258,7 @@ def modules() -> list[types.ModuleType]:
 def install() -> None:
     """Called by :func:`graphsdg.compat.isaac.install`: old names import from now on, old extension names are known."""
     global _finder
+    warnings.filterwarnings("default", category=IsaacDeprecationWarning)   # once per importing line
     extensions.RENAMED.update(RENAMED_EXTENSIONS)
     if _finder is None:
         _finder = LegacyNameFinder()
@@ -264,6 +272,8 @@ def uninstall() -> None:
     if _finder is not None and _finder in sys.meta_path:
         sys.meta_path.remove(_finder)
     _finder = None
+    for entry in [f for f in warnings.filters if f[2] is IsaacDeprecationWarning]:
+        warnings.filters.remove(entry)
     for name, module in list(sys.modules.items()):
         if isinstance(module, LegacyModule):
             del sys.modules[name]
