@@ -84,15 +84,15 @@ def test_shapes_wrap_existing_prims_and_reject_mixes_wrong_types_and_bad_values(
 
 
 def test_unmapped_experimental_names_fail_naming_themselves(compat):
-    with pytest.raises(CompatImportError, match="DomeLight"):
-        from isaacsim.core.experimental.objects import DomeLight  # noqa: F401
+    with pytest.raises(CompatImportError, match="OmniGlassMaterial"):
+        from isaacsim.core.experimental.materials import OmniGlassMaterial  # noqa: F401
     from isaacsim.core.experimental.objects import Cube
     with pytest.raises(CompatError, match="set_radii"):
         Cube("/World/C").set_radii(1.0)
     from isaacsim.core.simulation_manager import SimulationManager  # noqa: F401
     import isaacsim.core.simulation_manager as sm
-    with pytest.raises(CompatError, match="PhysicsScene"):
-        sm.PhysicsScene
+    with pytest.raises(CompatError, match="PhysxScene"):
+        sm.PhysxScene
 
 
 def test_xform_prim_local_poses_scales_visibility_and_op_reset(compat):

@@ -306,3 +306,63 @@ def test_randomization_calls_name_what_is_wrong(fresh_stage):
     rep.graph.clear()
     with pytest.raises(GraphBuildError, match="no on_rl_frame trigger"):
         dr.step_randomization()
+
+
+# ---- Isaac's faces (compat mode) -------------------------------------------------------------------------
+def test_isaac_physics_scenes_and_simulation_view_reach_the_model(fresh_stage):
+    from graphsdg.compat import isaac
+    isaac.install()
+    try:
+        import omni.physics.tensors as tensors
+        from isaacsim.core.simulation_manager import SimulationManager
+        for e in range(2):
+            UsdGeom.Xform.Define(fresh_stage, f"/World/envs/env_{e}")
+            _ball("object", 2.0 * e, parent=f"/World/envs/env_{e}")
+        SimulationManager.setup_simulation()
+        scene = SimulationManager.get_physics_scenes()[0]
+        scene.set_gravity((0.0, 0.0, -3.0))
+        assert tuple(scene.get_gravity()) == (0.0, 0.0, -3.0)
+        sim = runtime().sim
+        sim.sync_dirty_prims()
+        assert np.allclose(sim.model.opt.gravity, [0, 0, -3])                     # authored: compiled
+        view = tensors.create_simulation_view("numpy")
+        view.set_gravity((0.0, 0.0, 0.0))                                         # live: the model only
+        assert np.allclose(runtime().sim.model.opt.gravity, 0.0)
+        bodies = view.create_rigid_body_view("/World/envs/*/object")
+        assert bodies.prim_paths == ["/World/envs/env_0/object", "/World/envs/env_1/object"]
+        bodies.set_masses(np.array([[3.0], [4.0]]), np.array([1]))
+        assert runtime().sim.model.body_mass[_body("/World/envs/env_1/object")] == 4.0
+    finally:
+        isaac.uninstall()
+
+
+def test_isaac_domain_randomization_module_drives_the_graph(fresh_stage):
+    from graphsdg.compat import isaac
+    isaac.install()
+    try:
+        import isaacsim.replicator.experimental.domain_randomization as isaac_dr
+        import omni.replicator.core as rep_core
+        for e in range(2):
+            UsdGeom.Xform.Define(fresh_stage, f"/World/envs/env_{e}")
+            _ball("object", 2.0 * e, parent=f"/World/envs/env_{e}")
+        isaac_dr.physics_view.register_rigid_prim_view("/World/envs/.*/object", name="object_view")
+        assert list(isaac_dr.physics_view._rigid_prim_views) == ["object_view"]
+        with isaac_dr.trigger.on_rl_frame(num_envs=2):
+            with isaac_dr.gate.on_env_reset():
+                isaac_dr.physics_view.randomize_rigid_prim_view(
+                    view_name="object_view", operation="direct",
+                    material_properties=rep_core.distribution.uniform((0.2, 0.2, 0.0), (1.0, 1.0, 0.5)),
+                    num_buckets=4)
+        isaac_dr.physics_view.step_randomization([0, 1])
+        assert isaac_dr.context.get_reset_inds().tolist() == [0, 1]
+        model = runtime().sim.model
+        for e in range(2):
+            g = _geom(f"/World/envs/env_{e}/object")
+            # snapped to the buckets 0.2 + 0.8 k / 4 (frictions) and 0.5 k / 4 (restitution)
+            assert min(abs(model.geom_friction[g, 0] - b) for b in (0.2, 0.4, 0.6, 0.8)) < 1e-12
+            e_back = damping_ratio_to_restitution(model.geom_solref[g, 1])
+            assert min(abs(e_back - b) for b in (0.0, 0.125, 0.25, 0.375)) < 1e-9
+        isaac_dr.physics_view._rigid_prim_views = {}          # Isaac's tests reset the module this way
+        assert len(isaac_dr.physics_view._rigid_prim_views_initial_values) == 0
+    finally:
+        isaac.uninstall()

@@ -75,6 +75,24 @@ class _Registered(Mapping):
         return len(self._targets())
 
 
+class _PhysicsViewModule(CompatModule):
+    """``physics_view``: assigning an empty dict to one of its registries (Isaac's tests reset module state
+    that way) forgets the registered views of that kind; the registries stay live views."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        current = self.__dict__.get(name)
+        if isinstance(current, _Registered) and not isinstance(value, _Registered):
+            if value:
+                raise ValueError(f"physics_view.{name} is graphsdg's live registry; register views with "
+                                 f"register_*_view instead of assigning {value!r}")
+            targets = engine.randomization_targets().targets
+            for view_name in [n for n, t in targets.items() if t.kind == current.kind]:
+                del targets[view_name]
+                _originals.pop(view_name, None)
+            return
+        super().__setattr__(name, value)
+
+
 # ---- physics_view -----------------------------------------------------------------------------------------
 def register_simulation_context(simulation_context: Any = None) -> None:
     """Register the simulation's gravity (``simulation_context``: SimulationManager or a World; its physics is
@@ -215,7 +233,7 @@ def _package(root: str) -> list[types.ModuleType]:
                  "RIGID_PRIM_ATTRIBUTES": list(engine.RIGID_BODY_ATTRIBUTES),
                  "SIMULATION_CONTEXT_ATTRIBUTES": list(engine.SIMULATION_ATTRIBUTES),
                  "TENDON_ATTRIBUTES": list(engine.TENDON_ATTRIBUTES)}
-    physics_view = CompatModule(
+    physics_view = _PhysicsViewModule(
         f"{root}.physics_view", register_simulation_context=register_simulation_context,
         register_rigid_prim_view=register_rigid_prim_view, register_articulation_view=register_articulation_view,
         step_randomization=step_randomization, randomize_rigid_prim_view=randomize_rigid_prim_view,

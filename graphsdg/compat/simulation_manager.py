@@ -48,6 +48,7 @@ from pxr import Tf, Usd, UsdPhysics
 
 from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.compat.physics_views import PhysicsScene, SimulationView
 from graphsdg.functional.physics import create_physics_scene
 from graphsdg.runtime import runtime
 from graphsdg.sim import physics_steps
@@ -376,6 +377,22 @@ class SimulationManager:
             _physics_scenes(create=True)
         for path in scenes:
             create_physics_scene(path, time_steps_per_second=max(1, round(1.0 / float(dt))))
+
+    # ---- physics scenes and the tensor API's simulation view (graphsdg.compat.physics_views) ------
+    @classmethod
+    def get_physics_scenes(cls) -> list[PhysicsScene]:
+        """The stage's physics scenes, in stage order."""
+        return [PhysicsScene(p) for p in _physics_scenes()]
+
+    @classmethod
+    def get_physics_simulation_view(cls) -> SimulationView | None:
+        """The physics simulation view (None until physics is initialized, as in Isaac)."""
+        return SimulationView() if cls._initialized else None
+
+    @classmethod
+    def get_physics_sim_view(cls) -> SimulationView | None:
+        """Isaac's older name for :meth:`get_physics_simulation_view`."""
+        return cls.get_physics_simulation_view()
 
     # ---- device and fabric ----------------------------------------------------------------
     @classmethod
