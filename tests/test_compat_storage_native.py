@@ -65,8 +65,27 @@ def test_asset_root_and_servers(native, monkeypatch):
     assert native.Version("4.5.0") < native.Version("5.0.0") and repr(native.Version("4.5.1")) == "4.5.1"
 
 
+def test_asset_root_setting_semantics_of_isaac_sim_6(native, tmp_path):
+    assert settings.get("/persistent/isaac/asset_root/default") == builtin_pack_root()   # given its value at install
+    settings.set("/persistent/isaac/asset_root/default", "")
+    with pytest.raises(RuntimeError, match="setting is not set"):
+        native.get_assets_root_path()
+    settings.set("/persistent/isaac/asset_root/default", str(tmp_path))   # a folder without /Isaac and /NVIDIA
+    with pytest.raises(RuntimeError, match="Could not find assets root folder: " + str(tmp_path)):
+        asyncio.run(native.get_assets_root_path_async())
+    assert native.get_assets_root_path(skip_check=True) == str(tmp_path)
+    (tmp_path / "Isaac").mkdir()
+    (tmp_path / "NVIDIA").mkdir()
+    assert native.get_assets_root_path() == str(tmp_path)
+    settings.set("/persistent/isaac/asset_root/default", "omniverse://localhost/NVIDIA/Assets/Isaac/4.5")
+    assert native.get_assets_root_path() == "omniverse://localhost/NVIDIA/Assets/Isaac/4.5"   # served by the pack
+    assert native.resolve_asset_path(GRID) == "omniverse://localhost/NVIDIA/Assets/Isaac/4.5" + GRID
+
+
 def test_isaacsim_asset_root_environment_variable(tmp_path, monkeypatch):
     monkeypatch.setenv("ISAACSIM_ASSET_ROOT", str(tmp_path) + "/")
+    (tmp_path / "Isaac").mkdir()
+    (tmp_path / "NVIDIA").mkdir()
     isaac.install()
     try:
         from isaacsim.storage.native import get_assets_root_path

@@ -14,7 +14,8 @@ a URL with a local file of the same path:
 2. for ``/Isaac/...`` and ``/NVIDIA/...`` (with or without the versioned root
    ``/NVIDIA/Assets/Isaac/<version>`` in front), in the asset root that
    :func:`~graphsdg.assets.root.get_assets_root_path` gives: the built-in pack
-   unless another local tree is configured.
+   unless another local tree is configured (a root configured as a URL, such as
+   ``omniverse://localhost/NVIDIA/Assets/Isaac/4.5``, is served by the pack).
 
 Any other URL, or one whose file no local tree holds, raises
 :class:`NucleusUnavailableError` naming it. :func:`resolve_asset_path` is the one
@@ -35,7 +36,7 @@ import re
 from urllib.parse import unquote, urlsplit
 
 from graphsdg import settings_store as settings
-from graphsdg.assets.root import get_assets_root_path
+from graphsdg.assets.root import builtin_pack_root, get_assets_root_path
 
 SCHEME = "omniverse"
 NUCLEUS_MIRROR_SETTING = "/graphsdg/assets/nucleusMirror"
@@ -83,8 +84,12 @@ def _asset_root_path(path: str) -> str | None:
 
 
 def _local_asset_root() -> str | None:
+    """The local folder standing in for Isaac's asset root: the configured one, or the built-in pack where the
+    configured root is itself a URL (a Nucleus or S3 asset root that nothing here can reach)."""
     root = get_assets_root_path(skip_check=True)
-    if root is None or "://" in root or not os.path.isdir(root):
+    if root is not None and "://" in root:
+        root = builtin_pack_root()
+    if root is None or not os.path.isdir(root):
         return None
     return root
 

@@ -6,10 +6,11 @@ local files, the asset pack and a Nucleus mirror stand in for the Nucleus server
 A "server" here is a root URL or folder whose paths ``omni.client`` can reach
 (``omniverse://localhost`` reaches the asset pack's ``/Isaac`` and ``/NVIDIA``).
 
-* asset roots: ``get_assets_root_path[_async]`` (graphsdg's built-in pack or the
-  configured tree; Isaac's ``ISAACSIM_ASSET_ROOT`` environment variable sets the
-  root setting when compat mode is installed, as Isaac's extension does at
-  startup), ``get_full_asset_path[_async]``, ``get_server_path[_async]``,
+* asset roots: ``get_assets_root_path[_async]`` (Isaac Sim 6's: the value of the
+  setting ``/persistent/isaac/asset_root/default``, checked, raising ``RuntimeError``
+  where unset or unreachable; installing compat mode gives the setting Isaac's
+  ``ISAACSIM_ASSET_ROOT`` environment variable, as Isaac's extension does at startup,
+  else graphsdg's root: the built-in pack), ``get_full_asset_path[_async]``, ``get_server_path[_async]``,
   ``get_url_root``, ``verify_asset_root_path``, ``check_server[_async]``,
   ``build_server_list``, and the deprecated finders (which answer None / False
   and warn, as in Isaac);
@@ -292,14 +293,30 @@ async def find_filtered_files_async(root_path: str, filter_patterns: list[str] |
 ISAAC_SIM_VERSION = "6.0.1"
 
 
-def get_assets_root_path(*, skip_check: bool = False) -> str | None:
-    """The asset root: the configured tree, else graphsdg's built-in pack (:mod:`graphsdg.assets.root`)."""
-    return asset_root.get_assets_root_path(skip_check=skip_check)
+def get_assets_root_path(*, skip_check: bool = False) -> str:
+    """The asset root setting's value, checked (unless ``skip_check``) to hold ``/Isaac`` and ``/NVIDIA``.
+
+    As Isaac Sim 6: a setting set to nothing raises ``RuntimeError`` (``... setting is not set``), a root
+    without those folders raises ``RuntimeError`` (``Could not find assets root folder: ...``). Never set
+    (graphsdg's settings reset), it is graphsdg's own root (:mod:`graphsdg.assets.root`: the built-in pack
+    unless ``GRAPHSDG_ASSETS_ROOT`` names another tree); :func:`install` writes that into the setting, as
+    Kit's configuration gives the setting its default.
+    """
+    value = settings.get(DEFAULT_ASSET_ROOT_PATH_SETTING)
+    if value is None:
+        value = asset_root.get_assets_root_path(skip_check=True)
+    if not value:
+        raise RuntimeError(f"The '{DEFAULT_ASSET_ROOT_PATH_SETTING}' setting is not set")
+    value = str(value)
+    if skip_check or (check_server(value, "/Isaac") and check_server(value, "/NVIDIA")):
+        return value
+    raise RuntimeError(f"Could not find assets root folder: {value} (it holds no /Isaac and /NVIDIA folders that "
+                       f"graphsdg can read; see docs/assets.md)")
 
 
-async def get_assets_root_path_async(*, skip_check: bool = False) -> str | None:
+async def get_assets_root_path_async(*, skip_check: bool = False) -> str:
     """Awaitable :func:`get_assets_root_path`."""
-    return asset_root.get_assets_root_path(skip_check=skip_check)
+    return get_assets_root_path(skip_check=skip_check)
 
 
 def build_server_list() -> list[str]:
@@ -312,11 +329,12 @@ def build_server_list() -> list[str]:
 
 def get_full_asset_path(path: str) -> str:
     """``path`` under the asset root, else under the first mounted server that has it (``RuntimeError`` if none)."""
-    for root in [get_assets_root_path(skip_check=True)] + build_server_list():
+    for root in [asset_root.get_assets_root_path(skip_check=True)] + build_server_list():
         if root and check_server(root, path):
             return root + path
-    raise RuntimeError(f"Could not find assets path: {path} (searched the asset root {get_assets_root_path()!r} and "
-                       f"the mounted drives {build_server_list()})")
+    raise RuntimeError(f"Could not find assets path: {path} (searched the asset root "
+                       f"{asset_root.get_assets_root_path(skip_check=True)!r} and the mounted drives "
+                       f"{build_server_list()})")
 
 
 async def get_full_asset_path_async(path: str) -> str:
@@ -326,7 +344,7 @@ async def get_full_asset_path_async(path: str) -> str:
 
 def get_server_path(suffix: str = "") -> str:
     """The server (``scheme://host``, or the asset root folder) of the asset root, if it has ``suffix``."""
-    root = settings.get(DEFAULT_ASSET_ROOT_PATH_SETTING) or get_assets_root_path(skip_check=True) or ""
+    root = settings.get(DEFAULT_ASSET_ROOT_PATH_SETTING) or asset_root.get_assets_root_path(skip_check=True) or ""
     server = get_url_root(root) if "://" in root else root
     if server and check_server(server, suffix):
         return server
@@ -378,7 +396,11 @@ def resolve_asset_path(original_path: str) -> str | None:
     """``original_path`` where it exists, else the asset root joined with it where that exists, else None."""
     if client.stat(original_path)[0] == client.Result.OK:
         return original_path
-    root = get_assets_root_path()
+    try:
+        root = get_assets_root_path()
+    except RuntimeError as exc:
+        log.warning(f"resolve_asset_path: could not get the asset root: {exc}")
+        return None
     if root:
         alternate = root + original_path if original_path.startswith("/") else root + "/" + original_path
         if client.stat(alternate)[0] == client.Result.OK:
@@ -523,12 +545,19 @@ def modules() -> list[types.ModuleType]:
     nucleus = CompatModule("isaacsim.storage.native.nucleus", **{name: here[name] for name in _NUCLEUS},
                            **_CONSTANTS)
     core_nucleus = CompatModule("isaacsim.core.utils.nucleus", **every, **_CONSTANTS)
-    return [native, nucleus, core_nucleus]
+    file_utils = CompatModule("isaacsim.storage.native.impl.file_utils", _URL_SCHEMES=_URL_SCHEMES,
+                              **{name: here[name] for name in _FILE_UTILS})
+    extension = CompatModule("isaacsim.storage.native.impl.extension", ASSET_ROOT_ENV_VAR=ASSET_ROOT_ENV_VAR)
+    return [native, nucleus, core_nucleus, file_utils, extension]
 
 
 def install() -> None:
-    """Called by :func:`graphsdg.compat.isaac.install`: ``ISAACSIM_ASSET_ROOT`` sets the asset root setting (unless
-    it is set already), as Isaac's storage extension does when it starts."""
+    """Called by :func:`graphsdg.compat.isaac.install`: the asset root setting gets its value, as in Kit: Isaac's
+    ``ISAACSIM_ASSET_ROOT`` environment variable if set (Isaac's storage extension applies it at startup), else
+    graphsdg's root (the built-in pack or ``GRAPHSDG_ASSETS_ROOT``); a value already set stays."""
+    if settings.get(DEFAULT_ASSET_ROOT_PATH_SETTING) is not None:
+        return
     value = os.environ.get(ASSET_ROOT_ENV_VAR)
-    if value and not settings.get(DEFAULT_ASSET_ROOT_PATH_SETTING):
-        settings.set(DEFAULT_ASSET_ROOT_PATH_SETTING, value.rstrip("/"))
+    value = value.rstrip("/") if value else asset_root.get_assets_root_path(skip_check=True)
+    if value:
+        settings.set(DEFAULT_ASSET_ROOT_PATH_SETTING, value)
