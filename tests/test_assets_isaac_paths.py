@@ -407,3 +407,32 @@ def test_nova_carter_drives_on_its_wheel_dofs_and_turns_in_place():
     # 1.5 rad/s x 0.14 m on each wheel, 0.413 m apart: 1.02 rad/s about the axle's middle
     assert (yaw() - before) / 0.5 == pytest.approx(2 * 1.5 * 0.14 / 0.413, rel=0.1)
     assert np.linalg.norm(np.array(chassis.GetAttribute("xformOp:translate").Get()) - centre) < 0.02
+
+
+# ---- grid rooms and skies --------------------------------------------------------------------
+def test_grid_rooms_have_a_colliding_floor_at_zero_and_walls_round_it():
+    for rel in ("/Isaac/Environments/Grid/gridroom_black.usd", "/Isaac/Environments/Grid/gridroom_curved.usd"):
+        stage = _open(rel)
+        floor = stage.GetPrimAtPath("/GridRoom/Floor")
+        assert floor.HasAPI(UsdPhysics.CollisionAPI)
+        lo, hi = _bounds(floor)
+        assert hi[2] == pytest.approx(0.0) and hi[0] - lo[0] == pytest.approx(20.0)
+        assert any(p.GetTypeName() == "DistantLight" for p in stage.Traverse())
+    # the cyclorama's coves: a point 1 m in from the north wall is on the curve, 0.17 m up (3 - sqrt(9 - 4))
+    curved = _open("/Isaac/Environments/Grid/gridroom_curved.usd")
+    pts = np.array(UsdGeom.Mesh(curved.GetPrimAtPath("/GridRoom/Cyclorama")).GetPointsAttr().Get())
+    north = pts[np.abs(pts[:, 0]) < 10.5]
+    d = 10.0 - north[:, 1]
+    on_cove = (d > 1e-6) & (d < 3.0)
+    np.testing.assert_allclose(north[on_cove, 2], 3.0 - np.sqrt(9.0 - (3.0 - d[on_cove]) ** 2), atol=1e-4)
+    black = __import__("cv2").imread(get_assets_root_path() + "/Isaac/Environments/Grid/Materials/Textures/"
+                                     "GridBlack_BaseColor.png")
+    assert np.median(black) < 20 and black.max() > 120                    # black with light lines
+
+
+def test_hotel_room_sky_is_an_hdr_lat_long_map_like_the_other_indoor_skies():
+    import cv2
+    path = get_assets_root_path() + "/NVIDIA/Assets/Skies/Indoor/hotel_room_4k.hdr"
+    img = cv2.imread(path, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_COLOR)
+    assert img.shape == (128, 256, 3) and img.dtype == np.float32
+    assert img.max() > 5.0 * np.median(img)                               # lamps and a window, brighter than walls

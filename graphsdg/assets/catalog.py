@@ -21,7 +21,7 @@ from typing import Callable
 import numpy as np
 from pxr import Gf, Kind, UsdGeom, UsdLux, UsdPhysics
 
-from graphsdg.assets import (authoring, forklift, franka, geometry, handling_props, mdl_materials, outdoor_skies,
+from graphsdg.assets import (authoring, forklift, franka, geometry, grid_rooms, handling_props, mdl_materials, outdoor_skies,
                              nova_carter, packing_table, simready, skies, textures, warehouse_props, warehouse_stages,
                              ycb)
 from graphsdg.assets.entries import ImageAsset, UsdAsset
@@ -215,6 +215,23 @@ IMAGE_ASSETS.update({
         _outdoor_sky_builder(n))
     for n in outdoor_skies.OUTDOOR_SKIES})
 
+SMALL_SKY_SIZE = (128, 256)
+
+
+def _small_sky_builder(name: str) -> Callable[[str], list[str]]:
+    def build(root: str) -> list[str]:
+        rel = f"{SKIES_DIR}/{name}.hdr"
+        skies.write_hdr(_abs(root, rel), skies.render_room(skies.SMALL_INDOOR_SKIES[name], SMALL_SKY_SIZE[1],
+                                                           SMALL_SKY_SIZE[0]))
+        return [rel]
+    return build
+
+
+IMAGE_ASSETS.update({
+    f"sky_{n}": ImageAsset(f"sky_{n}", f"{SKIES_DIR}/{n}.hdr", SMALL_SKY_SIZE,
+                           f"indoor HDR lat-long sky ({n.replace('_4k', '').replace('_', ' ')})", _small_sky_builder(n))
+    for n in skies.SMALL_INDOOR_SKIES})
+
 # Ground textures at the paths of Isaac's vMaterials_2 (the "Randomizing Textures" snippet reads them)
 GROUND_SIZE = (256, 256)
 
@@ -254,7 +271,8 @@ IMAGE_ASSETS.update({
 
 # Stand-ins for the further /Isaac/... paths Isaac's Replicator examples and tests load, module by module
 # (stages that reference props come after the props).
-ISAAC_STAND_IN_MODULES = (warehouse_props, handling_props, forklift, franka, nova_carter, warehouse_stages)
+ISAAC_STAND_IN_MODULES = (warehouse_props, handling_props, forklift, franka, nova_carter, warehouse_stages,
+                          grid_rooms)
 ISAAC_ASSETS: dict[str, UsdAsset] = {a.key: a for m in ISAAC_STAND_IN_MODULES for a in m.ASSETS}
 # Material-instance modules (.mdl) at the paths of Isaac's environment materials, with their textures
 MDL_ASSETS: dict[str, ImageAsset] = {a.key: a for a in mdl_materials.ASSETS}

@@ -58,6 +58,11 @@ def _polygons_to_mesh(polys: Sequence[np.ndarray], uvs: Sequence[np.ndarray]) ->
                     normals=np.concatenate(normals, axis=0))
 
 
+def polygons(polys: Sequence[np.ndarray], uvs: Sequence[np.ndarray]) -> MeshData:
+    """A mesh of the given polygons (corner positions, counter-clockwise seen from outside) and their UVs."""
+    return _polygons_to_mesh(polys, uvs)
+
+
 def planar_uv(tile: float = 1.0, offset: tuple[float, float] = (0.0, 0.0),
               grain_axis: int | None = None) -> Callable[[np.ndarray, int], np.ndarray]:
     """A UV rule for :func:`box`: each face is projected onto its own plane, ``tile`` metres per UV unit.

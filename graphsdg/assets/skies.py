@@ -184,6 +184,18 @@ INDOOR_SKIES: dict[str, Room] = {
 }
 
 
+#: indoor skies written at a quarter of the others' pixels (256 x 128): scripts use them only as backgrounds
+SMALL_INDOOR_SKIES: dict[str, Room] = {
+    # a hotel room: carpet, warm beige walls, a curtained window wall and two bedside lamps
+    "hotel_room_4k": Room(
+        half_x=3.5, half_y=3.0, height=2.7, floor=(0.36, 0.27, 0.22), walls=(0.74, 0.66, 0.55),
+        ceiling=(0.80, 0.78, 0.74), seed=404, wall_band=(0.45, 0.33, 0.24),
+        emitters=(Emitter("+y", (0.0, 1.4), (2.4, 1.6), (22.0, 24.0, 28.0)),
+                  Emitter("-x", (-1.2, 0.9), (0.3, 0.3), (90.0, 62.0, 30.0)),
+                  Emitter("-x", (1.2, 0.9), (0.3, 0.3), (90.0, 62.0, 30.0)))),
+}
+
+
 def write_hdr(path: str, radiance: np.ndarray) -> None:
     """Write an (H, W, 3) linear RGB float map as a Radiance ``.hdr`` file."""
     os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
