@@ -247,9 +247,12 @@ CASES: list[Case] = [
       "ValueError", "seek frame must be a non-negative integer, got -1"),
     # ---- annotators --------------------------------------------------------------------------------------------
     C("annotators", "a misspelt annotator name", 'rep.annotators.get("semantic_segmentaton")',
-      "UnknownNameError", "unknown annotator 'semantic_segmentaton' (did you mean 'semantic_segmentation'?); known "
-                          "annotators: CameraParams, HdrColor, HdrColorSD, HdrColor_fast, LdrColor, LdrColorSD, "
-                          "MotionVectors, Occlusion, ReferenceTime, ReferenceTime_fast, bounding_box_2d_loose, "
+      "AnnotatorRegistryError", "unknown annotator 'semantic_segmentaton' (did you mean 'semantic_segmentation'?); "
+                                "known annotators: CameraParams, HdrColor, HdrColorSD, HdrColor_fast, IsaacNoop, "
+                                "IsaacNoop_fast, IsaacReadSimulationTime, IsaacReadSimulationTime_fast, "
+                                "IsaacReadSystemTime, IsaacReadSystemTime_fast, LdrColor, LdrColorSD, "
+                          "MotionVectors, Occlusion, ReferenceTime, ReferenceTime_fast, StableIdMap, StableIdMap_fast, "
+                          "bounding_box_2d_loose, "
                           "bounding_box_2d_loose_fast, bounding_box_2d_tight, bounding_box_2d_tight_fast, "
                           "bounding_box_3d, bounding_box_3d_360, bounding_box_3d_360_fast, bounding_box_3d_fast, "
                           "camera_params, camera_params_fast, distance_to_camera, distance_to_camera_fast, "

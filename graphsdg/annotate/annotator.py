@@ -79,7 +79,7 @@ class AnnotatorRegistry:
     def resolve(cls, name: str) -> AnnotatorSpec:
         """The spec registered as ``name`` (an alias or a ``_fast`` variant included)."""
         if not isinstance(name, str):
-            raise AnnotatorRegistryError(f"annotator name must be a string, got {type(name).__name__} {name!r}")
+            raise TypeError(f"annotator name must be a string, got {type(name).__name__}")
         key = cls._aliases.get(name, name)
         if key not in cls._specs and key.endswith("_fast"):
             key = cls._aliases.get(key[:-5], key[:-5])
