@@ -175,10 +175,12 @@ class _PhysicsStepClock:
         self._handles: list[int] = []
 
     def start(self) -> None:
+        """Start timing steps."""
         self._handles = [physics_steps.subscribe(True, 2 ** 31 - 1, self._pre),
                          physics_steps.subscribe(False, -(2 ** 31), self._post)]
 
     def stop(self) -> None:
+        """Stop timing steps."""
         for handle in self._handles:
             physics_steps.unsubscribe(handle)
         self._handles = []

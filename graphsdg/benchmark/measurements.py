@@ -206,6 +206,7 @@ class TestPhaseEncoder(json.JSONEncoder):
     __test__ = False
 
     def default(self, o: object) -> Any:
+        """``o``'s attribute dictionary (a record's fields)."""
         if hasattr(o, "__dict__"):
             return o.__dict__
         return super().default(o)

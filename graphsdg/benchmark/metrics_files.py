@@ -98,6 +98,7 @@ class LocalLogMetrics(MetricsBackendInterface):
     """Logs each phase as it is added; writes nothing."""
 
     def add_metrics(self, test_phase: TestPhase) -> None:
+        """Log ``test_phase``."""
         log.info("benchmark phase %s: %s", test_phase.phase_name, test_phase)
 
 
@@ -110,10 +111,12 @@ class JSONFileMetrics(MetricsBackendInterface):
         self.test_name = ""
 
     def add_metrics(self, test_phase: TestPhase) -> None:
+        """Keep a copy of ``test_phase`` (the file's names are prefixed on the copy)."""
         self.data.append(copy.deepcopy(test_phase))
 
     def finalize(self, metrics_output_folder: str | Path, randomize_filename_prefix: bool = False,
                  **kwargs: Any) -> None:
+        """Write the file(s) into ``metrics_output_folder``."""
         self.written = []
         if not self.data:
             log.warning("no benchmark phases to write; no metrics file")
@@ -141,10 +144,12 @@ class OsmoKPIFile(MetricsBackendInterface):
         self._test_phases: list[TestPhase] = []
 
     def add_metrics(self, test_phase: TestPhase) -> None:
+        """Keep ``test_phase`` for the file."""
         self._test_phases.append(test_phase)
 
     def finalize(self, metrics_output_folder: str | Path, randomize_filename_prefix: bool = False,
                  **kwargs: Any) -> None:
+        """Write the file(s) into ``metrics_output_folder``."""
         self.written = []
         for phase in self._test_phases:
             stem = f"kpis_{phase.get_metadata_field('workflow_name')}_{phase.get_metadata_field('phase')}"
@@ -161,10 +166,12 @@ class OmniPerfKPIFile(MetricsBackendInterface):
         self._test_phases: list[TestPhase] = []
 
     def add_metrics(self, test_phase: TestPhase) -> None:
+        """Keep ``test_phase`` for the file."""
         self._test_phases.append(test_phase)
 
     def finalize(self, metrics_output_folder: str | Path, randomize_filename_prefix: bool = False,
                  **kwargs: Any) -> None:
+        """Write the file(s) into ``metrics_output_folder``."""
         self.written = []
         if not self._test_phases:
             log.warning("no benchmark phases to write; no metrics file")

@@ -85,6 +85,7 @@ class MeasurementDataRecorderRegistry:
     def register(cls, name: str) -> Callable[[type[MeasurementDataRecorder]], type[MeasurementDataRecorder]]:
         """A class decorator registering the class as ``name``."""
         def decorator(recorder: type[MeasurementDataRecorder]) -> type[MeasurementDataRecorder]:
+            """Register ``recorder`` and give it back unchanged."""
             cls.add(name, recorder)
             return recorder
         return decorator

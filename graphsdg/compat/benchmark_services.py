@@ -175,6 +175,7 @@ class BaseIsaacBenchmarkAsync(BenchmarkSession, kit.AsyncTestCase):
         return _LazyAwait(lambda: self._set_up(backend_type, report_generation, workflow_metadata, recorders))
 
     async def asyncSetUp(self) -> None:  # noqa: N802 - unittest's name
+        """Set the benchmark up with the defaults (a test case that does not override ``setUp``)."""
         await self._set_up("JSONFileMetrics", False, None, None)
 
     async def _set_up(self, backend_type: str, report_generation: bool, workflow_metadata: dict | None,

@@ -197,11 +197,13 @@ class TimedAsyncTestCase(kit.AsyncTestCase):
     """An ``omni.kit.test.AsyncTestCase`` that prints ``[TEST TIMING] <test>: <seconds> seconds`` after each test."""
 
     async def setUp(self) -> None:
+        """Start the test's clock."""
         await super().setUp()
         self._test_start_time = time.time()
         self._assets_root_path = assets.get_assets_root_path()
 
     async def tearDown(self) -> None:
+        """Print the test's time."""
         if hasattr(self, "_test_start_time"):
             print(f"\n[TEST TIMING] {self._testMethodName}: {time.time() - self._test_start_time:.3f} seconds")
         await super().tearDown()
@@ -253,6 +255,7 @@ def _prim_exists(prim_path: str) -> Callable[[], bool]:
 
 def _has_prims(min_prims: int) -> Callable[[], bool]:
     def check() -> bool:
+        """Whether the stage holds ``min_prims`` prims."""
         for count, _ in enumerate(get_stage().Traverse(), start=1):
             if count >= min_prims:
                 return True
