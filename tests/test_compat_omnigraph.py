@@ -224,3 +224,11 @@ def test_replicator_items_wrappers_and_attribute_connections(compat):
     rep_core.orchestrator.step()
     prim = cube.get_output_prims()["prims"][0]
     assert tuple(prim.GetAttribute("xformOp:scale").Get()) == (5.0, 5.0, 5.0)
+
+
+@pytest.mark.parametrize("name", ["graphsdg.graph.attributes", "graphsdg.graph.ogn"])
+def test_docstring_examples(name):
+    import doctest
+    import importlib
+    rep.stage.new_stage()
+    assert doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS).failed == 0

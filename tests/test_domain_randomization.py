@@ -366,3 +366,12 @@ def test_isaac_domain_randomization_module_drives_the_graph(fresh_stage):
         assert len(isaac_dr.physics_view._rigid_prim_views_initial_values) == 0
     finally:
         isaac.uninstall()
+
+
+@pytest.mark.parametrize("name", ["graphsdg.physics.model_overrides", "graphsdg.physics.rigid_body_tensor_view",
+                                  "graphsdg.physics.gravity", "graphsdg.physics.domain_randomization"])
+def test_docstring_examples(name):
+    import doctest
+    import importlib
+    rep.stage.new_stage()
+    assert doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS).failed == 0

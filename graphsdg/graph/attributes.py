@@ -25,7 +25,7 @@ Example:
     >>> import graphsdg as rep
     >>> _ = rep.stage.new_stage()
     >>> dist = rep.distribution.uniform(0.0, 1.0)
-    >>> dist.node.get_attribute("inputs:upper").set(2.0)
+    >>> _ = dist.node.get_attribute("inputs:upper").set(2.0)
     >>> dist.node.get_attribute("inputs:upper").get()
     2.0
 """

@@ -33,13 +33,13 @@ Example:
     >>> import numpy as np
     >>> import graphsdg as rep
     >>> from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
-from graphsdg.stage.context import stage_context
     >>> _ = rep.stage.new_stage()
     >>> box = rep.functional.create.cube(position=(0, 0, 1), name="Box")
     >>> rep.functional.physics.apply_collider(box); rep.functional.physics.apply_rigid_body(box)
     >>> targets = RandomizationTargets()
     >>> target = targets.register_rigid_bodies(RigidBodyTensorView("/Box"), "boxes")
-    >>> write_samples(target, "mass", "scaling", np.array([[2.0]]), np.array([0]))
+    >>> write_samples(target, "mass", "scaling", np.array([[2.0]]), np.array([0])).tolist()
+    [[2000.0]]
     >>> target.view.get_masses().tolist()
     [[2000.0]]
 """
