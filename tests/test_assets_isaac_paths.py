@@ -436,3 +436,23 @@ def test_hotel_room_sky_is_an_hdr_lat_long_map_like_the_other_indoor_skies():
     img = cv2.imread(path, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_COLOR)
     assert img.shape == (128, 256, 3) and img.dtype == np.float32
     assert img.max() > 5.0 * np.median(img)                               # lamps and a window, brighter than walls
+
+
+# ---- Office and Hospital props ------------------------------------------------------------------
+def test_office_and_hospital_props_stand_on_their_bottom_centre_without_physics():
+    from graphsdg.assets import interior_props
+    office = sorted(f for f in os.listdir(get_assets_root_path() + "/Isaac/Environments/Office/Props")
+                    if f.endswith(".usd"))
+    assert office == ["SM_Board.usd", "SM_BookOpen_01.usd", "SM_Book_03.usd", "SM_Book_34.usd", "SM_Briefcase.usd",
+                      "SM_Extinguisher.usd"]
+    for prop in interior_props.INTERIOR_PROPS.values():
+        stage = _open(f"{prop.folder}/{prop.name}.usd")
+        root = stage.GetDefaultPrim()
+        assert root.GetName() == prop.name
+        lo, hi = _bounds(root)
+        assert lo[2] == pytest.approx(0.0, abs=1e-5)
+        np.testing.assert_allclose((lo[:2] + hi[:2]) / 2, 0.0, atol=1e-5)
+        assert not any(p.HasAPI(UsdPhysics.RigidBodyAPI) or p.HasAPI(UsdPhysics.CollisionAPI)
+                       for p in Usd.PrimRange(root))
+        meshes = [p for p in Usd.PrimRange(root) if p.IsA(UsdGeom.Mesh)]
+        assert meshes and all(matlib.bound_material(m) is not None for m in meshes)
