@@ -210,3 +210,15 @@ def test_tools_colorize_against_hand_worked_values():
     drawn = rep.tools.colorize_bbox_2d(np.zeros((10, 10, 3), dtype=np.uint8), boxes)
     colour = list(rep.tools.data_to_colour(1))
     assert drawn[2, 4].tolist() == colour and drawn[4, 4].tolist() == [0, 0, 0]   # outline only
+
+
+def test_a_finished_run_is_seen_starting_once_as_kit_polling_loops_expect(compat_rep):
+    compat_rep.orchestrator.stop()                                  # whatever an earlier test left
+    cube = compat_rep.create.cube()
+    with compat_rep.trigger.on_frame(max_execs=2):
+        with cube:
+            compat_rep.modify.pose(position=compat_rep.distribution.uniform((0, 0, 0), (1, 1, 1)))
+    assert compat_rep.orchestrator.get_is_started() is False
+    compat_rep.orchestrator.run()
+    assert [compat_rep.orchestrator.get_is_started() for _ in range(3)] == [True, False, False]
+    assert compat_rep.orchestrator.get_is_stopped()

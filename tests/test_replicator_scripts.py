@@ -187,3 +187,12 @@ def test_per_prim_heights_from_a_sequence_lift_each_box(tmp_path, monkeypatch, c
         expected = project([(x, 0.0, z) for x, z in zip((-2.0, 0.0, 2.0), heights)])
         for got, want in zip(found, expected):
             assert np.all(np.abs(got - want) < 2.0), (k, got, want)
+
+
+def test_kit_polling_loop_ends_after_the_run(tmp_path, monkeypatch, capsys):
+    out, printed = run_script("kit_polling_loop", tmp_path, monkeypatch, capsys)
+    assert len(frames(out / "_out_polling", "rgb")) == 3
+    assert "STATUS 0 False True" in printed, printed                  # Status.STOPPED (0), not started, stopped
+    for k in range(3):
+        data, labels = boxes(out / "_out_polling", k)
+        assert classes(data, labels) == ["crate"]

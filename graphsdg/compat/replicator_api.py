@@ -9,6 +9,10 @@ forwarding modules of its submodules, what Replicator documents and graphsdg has
 * ``rep.orchestrator.set_next_rt_subframes`` / ``set_minimum_next_rt_subframes`` (the next capture's
   subframes, through the runtime's graph hooks) and ``get_sim_times_to_write`` (always empty: graphsdg
   writes each capture in its own step, nothing waits);
+* ``rep.orchestrator.run`` / ``run_async`` and ``get_is_started`` as Kit scripts poll them: in Kit ``run()``
+  returns at once and the script updates the app ``while not get_is_started()`` and then ``while
+  get_is_started()``; graphsdg's ``run()`` has made every frame when it returns, so the first
+  ``get_is_started()`` after it answers True once (the run did start), and False from then on;
 * ``omni.replicator.core.scripts.writers_default.tools``, the module path of ``rep.tools``.
 
 A refusal is added only where graphsdg has no such name, so an area or a room that implements one later
@@ -101,6 +105,32 @@ def get_sim_times_to_write() -> list:
     return []
 
 
+class _RunStarts:
+    """Whether a finished ``run()``'s start has not been seen by ``get_is_started()`` yet."""
+
+    unseen = False
+
+
+def run(*args: Any, **kwargs: Any) -> None:
+    """``rep.orchestrator.run``: make the frames, then let one ``get_is_started()`` see that the run started."""
+    _RunStarts.unseen = False
+    graphsdg.orchestrator.run(*args, **kwargs)
+    _RunStarts.unseen = True
+
+
+async def run_async(*args: Any, **kwargs: Any) -> None:
+    """``rep.orchestrator.run_async``: :func:`run` for ``await``."""
+    run(*args, **kwargs)
+
+
+def get_is_started() -> bool:
+    """True while generating, and once more after a ``run()`` finished (Kit's polling loops see it start)."""
+    if graphsdg.orchestrator.get_is_started():
+        return True
+    seen, _RunStarts.unseen = _RunStarts.unseen, False
+    return seen
+
+
 def _family_module(family: str, target: types.ModuleType) -> ForwardingModule:
     """``omni.replicator.core.<family>`` forwarding to graphsdg's module, with the refusals graphsdg lacks."""
     extra = {name: refusal(f"omni.replicator.core.{family}.{name}", why)
@@ -115,6 +145,7 @@ def modules() -> list[types.ModuleType]:
         ("set_next_rt_subframes", set_next_rt_subframes),
         ("set_minimum_next_rt_subframes", set_minimum_next_rt_subframes),
         ("get_sim_times_to_write", get_sim_times_to_write)) if not hasattr(graphsdg.orchestrator, name)}
+    orchestrator_extra.update(run=run, run_async=run_async, get_is_started=get_is_started)
     out.append(ForwardingModule("omni.replicator.core.orchestrator", graphsdg.orchestrator, **orchestrator_extra))
     writers_tools = ForwardingModule("omni.replicator.core.scripts.writers_default.tools", tools)
     out.append(writers_tools)
@@ -132,6 +163,7 @@ def install() -> None:
 def uninstall() -> None:
     """Stop answering subframe requests (compat mode removed)."""
     _requests.pending = 0
+    _RunStarts.unseen = False
     hooks = runtime().graph_hooks
     if _requests in hooks:
         hooks.remove(_requests)
