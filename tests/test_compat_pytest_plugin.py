@@ -75,3 +75,20 @@ def test_extension_tests_run_with_their_dependencies_enabled(tmp_path):
                          capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
     assert "2 passed" in run.stdout
+
+
+def test_an_extension_under_test_has_its_folder_as_extension_path(tmp_path):
+    root = _extension(tmp_path)
+    (root / "python" / "tests" / "test_path.py").write_text(textwrap.dedent(f'''
+        import omni.kit.app
+
+        def test_folder():
+            manager = omni.kit.app.get_app().get_extension_manager()
+            assert manager.get_extension_path("my.ext") == {str(root)!r}
+            assert manager.get_extension_path_by_module("my.ext.tests") == {str(root)!r}
+    '''))
+    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "graphsdg.compat.pytest_plugin",
+                          "--import-mode=importlib", "-p", "no:cacheprovider",
+                          str(root / "python" / "tests" / "test_path.py")],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr

@@ -27,7 +27,7 @@ import graphsdg
 
 from graphsdg.compat import extensions
 from graphsdg.compat.kit import get_app, get_timeline_interface
-from graphsdg.compat.modules import CompatImportError, CompatModule
+from graphsdg.compat.modules import CompatModule
 
 StepCallback = Callable[[int, int], "bool | None"]
 
@@ -112,11 +112,9 @@ def get_extension_id(name: str) -> str | None:
 
 
 def get_extension_path(name: str) -> str:
-    """Extensions are part of graphsdg here and have no folder: raises, naming the extension."""
-    extension_id = get_extension_id(name)
-    raise CompatImportError(f"extension {name!r} has no folder in graphsdg's compat mode (it is "
-                            f"{'enabled' if extension_id else 'not enabled'}; its modules are part of graphsdg), so "
-                            f"there is no path to return", name=str(name))
+    """The extension's folder where one is known (an Isaac extension whose tests run from its source tree);
+    otherwise raises, naming the extension."""
+    return extensions.get_extension_manager().get_extension_path(name)
 
 
 def get_extension_dict(name: str) -> dict | None:

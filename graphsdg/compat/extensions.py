@@ -95,6 +95,32 @@ class ExtensionManager(CompatObject):
 
     def __init__(self) -> None:
         self._enabled = set(KNOWN) - OFF_AT_START
+        self._folders: dict[str, str] = {}   # extensions whose source folder is on disk (an Isaac tree's tests)
+
+    def set_extension_folder(self, ext_name: str, folder: str) -> None:
+        """Record where an extension's folder is (its ``config/extension.toml`` and data), as Kit knows it."""
+        self._folders[str(ext_name).split("-")[0]] = str(folder)
+
+    def get_extension_path(self, ext_id: str) -> str:
+        """The extension's folder: known for an extension whose tests run from its source tree, else an error."""
+        ext = str(ext_id).split("-")[0]
+        if ext in self._folders:
+            return self._folders[ext]
+        _check(ext_id)
+        raise CompatImportError(f"extension {ext_id!r} has no folder in graphsdg's compat mode (its modules are part "
+                                f"of graphsdg); only an extension whose tests run from its own source folder has one. "
+                                f"{PORTING}", name=str(ext_id))
+
+    def get_extension_path_by_module(self, module_name: str) -> str:
+        """The folder of the extension that provides the Python module ``module_name``."""
+        for ext in sorted(self._folders, key=len, reverse=True):
+            if module_name == ext or module_name.startswith(ext + "."):
+                return self._folders[ext]
+        for ext, prefixes in KNOWN.items():
+            if any(module_name == p or module_name.startswith(p + ".") for p in prefixes):
+                return self.get_extension_path(ext)
+        raise CompatImportError(f"no extension provides the module {module_name!r} in graphsdg's compat mode. "
+                                f"{PORTING}", name=str(module_name))
 
     def is_extension_enabled(self, ext_name: str) -> bool:
         return _check(ext_name) in self._enabled
@@ -155,10 +181,8 @@ def get_extension_id(extension_name: str) -> str:
 
 
 def get_extension_path_from_name(extension_name: str) -> str:
-    """Extensions have no folders here: a clear error rather than a path that does not exist."""
-    _check(extension_name)
-    raise CompatImportError(f"extension {extension_name!r} has no folder in graphsdg's compat mode (its modules "
-                            f"are part of graphsdg). {PORTING}", name=str(extension_name))
+    """The extension's folder where one is known (:meth:`ExtensionManager.get_extension_path`), else an error."""
+    return _manager.get_extension_path(extension_name)
 
 
 class IExt:

@@ -12,7 +12,8 @@ installs them.
 
 A test file that belongs to a Kit extension (an ``extension.toml`` under a
 ``config/`` folder of one of its parent folders) gets what Kit's test runner
-gives it: the extension's ``[dependencies]`` and the ``dependencies`` of each
+gives it: the extension itself (its folder's name; its folder becomes its
+extension path), its ``[dependencies]`` and the ``dependencies`` of each
 ``[[test]]`` entry that selects the file are enabled, and that entry's
 ``--/path=value`` arguments that name a setting graphsdg honours are applied,
 before the file is imported (the rest tune Kit's renderer and app loop, which
@@ -139,10 +140,12 @@ def prepare_extension_test(test_file: Path) -> list[str]:
     if manifest is None:
         return []
     entries = selected_test_entries(manifest, test_module_name(manifest, toml_path, test_file))
-    wanted = list(manifest.get("dependencies", {}))
+    from graphsdg.compat import extensions, kit
+    folder = toml_path.parent.parent
+    extensions.get_extension_manager().set_extension_folder(folder.name, str(folder))
+    wanted = [folder.name, *manifest.get("dependencies", {})]
     for entry in entries:
         wanted += list(entry.get("dependencies", []))
-    from graphsdg.compat import extensions, kit
     enabled = []
     for name in dict.fromkeys(wanted):
         try:
