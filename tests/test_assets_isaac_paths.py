@@ -456,3 +456,25 @@ def test_office_and_hospital_props_stand_on_their_bottom_centre_without_physics(
                        for p in Usd.PrimRange(root))
         meshes = [p for p in Usd.PrimRange(root) if p.IsA(UsdGeom.Mesh)]
         assert meshes and all(matlib.bound_material(m) is not None for m in meshes)
+
+
+# ---- the Cosmos warehouse sample stage ------------------------------------------------------------
+def test_worker_and_anim_cameras_stage_holds_the_warehouse_a_walking_worker_and_cameras():
+    from graphsdg.assets.sample_stages import worker_pose
+    stage = _open("/Isaac/Samples/Replicator/Stage/full_warehouse_worker_and_anim_cameras.usd")
+    assert stage.GetDefaultPrim().GetName() == "World"
+    assert stage.GetPrimAtPath("/World/Warehouse/Floor").HasAPI(UsdPhysics.CollisionAPI)
+    assert (stage.GetStartTimeCode(), stage.GetEndTimeCode()) == (0.0, 600.0)
+    worker = UsdGeom.Xformable(stage.GetPrimAtPath("/World/Worker"))
+    translate = stage.GetPrimAtPath("/World/Worker").GetAttribute("xformOp:translate")
+    assert translate.GetNumTimeSamples() >= 10
+    np.testing.assert_allclose(translate.Get(), (-4.0, 6.5, 0.0))                # default: the first pose
+    np.testing.assert_allclose(translate.Get(300.0), (4.0, 6.5, 0.0), atol=1e-6)  # the far end half-way
+    assert worker_pose(450.0)[0][0] == pytest.approx(0.0) and worker_pose(450.0)[1] == pytest.approx(180.0)
+    lo, hi = _bounds(stage.GetPrimAtPath("/World/Worker"))
+    assert hi[2] - lo[2] == pytest.approx(1.75, abs=1e-3)
+    for name in ("AnimCamera_01", "AnimCamera_02"):
+        cam = stage.GetPrimAtPath(f"/World/Cameras/{name}")
+        assert cam.IsA(UsdGeom.Camera) and cam.GetAttribute("xformOp:translate").GetNumTimeSamples() >= 2
+        m = np.array(UsdGeom.Xformable(cam).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
+        assert 0.0 < m[3, 2] < 8.0                                                # inside, under the roof

@@ -343,14 +343,14 @@ def _full_warehouse_props(stage: Usd.Stage, parent: str) -> None:
 def _ceiling_lights(stage: Usd.Stage, parent: str) -> None:
     UsdGeom.Scope.Define(stage, parent)
     dome = UsdLux.DomeLight.Define(stage, f"{parent}/AmbientDome")
-    dome.CreateIntensityAttr(250.0)
+    dome.CreateIntensityAttr(500.0)
     k = 0
     for x in (-20.0, -8.0, 4.0):
         for y in (-6.0, 12.0):
             light = UsdLux.RectLight.Define(stage, f"{parent}/CeilingLight_{k:02d}")
             light.CreateWidthAttr(3.0)
             light.CreateHeightAttr(1.0)
-            light.CreateIntensityAttr(4000.0)
+            light.CreateIntensityAttr(12000.0)
             light.CreateColorAttr(Gf.Vec3f(1.0, 0.97, 0.9))
             UsdGeom.Xformable(light).AddTranslateOp().Set(Gf.Vec3d(x, y, FULL_H - 0.3))   # emits down (-Z)
             k += 1
