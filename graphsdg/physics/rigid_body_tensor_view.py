@@ -30,7 +30,7 @@ import numpy as np
 from graphsdg.maths.rotations import quat_wxyz_to_matrix
 from graphsdg.physics import body_properties
 from graphsdg.physics.bodies import RigidBodyView
-from graphsdg.physics.one_step_forces import apply_for_one_step
+from graphsdg.physics.forces import apply_force_at_pos
 from graphsdg.physics.shape_properties import ShapeTable
 from graphsdg.runtime import runtime
 from graphsdg.sim.scene import SimScene
@@ -139,10 +139,11 @@ class RigidBodyTensorView:
         sim = self.sim
         roots = self._roots()
         for row, force in zip(idx, rows):
-            b = sim.body(roots[int(row)])
+            root = roots[int(row)]
             if not is_global:
-                force = quat_wxyz_to_matrix(sim.body_pose(roots[int(row)])[1]) @ force
-            apply_for_one_step(sim, b.body_id, force)
+                force = quat_wxyz_to_matrix(sim.body_pose(root)[1]) @ force
+            centre = sim.data.xipos[sim.body(root).body_id]      # at the centre of mass: no torque
+            apply_force_at_pos(root, force, centre, mode="Force")
 
     # ---- mass properties -----------------------------------------------------------------------------------
     def get_masses(self) -> np.ndarray:
