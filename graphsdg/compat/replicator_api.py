@@ -13,7 +13,9 @@ forwarding modules of its submodules, what Replicator documents and graphsdg has
   returns at once and the script updates the app ``while not get_is_started()`` and then ``while
   get_is_started()``; graphsdg's ``run()`` has made every frame when it returns, so the first
   ``get_is_started()`` after it answers True once (the run did start), and False from then on;
-* ``omni.replicator.core.scripts.writers_default.tools``, the module path of ``rep.tools``.
+* ``omni.replicator.core.scripts.writers_default`` (and ``omni.replicator.core.writers_default``): the writer
+  classes (``BasicWriter``, ``KittiWriter``, ...) and ``tools``, the module path of ``rep.tools``, with
+  ``basicwriter`` / ``kitti`` / ``cocowriter`` submodules as custom-writer tutorials import them.
 
 A refusal is added only where graphsdg has no such name, so an area or a room that implements one later
 (``render_product_tiled``, ``omni_lidar``) is not hidden. ``docs/porting.md`` ("Replicator's public API")
@@ -148,8 +150,14 @@ def modules() -> list[types.ModuleType]:
     orchestrator_extra.update(run=run, run_async=run_async, get_is_started=get_is_started)
     out.append(ForwardingModule("omni.replicator.core.orchestrator", graphsdg.orchestrator, **orchestrator_extra))
     writers_tools = ForwardingModule("omni.replicator.core.scripts.writers_default.tools", tools)
+    writer_classes = dict(graphsdg.WriterRegistry.get_writers())   # BasicWriter, KittiWriter, ... as classes
     out.append(writers_tools)
-    out.append(CompatModule("omni.replicator.core.scripts.writers_default", tools=writers_tools))
+    out.append(CompatModule("omni.replicator.core.scripts.writers_default", tools=writers_tools, **writer_classes))
+    out.append(CompatModule("omni.replicator.core.writers_default", tools=writers_tools, **writer_classes))
+    for module, cls in (("basicwriter", "BasicWriter"), ("kitti", "KittiWriter"), ("cocowriter", "CocoWriter")):
+        if cls in writer_classes:
+            out.append(CompatModule(f"omni.replicator.core.scripts.writers_default.{module}",
+                                    **{cls: writer_classes[cls]}))
     return out
 
 
