@@ -105,6 +105,9 @@ def test_module_paths_of_the_api_import(compat_rep):
         assert importlib.import_module(module) is not None
     from omni.replicator.core.scripts.writers_default.tools import colorize_segmentation
     assert colorize_segmentation is compat_rep.tools.colorize_segmentation
+    from omni.replicator.core.scripts.writers_default import BasicWriter
+    from omni.replicator.core.scripts.writers_default.basicwriter import BasicWriter as BasicWriterAgain
+    assert BasicWriter is BasicWriterAgain is compat_rep.WriterRegistry.get_writers()["BasicWriter"]
 
 
 def test_next_capture_subframes_reach_the_orchestrator(compat_rep):
