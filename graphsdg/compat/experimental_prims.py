@@ -49,9 +49,6 @@ class XformPrim(Prim):
         missing = [p for p, prim in zip(self._paths, self._prims) if not prim]
         if missing:
             raise ValueError(f"specified paths must correspond to existing prims: {', '.join(missing)}")
-        not_xformable = [p for p, prim in zip(self._paths, self._prims) if not prim.IsA(UsdGeom.Xformable)]
-        if not_xformable:
-            raise ValueError(f"prims {not_xformable} are not Xformable; XformPrim wraps prims with a transform")
         if positions is not None and translations is not None:
             raise ValueError("positions (world) and translations (local) cannot both be given")
         self._default_state: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
@@ -69,8 +66,15 @@ class XformPrim(Prim):
         return [self._paths[i] for i in resolve_indices(indices, len(self._paths))]
 
     # ---- xform ops ---------------------------------------------------------------
+    def _check_xformable(self, what: str) -> None:
+        """Raise naming the wrapped prims without a transform (Isaac wraps them, and fails where a pose is needed)."""
+        not_xformable = [p for p, prim in zip(self._paths, self._prims) if not prim.IsA(UsdGeom.Xformable)]
+        if not_xformable:
+            raise ValueError(f"{what}: prims {not_xformable} are not Xformable (they have no transform)")
+
     def reset_xform_op_properties(self) -> None:
         """Rewrite each prim's ops as ``translate``, ``orient``, ``scale`` (double), keeping its local transform."""
+        self._check_xformable("reset_xform_op_properties")
         for prim in self._prims:
             xf = UsdGeom.Xformable(prim)
             m = np.array(xf.GetLocalTransformation(Usd.TimeCode.Default()), dtype=np.float64)
@@ -248,6 +252,9 @@ _APPROXIMATIONS = ("none", "convexDecomposition", "convexHull", "boundingSphere"
 class GeomPrim(XformPrim):
     """``isaacsim.core.experimental.prims.GeomPrim``: gprims with collision and physics-material properties.
 
+    As in Isaac, any prim may be wrapped (a regular expression matching a gprim's siblings, say); collision
+    schemas authored on prims that are not gprims are left unused by the simulation, as PhysX leaves them.
+
     ``apply_collision_apis=True`` applies ``CollisionAPI`` (and ``MeshCollisionAPI`` on meshes)
     at construction. Collision enablement, mesh approximations and physics materials
     reach MuJoCo; contact / rest offsets and torsional patch radii are authored
@@ -262,10 +269,6 @@ class GeomPrim(XformPrim):
         super().__init__(paths, resolve_paths=resolve_paths, positions=positions, translations=translations,
                          orientations=orientations, scales=scales,
                          reset_xform_op_properties=reset_xform_op_properties)
-        not_gprims = [p for p, prim in zip(self._paths, self._prims) if not prim.IsA(UsdGeom.Gprim)]
-        if not_gprims:
-            raise ValueError(f"prims {not_gprims} are not geometric prims (UsdGeom.Gprim); GeomPrim wraps shapes "
-                             f"and meshes")
         if apply_collision_apis:
             self.apply_collision_apis()
 
@@ -380,7 +383,7 @@ class GeomPrim(XformPrim):
 # ---- RigidPrim ------------------------------------------------------------------------------------------
 class RigidPrim(XformPrim):
     """``isaacsim.core.experimental.prims.RigidPrim`` over graphsdg's rigid-body view (simulated poses and
-    velocities of prims with ``RigidBodyAPI``)."""
+    velocities); as in Isaac, ``RigidBodyAPI`` is applied to the wrapped prims that lack it."""
 
     _compat_name = "isaacsim.core.experimental.prims.RigidPrim"
 
@@ -389,6 +392,9 @@ class RigidPrim(XformPrim):
                  scales: Any = None, reset_xform_op_properties: bool = False) -> None:
         super().__init__(paths, resolve_paths=resolve_paths, translations=translations, scales=scales,
                          reset_xform_op_properties=reset_xform_op_properties)
+        for prim in self._prims:
+            if not prim.HasAPI(UsdPhysics.RigidBodyAPI):
+                UsdPhysics.RigidBodyAPI.Apply(prim)
         self._view = RigidBodyView(self.paths)
         if masses is not None or densities is not None:
             self._set_mass_api(masses, densities)
