@@ -352,3 +352,35 @@ def test_an_array_attribute_value_is_never_split():
         rep.modify.attribute("primvars:weights", [0.5, 0.25], attribute_type="float[]")
     assert [list(p.GetAttribute("primvars:weights").Get()) for p in prims] == [[0.5, 0.25], [0.5, 0.25]]
     assert prims[0].GetAttribute("primvars:weights").GetTypeName() == Sdf.ValueTypeNames.FloatArray
+
+
+def _texture_shader(prim):
+    material = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()[0]
+    return material.GetPrim().GetStage().GetPrimAtPath(material.GetPath().AppendChild("DiffuseTexture"))
+
+
+def test_texture_scale_and_rotation_one_for_all_and_per_prim():
+    texture = rep.example.TEXTURES[0]
+    group, prims = _cubes(2)
+    with group:
+        rep.randomizer.texture(textures=[texture], texture_scale=[(0.5, 2.0)], texture_rotate=[30, 60])
+    shaders = [_texture_shader(p) for p in prims]
+    assert [tuple(s.GetAttribute("inputs:scale").Get())[:2] for s in shaders] == [(0.5, 2.0), (0.5, 2.0)]
+    assert [s.GetAttribute("graphsdg:textureRotate").Get() for s in shaders] == [30.0, 60.0]
+    assert all(s.GetAttribute("inputs:file").Get().path == texture for s in shaders)
+    with rep.trigger.on_frame(max_execs=1):
+        with group:
+            rep.randomizer.texture(textures=[texture], texture_rotate=rep.distribution.sequence([(10, 20)]))
+    rep.orchestrator.step()
+    assert [s.GetAttribute("graphsdg:textureRotate").Get() for s in shaders] == [10.0, 20.0]
+
+
+def test_material_and_camera_arguments_re_sampled_per_prim():
+    with rep.trigger.on_frame(max_execs=1):
+        mats = rep.create.material_omnipbr(diffuse=rep.distribution.sequence([[(1, 0, 0), (0, 0, 1)]]), count=2)
+        cams = rep.create.camera(focal_length=rep.distribution.sequence([(18.0, 35.0)]), count=2)
+    rep.orchestrator.step()
+    colours = [tuple(matlib.surface_shader(UsdShade.Material(m)).GetInput("diffuseColor").Get())
+               for m in mats.get_output_prims()["prims"]]
+    assert colours == [(1.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
+    assert [UsdGeom.Camera(c).GetFocalLengthAttr().Get() for c in cams.get_output_prims()["prims"]] == [18.0, 35.0]
