@@ -26,7 +26,8 @@ globals().update(_calls)
 def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None = None) -> None:
     """Add ``fn`` as ``rep.randomizer.<fn_name>``; calling it builds the nodes ``fn`` builds.
 
-    ``fn`` must return what it built (an item or ``item.node``).
+    ``fn`` may return what it built (an item, ``item.node`` or a list of them) or nothing: its nodes join the
+    graph where it is called, gated by the enclosing trigger, either way.
     """
     register_function(sys.modules[__name__], fn, override, fn_name)
 
