@@ -87,14 +87,14 @@ class Cloner(CompatObject):
     def replicate_physics(self, source_prim_path: str, prim_paths: list[str], base_env_path: str | None,
                           root_path: str | None, enable_env_ids: bool = False, clone_in_fabric: bool = False) -> None:
         """Check PhysX replication's arguments; the clones' physics is compiled from USD (the same result)."""
-        if base_env_path is None and self._base_env_path is None:
-            raise ValueError("base_env_path needs to be specified!")
-        if root_path is None and self._root_path is None:
-            raise ValueError("root_path needs to be specified!")
         if enable_env_ids:
             raise CompatError("Cloner enable_env_ids=True (co-located clones with automatic collision filtering) is "
                               "not available in graphsdg's compat mode: MuJoCo has no environment ids; place the "
                               "clones apart (GridCloner). See docs/porting.md.")
+        if base_env_path is None and self._base_env_path is None:
+            raise ValueError("base_env_path needs to be specified!")
+        if root_path is None and self._root_path is None:
+            raise ValueError("root_path needs to be specified!")
 
     def disable_change_listener(self) -> None:
         """Nothing to pause: graphsdg syncs stage edits into the simulation when it next needs them."""

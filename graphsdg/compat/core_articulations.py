@@ -91,9 +91,9 @@ class Articulation(XFormPrim):
         if self._default_state.positions is None or self._default_state.orientations is None:
             pos, quat = self.get_world_poses()
             self._default_state = XFormPrimViewState(positions=pos, orientations=quat)
-        if self._default_joints_state is None:
-            self._default_joints_state = JointsState(self.get_joint_positions(), self.get_joint_velocities(),
-                                                     np.zeros((self.count, self.num_dof), dtype=np.float32))
+        if self._default_joints_state is None:   # Isaac's defaults: the drives' targets, at rest, no effort
+            targets = self._physics_view.get_dof_position_targets().astype(np.float32)
+            self._default_joints_state = JointsState(targets, np.zeros_like(targets), np.zeros_like(targets))
         self._default_kps, self._default_kds = self.get_gains()
 
     def _view(self) -> ArticulationTensorView | None:
@@ -430,7 +430,11 @@ class Articulation(XFormPrim):
 
     def _on_post_reset(self) -> None:
         if self._default_state.positions is not None:
-            self.set_world_poses(self._default_state.positions, self._default_state.orientations)
+            pos, quat = self.get_world_poses()
+            moved = not (np.allclose(pos, self._default_state.positions, atol=1e-6) and
+                         np.allclose(np.abs(np.sum(quat * self._default_state.orientations, axis=1)), 1.0, atol=1e-6))
+            if moved:   # a root already at its default is left alone (no model write for a root on a joint)
+                self.set_world_poses(self._default_state.positions, self._default_state.orientations)
         state = self._default_joints_state
         if state is None or self._view() is None:
             return

@@ -33,7 +33,7 @@ import types
 from typing import Any, Sequence
 
 import numpy as np
-from pxr import Gf, Sdf, Usd, UsdGeom
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.compat.core_materials import PhysicsMaterial, PreviewSurface, VisualMaterial
 from graphsdg.compat.core_single_prims import SingleGeometryPrim, SingleRigidPrim, SingleXFormPrim
@@ -336,7 +336,8 @@ class GroundPlane(CompatObject):
     A new plane is ``size`` (50 m / stage units by default) across at height
     ``z_position``, with friction 0.5 / 0.5 and restitution 0.8 (authored; not
     simulated) unless a ``physics_material`` is given. The physics material is
-    bound to the infinite ``CollisionPlane`` (the collider); Isaac binds it to a
+    bound to the infinite ``CollisionPlane`` (the collider; an existing ground
+    without a Plane is wrapped by its first collider); Isaac binds it to a
     ``geom`` prim it adds beside it.
     """
 
@@ -357,10 +358,13 @@ class GroundPlane(CompatObject):
                 physics_material = _default_physics_material(0.5, 0.5, 0.8)
             if visual_material is None:
                 visual_material = _default_visual_material(color)
-        planes = [p for p in Usd.PrimRange(stage.GetPrimAtPath(prim_path)) if p.IsA(UsdGeom.Plane)]
+        below = list(Usd.PrimRange(stage.GetPrimAtPath(prim_path)))
+        # Isaac's ground assets hold a Plane collider; an asset whose ground collides as a mesh is wrapped by that mesh
+        planes = [p for p in below if p.IsA(UsdGeom.Plane)] or \
+            [p for p in below if p.IsA(UsdGeom.Gprim) and p.HasAPI(UsdPhysics.CollisionAPI)]
         if not planes:
-            raise ValueError(f"the prim at {prim_path} holds no UsdGeom.Plane collider; GroundPlane wraps a ground "
-                             f"plane made by PhysicsSchemaTools.addGroundPlane")
+            raise ValueError(f"the prim at {prim_path} holds no UsdGeom.Plane (or other) collider; GroundPlane wraps a "
+                             f"ground plane such as PhysicsSchemaTools.addGroundPlane makes")
         self._xform_prim = SingleXFormPrim(prim_path, name=name, scale=scale, visible=visible)
         self._collision_prim = SingleGeometryPrim(str(planes[0].GetPath()), name=name + "_collision_plane",
                                                   scale=scale, visible=visible, collision=True)

@@ -48,7 +48,7 @@ from graphsdg.compat.experimental_arguments import warn_once
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from graphsdg.physics.one_step_forces import apply_for_one_step
+from graphsdg.physics.forces import apply_force_at_pos
 from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
 from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.runtime import runtime
@@ -441,7 +441,11 @@ class RigidPrim(XFormPrim):
             self.set_masses(masses)
         if densities is not None:
             self.set_densities(densities)
-        self._dynamics_default_state = DynamicsViewState(None, None, None, None)
+        # the velocities a reset returns to: those the bodies start with (authored ones; angular in rad/s, as the
+        # simulation reads it), not whatever the first physics step left
+        idx = np.arange(self._count)
+        self._dynamics_default_state = DynamicsViewState(None, None, self._usd_velocities(idx, False),
+                                                         np.radians(self._usd_velocities(idx, True)))
 
     # ---- physics handle ---------------------------------------------------------------------------------
     def is_physics_handle_valid(self) -> bool:
@@ -578,12 +582,18 @@ class RigidPrim(XFormPrim):
         for k, i in enumerate(idx):
             body = sim.body(self._prim_paths[i])
             rot = data.xmat[body.body_id].reshape(3, 3)
-            origin = data.xpos[body.body_id]
+            com = data.xipos[body.body_id]
             force, torque = (f[k], tau[k]) if is_global else (rot @ f[k], rot @ tau[k])
-            if at is not None:   # MuJoCo applies xfrc_applied at the centre of mass: add the force's moment about it
-                point = at[k] if is_global else origin + rot @ at[k]
-                torque = torque + np.cross(point - data.xipos[body.body_id], force)
-            apply_for_one_step(sim, body.body_id, force, torque)
+            point = com if at is None else (at[k] if is_global else data.xpos[body.body_id] + rot @ at[k])
+            if np.any(force):
+                apply_force_at_pos(body.path, force, point)
+            if np.any(torque):   # a couple: +F at com + r/2, -F at com - r/2 with r x F = torque
+                r = np.cross(torque, [1.0, 0.0, 0.0] if abs(torque[0]) < 0.9 * np.linalg.norm(torque) else
+                             [0.0, 1.0, 0.0])
+                r /= np.linalg.norm(r)
+                couple = np.cross(torque, r)
+                apply_force_at_pos(body.path, couple, com + r / 2)
+                apply_force_at_pos(body.path, -couple, com - r / 2)
 
     # ---- mass properties --------------------------------------------------------------------------------
     def get_masses(self, indices: Any = None, clone: bool = True) -> np.ndarray:
@@ -796,10 +806,10 @@ class GeometryPrim(XFormPrim):
         super().__init__(prim_paths_expr, name, positions, translations, orientations, scales, visibilities,
                          reset_xform_properties)
         self._applied_physics_materials: list[PhysicsMaterial | None] = [None] * self._count
-        if collisions is not None:
+        if collisions is not None:   # True: the prim becomes a collider (False leaves it as it is, as in Isaac)
             for flag, i in zip(np.broadcast_to(np.asarray(collisions).reshape(-1), (self._count,)), range(self._count)):
-                self.apply_collision_apis(indices=[i])
-                (self.enable_collision if bool(flag) else self.disable_collision)(indices=[i])
+                if bool(flag):
+                    self.apply_collision_apis(indices=[i])
 
     @property
     def geoms(self) -> list[UsdGeom.Gprim]:
@@ -819,9 +829,11 @@ class GeometryPrim(XFormPrim):
             UsdPhysics.CollisionAPI.Apply(self._prims[i]).CreateCollisionEnabledAttr().Set(True)
 
     def disable_collision(self, indices: Any = None) -> None:
-        """``physics:collisionEnabled = False``."""
+        """``physics:collisionEnabled = False`` on the colliders (prims without ``CollisionAPI`` already do not
+        collide)."""
         for i in self._indices(indices):
-            UsdPhysics.CollisionAPI.Apply(self._prims[i]).CreateCollisionEnabledAttr().Set(False)
+            if self._prims[i].HasAPI(UsdPhysics.CollisionAPI):
+                UsdPhysics.CollisionAPI(self._prims[i]).CreateCollisionEnabledAttr().Set(False)
 
     def is_collision_enabled(self, indices: Any = None) -> np.ndarray:
         """Whether each prim collides (an enabled ``CollisionAPI``)."""
