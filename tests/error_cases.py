@@ -231,18 +231,23 @@ CASES: list[Case] = [
                           "node types: create.camera, create.capsule, create.cone, create.cube, create.cylinder, "
                           "create.disk, create.from_usd, create.group, create.light, create.material_omnipbr, "
                           "create.plane, create.sphere, create.torus, create.xform, distribution.choice, "
-                          "distribution.combine, distribution.log_uniform, distribution.normal, "
-                          "distribution.sequence, distribution.uniform, get.prim_at_path, get.prims, "
-                          "modify.attribute, modify.material, modify.pose, modify.semantics, modify.visibility, "
-                          "randomizer.color, randomizer.instantiate, randomizer.materials, randomizer.rotation, "
-                          "randomizer.scatter_2d, randomizer.scatter_3d, randomizer.texture, "
-                          "trigger.on_custom_event, trigger.on_frame, trigger.on_time"),
+                          "distribution.combine, distribution.log_uniform, distribution.normal, distribution.sequence, "
+                          "distribution.uniform, gate.environments, get.prim_at_path, get.prims, modify.attribute, "
+                          "modify.material, modify.pose, modify.pose_camera_relative, modify.pose_orbit, "
+                          "modify.semantics, modify.timeline, modify.variant, modify.visibility, physics.collider, "
+                          "physics.drive_properties, physics.mass, physics.physics_material, physics.reset, "
+                          "physics.rigid_body, physics.simulate, randomizer.color, randomizer.instantiate, "
+                          "randomizer.materials, randomizer.rotation, randomizer.scatter_2d, randomizer.scatter_3d, "
+                          "randomizer.texture, randomizer.write_articulation_view, randomizer.write_rigid_body_view, "
+                          "randomizer.write_simulation, trigger.on_condition, trigger.on_custom_event, "
+                          "trigger.on_frame, trigger.on_rl_frame, trigger.on_time, trigger.on_time_end"),
     C("graph", "an invalid regular expression in get.prims", 'rep.get.prims(path_pattern="[")',
       "ValueError", "path_pattern '[' is not a valid regular expression: unterminated character set at position 0"),
     C("graph", "a distribution of 2-vectors for a 3-vector position",
       "with rep.trigger.on_frame():\n    rep.modify.pose(position=rep.distribution.uniform((0, 0), (0, 0)), "
       "input_prims=[cube])\nrep.orchestrator.step()",
-      "ValueError", "position must be 3 finite numbers, got [0.0, 0.0]"),
+      "ValueError", "modify.pose position (one draw of 'uniform'): got [0.0, 0.0] (shape (2,)) for 1 prim; expected "
+                    "one value (a scalar or (x, y, z))"),
     C("graph", "seeking to a negative frame", "rep.graph.seek(-1)",
       "ValueError", "seek frame must be a non-negative integer, got -1"),
     # ---- annotators --------------------------------------------------------------------------------------------

@@ -100,7 +100,7 @@ def test_visibility_choice_of_scalars_draws_per_prim():
 def test_visibility_wrong_count_names_the_call_value_and_shapes():
     group, _ = _cubes(3)
     with pytest.raises(ValueError, match=r"modify.visibility value: got \[True, False\] \(shape \(2,\)\) for 3 "
-                                         r"prim\(s\); expected one value \(a scalar\) for every prim, or a list "
+                                         r"prims; expected one value \(a scalar\) for every prim, or a list "
                                          r"of 3"):
         with group:
             rep.modify.visibility([True, False])

@@ -97,9 +97,9 @@ def spread_value(value: Any, n: int, shapes: Sequence[Shape] | None, what: str) 
             return _elements(value)
         if shape[0] == 1:
             return _elements(value) * n
+    per_prim = f" for every prim, or a list of {n} of them (one per prim)" if n > 1 else ""
     raise ValueError(f"{what}: got {_describe(value)} (shape {shape if shape is not None else 'ragged'}) for "
-                     f"{n} prim(s); expected one value ({_shape_names(shapes)}) for every prim, or a list of {n} "
-                     f"of them (one per prim)")
+                     f"{n} prim{'s' if n != 1 else ''}; expected one value ({_shape_names(shapes)}){per_prim}")
 
 
 def spread_samples(samples: Samples, n: int, shapes: Sequence[Shape] | None, what: str) -> list[Any]:
