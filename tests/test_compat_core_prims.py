@@ -197,3 +197,42 @@ def test_articulation_joint_state_targets_and_gains(compat, fresh_stage):
     np.testing.assert_allclose(view.get_joint_positions(), [[0.0]], atol=1e-6)
     np.testing.assert_allclose(view.get_joint_velocities(), [[0.0]], atol=1e-6)
     World.clear_instance()
+
+
+def test_net_contact_force_of_a_resting_box_is_its_weight(compat):
+    from isaacsim.core.api import World
+    from isaacsim.core.api.objects import DynamicCuboid
+    from isaacsim.core.prims import RigidPrim
+    world = World(physics_dt=1 / 60)
+    world.scene.add_ground_plane()
+    DynamicCuboid("/World/Box", size=0.5, mass=2.0, position=(0.0, 0.0, 0.3))
+    tracked = RigidPrim("/World/Box", track_contact_forces=True)
+    untracked = RigidPrim("/World/Box")
+    world.reset()
+    for _ in range(120):
+        world.step(render=False)
+    np.testing.assert_allclose(tracked.get_net_contact_forces(dt=1 / 60), [[0.0, 0.0, 2.0 * 9.81]], atol=1e-3)
+    np.testing.assert_allclose(tracked.get_net_contact_forces(), [[0.0, 0.0, 2.0 * 9.81 / 60]], atol=1e-4)   # impulse
+    assert untracked.get_net_contact_forces() is None
+    with pytest.raises(AttributeError, match="get_contact_force_matrix"):
+        tracked.get_contact_force_matrix()
+    World.clear_instance()
+
+
+def test_views_need_the_numpy_backend_and_ray_cast_hits_colliders(compat):
+    from isaacsim.core.prims import XFormPrim
+    from isaacsim.core.simulation_manager import SimulationManager
+    from isaacsim.core.utils.collisions import ray_cast
+    from graphsdg.compat.modules import CompatError
+    wall = rep.functional.create.cube(position=(0.0, 3.0, 0.0), name="Wall")
+    rep.functional.physics.apply_collider(wall)
+    turn = [math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4)]       # +X turned onto +Y
+    path, distance = ray_cast(np.zeros(3), np.array(turn), np.array([0.5, 0.0, 0.0]))
+    assert path == "/Wall" and distance == pytest.approx(2.0)
+    assert ray_cast(np.zeros(3), np.array([1.0, 0, 0, 0]), np.zeros(3)) == (None, 10000.0)
+    SimulationManager.set_backend("torch")
+    try:
+        with pytest.raises(CompatError, match="'torch'"):
+            XFormPrim("/Wall")
+    finally:
+        SimulationManager.set_backend("numpy")

@@ -37,6 +37,7 @@ import logging
 import types
 from typing import Any, Sequence
 
+import mujoco
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 
@@ -45,7 +46,7 @@ from graphsdg.compat.core_materials import OmniGlass, OmniPBR, PhysicsMaterial, 
 from graphsdg.compat.core_types import DynamicsViewState, XFormPrimViewState
 from graphsdg.compat.core_utils_prims import is_prim_non_root_articulation_link
 from graphsdg.compat.experimental_arguments import warn_once
-from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.compat.modules import CompatError, CompatModule, CompatObject
 from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.physics.forces import apply_force_at_pos
@@ -86,6 +87,11 @@ class XFormPrim(CompatObject):
     def __init__(self, prim_paths_expr: str | list[str], name: str = "xform_prim_view", positions: Any = None,
                  translations: Any = None, orientations: Any = None, scales: Any = None, visibilities: Any = None,
                  reset_xform_properties: bool = True, usd: bool = True) -> None:
+        backend = SimulationManager.get_backend()
+        if backend != "numpy":
+            raise CompatError(f"isaacsim.core.prims views with backend {backend!r} (SimulationManager.set_backend) are "
+                              f"not available in graphsdg's compat mode: the core API runs its NumPy backend only. "
+                              f"See docs/porting.md.")
         exprs = list(prim_paths_expr) if isinstance(prim_paths_expr, (list, tuple)) else [prim_paths_expr]
         self._regex_prim_paths = exprs
         self._prim_paths: list[str] = []
@@ -422,10 +428,10 @@ class RigidPrim(XFormPrim):
                  linear_velocities: Any = None, angular_velocities: Any = None, track_contact_forces: bool = False,
                  prepare_contact_sensors: bool = True, disable_stablization: bool = True,
                  contact_filter_prim_paths_expr: list[str] | None = None, max_contact_count: int = 0) -> None:
-        if track_contact_forces or contact_filter_prim_paths_expr:
-            raise CompatNotSupported("RigidPrim(track_contact_forces=True / contact_filter_prim_paths_expr)",
-                                     "graphsdg has no PhysX contact-report views; read contacts through "
-                                     "omni.physx scene queries instead")
+        if contact_filter_prim_paths_expr:
+            raise CompatNotSupported("RigidPrim(contact_filter_prim_paths_expr=...)", "graphsdg reports each body's "
+                                     "net contact force only (track_contact_forces=True), not per-filter matrices")
+        self._track_contact_forces = bool(track_contact_forces)
         self._physics_view: RigidBodyTensorView | None = None
         super().__init__(prim_paths_expr, name, positions, translations, orientations, scales, visibilities,
                          reset_xform_properties)
@@ -771,11 +777,47 @@ class RigidPrim(XFormPrim):
         self._set_velocities(zeros if state.linear_velocities is None else state.linear_velocities,
                              zeros if state.angular_velocities is None else state.angular_velocities, None)
 
-    def get_net_contact_forces(self, *args: Any, **kwargs: Any) -> np.ndarray:
-        """Not mapped: PhysX contact-report views (see :class:`CompatNotSupported`)."""
-        raise CompatNotSupported("RigidPrim.get_net_contact_forces", "graphsdg has no PhysX contact-report views")
+    def get_net_contact_forces(self, indices: Any = None, clone: bool = True, dt: float = 1.0) -> np.ndarray | None:
+        """World-frame net contact force on each body (normal and friction of all its contacts, from the last
+        physics step) times ``physics_dt / dt``: PhysX's contact impulses for ``dt = 1``, newtons for ``dt`` = the
+        physics step. Needs ``track_contact_forces=True`` (else a warning and None, as in Isaac)."""
+        self._check()
+        if not self._track_contact_forces:
+            log.warning("contact forces cannot be retrieved with this API unless the RigidPrim is initialized with "
+                        "track_contact_forces= True.")
+            return None
+        sim = runtime().sim
+        sim.sync_dirty_prims()
+        bodies = [sim.body(self._prim_paths[i]).body_id for i in self._indices(indices)]
+        forces = net_contact_forces(sim.model, sim.data, bodies)
+        return (forces * float(sim.model.opt.timestep) / float(dt)).astype(np.float32)
 
-    get_contact_force_matrix = get_contact_force_data = get_friction_data = get_net_contact_forces
+    def get_contact_force_matrix(self, *args: Any, **kwargs: Any) -> np.ndarray:
+        """Not mapped: per-filter contact force matrices (raises naming it)."""
+        raise CompatNotSupported("RigidPrim.get_contact_force_matrix / get_contact_force_data / get_friction_data",
+                                 "graphsdg reports each body's net contact force only (get_net_contact_forces)")
+
+    get_contact_force_data = get_friction_data = get_contact_force_matrix
+
+
+def net_contact_forces(model: Any, data: Any, bodies: Sequence[int]) -> np.ndarray:
+    """(len(bodies), 3) world-frame sums of the contact forces (normal and friction) acting on each MuJoCo body."""
+    out = np.zeros((len(bodies), 3))
+    rows = {b: k for k, b in enumerate(bodies)}
+    wrench = np.zeros(6)
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        b1, b2 = int(model.geom_bodyid[contact.geom1]), int(model.geom_bodyid[contact.geom2])
+        if b1 not in rows and b2 not in rows:
+            continue
+        mujoco.mj_contactForce(model, data, i, wrench)
+        # the contact frame's rows are the normal (from geom1 to geom2) and two tangents; the force acts on geom2
+        on_second = np.asarray(contact.frame).reshape(3, 3).T @ wrench[:3]
+        if b2 in rows:
+            out[rows[b2]] += on_second
+        if b1 in rows:
+            out[rows[b1]] -= on_second
+    return out
 
 
 class CompatNotSupported(AttributeError):

@@ -95,6 +95,7 @@ class SimulationContext(CompatObject):
                         "calls. Call SimulationContext.clear_instance() first to re-initialize with new parameters.")
             return
         require_numpy_backend(backend)
+        SimulationManager.set_backend(backend)
         self._backend = backend
         self._device = device
         self._stage = stage
@@ -146,6 +147,7 @@ class SimulationContext(CompatObject):
             stage_context.unsubscribe(ctx._on_stage_replaced)
         SimulationContext._instance = None
         SimulationContext._sim_context_initialized = False
+        SimulationManager.set_backend("numpy")
 
     # ---- properties -----------------------------------------------------------------------------------------------
     @property

@@ -169,24 +169,34 @@ def is_prim_ancestral(prim_path: str) -> bool:
     return False
 
 
+def _kit_flag(prim: Usd.Prim, key: str) -> bool:
+    """A Kit prim flag: its metadata where Kit's schema registers the key, else the prim's customData entry
+    (plain USD has no such metadata field, so graphsdg keeps the flag in customData)."""
+    try:
+        value = prim.GetMetadata(key)
+    except Exception:  # noqa: BLE001 - pxr raises Tf errors for an unregistered metadata key
+        value = None
+    return bool(value if value is not None else prim.GetCustomDataByKey(key))
+
+
 def is_prim_no_delete(prim_path: str) -> bool:
-    """The prim's ``no_delete`` metadata."""
-    return bool(_prim(prim_path).GetMetadata("no_delete"))
+    """The prim's ``no_delete`` flag."""
+    return _kit_flag(_prim(prim_path), "no_delete")
 
 
 def is_prim_hidden_in_stage(prim_path: str) -> bool:
-    """The prim's ``hide_in_stage_window`` metadata (not its visibility)."""
-    return bool(_prim(prim_path).GetMetadata("hide_in_stage_window"))
+    """The prim's ``hide_in_stage_window`` flag (not its visibility)."""
+    return _kit_flag(_prim(prim_path), "hide_in_stage_window")
 
 
 def set_prim_hide_in_stage_window(prim: Usd.Prim, hide: bool) -> None:
-    """Set ``hide_in_stage_window`` metadata (Kit's stage window; no effect on rendering)."""
-    prim.SetMetadata("hide_in_stage_window", bool(hide))
+    """Set the ``hide_in_stage_window`` flag (Kit's stage window; no effect on rendering) in customData."""
+    prim.SetCustomDataByKey("hide_in_stage_window", bool(hide))
 
 
 def set_prim_no_delete(prim: Usd.Prim, no_delete: bool) -> None:
-    """Set ``no_delete`` metadata (``World.clear`` and ``Scene.remove_object`` then keep the prim)."""
-    prim.SetMetadata("no_delete", bool(no_delete))
+    """Set the ``no_delete`` flag (``World.clear`` and ``Scene.remove_object`` then keep the prim) in customData."""
+    prim.SetCustomDataByKey("no_delete", bool(no_delete))
 
 
 # ---- physics queries ----------------------------------------------------------------------------------------

@@ -35,7 +35,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 from graphsdg.compat import viewport
 from graphsdg.compat.kit import CarbSettings, Float3
 from graphsdg.compat.modules import CompatError, CompatModule
-from graphsdg.compat.rendering_manager import aim_camera
+from graphsdg.compat.rendering_manager import aim_camera, camera_edit_context
 from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.render.render_product import RenderProduct, registry
 from graphsdg.stage.context import get_stage
@@ -54,13 +54,14 @@ def set_camera_view(eye: Any, target: Any, camera_prim_path: str = "/OmniverseKi
     target = np.asarray(target, dtype=np.float64).reshape(3)
     up = 1 if UsdGeom.GetStageUpAxis(get_stage()) == UsdGeom.Tokens.y else 2
     across = [a for a in range(3) if a != up]
-    if np.allclose(eye[across], target[across]):   # straight down (identity) or straight up (half turn about Y)
-        set_world_pose(prim, position=eye, orientation=(1.0, 0.0, 0.0, 0.0) if target[up] < eye[up] else
-                       (0.0, 0.0, 1.0, 0.0))
-    else:
+    if not np.allclose(eye[across], target[across]):
         aim_camera(prim, eye, target)
-    prim.CreateAttribute("omni:kit:centerOfInterest", Sdf.ValueTypeNames.Vector3d, True,
-                         Sdf.VariabilityUniform).Set(Gf.Vec3d(0.0, 0.0, -float(np.linalg.norm(target - eye))))
+    with camera_edit_context(prim):
+        if np.allclose(eye[across], target[across]):   # straight down (identity) or up (half turn about Y)
+            set_world_pose(prim, position=eye, orientation=(1.0, 0.0, 0.0, 0.0) if target[up] < eye[up] else
+                           (0.0, 0.0, 1.0, 0.0))
+        prim.CreateAttribute("omni:kit:centerOfInterest", Sdf.ValueTypeNames.Vector3d, True,
+                             Sdf.VariabilityUniform).Set(Gf.Vec3d(0.0, 0.0, -float(np.linalg.norm(target - eye))))
 
 
 def get_viewport_names(usd_context_name: str | None = None) -> list[str]:

@@ -48,7 +48,7 @@ from graphsdg.compat.core_simulation_context import SimulationContext
 from graphsdg.compat.core_single_prims import SingleGeometryPrim, SingleRigidPrim, SingleXFormPrim
 from graphsdg.compat.core_types import DataFrame
 from graphsdg.compat.core_utils import add_reference_to_stage
-from graphsdg.compat.core_utils_prims import find_unique_string_name, is_prim_ancestral
+from graphsdg.compat.core_utils_prims import find_unique_string_name, is_prim_ancestral, is_prim_no_delete
 from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.compat.simulation_manager import IsaacEvents
@@ -227,7 +227,11 @@ class Scene(CompatObject):
                 while prim and prim.GetParent() and not prim.GetParent().IsPseudoRoot() and \
                         is_prim_ancestral(str(prim.GetPath())) and len(prim.GetParent().GetChildren()) == 1:
                     prim = prim.GetParent()
-                if prim and prim.IsValid() and not is_prim_ancestral(str(prim.GetPath())):
+                path = str(prim.GetPath()) if prim else ""
+                if prim and prim.IsValid() and not is_prim_ancestral(path):
+                    if is_prim_no_delete(path):   # Kit's delete command keeps these too
+                        log.warning(f"{path} is marked no_delete; it stays on the stage")
+                        continue
                     stage.RemovePrim(prim.GetPath())
         self._scene_registry.remove_object(name)
 

@@ -207,9 +207,23 @@ def _up_vector() -> np.ndarray:
         np.array([0.0, 0.0, 1.0])
 
 
+def camera_edit_context(prim: Usd.Prim) -> Usd.EditContext:
+    """Where a camera's pose is authored: the session layer for a camera defined there (Kit's viewport cameras,
+    whose session opinions would hide a root-layer edit), else the stage's edit target."""
+    stage = prim.GetStage()
+    session = stage.GetSessionLayer()
+    target = session if session.GetPrimAtPath(prim.GetPath()) is not None else stage.GetEditTarget()
+    return Usd.EditContext(stage, target)
+
+
 def aim_camera(prim: Usd.Prim, eye: np.ndarray | None, target: np.ndarray | None) -> None:
     """Move the camera to world ``eye`` (orientation kept) and / or turn it to look at world ``target`` with the
     stage's up axis up; a target straight along the up axis is nudged 1e-5 sideways, as Kit does."""
+    with camera_edit_context(prim):
+        _aim(prim, eye, target)
+
+
+def _aim(prim: Usd.Prim, eye: np.ndarray | None, target: np.ndarray | None) -> None:
     if eye is not None:
         set_world_pose(prim, position=eye)
     if target is not None:
@@ -344,7 +358,8 @@ class ViewportManager:
             update_coi = True
         aim_camera(prim, eye, target)
         if update_coi:
-            coi.Set(Gf.Vec3d(*target.tolist()))
+            with camera_edit_context(prim):
+                coi.Set(Gf.Vec3d(*target.tolist()))
 
 
 def modules() -> list[types.ModuleType]:

@@ -419,6 +419,19 @@ class SimulationManager:
         """The requested device as a string (``"cpu"`` or ``"cuda:N"``)."""
         return cls._device.alias
 
+    _backend = "numpy"
+
+    @classmethod
+    def set_backend(cls, val: str) -> None:
+        """Record the tensor backend of Isaac's deprecated core API; graphsdg's runs ``numpy`` only, and its views
+        and ``World`` raise when made under another (graphsdg.compat.core_simulation_context)."""
+        cls._backend = str(val)
+
+    @classmethod
+    def get_backend(cls) -> str:
+        """The backend :meth:`set_backend` recorded (``numpy`` by default)."""
+        return cls._backend
+
     @classmethod
     def enable_fabric(cls, enable: bool) -> None:
         """Record Fabric on or off; graphsdg writes physics results to USD after every step either way."""
