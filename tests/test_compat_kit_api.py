@@ -236,3 +236,23 @@ def test_uninstall_unhooks_the_simulation_manager_from_plain_graphsdg():
     timeline.play()
     timeline.stop()
     assert not [p for p in rep.stage.get_stage().Traverse() if p.GetTypeName() == "PhysicsScene"]
+
+
+def test_the_context_stage_has_an_id_in_usd_stage_cache():
+    from pxr import UsdUtils
+
+    from graphsdg.compat import isaac
+    isaac.install()
+    try:
+        import omni.usd
+        context = omni.usd.get_context()
+        context.new_stage()
+        first = context.get_stage()
+        first_id = UsdUtils.StageCache.Get().GetId(first).ToLongInt()
+        assert first_id > 0
+        context.new_stage()
+        second = context.get_stage()
+        assert UsdUtils.StageCache.Get().GetId(second).ToLongInt() > 0
+        assert not UsdUtils.StageCache.Get().Contains(first)   # a closed stage leaves the cache
+    finally:
+        isaac.uninstall()
