@@ -192,5 +192,6 @@ def test_warning_shows_for_imports_outside_main(tmp_path):
             "import helper_one, helper_two; isaac.uninstall()")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
-    lines = [line for line in done.stderr.splitlines() if "IsaacDeprecationWarning: omni.isaac.core.utils.prims " in line]
+    notice = "IsaacDeprecationWarning: omni.isaac.core.utils.prims "
+    lines = [line for line in done.stderr.splitlines() if notice in line]
     assert len(lines) == 1 and "helper_one.py:1" in lines[0] and "isaacsim.core.utils.prims" in lines[0]

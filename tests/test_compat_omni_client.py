@@ -163,3 +163,12 @@ def test_live_features_fail_clearly(client):
     from graphsdg.compat.modules import CompatError
     with pytest.raises(CompatError, match="omni.client.live_process is not available.*Nucleus server"):
         client.live_process()
+
+
+def test_docstring_examples():
+    import doctest
+
+    from graphsdg.compat import omni_client, omni_client_urls
+    for module in (omni_client, omni_client_urls):
+        result = doctest.testmod(module)
+        assert result.failed == 0 and result.attempted > 0, module.__name__

@@ -183,7 +183,8 @@ def test_usd_reference_checks(native, scene_tree):
     external = asyncio.run(native.find_external_references(str(scene_tree)))
     assert external == {scene: [lamp]}
     counts = asyncio.run(native.count_asset_references(str(scene_tree)))
-    assert counts[str(scene_tree / "parts" / "box.usda")] == 1 and counts[str(scene_tree / "parts" / "unused.usda")] == 0
+    assert counts[str(scene_tree / "parts" / "box.usda")] == 1
+    assert counts[str(scene_tree / "parts" / "unused.usda")] == 0
 
 
 def test_old_homes(native):

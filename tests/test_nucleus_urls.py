@@ -194,3 +194,10 @@ def test_texture_urls_resolve_for_the_compiler():
     file_input.Set(Sdf.AssetPath(MISSING))
     with pytest.raises(NucleusUnavailableError):
         texture_file_path(file_input)
+
+
+def test_docstring_example():
+    import doctest
+
+    import graphsdg.assets.nucleus as module
+    assert doctest.testmod(module).failed == 0

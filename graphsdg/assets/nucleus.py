@@ -24,8 +24,9 @@ becomes its local file, anything else passes through unchanged.
 
 Example:
     >>> from graphsdg.assets.nucleus import local_path
-    >>> local_path("omniverse://localhost/NVIDIA/Assets/Isaac/4.5/Isaac/Environments/Simple_Warehouse/"
-    ...            "Props/SM_PaletteA_01.usd").endswith("/pack/Isaac/Environments/Simple_Warehouse/Props/SM_PaletteA_01.usd")
+    >>> path = local_path("omniverse://localhost/NVIDIA/Assets/Isaac/4.5/Isaac/Environments/Simple_Warehouse/"
+    ...                   "Props/SM_PaletteA_01.usd")
+    >>> path.endswith("/pack/Isaac/Environments/Simple_Warehouse/Props/SM_PaletteA_01.usd")
     True
 """
 from __future__ import annotations

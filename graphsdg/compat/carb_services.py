@@ -41,7 +41,7 @@ from graphsdg.compat.modules import PORTING, CompatError, CompatModule, CompatOb
 
 log = logging.getLogger("carb")
 
-# ---- carb.tokens ------------------------------------------------------------------------------------------------------
+# ---- carb.tokens ----------------------------------------------------------------------------------------------------
 RESOLVE_FLAG_NONE = 0
 RESOLVE_FLAG_LEAVE_TOKEN_IF_NOT_FOUND = 1
 _TOKEN = re.compile(r"\$\$|\$\{([^}]*)\}")

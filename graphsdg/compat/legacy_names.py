@@ -105,8 +105,8 @@ class LegacyModule(types.ModuleType):
     """One of Isaac's pre-4.5 module names, answering each attribute from the module that replaced it."""
 
     def __init__(self, name: str, kind: str, data: Any) -> None:
-        super().__init__(name, f"Isaac Sim's pre-4.5 name {name} (graphsdg compat mode; "
-                               f"{'a package of old names' if kind == 'namespace' else 'now ' + _new_names(kind, data)}).")
+        now = "a package of old names" if kind == "namespace" else "now " + _new_names(kind, data)
+        super().__init__(name, f"Isaac Sim's pre-4.5 name {name} (graphsdg compat mode; {now}).")
         self.__path__: list[str] = []   # a package, so the old submodules import
         self._kind, self._data = kind, data
 

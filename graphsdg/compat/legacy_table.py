@@ -182,8 +182,10 @@ NAMES: dict[str, dict[str, str]] = {
     "omni.isaac.sensor.lidar_rtx": {"LidarRtx": "isaacsim.sensors.rtx:LidarRtx"},
     "omni.isaac.sensor.rotating_lidar_physX": {"RotatingLidarPhysX": "isaacsim.sensors.physx:RotatingLidarPhysX"},
     "omni.isaac.proximity_sensor.extension": {
-        "Sensor": "isaacsim.sensors.physx:ProximitySensor", "SensorManager": "isaacsim.sensors.physx:ProximitySensorManager",
-        "clear_sensors": "isaacsim.sensors.physx:clear_sensors", "register_sensor": "isaacsim.sensors.physx:register_sensor"},
+        "Sensor": "isaacsim.sensors.physx:ProximitySensor",
+        "SensorManager": "isaacsim.sensors.physx:ProximitySensorManager",
+        "clear_sensors": "isaacsim.sensors.physx:clear_sensors",
+        "register_sensor": "isaacsim.sensors.physx:register_sensor"},
     "omni.isaac.occupancy_map.bindings": {"_occupancy_map": "isaacsim.asset.gen.omap.bindings:_omap"},
     # domain randomization and writers left omni.replicator.isaac
     "omni.replicator.isaac": {
@@ -200,7 +202,8 @@ NAMES: dict[str, dict[str, str]] = {
 REMOVED: dict[str, str] = {
     "omni.isaac.dynamic_control": "Isaac Sim 4.5 deprecated it without a replacement (its articulation and rigid-body "
                                   "handles became isaacsim.core.prims' views)",
-    "omni.isaac.physics_inspector": "Isaac Sim 4.2 replaced it by PhysX's visualization tools, which have no Python API",
+    "omni.isaac.physics_inspector": "Isaac Sim 4.2 replaced it by PhysX's visualization tools, which have no Python "
+                                    "API",
     "omni.isaac.examples_nodes": "Isaac Sim 4.5 deprecated it without a replacement",
 }
 
