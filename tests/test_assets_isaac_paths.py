@@ -468,9 +468,11 @@ def test_worker_and_anim_cameras_stage_holds_the_warehouse_a_walking_worker_and_
     worker = UsdGeom.Xformable(stage.GetPrimAtPath("/World/Worker"))
     translate = stage.GetPrimAtPath("/World/Worker").GetAttribute("xformOp:translate")
     assert translate.GetNumTimeSamples() >= 10
-    np.testing.assert_allclose(translate.Get(), (-4.0, 6.5, 0.0))                # default: the first pose
-    np.testing.assert_allclose(translate.Get(300.0), (4.0, 6.5, 0.0), atol=1e-6)  # the far end half-way
-    assert worker_pose(450.0)[0][0] == pytest.approx(0.0) and worker_pose(450.0)[1] == pytest.approx(180.0)
+    np.testing.assert_allclose(translate.Get(), (-1.0, 5.5, 0.0))                # default: the first pose
+    np.testing.assert_allclose(translate.Get(300.0), (6.0, 5.5, 0.0), atol=1e-6)  # the far end half-way
+    assert worker_pose(450.0)[0][0] == pytest.approx(2.5) and worker_pose(450.0)[1] == pytest.approx(180.0)
+    # in view of the Cosmos example's robot camera at (-6, 4) looking along +X (41 degrees either side)
+    assert math.degrees(math.atan2(5.5 - 4.0, -1.0 + 6.0)) < 35.0
     lo, hi = _bounds(stage.GetPrimAtPath("/World/Worker"))
     assert hi[2] - lo[2] == pytest.approx(1.75, abs=1e-3)
     for name in ("AnimCamera_01", "AnimCamera_02"):

@@ -1,16 +1,17 @@
 """Stand-in for Replicator's sample stage ``/Isaac/Samples/Replicator/Stage/full_warehouse_worker_and_anim_cameras.usd``.
 
 The stage the Cosmos warehouse example opens: the full warehouse with a worker
-walking an aisle and two animated cameras. Its default prim ``/World`` holds
+walking across the main floor and two animated cameras. Its default prim ``/World`` holds
 
 * ``Warehouse``: a reference to ``Simple_Warehouse/full_warehouse.usd``;
 * ``Worker``: a 1.75 m figure in a hi-vis vest (legs, torso, arms, head and
-  hard hat, one mesh each) walking back and forth between ``x = -4`` and
-  ``x = 4`` along ``y = 6.5`` (time samples on ``xformOp:translate`` and
-  ``xformOp:rotateZ``, 0 to 600 at 60 time codes per second; the default
-  values are the first pose);
-* ``Cameras/AnimCamera_01`` (dollies along the aisle looking at the worker's
-  path) and ``Cameras/AnimCamera_02`` (circles the main floor looking at its
+  hard hat, one mesh each) walking back and forth between ``x = -1`` and
+  ``x = 6`` along ``y = 5.5`` (time samples on ``xformOp:translate`` and
+  ``xformOp:rotateXYZ``, 0 to 600 at 60 time codes per second; the default
+  values are the first pose, in view of a robot camera at ``(-6, 4)`` looking
+  along +X);
+* ``Cameras/AnimCamera_01`` (dollies along the worker's path, looking at it)
+  and ``Cameras/AnimCamera_02`` (circles the main floor looking at its
   middle), also time-sampled with their first pose as default.
 
 The Cosmos example drives its own robot camera; the walking worker gives its
@@ -37,7 +38,7 @@ SAMPLE_PATH = "/Isaac/Samples/Replicator/Stage/full_warehouse_worker_and_anim_ca
 WORKER_PATH = "/Isaac/Samples/Replicator/Stage/Props/warehouse_worker.usd"
 WORKER_HEIGHT = 1.75
 END_TIME = 600.0
-WALK = ((-4.0, 6.5), (4.0, 6.5))          # the worker's aisle, walked there and back over END_TIME
+WALK = ((-1.0, 5.5), (6.0, 5.5))          # the worker's path, walked there and back over END_TIME
 
 
 def worker_parts() -> list[Part]:
@@ -71,7 +72,7 @@ def build_worker(root: str) -> list[str]:
 
 
 def worker_pose(frame: float) -> tuple[tuple[float, float, float], float]:
-    """The worker's position and heading (degrees about Z) at ``frame``: out along the aisle, then back."""
+    """The worker's position and heading (degrees about Z) at ``frame``: out along its path, then back."""
     (x0, y0), (x1, y1) = WALK
     u = (frame % END_TIME) / END_TIME * 2.0
     if u <= 1.0:
@@ -105,8 +106,8 @@ def build_sample_stage(root: str) -> list[str]:
     UsdGeom.Scope.Define(stage, "/World/Cameras")
     dolly = UsdGeom.Camera.Define(stage, "/World/Cameras/AnimCamera_01")
     dolly.CreateFocalLengthAttr(18.0)
-    # looking at the aisle from its south side, level, sliding from x = -5 to 5
-    _animate(dolly, [(f, (-5.0 + 10.0 * f / END_TIME, 0.5, 1.8), (85.0, 0.0, 0.0)) for f in (0.0, END_TIME)])
+    # looking at the worker's path from its south side, nearly level, sliding from x = -3 to 7
+    _animate(dolly, [(f, (-3.0 + 10.0 * f / END_TIME, 0.5, 1.8), (85.0, 0.0, 0.0)) for f in (0.0, END_TIME)])
     orbit = UsdGeom.Camera.Define(stage, "/World/Cameras/AnimCamera_02")
     orbit.CreateFocalLengthAttr(18.0)
     poses = []
@@ -122,7 +123,7 @@ def build_sample_stage(root: str) -> list[str]:
 
 ASSETS: list[UsdAsset] = [
     UsdAsset("full_warehouse_worker_and_anim_cameras", SAMPLE_PATH, (36.6, 44.6, 8.4),
-             "full_warehouse.usd with a walking worker (time-sampled along an aisle) and two animated cameras "
+             "full_warehouse.usd with a walking worker (time-sampled across the main floor) and two animated cameras "
              "(Cameras/AnimCamera_01 dollies, AnimCamera_02 circles)", build_sample_stage),
 ]
 
