@@ -199,3 +199,20 @@ class Helper:
             omni.kit.commands.register(CreatePrimCommand)
     finally:
         del sys.modules[module.__name__]
+
+
+def test_omni_usd_commands_classes_run_the_built_in_commands(stage):
+    import omni.kit.commands
+    import omni.usd.commands
+    UsdGeom.Cube.Define(stage, "/World/A")
+    UsdGeom.Cube.Define(stage, "/World/B")
+    omni.usd.commands.DeletePrimsCommand(["/World/A"]).do()
+    assert not stage.GetPrimAtPath("/World/A") and stage.GetPrimAtPath("/World/B")
+    omni.usd.commands.MovePrimCommand(path_from="/World/B", path_to="/World/C").do()
+    assert stage.GetPrimAtPath("/World/C") and not stage.GetPrimAtPath("/World/B")
+    command = omni.kit.commands.create("ChangePropertyCommand", prop_path="/World/C.size", value=4.0, prev=None)
+    assert isinstance(command, omni.usd.commands.ChangePropertyCommand)
+    command.do()
+    assert stage.GetPrimAtPath("/World/C").GetAttribute("size").Get() == 4.0
+    with pytest.raises(TypeError, match="MovePrimCommand: .*path_to"):
+        omni.usd.commands.MovePrimCommand(path_from="/World/C")

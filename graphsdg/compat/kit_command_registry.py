@@ -8,7 +8,8 @@ keyword arguments and ``do()``'s result comes back as ``(True, result)``. A clas
 registers under its name less a ``Command`` suffix; either spelling executes it,
 as in Kit. :func:`create` builds a command (registered or one of graphsdg's
 built-in Kit commands, :mod:`graphsdg.compat.kit_commands`) for the caller to
-``do()`` itself. There is no undo stack here: ``undo()`` is the command's own
+``do()`` itself; ``omni.usd.commands`` holds the built-in ones as classes
+(``omni.usd.commands.DeletePrimsCommand(["/World/Cube"]).do()``). There is no undo stack here: ``undo()`` is the command's own
 method, called by whoever holds the command.
 
 Example:
@@ -35,7 +36,7 @@ import inspect
 import types
 from typing import Any
 
-from graphsdg.compat.kit import execute
+from graphsdg.compat.kit import delete_prims, execute
 from graphsdg.compat.kit_commands import COMMANDS
 from graphsdg.compat.modules import CompatError, CompatModule
 
@@ -143,28 +144,42 @@ def get_commands_list() -> list[type[Command]]:
     return list(_registered.values())
 
 
-class BuiltinCommand(Command):
-    """One of graphsdg's built-in Kit commands with its arguments, as :func:`create` returns it."""
+def _builtin_class(name: str, fn: Any) -> type[Command]:
+    """A ``Command`` class for one of graphsdg's built-in Kit commands: its constructor takes the command's
+    arguments (checked against its signature at once), ``do()`` runs it."""
+    signature = inspect.signature(fn)
 
-    def __init__(self, name: str, kwargs: dict[str, Any]) -> None:
-        self.name = name
-        self.kwargs = dict(kwargs)
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        try:
+            self._arguments = signature.bind(*args, **kwargs)
+        except TypeError as exc:
+            raise TypeError(f"{name}Command: {exc}") from None
 
     def do(self) -> Any:
-        """Run the command (``omni.kit.commands.execute``'s result without the success flag)."""
-        return execute(self.name, **self.kwargs)[1]
+        return fn(*self._arguments.args, **self._arguments.kwargs)
+
+    return type(f"{name}Command", (Command,), {"__init__": __init__, "do": do, "__doc__": fn.__doc__,
+                                                "__module__": __name__})
+
+
+# graphsdg's built-in Kit commands as classes (``omni.usd.commands.DeletePrimsCommand([path]).do()``)
+BUILTIN_CLASSES: dict[str, type[Command]] = {name: _builtin_class(name, fn) for name, fn in
+                                             {**COMMANDS, "DeletePrims": delete_prims}.items()}
+# the commands Kit's omni.usd.commands module defines (the others come from omni.kit.primitive.mesh and
+# omni.kit.material.library)
+OMNI_USD_COMMANDS = ("CreatePrim", "CreatePrimWithDefaultXform", "ChangeProperty", "CreateReference", "AddReference",
+                     "MovePrim", "MovePrims", "CopyPrim", "CopyPrims", "TransformPrim", "TransformPrimSRT",
+                     "DeletePrims", "CreateMdlMaterialPrim", "BindMaterial")
 
 
 def create(name: str, **kwargs: Any) -> Command:
     """A command object for ``name`` with ``kwargs``, not yet run (call its ``do()``)."""
-    command_class = get_command_class(name)
-    if command_class is not None:
-        return command_class(**kwargs)
-    if not any(key in COMMANDS for key in (name, name.removesuffix("Command"))) and \
-            name.removesuffix("Command") != "DeletePrims":
+    command_class = get_command_class(name) or BUILTIN_CLASSES.get(name) or \
+        BUILTIN_CLASSES.get(name.removesuffix("Command"))
+    if command_class is None:
         raise CompatError(f"omni.kit.commands {name!r} is not available in graphsdg's compat mode; available: "
-                          f"{', '.join(sorted({*COMMANDS, 'DeletePrims'}))}. See docs/porting.md.")
-    return BuiltinCommand(name, kwargs)
+                          f"{', '.join(sorted({*BUILTIN_CLASSES, *_registered}))}. See docs/porting.md.")
+    return command_class(**kwargs)
 
 
 def modules() -> list[types.ModuleType]:
@@ -172,4 +187,5 @@ def modules() -> list[types.ModuleType]:
     return [CompatModule("omni.kit.commands", Command=Command, register=register, unregister=unregister,
                          register_all_commands_in_module=register_all_commands_in_module,
                          unregister_module_commands=unregister_module_commands, create=create,
-                         get_command_class=get_command_class, get_commands_list=get_commands_list)]
+                         get_command_class=get_command_class, get_commands_list=get_commands_list),
+            CompatModule("omni.usd.commands", **{f"{name}Command": BUILTIN_CLASSES[name] for name in OMNI_USD_COMMANDS})]
