@@ -21,6 +21,10 @@ from graphsdg.render.gl_platform import select_gl_platform
 
 select_gl_platform()   # before anything imports mujoco
 
+from graphsdg.sensors.usd_schemas import register_sensor_schemas  # noqa: E402
+
+register_sensor_schemas()   # before anything makes a stage: USD builds its schema registry once
+
 from graphsdg import (annotators, backends, functional, orchestrator, rng, settings,  # noqa: E402
                       stage, writers)
 from graphsdg import augmentations_default  # noqa: E402  (rep.augmentations_default; registers RgbToHsv, ...)

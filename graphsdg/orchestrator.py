@@ -14,6 +14,8 @@ import sys
 import time
 from typing import Any, Callable
 
+from pxr import UsdGeom
+
 from graphsdg import settings_store as settings
 from graphsdg.jobs import interrupts
 from graphsdg.benchmark import profiling
@@ -33,6 +35,7 @@ from graphsdg.render.attachments import attachments
 from graphsdg.render.backend import RenderRequest
 from graphsdg.render.camera import CameraView, camera_view, read_lens
 from graphsdg.runtime import runtime
+from graphsdg.sensors.sensor_view import sensor_camera_view
 from graphsdg.stage.context import stage_context
 from graphsdg.stage.prims import prim_facts
 
@@ -208,6 +211,8 @@ def _camera_view(rt, rp) -> CameraView:
     read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
     sim = rt.sim
+    if not prim.IsA(UsdGeom.Camera):   # a lidar / radar product: its annotators read scans (graphsdg.sensors)
+        return sensor_camera_view(prim, rp.width, rp.height, sim.world_transforms.meters_per_unit())
     lens = sim.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
     return camera_view(prim, rp.width, rp.height, world=sim.camera_poses.world(prim), lens=lens,
                        meters_per_unit=sim.world_transforms.meters_per_unit())
@@ -249,12 +254,13 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
     views: list[CameraView] = []
     requests: list[RenderRequest | None] = []
     for rp, annotators in products.values():
-        sim.require_offscreen(rp.width, rp.height)
         with profiling.timed("render:camera"):
             view = _camera_view(rt, rp)
         passes: set[str] = set()
         for a in annotators:
             passes |= a.spec.passes
+        if passes:   # products whose annotators read no pixels (a lidar's) need no framebuffer
+            sim.require_offscreen(rp.width, rp.height)
         motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
         views.append(view)
         requests.append(RenderRequest(view, passes, subframes, defer, motion) if passes else None)

@@ -102,6 +102,13 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                    "mode (above 1: the whole step)"),
     "/rtx/post/motionblur/maxBlurDiameterFraction": (0.02, "longest motion-blur smear, as a fraction of the image's "
                                                            "larger side, outside PathTracing mode"),
+    # ray-cast sensors (graphsdg.sensors, docs/sensors.md)
+    "/graphsdg/sensors/rayBackend": ("auto", "where lidar and radar rays are cast: cpu (mj_multiRay on threads), "
+                                             "gpu (MuJoCo Warp on a CUDA GPU; pip install 'graphsdg[gpu]') or auto "
+                                             "(gpu where it can run, else cpu)"),
+    "/graphsdg/sensors/rayThreads": (0, "threads the cpu ray backend casts on; 0: one per core"),
+    "/rtx/materialDb/nonVisualMaterialSemantics/prefix": ("omni:simready:nonvisual", "attribute prefix of the "
+                                                          "non-visual material labels lidar and radar read"),
 }
 
 def _integer(minimum: int, none_ok: bool = False) -> Callable[[str, Any], None]:
@@ -195,6 +202,8 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/app/player/timelineSubsampleRate": _integer(1),
     "/app/player/playSimulations": _boolean,
     "/syntheticdata/sensors/perSubsetSegmentation": _boolean,
+    "/graphsdg/sensors/rayBackend": _choice("cpu", "gpu", "auto"),
+    "/graphsdg/sensors/rayThreads": _integer(0),
 }
 
 _values: dict[str, Any] = {}

@@ -18,7 +18,7 @@ import graphsdg
 PACKAGE_DIR = Path(graphsdg.__file__).resolve().parent
 
 #: The engine: the stage, the simulation, rendering, annotation, image maths.
-ENGINE_ROOMS = ("sim", "stage", "render", "annotate", "imaging")
+ENGINE_ROOMS = ("sim", "stage", "render", "annotate", "imaging", "sensors")
 
 #: What is built on the engine: the runtime and orchestrator, the immediate-mode and graph APIs, Isaac's
 #: physics API, compat mode, and the top-level faces of Replicator's API.

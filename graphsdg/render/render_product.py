@@ -13,6 +13,7 @@ from pxr import Usd, UsdGeom
 
 from graphsdg import settings_store as settings
 from graphsdg.errors import InvalidPrimError, RenderProductDestroyedError
+from graphsdg.sensors.usd_schemas import SENSOR_PRIM_TYPES
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prim, structure_version
 
@@ -74,9 +75,9 @@ class RenderProduct:
         if kept is not None and kept[0] == id(stage) and kept[1] == self.camera and kept[2] == version:
             return kept[3]
         prim = stage.GetPrimAtPath(self.camera)
-        if not prim or not prim.IsA(UsdGeom.Camera):
+        if not prim or not is_product_source(prim):
             raise InvalidPrimError(f"render product {self.name!r}: camera {self.camera!r} no longer exists "
-                                   f"or is not a Camera")
+                                   f"or is not a Camera (or a lidar / radar)")
         # the stage by id: holding it would keep its layers, and the edits in them, alive after it is closed
         self._camera_prim = (id(stage), self.camera, version, prim)
         return prim
@@ -176,6 +177,12 @@ def _scaled(resolution: tuple[int, int]) -> tuple[int, int]:
     return max(1, round(resolution[0] * scale)), max(1, round(resolution[1] * scale))
 
 
+def is_product_source(prim: Usd.Prim) -> bool:
+    """Whether a render product can be made of ``prim``: a ``UsdGeom.Camera``, or a ray-cast sensor (``OmniLidar``,
+    ``OmniRadar``: its product's annotators read the sensor's scans, docs/sensors.md)."""
+    return prim.IsA(UsdGeom.Camera) or prim.GetTypeName() in SENSOR_PRIM_TYPES
+
+
 def _camera_path(camera: object) -> str:
     if hasattr(camera, "get_output_prims"):  # a graph item wrapping a camera node
         prims = camera.get_output_prims()["prims"]
@@ -183,9 +190,9 @@ def _camera_path(camera: object) -> str:
             raise InvalidPrimError(f"render product camera item yields {len(prims)} prims; expected one camera")
         camera = prims[0]
     prim = resolve_prim(camera)  # type: ignore[arg-type]
-    if not prim.IsA(UsdGeom.Camera):
+    if not is_product_source(prim):
         raise InvalidPrimError(f"render product camera {str(prim.GetPath())!r} is a {prim.GetTypeName() or 'typeless'} "
-                               f"prim, not a UsdGeom.Camera")
+                               f"prim, not a UsdGeom.Camera (or an OmniLidar / OmniRadar sensor)")
     return str(prim.GetPath())
 
 
