@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -76,6 +77,10 @@ def compat_rep():
         yield importlib.import_module("omni.replicator.core")
     finally:
         isaac.uninstall()
+        # submodules imported by their dotted path (omni.replicator.core.example) are wrapped on first import,
+        # outside the installed table uninstall() clears: drop them so later tests start with no omni.* module
+        for name in [n for n in sys.modules if n.split(".")[0] in ("omni", "carb", "isaacsim")]:
+            del sys.modules[name]
 
 
 def _all_names():
