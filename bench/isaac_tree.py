@@ -207,7 +207,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", choices=("scripts", "tests", "all"), default="all")
     parser.add_argument("--match", default="", help="run only files whose path contains this text")
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds per file")
-    parser.add_argument("--resolution-scale", type=float, default=0.125)
+    parser.add_argument("--resolution-scale", type=float, default=0.125,
+                        help="scripts' render products at this fraction of their resolution (default 0.125)")
+    parser.add_argument("--test-resolution-scale", type=float, default=1.0,
+                        help="tests' render products at this fraction (default 1: tests read resolutions back)")
     parser.add_argument("--markdown", type=Path, help="write the table to this file")
     args = parser.parse_args(argv)
     source = args.isaac / "source"
@@ -221,7 +224,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.only in ("tests", "all"):
         for test in tests:
             if args.match in str(test):
-                outcomes.append(run_test_file(source, test, args.out, args.timeout, args.resolution_scale))
+                outcomes.append(run_test_file(source, test, args.out, args.timeout, args.test_resolution_scale))
                 print(outcomes[-1].line(), flush=True)
     for kind, label in (("script", "scripts"), ("tests", "tests")):
         chosen = [o for o in outcomes if o.kind == kind and o.scope == "in"]
