@@ -33,7 +33,7 @@ Example:
 from __future__ import annotations
 
 import types
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, Vt

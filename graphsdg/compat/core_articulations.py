@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import logging
 import types
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 from pxr import Sdf

@@ -25,7 +25,9 @@ import numpy as np
 from pxr import Usd, UsdGeom
 
 from graphsdg.compat.core_materials import PhysicsMaterial, VisualMaterial
-from graphsdg.compat.core_prims import GeometryPrim, RigidPrim, XFormPrim
+from graphsdg.compat.core_geometry_prims import GeometryPrim
+from graphsdg.compat.core_prims import XFormPrim
+from graphsdg.compat.core_rigid_prims import RigidPrim
 from graphsdg.compat.core_types import DynamicState, XFormPrimState
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.stage.context import get_stage

@@ -43,7 +43,9 @@ from pxr import Sdf, Usd, UsdGeom
 from graphsdg.compat.core_articulations import Articulation, Robot, SingleArticulation
 from graphsdg.compat.core_materials import PhysicsMaterial
 from graphsdg.compat.core_objects import GroundPlane
-from graphsdg.compat.core_prims import GeometryPrim, RigidPrim, XFormPrim
+from graphsdg.compat.core_geometry_prims import GeometryPrim
+from graphsdg.compat.core_prims import XFormPrim
+from graphsdg.compat.core_rigid_prims import RigidPrim
 from graphsdg.compat.core_simulation_context import SimulationContext
 from graphsdg.compat.core_single_prims import SingleGeometryPrim, SingleRigidPrim, SingleXFormPrim
 from graphsdg.compat.core_types import DataFrame
