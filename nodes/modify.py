@@ -11,7 +11,7 @@ from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port, flatten_prims
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
-from graphsdg.graph.value_shapes import SCALAR, SCALAR_OR_VEC3, WHOLE, attribute_shapes
+from graphsdg.graph.value_shapes import SCALAR, SCALAR_OR_VEC3, WHOLE, attribute_shapes, spread_rows
 from graphsdg.maths.rotations import decompose, matrix_to_euler_xyz
 from graphsdg.physics.timeline import get_timeline_interface
 from graphsdg.render.render_product import registry as render_products
@@ -25,10 +25,13 @@ POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
 def pose_rows(ctx: ExecContext, port: str, n: int) -> np.ndarray | None:
     """Pose port ``port`` as ``(n, 3)`` rows: one value (a number fills x, y and z) or one per prim, plain or
     drawn (:mod:`graphsdg.graph.value_shapes`)."""
-    values = ctx.per_prim(port, n, SCALAR_OR_VEC3)
-    if values is None:
+    if not ctx.given(port):
         return None
-    return np.array([np.broadcast_to(np.asarray(v, dtype=np.float64), (3,)) for v in values])
+    value = ctx.value(port)
+    rows = spread_rows(value, n, 3, f"{ctx.node.type_name} {port}")
+    if isinstance(value, Samples):
+        ctx.record(port, rows)
+    return rows
 
 
 def look_at_points(value: Any, n: int) -> Any:

@@ -131,6 +131,23 @@ def spread(value: Any, n: int, shapes: Sequence[Shape] | None, what: str) -> lis
     return spread_value(value, n, shapes, what)
 
 
+def spread_rows(value: Any, n: int, width: int, what: str) -> np.ndarray:
+    """A numeric per-prim value as ``(n, width)`` float rows, by the same shapes (a number fills its row).
+
+    A distribution drawing one number or one ``width``-vector per prim is read straight from its draws (no
+    per-prim Python objects: graphs with thousands of prims stay cheap); every other shape goes through
+    :func:`spread`.
+    """
+    if isinstance(value, Samples) and not value.per_execution:
+        first = np.asarray(value.one())
+        if first.dtype.kind in "biuf" and first.shape in ((), (width,)):
+            drawn = np.asarray(value.take(n), dtype=np.float64)
+            drawn = drawn[:n] if drawn.shape[0] >= n else np.repeat(drawn[:1], n, axis=0)
+            return np.repeat(drawn[:, None], width, axis=1) if drawn.ndim == 1 else drawn
+    values = spread(value, n, ((), (width,)), what)
+    return np.array([np.broadcast_to(np.asarray(v, dtype=np.float64), (width,)) for v in values])
+
+
 def _shape_names(shapes: Sequence[Shape]) -> str:
     names = {(): "a scalar", (2,): "(a, b)", (3,): "(x, y, z)", (4,): "(a, b, c, d)"}
     return " or ".join(names.get(tuple(s), str(tuple(s))) for s in shapes)
@@ -150,4 +167,4 @@ def attribute_shapes(type_name: Sdf.ValueTypeName | None) -> tuple[Shape, ...] |
 
 
 __all__ = ["Shape", "SCALAR", "VEC2", "VEC3", "SCALAR_OR_VEC3", "WHOLE", "value_shape", "spread_value", "spread_samples",
-           "spread", "attribute_shapes"]
+           "spread", "spread_rows", "attribute_shapes"]

@@ -197,16 +197,17 @@ def _camera_path(camera: object) -> str:
 
 
 def _item_cameras(item: object) -> list[Usd.Prim]:
-    """The cameras of a graph item: each prim that is a camera, else the cameras below it (Replicator's Xform
-    wrappers and stereo rigs)."""
+    """The cameras (and sensors) of a graph item: each prim a product can be made of, else those below it
+    (Replicator's Xform wrappers and stereo rigs)."""
     cameras: list[Usd.Prim] = []
     for prim in item.get_output_prims()["prims"]:  # type: ignore[attr-defined]
-        if prim.IsA(UsdGeom.Camera):
+        if is_product_source(prim):
             cameras.append(prim)
         else:
-            cameras += [p for p in Usd.PrimRange(prim) if p.IsA(UsdGeom.Camera)]
+            cameras += [p for p in Usd.PrimRange(prim) if is_product_source(p)]
     if not cameras:
-        raise InvalidPrimError(f"render product camera item {item!r} holds no UsdGeom.Camera prim")
+        raise InvalidPrimError(f"render product camera item {item!r} holds no UsdGeom.Camera prim (or OmniLidar / "
+                               f"OmniRadar sensor)")
     return cameras
 
 
