@@ -65,6 +65,7 @@ class EpisodeRecorder(episodes.EpisodeRecorder):
     """``EpisodeRecorder``: graphsdg's recorder listening to the carb command bus while its session is open."""
 
     _command_guard: Any = None
+    _tick = episodes.EpisodeRecorder.tick   # Isaac's name of one sampling tick (its tests drive it by hand)
 
     def open_session(self, output_path: str | None = None) -> str:
         path = super().open_session(output_path)

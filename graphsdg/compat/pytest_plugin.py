@@ -58,6 +58,38 @@ def pytest_collect_file(file_path: Path, parent):
     return None
 
 
+def stand_in_source_packages(test_file: Path) -> list[str]:
+    """Empty packages in ``sys.modules`` for the source folders with an ``__init__.py`` above ``test_file``.
+
+    pytest's importlib mode imports a test file inside a package as part of it (``python.tests.test_x`` for an
+    extension's ``python/tests/test_x.py``), running each package's ``__init__.py`` first. In Kit those packages are
+    the extension's own modules; in compat mode the extension's modules are graphsdg's, so its source
+    ``__init__.py`` files (which import the extension's implementation, UI included) must not run: each package is
+    stood in by an empty module whose ``__path__`` is its folder, so relative imports between test files still
+    work. Returns the names stood in.
+    """
+    import types
+    folders = []
+    folder = test_file.resolve().parent
+    while (folder / "__init__.py").is_file():
+        folders.append(folder)
+        folder = folder.parent
+    names = []
+    for depth in range(len(folders), 0, -1):
+        chain = folders[depth - 1:]
+        name = ".".join(f.name for f in reversed(chain))
+        existing = sys.modules.get(name)
+        if existing is not None and not getattr(existing, "__graphsdg_stand_in__", False):
+            continue   # a real module of that name: leave it
+        package = types.ModuleType(name, f"Stand-in for the source package {chain[0]} (graphsdg compat tests).")
+        package.__path__ = [str(chain[0])]
+        package.__package__ = name
+        package.__graphsdg_stand_in__ = True
+        sys.modules[name] = package
+        names.append(name)
+    return names
+
+
 def find_extension_toml(test_file: Path) -> Path | None:
     """The ``config/extension.toml`` of the Kit extension ``test_file`` belongs to, if any."""
     for folder in test_file.resolve().parents:
@@ -87,7 +119,7 @@ def _load(toml_path: Path) -> dict | None:
 def test_module_name(manifest: dict, toml_path: Path, test_file: Path) -> str:
     """The dotted module name Kit gives ``test_file``: the extension's python module + ``.tests.`` + its stem."""
     modules = manifest.get("python", {}).get("module", [])
-    root = modules[0]["name"] if modules else toml_path.parent.parent.name
+    root = next((m["name"] for m in modules if "name" in m), toml_path.parent.parent.name)   # "path" entries: no name
     return f"{root}.tests.{test_file.stem}"
 
 
@@ -136,6 +168,7 @@ def prepare_extension_test(test_file: Path) -> list[str]:
     toml_path = find_extension_toml(test_file)
     if toml_path is None:
         return []
+    stand_in_source_packages(test_file)
     manifest = _load(toml_path)
     if manifest is None:
         return []

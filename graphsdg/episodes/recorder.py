@@ -416,6 +416,10 @@ class EpisodeRecorder:
                 return
         assert self._storage is not None
         for rec in self._recordables:
-            self._storage.append_frame(rec.group, frames[rec.group])
+            try:
+                self._storage.append_frame(rec.group, frames[rec.group])
+            except Exception as exc:  # noqa: BLE001 - the episode is trimmed to the frames every group has
+                log.error("storing the frame of %s failed, frame dropped: %s", rec.group, exc)
+                return
         self._storage.advance_episode_frame()
         self._frames += 1

@@ -19,6 +19,7 @@ moving the timeline to each frame's recorded time without playing it.
 """
 from __future__ import annotations
 
+import asyncio
 import logging
 import os
 from collections.abc import Callable
@@ -150,6 +151,41 @@ class EpisodeReplayer:
 
     def prepare_episode(self, episode: int | str) -> None:
         """Bind the session's recordables to the live stage and read ``episode`` into memory."""
+        name = self._begin_prepare(episode)
+        try:
+            frames = self._read_groups(self._reader, name, tuple(rec.group for rec in self._prepared))
+        except BaseException:
+            self._abandon_prepare()
+            raise
+        self._finish_prepare(name, frames)
+
+    async def prepare_episode_async(self, episode: int | str) -> None:
+        """:meth:`prepare_episode` with the file read on a worker thread (binding stays on this thread)."""
+        name = self._begin_prepare(episode)
+        try:
+            frames = await asyncio.get_running_loop().run_in_executor(
+                None, self._prefetch_frames_from_new_reader, name, tuple(rec.group for rec in self._prepared))
+        except BaseException:
+            self._abandon_prepare()
+            raise
+        self._finish_prepare(name, frames)
+
+    def _prefetch_frames_from_new_reader(self, episode_name: str,
+                                         groups: tuple[str, ...]) -> dict[str, dict[str, np.ndarray]]:
+        """Every frame of ``groups`` read through a reader of the worker's own (h5py objects stay per thread)."""
+        with SessionReader(self._path) as reader:
+            return self._read_groups(reader, episode_name, groups)
+
+    def _read_groups(self, reader: SessionReader, name: str, groups: tuple[str, ...]) -> dict[str, dict]:
+        frames = {}
+        for group in groups:
+            try:
+                frames[group] = reader.read_group_all_frames(name, group)
+            except KeyError as exc:
+                self._fail(f"reading group {group}", exc)
+        return frames
+
+    def _begin_prepare(self, episode: int | str) -> str:
         name = self._reader.normalize_episode(episode)
         self._release()
         stage = get_stage()
@@ -159,16 +195,17 @@ class EpisodeReplayer:
         self._push_layer(stage)
         try:
             self._prepared = self._bind(stage)
-            self._frames = {}
-            for rec in self._prepared:
-                try:
-                    self._frames[rec.group] = self._reader.read_group_all_frames(name, rec.group)
-                except KeyError as exc:
-                    self._fail(f"reading group {rec.group}", exc)
         except BaseException:
-            self._release()
-            self._pop_layer()
+            self._abandon_prepare()
             raise
+        return name
+
+    def _abandon_prepare(self) -> None:
+        self._release()
+        self._pop_layer()
+
+    def _finish_prepare(self, name: str, frames: dict[str, dict[str, np.ndarray]]) -> None:
+        self._frames = frames
         self._episode, self._num_frames = name, self._reader.num_frames(name)
         self._times = self._recorded_times()
         self._build_batch()
@@ -326,6 +363,19 @@ class EpisodeReplayer:
         if self.is_replaying:
             self.stop_replay()
         self.prepare_episode(episode)
+        self._drive(episode, loop, seek_timeline, on_applied, on_finished)
+
+    async def start_replay_async(self, *, episode: int | str = 0, loop: bool = False, seek_timeline: bool = True,
+                                 on_applied: Callable[[int], None] | None = None,
+                                 on_finished: Callable[[], None] | None = None) -> None:
+        """:meth:`start_replay` with the file read on a worker thread."""
+        if self.is_replaying:
+            self.stop_replay()
+        await self.prepare_episode_async(episode)
+        self._drive(episode, loop, seek_timeline, on_applied, on_finished)
+
+    def _drive(self, episode: int | str, loop: bool, seek_timeline: bool,
+               on_applied: Callable[[int], None] | None, on_finished: Callable[[], None] | None) -> None:
         if self._num_frames <= 0:
             self.stop_replay()
             raise RuntimeError(f"episode {episode!r} of {self._path} has no frames to replay")

@@ -43,8 +43,8 @@ class TimelineDrivenEpisodeController:
         if self._subscriptions:
             return
         timeline = runtime().timeline
-        self._subscriptions = [timeline.subscribe(self._on_play, TimelineEventType.PLAY),
-                               timeline.subscribe(self._on_stop, TimelineEventType.STOP)]
+        self._subscriptions = [timeline.subscribe(self._on_started, TimelineEventType.PLAY),
+                               timeline.subscribe(self._on_stopped, TimelineEventType.STOP)]
 
     def disable(self) -> None:
         """Stop listening (disabling twice does nothing)."""
@@ -52,7 +52,7 @@ class TimelineDrivenEpisodeController:
             subscription.unsubscribe()
         self._subscriptions = []
 
-    def _on_play(self, event: Any) -> None:
+    def _on_started(self, event: Any) -> None:
         rec = self._recorder
         if self._auto_start and rec.is_session_open and not (rec.is_recording or rec.is_paused):
             try:
@@ -60,7 +60,7 @@ class TimelineDrivenEpisodeController:
             except Exception as exc:  # noqa: BLE001 - the timeline goes on
                 log.error("starting an episode on play failed: %s", exc)
 
-    def _on_stop(self, event: Any) -> None:
+    def _on_stopped(self, event: Any) -> None:
         if self._recorder.state == EPISODE_ACTIVE:
             try:
                 self._recorder.end_episode()
