@@ -480,3 +480,25 @@ def test_worker_and_anim_cameras_stage_holds_the_warehouse_a_walking_worker_and_
         assert cam.IsA(UsdGeom.Camera) and cam.GetAttribute("xformOp:translate").GetNumTimeSamples() >= 2
         m = np.array(UsdGeom.Xformable(cam).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
         assert 0.0 < m[3, 2] < 8.0                                                # inside, under the roof
+
+
+# ---- Infinigen dining rooms ---------------------------------------------------------------------
+def test_infinigen_dining_rooms_carry_the_names_the_example_matches():
+    folder = get_assets_root_path() + "/Isaac/Samples/Replicator/Infinigen/dining_rooms"
+    rooms = sorted(f for f in os.listdir(folder) if f.endswith((".usd", ".usda", ".usdc")))
+    assert rooms == ["dining_room_0.usd", "dining_room_1.usd"]           # the folder lists rooms only
+    for name in rooms:
+        stage = Usd.Stage.Open(os.path.join(folder, name))
+        prims = list(Usd.PrimRange(stage.GetPseudoRoot()))
+        tables = [p for p in prims if "TableDining" in str(p.GetPath()) and p.GetTypeName() == "Xform"]
+        table = tables[0]
+        loc = table.GetAttribute("xformOp:translate").Get()
+        top = _bounds(table)[1][2]
+        assert loc[2] == 0.0 and top == pytest.approx(0.75)
+        lo, hi = _bounds(stage.GetDefaultPrim())
+        assert lo[0] < loc[0] < hi[0] and lo[1] < loc[1] < hi[1]
+        lamps = [p for p in prims if "001_SPLIT_GLA" in str(p.GetPath()) and p.GetTypeName() == "Xform"]
+        assert len(lamps) == 1 and any(p.GetTypeName() == "SphereLight" for p in prims)
+        assert sum(1 for p in prims if str(p.GetPath()).endswith("_exterior")) == 4
+        assert sum(1 for p in prims if str(p.GetPath()).endswith("_ceiling")) == 1
+        assert all(matlib.bound_material(p) is not None for p in prims if p.IsA(UsdGeom.Mesh))
