@@ -60,7 +60,7 @@ def _warehouse(root: str) -> np.ndarray:
     rep = _scene(root)
     rep.functional.create.reference(usd_path=root + "/Isaac/Environments/Simple_Warehouse/warehouse.usd",
                                     parent="/World", name="Warehouse")
-    return _shoot(rep, (-6.5, -10.8, 3.6), (3.0, 4.0, 1.2), focal_length=18.0)
+    return _shoot(rep, (-7.6, -8.8, 3.8), (3.0, 4.0, 1.2), focal_length=18.0)
 
 
 def _grid(root: str) -> np.ndarray:
