@@ -77,8 +77,8 @@ UNSUPPORTED = [
      "omni.usd.UsdContext.get_selection is not available"),
     ("import omni.timeline\nomni.timeline.get_timeline_interface().get_director()", CompatError,
      "omni.timeline.ITimeline.get_director is not available"),
-    ("import omni.kit.commands\nomni.kit.commands.execute('CreatePrimCommand', prim_type='Cube')", CompatError,
-     "'CreatePrimCommand' is not available"),
+    ("import omni.kit.commands\nomni.kit.commands.execute('SelectPrimsCommand', new_selected_paths=[])", CompatError,
+     "'SelectPrimsCommand' is not available"),
 ]
 
 
