@@ -502,3 +502,41 @@ def test_infinigen_dining_rooms_carry_the_names_the_example_matches():
         assert sum(1 for p in prims if str(p.GetPath()).endswith("_exterior")) == 4
         assert sum(1 for p in prims if str(p.GetPath()).endswith("_ceiling")) == 1
         assert all(matlib.bound_material(p) is not None for p in prims if p.IsA(UsdGeom.Mesh))
+
+
+# ---- camera calibration, simple room, ROS sample robot -------------------------------------------
+def test_hawk_sees_the_checkerboard_corners_with_the_stereo_disparity_of_its_baseline():
+    import cv2
+    root = get_assets_root_path()
+    rep.functional.create.dome_light(intensity=800)
+    rep.functional.create.reference(usd_path=root + "/Isaac/Sensors/LeopardImaging/Hawk/hawk_v1.1_nominal.usd",
+                                    name="Hawk")
+    # as the ROS 2 camera-info test places it: 1.1 m ahead, its bottom 0.6 m below the cameras
+    rep.functional.create.reference(usd_path=root + "/Isaac/Props/Camera/checkerboard_6x10.usd",
+                                    name="calibration_target", position=(1.1, 0.0, -0.6))
+    width, height = 320, 200
+    centres = {}
+    for side in ("left", "right"):
+        rp = rep.create.render_product(f"/Hawk/{side}/camera_{side}", (width, height))
+        rgb = rep.annotators.get("rgb")
+        rgb.attach(rp)
+        rep.orchestrator.step()
+        gray = cv2.cvtColor(rgb.get_data()[..., :3].copy(), cv2.COLOR_RGB2GRAY)
+        found, corners = cv2.findChessboardCorners(gray, (6, 10))
+        assert found, side
+        centres[side] = corners.reshape(-1, 2).mean(0)
+    focal_px = 2.87 / 5.76 * width
+    # the board's face is 1.09 m away (it is 0.01 m thick); its centre is on both optical axes' plane
+    np.testing.assert_allclose(centres["left"][0] - centres["right"][0], focal_px * 0.15 / 1.09, atol=0.6)
+    assert centres["left"][1] == pytest.approx(height / 2 - 0.5, abs=1.0)
+
+
+def test_simple_room_and_ros_sample_robot_resolve_with_their_layout():
+    stage = _open("/Isaac/Environments/Simple_Room/simple_room.usd")
+    lo, hi = _bounds(stage.GetPrimAtPath("/SimpleRoom/Table"))
+    assert hi[2] == pytest.approx(0.75)
+    walls = stage.GetPrimAtPath("/SimpleRoom/Walls").GetChildren()
+    assert len(walls) == 4 and all(w.HasAPI(UsdPhysics.CollisionAPI) for w in walls)
+    assert any(p.GetTypeName() == "DomeLight" for p in stage.Traverse())
+    ros = _open("/Isaac/Samples/ROS2/Robots/Nova_Carter_ROS.usd")
+    assert ros.GetPrimAtPath("/Nova_Carter_ROS/chassis_link").HasAPI(UsdPhysics.ArticulationRootAPI)

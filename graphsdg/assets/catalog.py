@@ -21,9 +21,10 @@ from typing import Callable
 import numpy as np
 from pxr import Gf, Kind, UsdGeom, UsdLux, UsdPhysics
 
-from graphsdg.assets import (authoring, forklift, franka, geometry, grid_rooms, handling_props, infinigen_rooms,
-                             interior_props, mdl_materials, nova_carter, outdoor_skies, packing_table, sample_stages,
-                             simready, skies, textures, warehouse_props, warehouse_stages, ycb)
+from graphsdg.assets import (authoring, camera_calibration, forklift, franka, geometry, grid_rooms, handling_props,
+                             infinigen_rooms, interior_props, mdl_materials, nova_carter, outdoor_skies, packing_table,
+                             sample_stages, simple_room, simready, skies, textures, warehouse_props, warehouse_stages,
+                             ycb)
 from graphsdg.assets.entries import ImageAsset, UsdAsset
 from graphsdg.assets.pallets import (BLOCK_H, BLOCK_W, BOARD_T, PALLET_HEIGHT, PALLET_LENGTH,  # noqa: F401
                                     PALLET_WIDTH, pallet_parts)
@@ -272,7 +273,8 @@ IMAGE_ASSETS.update({
 # Stand-ins for the further /Isaac/... paths Isaac's Replicator examples and tests load, module by module
 # (stages that reference props come after the props).
 ISAAC_STAND_IN_MODULES = (warehouse_props, handling_props, forklift, franka, nova_carter, warehouse_stages,
-                          grid_rooms, interior_props, sample_stages, infinigen_rooms)
+                          grid_rooms, interior_props, sample_stages, infinigen_rooms, camera_calibration,
+                          simple_room)
 ISAAC_ASSETS: dict[str, UsdAsset] = {a.key: a for m in ISAAC_STAND_IN_MODULES for a in m.ASSETS}
 # Material-instance modules (.mdl) at the paths of Isaac's environment materials, with their textures
 MDL_ASSETS: dict[str, ImageAsset] = {a.key: a for a in mdl_materials.ASSETS}

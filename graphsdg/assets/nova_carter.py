@@ -12,7 +12,8 @@ robot with Isaac's prim layout:
   wheel_dof_names=["joint_wheel_left", "joint_wheel_right"])`` drives them);
 * sensors under ``chassis_link/sensors``: the front Hawk stereo pair
   ``front_hawk/left/camera_left`` and ``front_hawk/right/camera_right``
-  (``UsdGeom.Camera`` looking along the robot's +X, 0.15 m baseline) and the
+  (``UsdGeom.Camera`` looking along the robot's +X, 0.15 m baseline, the Hawk's
+  optics as in :mod:`graphsdg.assets.camera_calibration`) and the
   ``XT_32`` lidar mount on the mast.
 
 The robot's front is +X; ``chassis_link``'s origin is on the floor under the
@@ -38,9 +39,9 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 
 from graphsdg.assets import authoring, geometry, textures
+from graphsdg.assets.camera_calibration import HAWK_BASELINE, define_hawk_camera
 from graphsdg.assets.entries import UsdAsset, pack_file
 from graphsdg.assets.props import part_texture
-from graphsdg.maths.rotations import matrix_to_quat_wxyz
 
 CARTER_PATH = "/Isaac/Robots/NVIDIA/NovaCarter/nova_carter.usd"
 NAV_ONLY_PATH = "/Isaac/Samples/Replicator/OmniGraph/nova_carter_nav_only.usd"
@@ -48,19 +49,10 @@ ROOT = "nova_carter"
 WHEEL_RADIUS, WHEEL_WIDTH, TRACK_WIDTH = 0.14, 0.06, 0.413
 BODY = ((-0.36, -0.17, 0.06), (0.30, 0.17, 0.42))      # the main body (chassis frame, metres)
 CASTER_RADIUS, CASTER_X = 0.05, -0.28
-HAWK_POSITION, HAWK_BASELINE = (0.31, 0.0, 0.36), 0.15
+HAWK_POSITION = (0.31, 0.0, 0.36)
 CARTER_SIZE = (0.68, 0.473, 0.62)
 MASSES = {"chassis_link": 42.0, "wheel_left": 2.0, "wheel_right": 2.0}
 WHEEL_DRIVE = (400.0, 25.0)        # velocity drives: damping N m s / rad, max torque N m (more would wheelie)
-
-# A USD camera looks along its -Z with +Y up; the robot's cameras look along +X with +Z up.
-CAMERA_AXES = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])   # columns: camera X, Y, Z
-
-
-def _quat(m: np.ndarray) -> Gf.Quatf:
-    q = matrix_to_quat_wxyz(m)
-    return Gf.Quatf(float(q[0]), *map(float, q[1:]))
-
 
 def _xform(stage: Usd.Stage, path: str, translate, orient: Gf.Quatf | None = None) -> UsdGeom.Xform:
     x = UsdGeom.Xform.Define(stage, path)
@@ -155,14 +147,7 @@ def _sensors(stage: Usd.Stage) -> None:
     _xform(stage, f"{base}/front_hawk", HAWK_POSITION)
     for side, sign in (("left", 1.0), ("right", -1.0)):
         _xform(stage, f"{base}/front_hawk/{side}", (0.0, sign * HAWK_BASELINE / 2, 0.0))
-        cam = UsdGeom.Camera.Define(stage, f"{base}/front_hawk/{side}/camera_{side}")
-        cam.AddOrientOp().Set(_quat(CAMERA_AXES))
-        cam.CreateFocalLengthAttr(12.0)              # 82 degrees across, like a Hawk's wide lens
-        cam.CreateHorizontalApertureAttr(20.955)
-        cam.CreateVerticalApertureAttr(20.955 * 1200 / 1920)
-        cam.CreateClippingRangeAttr(Gf.Vec2f(0.01, 1000.0))
-        cam.CreateFStopAttr(0.0)
-        cam.CreateFocusDistanceAttr(400.0)
+        define_hawk_camera(stage, f"{base}/front_hawk/{side}/camera_{side}")
     _xform(stage, f"{base}/XT_32", (-0.25, 0.0, 0.62))
 
 
@@ -176,6 +161,17 @@ def build_nav_only(root: str) -> list[str]:
     return [NAV_ONLY_PATH]
 
 
+ROS_PATH = "/Isaac/Samples/ROS2/Robots/Nova_Carter_ROS.usd"
+
+
+def build_ros_sample(root: str) -> list[str]:
+    """Write ``Nova_Carter_ROS.usd``: the robot alone (Isaac's file adds ROS 2 OmniGraphs graphsdg cannot run)."""
+    stage, prim = authoring.new_asset_stage(pack_file(root, ROS_PATH), "Nova_Carter_ROS", kind=Kind.Tokens.component)
+    prim.GetReferences().AddReference("../../../Robots/NVIDIA/NovaCarter/nova_carter.usd")
+    authoring.save(stage)
+    return [ROS_PATH]
+
+
 ASSETS: list[UsdAsset] = [
     UsdAsset("nova_carter", CARTER_PATH, CARTER_SIZE,
              "Nova Carter differential-drive AMR: chassis_link (articulation root, floating), wheel_left/right on "
@@ -185,6 +181,9 @@ ASSETS: list[UsdAsset] = [
     UsdAsset("nova_carter_nav_only", NAV_ONLY_PATH, CARTER_SIZE,
              "the Nova Carter with its navigation target child `targetXform` (Replicator's AMR sample; the "
              "navigation graph itself is not included)", build_nav_only),
+    UsdAsset("nova_carter_ros", ROS_PATH, CARTER_SIZE,
+             "the Nova Carter (Isaac's ROS 2 sample adds ROS 2 publisher graphs, which are not included)",
+             build_ros_sample),
 ]
 
 __all__ = ["ASSETS", "CARTER_PATH", "NAV_ONLY_PATH", "build_carter", "build_nav_only"]
