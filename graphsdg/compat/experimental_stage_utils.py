@@ -40,6 +40,9 @@ from graphsdg.compat.kit_commands import next_free_path
 from graphsdg.compat.modules import CompatError, CompatModule
 from graphsdg.functional.create import add_reference
 
+# the Kit extensions this area provides (enable_extension("omni.kit.stage_templates") works)
+EXTENSIONS = {"omni.kit.stage_templates": ("omni.kit.stage_templates",),
+              "omni.usd.commands": (), "omni.kit.primitive.mesh": (), "omni.kit.material.library": ()}
 BACKENDS = ("usd", "usdrt", "fabric")
 KIT_TEMPLATES = ("empty", "sunlight", "default stage")
 
@@ -337,8 +340,9 @@ def set_stage_time_code(*, start_time_code: float | None = None, end_time_code: 
 
 # ---- omni.kit.stage_templates ---------------------------------------------------------------------------
 def get_stage_template_list() -> list[dict[str, Any]]:
-    """Kit's stage templates, as Kit lists them (one dict per group, keyed by template name)."""
-    return [{name: {"rebuild": True}} for name in KIT_TEMPLATES]
+    """Kit's stage templates as Kit lists them, one dict per template keyed by its name (the value builds the
+    template's prims on a given stage)."""
+    return [{name: (lambda stage, _name=name: _kit_template(stage, _name))} for name in KIT_TEMPLATES]
 
 
 def new_stage_from_template(template: str = "empty") -> bool:
