@@ -28,7 +28,6 @@ from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.sim.transforms import get_world_pose
 from graphsdg.compat.experimental_stage_scope import current_stage as get_stage
 from graphsdg.stage.xform import set_local_pose
-from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
 
 # ---- XformPrim ------------------------------------------------------------------------------------

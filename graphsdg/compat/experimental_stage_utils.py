@@ -154,7 +154,7 @@ async def create_new_stage_async(*, template: str | None = None) -> Usd.Stage:
     """:func:`create_new_stage`, then one app update (as Kit's asynchronous version)."""
     _check_template(template)
     await get_context().new_stage_async()
-    stage = _apply_template(template)
+    _apply_template(template)
     await get_app().next_update_async()
     return get_context().get_stage()
 
