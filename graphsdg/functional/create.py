@@ -411,3 +411,7 @@ def clone(input_prim: PrimLike, name: str | None = None, parent: PrimLike | None
         if not Sdf.CopySpec(layer, src, layer, dst):
             raise ValueError(f"clone could not copy {src} to {dst} in layer {layer.identifier}")
     return _finish(stage.GetPrimAtPath(dst), position, rotation, scale, None, None, semantics, visible)
+
+
+# ray-cast sensor prims (their render products run a lidar / radar: graphsdg.sensors, docs/sensors.md)
+from graphsdg.functional.sensors import omni_lidar, omni_radar  # noqa: E402,F401

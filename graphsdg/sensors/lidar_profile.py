@@ -9,8 +9,10 @@ the measured range window, the noise, and the detection limit (``min_reflectance
 
 On the stage the profile is the prim's ``OmniSensorGenericLidarCoreAPI`` attributes
 (``omni:sensor:Core:*``) and its ``OmniSensorGenericLidarCoreEmitterStateAPI:sNNN`` arrays
-(:func:`author_lidar_profile`, :func:`read_lidar_profile`). A prim with no emitter state fires
-``numberOfChannels`` emitters spread evenly over +-15 degrees of elevation (:data:`DEFAULT_HALF_FOV_DEG`).
+(:func:`author_lidar_profile`, :func:`read_lidar_profile`); the core API brings state ``s001`` with it, whose
+fallbacks are a 128-emitter rotary pattern. Emitter arrays authored empty fire ``numberOfChannels`` emitters
+spread evenly over +-15 degrees of elevation (:data:`DEFAULT_HALF_FOV_DEG`). The valid azimuth window
+(``validStartAzimuthDeg`` .. ``validEndAzimuthDeg``) may be given in -180..180 or 0..360 degrees.
 
 Example:
     >>> import numpy as np
@@ -191,7 +193,7 @@ _SCALARS: dict[str, tuple[str, Any]] = {
     "valid_start_azimuth_deg": ("validStartAzimuthDeg", Sdf.ValueTypeNames.Float),
     "valid_end_azimuth_deg": ("validEndAzimuthDeg", Sdf.ValueTypeNames.Float),
     "min_reflectance": ("minReflectance", Sdf.ValueTypeNames.Float),
-    "min_reflectance_range_m": ("minReflectanceRange", Sdf.ValueTypeNames.Float),
+    "min_reflectance_range_m": ("minReflectionRangeM", Sdf.ValueTypeNames.Float),
     "wavelength_nm": ("wavelengthNm", Sdf.ValueTypeNames.Float),
 }
 _TOKENS = {"scan_type": "scanType", "rotation_direction": "rotationDirection"}
@@ -243,8 +245,8 @@ def _get(prim: Usd.Prim, name: str, default: Any) -> Any:
 
 
 def _read_emitter_states(prim: Usd.Prim, channels: int) -> tuple[EmitterState, ...]:
-    instances = sorted(name.split(":", 1)[1] for name in prim.GetAppliedSchemas()
-                       if name.startswith(EMITTER_STATE_API + ":"))
+    instances = sorted({name.split(":", 1)[1] for name in prim.GetAppliedSchemas()
+                        if name.startswith(EMITTER_STATE_API + ":")} | {emitter_state_name(0)})
     states = []
     for instance in instances:
         base = f"{CORE}emitterState:{instance}:"
@@ -289,10 +291,24 @@ def read_lidar_profile(prim: Usd.Prim) -> LidarProfile:
         raise LidarProfileError(f"lidar {prim.GetPath()}: {text}") from None
 
 
+#: the auxiliary level Replicator's GenericModelOutput render variable is asked for on the sensor prim
+RENDER_VAR_CHANNELS = "_replicator:rendervar:GenericModelOutput:channels"
+
+
+def aux_level(prim: Usd.Prim, attribute: str, levels: tuple[str, ...] = AUX_LEVELS) -> str:
+    """The richer of the prim's auxiliary output type (``attribute``) and the level its GenericModelOutput render
+    variable asks for (:data:`RENDER_VAR_CHANNELS`, what Isaac's sensor classes author)."""
+    chosen = str(_get(prim, attribute, "NONE"))
+    for level in _get(prim, RENDER_VAR_CHANNELS, []) or []:
+        if str(level) in levels and levels.index(str(level)) > levels.index(chosen if chosen in levels else "NONE"):
+            chosen = str(level)
+    return chosen if chosen in levels else "NONE"
+
+
 def output_settings(prim: Usd.Prim, prefix: str = CORE) -> dict[str, Any]:
     """A sensor prim's output options: frame of reference, coordinates, aux level, accumulation."""
     return {"frame_of_reference": str(_get(prim, prefix + "outputFrameOfReference", "SENSOR")),
             "coords": str(_get(prim, prefix + "elementsCoordsType", "SPHERICAL")),
-            "aux": str(_get(prim, prefix + "auxOutputType", "NONE")),
+            "aux": aux_level(prim, prefix + "auxOutputType"),
             "accumulate": bool(_get(prim, prefix + "accumulateOutputs", False)),
             "keep_invalid": bool(_get(prim, prefix + "skipDroppingInvalidPoints", False))}

@@ -120,7 +120,7 @@ def _apply_variant(spec: dict[str, Any], variant: Variant, config: str) -> dict[
                 values["columns"] = int(round(360.0 / number))
             else:
                 values["farRangeM"] = number
-                values["minReflectanceRange"] = min(number, float(values.get("minReflectanceRange", number)))
+                values["minReflectionRangeM"] = min(number, float(values.get("minReflectionRangeM", number)))
     return values
 
 
@@ -160,7 +160,7 @@ def lidar_profile(config: str, variant: Variant = None) -> LidarProfile:
         elevation_error_std_deg=float(values.get("elevationErrorStd", 0.0)),
         valid_start_azimuth_deg=-fov / 2.0, valid_end_azimuth_deg=fov / 2.0,
         min_reflectance=float(values.get("minReflectance", 0.1)),
-        min_reflectance_range_m=float(values.get("minReflectanceRange", values["farRangeM"])),
+        min_reflectance_range_m=float(values.get("minReflectionRangeM", values["farRangeM"])),
         wavelength_nm=float(values.get("wavelengthNm", 905.0)), tick_rate_hz=scan_rate,
         model_name=str(values.get("model", config)), model_vendor=str(values.get("vendor", "")),
         market_name=str(values.get("model", config)))

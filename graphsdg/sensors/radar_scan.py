@@ -35,7 +35,7 @@ import numpy as np
 from pxr import Usd
 
 from graphsdg import rng
-from graphsdg.sensors.lidar_profile import LidarProfileError
+from graphsdg.sensors.lidar_profile import LidarProfileError, aux_level
 from graphsdg.sensors.lidar_scan import sensor_prim
 from graphsdg.sensors.ray_backend import ray_caster
 from graphsdg.sensors.scene_motion import GeomMotion, point_velocities
@@ -245,8 +245,8 @@ class RadarScanner:
         self.frames += 1
         options = {name: str(prim.GetAttribute(PREFIX + attr).Get() or default)
                    for name, attr, default in (("frame_of_reference", "outputFrameOfReference", "SENSOR"),
-                                               ("coords", "elementsCoordsType", "SPHERICAL"),
-                                               ("aux", "auxOutputType", "NONE"))}
+                                               ("coords", "elementsCoordsType", "SPHERICAL"))}
+        options["aux"] = aux_level(prim, PREFIX + "auxOutputType", ("NONE", "BASIC"))
         mpu = sim.world_transforms.meters_per_unit()
         return RadarScan(detections=detect(sim, pose, profile, noise), time_s=now,
                          pose=(pose.position * mpu, pose.quaternion_xyzw()), profile=profile, options=options,

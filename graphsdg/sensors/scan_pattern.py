@@ -5,7 +5,7 @@ Time is the simulation clock in seconds. Ticks are numbered from time 0: tick ``
 tick starts (emitter state ``k % len(states)``). A rotary lidar's column turns by ``360 / ticks_per_scan``
 degrees a tick, from -180 degrees (``CCW``: azimuth rising) or +180 (``CW``: falling); each emitter adds its
 azimuth offset. A solid-state lidar points each emitter at its own azimuth. Beams outside the valid azimuth
-window (``validStartAzimuthDeg`` .. ``validEndAzimuthDeg``) are not fired.
+window (from ``validStartAzimuthDeg`` counter-clockwise to ``validEndAzimuthDeg``) are not fired.
 
 Directions are in the sensor's frame: +x forward (azimuth 0), +y left (azimuth 90), +z up (elevation 90).
 
@@ -69,7 +69,9 @@ class ScanPattern:
         self.ticks_per_scan = profile.ticks_per_scan
         self.scan_period = self.ticks_per_scan * self.tick_period
         self.max_fire_s = max(float(s.fire_time_ns.max()) for s in profile.emitter_states) * 1e-9
-        self._windowed = not (profile.valid_start_azimuth_deg <= -180.0 and profile.valid_end_azimuth_deg >= 180.0)
+        self._window_start = float(profile.valid_start_azimuth_deg)
+        self._window_span = float(profile.valid_end_azimuth_deg) - self._window_start
+        self._windowed = self._window_span < 360.0
 
     def scan_start(self, scan: int | np.ndarray) -> np.ndarray:
         """Start time (s) of scan ``scan``."""
@@ -116,9 +118,9 @@ class ScanPattern:
             return self._empty()
         fired = Firings(*(np.concatenate([getattr(p, name) for p in parts]) for name in Firings.__dataclass_fields__))
         fired = fired.take(np.lexsort((fired.emitter, fired.time)))
-        if self._windowed:
-            start, end = self.profile.valid_start_azimuth_deg, self.profile.valid_end_azimuth_deg
-            fired = fired.take((fired.azimuth_deg >= start) & (fired.azimuth_deg <= end))
+        if self._windowed:   # the window may be written in -180..180 or in 0..360 degrees
+            offset = (fired.azimuth_deg - self._window_start) % 360.0
+            fired = fired.take(offset <= self._window_span + 1e-9)
         return fired
 
     @staticmethod

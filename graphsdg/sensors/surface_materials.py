@@ -60,9 +60,31 @@ BASE_REFLECTANCE: dict[str, float] = {
     "salt_water": 0.03, "snow": 0.85, "ice": 0.3, "calibration_lambertion": 0.8}
 
 
+#: lower-case spellings Isaac's older tables use for the same bases
+BASE_ALIASES = {"oxidized_bronze_patina": "oxidized_Bronze_Patina"}
+
+
+def base_name(name: str) -> str:
+    """The table's spelling of base ``name`` (``oxidized_bronze_patina`` is ``oxidized_Bronze_Patina``)."""
+    return BASE_ALIASES.get(name, name)
+
+
+def decode_material_id(material_id: int) -> tuple[str, str, str]:
+    """(base, coating, attribute) names of a 16-bit material id (``none`` for indices no name has)."""
+    if isinstance(material_id, bool) or not float(material_id).is_integer() or not 0 <= material_id <= 0xFFFF:
+        raise ValueError(f"Material ID {material_id} is outside valid uint16 range (0-65535)")
+    value = int(material_id)
+
+    def name_of(table: dict[str, int], index: int) -> str:
+        return next((n for n, i in table.items() if i == index), "none")
+
+    return (name_of(BASES, value & 0xFF), name_of(COATINGS, (value >> 8) & 0x7),
+            name_of(ATTRIBUTES, (value >> 11) & 0x1F))
+
+
 def encode_material_id(base: str, coating: str, attribute: str) -> int:
     """The 16-bit non-visual material id of (base, coating, attribute) (unknown names count as ``none``)."""
-    return (BASES.get(base, 0) & 0xFF) | ((COATINGS.get(coating, 0) & 0x7) << 8) | \
+    return (BASES.get(base_name(base), 0) & 0xFF) | ((COATINGS.get(coating, 0) & 0x7) << 8) | \
         ((ATTRIBUTES.get(attribute, 0) & 0x1F) << 11)
 
 
@@ -70,7 +92,7 @@ def reflectance_of(base: str, coating: str, attribute: str) -> float:
     """The reflectance graphsdg gives (base, coating, attribute) (module docstring)."""
     if attribute == "retroreflective":
         return 1.0
-    value = BASE_REFLECTANCE.get(base, DEFAULT_REFLECTANCE)
+    value = BASE_REFLECTANCE.get(base_name(base), DEFAULT_REFLECTANCE)
     if coating in ("paint", "paint_clearcoat"):
         value = PAINT_REFLECTANCE
     if coating in ("clearcoat", "paint_clearcoat"):
@@ -78,10 +100,15 @@ def reflectance_of(base: str, coating: str, attribute: str) -> float:
     return float(value)
 
 
+def label_attribute_names() -> list[str]:
+    """The (base, coating, attribute) attribute names under the current prefix setting."""
+    prefix = settings.get(PREFIX_SETTING) or DEFAULT_PREFIX
+    return [f"{prefix}:base", f"{prefix}:coating", f"{prefix}:attributes"]
+
+
 def material_labels(material: Usd.Prim) -> tuple[str, str, str] | None:
     """(base, coating, attribute) a material prim is labelled with, or None when it has no labels."""
-    prefix = settings.get(PREFIX_SETTING) or DEFAULT_PREFIX
-    names = [f"{prefix}:base", f"{prefix}:coating", f"{prefix}:attributes"]
+    names = label_attribute_names()
     values = []
     for name in names:
         attr = material.GetAttribute(name)
