@@ -67,7 +67,7 @@ def test_every_vendored_script_parses_and_only_uses_names_the_layer_maps():
 UNSUPPORTED = [
     ("import omni.isaac.no_such_extension", CompatImportError,
      "omni.isaac.no_such_extension is not one of Isaac's pre-4.5 module names"),
-    ("from isaacsim.core.api import World", CompatImportError, "isaacsim.core.api is not available"),
+    ("from isaacsim.core.api import NoSuchThing", CompatImportError, "isaacsim.core.api.NoSuchThing is not available"),
     ("from omni.replicator.core import no_such_thing", CompatImportError,
      "omni.replicator.core.no_such_thing is not available"),
     ("import omni.replicator.core as rep\nrep.functional.create.no_such_shape()", CompatError,
