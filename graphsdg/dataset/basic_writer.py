@@ -21,13 +21,15 @@ from functools import cached_property
 import numpy as np
 from PIL import Image
 
+from graphsdg.dataset.label_images import colour_ids, decode_image
 from graphsdg.io.basic_writer_layout import FLAGS, json_companions
 from graphsdg.io.location import Location, open_location
 
 # file stem -> the JSON companion files BasicWriter writes with it (from the writer's layout table)
 COMPANIONS = {stem: suffixes for stem in sorted({stem for _, stem in FLAGS.values()})
               if (suffixes := json_companions(stem))}
-_MAIN = re.compile(r"^(?P<stem>[a-z0-9_]+?)_(?P<frame>(?:\d+_)*\d+)\.(?P<ext>png|jpg|jpeg|npy|json)$")
+# point clouds (PLY, PCD) of sensors written beside the images share the frame numbering
+_MAIN = re.compile(r"^(?P<stem>[a-z0-9_]+?)_(?P<frame>(?:\d+_)*\d+)\.(?P<ext>png|jpg|jpeg|npy|json|ply|pcd)$")
 _COMPANION_SUFFIXES = tuple(sorted({suffix for suffixes in COMPANIONS.values() for suffix in suffixes}))
 
 
@@ -91,21 +93,61 @@ class Frame:
         return rows, self._json(self.companion(kind, "_labels")), self._json(self.companion(kind, "_prim_paths"))
 
     def segmentation(self, kind: str) -> tuple[np.ndarray, dict] | None:
-        """(ids (H, W) int64, id -> value mapping) for semantic/instance segmentation, colorized or not."""
+        """(ids (H, W) int, id -> value mapping) for semantic/instance segmentation, colorized or not.
+
+        Colorized images give each pixel the index of its colour among the mapping's ``"(r, g, b, a)"`` keys
+        (-1 for a colour the mapping lacks).
+        """
         name = self.files.get(kind)
         if not name:
             return None
         suffix = "_labels" if kind == "semantic_segmentation" else "_mapping"
         mapping = self._json(self.companion(kind, suffix))
-        img = np.array(Image.open(io.BytesIO(self.read(name))))
+        img = decode_image(self.read(name), rgb_order=False)
         if img.ndim == 3:   # colorized: pixel colours index the mapping's "(r, g, b, a)" keys
             keys = [k for k in mapping if _color_key(k) is not None]
-            ids = np.full(img.shape[:2], -1, dtype=np.int64)
-            for i, key in enumerate(keys):
-                color = _color_key(key)
-                ids[np.all(img[..., : len(color)] == color, axis=-1)] = i
-            return ids, {i: mapping[k] for i, k in enumerate(keys)}
+            return colour_ids(img, [_color_key(k) for k in keys], bgr=True), {i: mapping[k] for i, k in enumerate(keys)}
         return img.astype(np.int64), {int(k): v for k, v in mapping.items()}
+
+    def semantics_of_instances(self) -> dict[int, object] | None:
+        """Instance segmentation's id -> semantic labels (its ``_semantics_mapping`` file), ids as in
+        :meth:`segmentation`; None if not written."""
+        if "instance_segmentation" not in self.files:
+            return None
+        try:
+            mapping = self._json(self.companion("instance_segmentation", "_semantics_mapping"))
+        except FileNotFoundError:
+            return None
+        keys = [k for k in mapping if _color_key(k) is not None]
+        if keys:
+            return {i: mapping[k] for i, k in enumerate(keys)}
+        return {int(k): v for k, v in mapping.items()}
+
+    def semantic_labels(self) -> dict[int, object]:
+        """semanticId -> labels, from every ``_labels`` file of this frame's box annotators (the ids the
+        point cloud's ``pointcloud_semantic`` holds too)."""
+        out: dict[int, object] = {}
+        for kind in ("bounding_box_2d_tight", "bounding_box_2d_loose", "bounding_box_3d"):
+            if kind in self.files:
+                out.update({int(k): v for k, v in self._json(self.companion(kind, "_labels")).items()})
+        return out
+
+    def camera_params(self) -> dict | None:
+        """The ``camera_params`` annotator's output of this frame, or None if not written."""
+        name = self.files.get("camera_params")
+        return self._json(name) if name else None
+
+    def pointcloud(self) -> dict[str, np.ndarray] | None:
+        """The ``pointcloud`` annotator's arrays (``data`` and whichever of ``rgb``, ``normals``, ``semantic``,
+        ``instance`` were written), or None."""
+        name = self.files.get("pointcloud")
+        if not name:
+            return None
+        out = {"data": np.load(io.BytesIO(self.read(name)))}
+        for part in ("rgb", "normals", "semantic", "instance"):
+            if f"pointcloud_{part}" in self.files:
+                out[part] = np.load(io.BytesIO(self.read(self.files[f"pointcloud_{part}"])))
+        return out
 
     def depth(self, kind: str = "distance_to_image_plane") -> np.ndarray | None:
         name = self.files.get(kind)

@@ -3,10 +3,13 @@
 :func:`detect_format` tells the layout from its files (``coco_annotations*.json``;
 ``label_02/`` or ``object_detection/`` with ``.txt`` labels; ``data.yaml`` with
 ``images/`` and ``labels/``; otherwise BasicWriter's ``rgb_<n>.png``);
-:func:`read_dataset` returns every frame as a :class:`ViewFrame`: its image, its
-boxes (inclusive pixel bounds and class name) and, where the format has them,
-per-pixel masks. A dataset is a folder or an ``s3://bucket/prefix``
-(:mod:`graphsdg.io.location`), listed once.
+:func:`read_dataset` returns every frame as a :class:`ViewFrame`
+(:mod:`graphsdg.dataset.view_frame`): its image, its boxes (inclusive pixel
+bounds and class name) and, where the format has them, loaders for class and
+instance masks, depth, the camera, 3D boxes and point clouds (BasicWriter:
+:mod:`graphsdg.dataset.basic_frames`; KITTI: instance images, ``depth/`` and the
+label lines' 3D boxes; COCO: masks from RLE or polygons). A dataset is a folder
+or an ``s3://bucket/prefix`` (:mod:`graphsdg.io.location`), listed once.
 
 Example:
     >>> import tempfile
@@ -18,56 +21,25 @@ from __future__ import annotations
 import fnmatch
 import io
 import json
+import math
 import os
 import posixpath
-from dataclasses import dataclass, field
-from typing import Callable
+import re
 
 import cv2
 import numpy as np
 from PIL import Image
 
+from graphsdg.dataset.basic_frames import basic_frames
+from graphsdg.dataset.label_images import decode_image
+from graphsdg.dataset.view_frame import DepthMap, ViewBox, ViewBox3D, ViewFrame
+from graphsdg.io.camera_geometry import USD_TO_OPENCV
 from graphsdg.io.location import Location, open_location
 
 FORMATS = ("basic", "coco", "kitti", "yolo")
 KITTI_LABEL_DIRS = ("label_02", "object_detection")
 KITTI_IMAGE_DIRS = {"label_02": "image_02", "object_detection": "rgb"}
 KITTI_INSTANCE_DIRS = {"label_02": "instance", "object_detection": "instance_segmentation"}
-
-
-@dataclass
-class ViewBox:
-    """A 2D box: class name and inclusive pixel bounds."""
-
-    label: str
-    x0: int
-    y0: int
-    x1: int
-    y1: int
-
-    @property
-    def area(self) -> int:
-        return max(self.x1 - self.x0 + 1, 0) * max(self.y1 - self.y0 + 1, 0)
-
-
-@dataclass
-class ViewFrame:
-    """One image of a dataset with what is drawn over it (``image``: its path relative to ``location``)."""
-
-    name: str
-    location: Location
-    image: str
-    boxes: list[ViewBox] = field(default_factory=list)
-    # () -> (H, W) int array (0 = nothing) and {value: class name}; None if the format has no masks
-    masks: Callable[[], tuple[np.ndarray, dict[int, str]] | None] = lambda: None
-
-    @property
-    def image_path(self) -> str:
-        """The image as a path or ``s3://`` URL."""
-        return self.location.path_of(self.image)
-
-    def rgb(self) -> np.ndarray:
-        return np.array(Image.open(io.BytesIO(self.location.read(self.image))).convert("RGB"))
 
 
 def _names(listing: dict[str, int], folder: str) -> list[str]:
@@ -120,44 +92,19 @@ def read_dataset(root: str | Location, fmt: str | None = None) -> tuple[str, lis
     fmt = fmt or _detect(listing)
     if fmt not in FORMATS:
         raise ValueError(f"unknown dataset format {fmt!r}; known: {FORMATS}")
-    frames = {"basic": _basic, "coco": _coco, "kitti": _kitti, "yolo": _yolo}[fmt](location, listing)
-    return fmt, sorted(frames, key=lambda f: f.name)
+    frames = {"basic": lambda loc, _: basic_frames(loc), "coco": _coco, "kitti": _kitti,
+              "yolo": _yolo}[fmt](location, listing)
+    frames = sorted(frames, key=lambda f: natural_key(f.name))
+    index: dict[str, int] = {}
+    for f in frames:   # each stream's frames, in name order, are its timeline
+        f.index = index.get(f.stream, 0)
+        index[f.stream] = f.index + 1
+    return fmt, frames
 
 
-# ---- BasicWriter -----------------------------------------------------------------
-def _label_text(labels) -> str:
-    if isinstance(labels, dict):
-        return ",".join(str(v) for v in labels.values())
-    return str(labels)
-
-
-def _basic(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
-    from graphsdg.dataset.basic_writer import BasicWriterDataset
-    ds = BasicWriterDataset(location)
-    out = []
-    for key in ds.frame_ids:
-        f = ds.frame(key)
-        if "rgb" not in f.files:
-            continue
-        boxes = []
-        found = f.boxes("bounding_box_2d_tight")
-        if found is not None:
-            rows, labels, _ = found
-            boxes = [ViewBox(_label_text(labels.get(str(int(r["semanticId"])), int(r["semanticId"]))),
-                             int(r["x_min"]), int(r["y_min"]), int(r["x_max"]), int(r["y_max"])) for r in rows]
-
-        def masks(f=f):
-            seg = f.segmentation("semantic_segmentation")
-            if seg is None:
-                return None
-            ids, mapping = seg
-            names = {int(k) + 1: _label_text(v) for k, v in mapping.items()
-                     if _label_text(v) not in ("BACKGROUND", "UNLABELLED")}
-            shifted = np.where(np.isin(ids, [k - 1 for k in names]), ids + 1, 0)
-            return shifted, names
-        out.append(ViewFrame(f"{f.folder}/{f.frame_id}" if f.folder else f.frame_id, location,
-                             f.path(f.files["rgb"]), boxes, masks))
-    return out
+def natural_key(name: str) -> tuple:
+    """Sort key that orders the numbers inside ``name`` by value (``"2"`` before ``"10"``)."""
+    return tuple(int(p) if p.isdigit() else p for p in re.split(r"(\d+)", name))
 
 
 # ---- COCO -----------------------------------------------------------------------
@@ -193,47 +140,109 @@ def _coco(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
                 x, y, w, h = (float(v) for v in a["bbox"])
                 boxes.append(ViewBox(names.get(int(a["category_id"]), str(a["category_id"])), int(round(x)),
                                      int(round(y)), int(round(x + w)) - 1, int(round(y + h)) - 1))
-
-            def masks(anns=anns, image=image):
-                h, w = int(image["height"]), int(image["width"])
-                ids = np.zeros((h, w), np.int64)
-                for a in anns:
-                    if a.get("segmentation"):
-                        ids[_coco_mask(a["segmentation"], h, w)] = int(a["category_id"])
-                return ids, names
             rel = image["file_name"].replace(os.sep, "/")
-            out.append(ViewFrame(posixpath.splitext(rel)[0], location, rel, boxes, masks))
+            stream = str(image.get("render_product") or posixpath.dirname(rel) or "camera")
+            out.append(ViewFrame(posixpath.splitext(rel)[0], location, rel, boxes,
+                                 masks=lambda anns=anns, image=image: _coco_classes(anns, image, names),
+                                 stream=stream, instances=lambda anns=anns, image=image: _coco_instances(
+                                     anns, image, names)))
     return out
 
 
+def _coco_classes(anns: list[dict], image: dict, names: dict[int, str]) -> tuple[np.ndarray, dict[int, str]]:
+    h, w = int(image["height"]), int(image["width"])
+    ids = np.zeros((h, w), np.int64)
+    for a in anns:
+        if a.get("segmentation"):
+            ids[_coco_mask(a["segmentation"], h, w)] = int(a["category_id"])
+    return ids, names
+
+
+def _coco_instances(anns: list[dict], image: dict, names: dict[int, str]) -> tuple[np.ndarray, dict[int, str]]:
+    h, w = int(image["height"]), int(image["width"])
+    ids = np.zeros((h, w), np.int64)
+    labels = {}
+    for i, a in enumerate(anns, start=1):
+        if a.get("segmentation"):
+            ids[_coco_mask(a["segmentation"], h, w)] = i
+        category = names.get(int(a["category_id"]), str(a["category_id"]))
+        labels[i] = f"{a['prim_path']} ({category})" if a.get("prim_path") else f"{category} #{a.get('id', i)}"
+    return ids, labels
+
+
 # ---- KITTI ------------------------------------------------------------------------
+def _kitti_box_3d(fields: list[str]) -> ViewBox3D | None:
+    """A label line's 3D box (``h w l x y z rotation_y``, KITTI camera frame: x right, y down, z forward) in the
+    USD camera frame; None when the line has zeros there (Replicator's lines)."""
+    h, w, l, x, y, z, ry = (float(v) for v in fields[8:15])
+    if h <= 0 or w <= 0 or l <= 0:
+        return None
+    c, s = math.cos(ry), math.sin(ry)
+    rotation_cv = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])      # about the camera's y (down)
+    center_cv = np.array([x, y - h / 2, z])                                   # (x, y, z) is the bottom face's centre
+    return ViewBox3D(fields[0], USD_TO_OPENCV @ center_cv, np.array([l, h, w]) / 2,
+                     USD_TO_OPENCV @ rotation_cv @ USD_TO_OPENCV, "camera")
+
+
+def _kitti_instances(data: bytes, boxes: list[ViewBox]) -> tuple[np.ndarray, dict[int, str], dict[int, str]]:
+    """(class * 256 + n image, {value: "label #n"}, {class index: label}); labels by the box whose bounds are
+    the instance's pixel bounds (KITTI boxes are the tight boxes of the visible pixels), else "class k"."""
+    ids = decode_image(data).astype(np.int64)
+    bounds = {(b.x0, b.y0, b.x1, b.y1): b.label for b in boxes}
+    instances, classes = {}, {}
+    for value in (int(v) for v in np.unique(ids) if v):
+        ys, xs = np.nonzero(ids == value)
+        label = bounds.get((int(xs.min()), int(ys.min()), int(xs.max()), int(ys.max())))
+        if label is not None:
+            classes[value // 256] = label
+        instances[value] = label or f"class {value // 256}"
+    for value in instances:
+        name = classes.get(value // 256, f"class {value // 256}")
+        instances[value] = f"{name} #{value % 256}"
+        classes.setdefault(value // 256, name)
+    return ids, instances, classes
+
+
 def _kitti(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
     out = []
     for parent, label_dir in _kitti_label_folders(listing):
-        labels = posixpath.join(parent, label_dir) if parent else label_dir
-        images = posixpath.join(parent, KITTI_IMAGE_DIRS[label_dir]) if parent else KITTI_IMAGE_DIRS[label_dir]
-        image_names = _names(listing, images)
-        for label_name in (n for n in _names(listing, labels) if n.endswith(".txt")):
+        def under(folder: str, name: str = "") -> str:
+            rel = posixpath.join(parent, folder) if parent else folder
+            return posixpath.join(rel, name) if name else rel
+        image_names = _names(listing, under(KITTI_IMAGE_DIRS[label_dir]))
+        for label_name in (n for n in _names(listing, under(label_dir)) if n.endswith(".txt")):
             stem = posixpath.splitext(label_name)[0]
             image = [n for n in image_names if posixpath.splitext(n)[0] == stem]
             if not image:
                 continue
-            boxes = []
-            for line in location.read(f"{labels}/{label_name}").decode("utf-8").splitlines():
+            boxes, boxes_3d = [], []
+            for line in location.read(under(label_dir, label_name)).decode("utf-8").splitlines():
                 fields = line.split()
                 if len(fields) >= 8:
                     x0, y0, x1, y1 = (int(round(float(v))) for v in fields[4:8])
                     boxes.append(ViewBox(fields[0], x0, y0, x1, y1))
-            instance_dir = KITTI_INSTANCE_DIRS[label_dir]
-            instance = posixpath.join(parent, instance_dir, f"{stem}.png") if parent else f"{instance_dir}/{stem}.png"
+                if len(fields) >= 15 and (box := _kitti_box_3d(fields)) is not None:
+                    boxes_3d.append(box)
+            instance = under(KITTI_INSTANCE_DIRS[label_dir], f"{stem}.png")
+            depth = under("depth", f"{stem}.png")
 
-            def masks(instance=instance):
+            def masks(instance=instance, boxes=boxes, classes_only=True):
                 if instance not in listing:
                     return None
-                ids = np.array(Image.open(io.BytesIO(location.read(instance)))).astype(np.int64)   # class * 256 + n
-                return ids, {int(v): f"class {int(v) // 256}" for v in np.unique(ids) if v}
-            out.append(ViewFrame(f"{parent}/{stem}" if parent else stem, location, f"{images}/{image[0]}", boxes,
-                                 masks))
+                ids, instances, classes = _kitti_instances(location.read(instance), boxes)
+                return (ids // 256, classes) if classes_only else (ids, instances)
+
+            def depth_map(depth=depth):
+                if depth not in listing:
+                    return None
+                values = decode_image(location.read(depth)).astype(np.float32) / 256.0
+                values[values == 0] = np.inf
+                return DepthMap(values, "distance_to_camera")
+            out.append(ViewFrame(f"{parent}/{stem}" if parent else stem, location,
+                                 under(KITTI_IMAGE_DIRS[label_dir], image[0]), boxes, masks, stream=parent or "camera",
+                                 instances=lambda masks=masks: masks(classes_only=False), depth=depth_map,
+                                 camera_missing=under("calib", f"{stem}.txt") if depth in listing else None,
+                                 boxes_3d=lambda boxes_3d=boxes_3d: boxes_3d))
     return out
 
 

@@ -1,29 +1,29 @@
-"""``graphsdg view``: a contact sheet (and HTML gallery) of a dataset with boxes, names and masks drawn.
+"""``graphsdg view``: a contact sheet (and a gallery page) of a dataset with boxes, names and masks drawn.
 
 Reads BasicWriter, COCO, KITTI and YOLO outputs, in a folder or under an
 ``s3://bucket/prefix`` (:mod:`graphsdg.dataset.formats` detects which) and
-reports per-class box counts, empty frames and box-size statistics.
+reports per-class box counts, empty frames and box-size statistics
+(:mod:`graphsdg.dataset.box_statistics`). The gallery page is
+:mod:`graphsdg.dataset.gallery`; Rerun recordings are
+:mod:`graphsdg.dataset.rerun_recording`.
 """
 from __future__ import annotations
 
-import html
 import os
-from collections import Counter
 
 import cv2
 import numpy as np
 
-from graphsdg.annotate.ids import color_of
-from graphsdg.dataset.formats import ViewFrame, read_dataset
+from graphsdg.dataset.box_statistics import format_class_table, statistics
+from graphsdg.dataset.class_table import class_colour
+from graphsdg.dataset.formats import read_dataset
+from graphsdg.dataset.gallery import PAGE_SIZE, write_gallery
+from graphsdg.dataset.view_frame import ViewFrame
 from graphsdg.io.object_store import S3Url, is_s3_url
-from graphsdg.rng import stable_key
 
 THUMB_WIDTH = 320
-
-
-def class_colour(label: str) -> tuple[int, int, int]:
-    """The colour a class is drawn in (the same in every dataset and format)."""
-    return tuple(int(c) for c in color_of(stable_key("class", label) % 100_000 + 2)[:3])
+SHEET_FRAMES = 16
+__all__ = ["class_colour", "contact_sheet", "overlay", "statistics", "summary_lines", "view_folder", "write_view"]
 
 
 def overlay(frame: ViewFrame) -> np.ndarray:
@@ -47,27 +47,6 @@ def overlay(frame: ViewFrame) -> np.ndarray:
     return img
 
 
-def statistics(frames: list[ViewFrame]) -> dict:
-    """Per-class box counts, empty frames and box-size statistics."""
-    counts: Counter = Counter()
-    areas, widths, heights, empty = [], [], [], []
-    for f in frames:
-        if not f.boxes:
-            empty.append(f.name)
-        for b in f.boxes:
-            counts[b.label] += 1
-            areas.append(b.area)
-            widths.append(b.x1 - b.x0 + 1)
-            heights.append(b.y1 - b.y0 + 1)
-
-    def spread(values: list) -> tuple[float, float, float]:
-        a = np.array(values, dtype=np.float64) if values else np.zeros(1)
-        return float(a.min()), float(np.median(a)), float(a.max())
-    return {"frames": len(frames), "boxes": sum(counts.values()), "boxes per class": dict(sorted(counts.items())),
-            "empty frames": empty, "box area px (min/median/max)": spread(areas),
-            "box width px (min/median/max)": spread(widths), "box height px (min/median/max)": spread(heights)}
-
-
 def contact_sheet(frames: list[ViewFrame], max_frames: int = 16, columns: int = 4) -> np.ndarray:
     """A grid of overlay thumbnails (RGB)."""
     tiles = []
@@ -88,38 +67,55 @@ def contact_sheet(frames: list[ViewFrame], max_frames: int = 16, columns: int = 
     return np.vstack(rows)
 
 
-def write_view(root: str, out_dir: str | None = None, max_frames: int = 16, html_gallery: bool = False) -> dict:
-    """Write ``contact_sheet.png`` (and ``index.html`` with per-frame overlays) into ``out_dir``.
+def view_folder(root: str) -> str:
+    """The default output folder: ``<dataset>.view`` beside a folder, ``./<last part of the prefix>.view`` for
+    S3."""
+    if is_s3_url(root):
+        url = S3Url.parse(root)
+        return os.path.abspath((url.prefix.rstrip("/").rsplit("/", 1)[-1] or url.bucket) + ".view")
+    return os.path.abspath(root).rstrip(os.sep) + ".view"
 
-    ``root`` is a folder or an ``s3://bucket/prefix``; ``out_dir`` defaults to ``<root>.view`` next to a
-    folder, ``./<last part of the prefix>.view`` for S3.
-    """
+
+def read_view_frames(root: str) -> tuple[str, list[ViewFrame]]:
+    """The format and frames of the dataset at ``root``; ``ValueError`` naming the layouts looked for if it
+    holds none."""
     fmt, frames = read_dataset(root)
     if not frames:
-        raise ValueError(f"no {fmt} frames with images found under {root}")
-    if out_dir is None:
-        if is_s3_url(root):
-            url = S3Url.parse(root)
-            out_dir = os.path.abspath((url.prefix.rsplit("/", 1)[-1] or url.bucket) + ".view")
-        else:
-            out_dir = os.path.abspath(root).rstrip(os.sep) + ".view"
+        raise ValueError(f"{root} holds no dataset: no BasicWriter rgb_<n> images, COCO coco_annotations*.json, "
+                         f"KITTI label_02/ or object_detection/ labels, or YOLO data.yaml with labels/ found")
+    return fmt, frames
+
+
+def write_view(root: str, out_dir: str | None = None, max_frames: int | None = None, html_gallery: bool = False,
+               page_size: int = PAGE_SIZE) -> dict:
+    """Write ``contact_sheet.png`` (and, with ``html_gallery``, the gallery page ``index.html``) into
+    ``out_dir``; return the format, the paths written and the statistics.
+
+    ``root`` is a folder or an ``s3://bucket/prefix``; ``out_dir`` defaults to :func:`view_folder`.
+    ``max_frames`` limits the frames shown (default: 16 in the contact sheet, every frame in the gallery).
+    """
+    fmt, frames = read_view_frames(root)
+    out_dir = out_dir or view_folder(root)
     os.makedirs(out_dir, exist_ok=True)
-    sheet = contact_sheet(frames, max_frames)
+    sheet = contact_sheet(frames, max_frames or SHEET_FRAMES)
     sheet_path = os.path.join(out_dir, "contact_sheet.png")
     cv2.imwrite(sheet_path, cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR))
     stats = statistics(frames)
     result = {"format": fmt, "contact_sheet": sheet_path, **stats}
     if html_gallery:
-        items = []
-        for f in frames[:max_frames]:
-            name = "frame_" + "".join(c if c.isalnum() or c in "-." else "_" for c in f.name) + ".png"
-            cv2.imwrite(os.path.join(out_dir, name), cv2.cvtColor(overlay(f), cv2.COLOR_RGB2BGR))
-            items.append(f'<figure><img src="{html.escape(name)}"><figcaption>{html.escape(f.name)} '
-                         f"({len(f.boxes)} boxes)</figcaption></figure>")
-        page = ("<!doctype html><meta charset='utf-8'><title>graphsdg dataset</title>"
-                "<style>figure{display:inline-block;margin:4px}img{max-width:480px}</style>"
-                f"<h1>{html.escape(root)} ({fmt})</h1><pre>{html.escape(str(stats))}</pre>" + "".join(items))
-        with open(os.path.join(out_dir, "index.html"), "w", encoding="utf-8") as fh:
-            fh.write(page)
-        result["html"] = os.path.join(out_dir, "index.html")
+        shown = frames[:max_frames] if max_frames else frames
+        result["html"] = write_gallery(shown, out_dir, root, fmt, page_size)
     return result
+
+
+def summary_lines(result: dict) -> list[str]:
+    """:func:`write_view`'s (or a Rerun recording's) result as the lines ``graphsdg view`` prints."""
+    lines = []
+    for key, value in result.items():
+        if key == "classes" and isinstance(value, list):
+            lines += ["per class:", *("  " + line for line in format_class_table(value).splitlines())]
+        elif key == "empty frames" and isinstance(value, list) and len(value) > 20:
+            lines.append(f"{key}: {len(value)} ({', '.join(value[:20])}, ...)")
+        elif key != "warnings":
+            lines.append(f"{key}: {value}")
+    return lines

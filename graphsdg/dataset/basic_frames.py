@@ -1,0 +1,157 @@
+"""A BasicWriter output as :class:`~graphsdg.dataset.view_frame.ViewFrame` objects, with every layer it wrote.
+
+Each frame with an ``rgb`` file becomes a view frame: tight and loose 2D boxes
+(read at once; they are small), and loaders for semantic masks (class names
+from the ``_labels`` file), instance masks (``instance_segmentation``'s prim
+paths with their classes, else ``instance_id_segmentation``'s), depth
+(``distance_to_image_plane`` preferred, it is what a pinhole back-projects),
+the camera (``camera_params``), 3D boxes (``bounding_box_3d`` rows: local
+extents and a row-vector local-to-world transform) and the ``pointcloud``
+annotator's world-space points with their colours, classes and instances.
+Per-render-product folders are the frames' streams.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from graphsdg.dataset.basic_writer import BasicWriterDataset, Frame
+from graphsdg.dataset.point_cloud_files import POINT_CLOUD_EXTENSIONS, read_point_cloud
+from graphsdg.dataset.view_frame import DepthMap, PointCloud, ViewBox, ViewBox3D, ViewFrame
+from graphsdg.io.camera_geometry import PinholeCamera
+from graphsdg.io.location import Location
+from graphsdg.maths.rotations import decompose
+
+NOTHING = ("BACKGROUND", "UNLABELLED")
+DEPTH_KINDS = ("distance_to_image_plane", "distance_to_camera")
+
+
+def label_text(labels) -> str:
+    """A label set as one name: ``{"class": "cube"}`` -> ``"cube"``, several types joined with commas."""
+    if isinstance(labels, dict):
+        return ",".join(str(v) for v in labels.values())
+    return str(labels)
+
+
+def _boxes(f: Frame, kind: str) -> list[ViewBox]:
+    found = f.boxes(kind)
+    if found is None:
+        return []
+    rows, labels, _ = found
+    return [ViewBox(label_text(labels.get(str(int(r["semanticId"])), int(r["semanticId"]))),
+                    int(r["x_min"]), int(r["y_min"]), int(r["x_max"]), int(r["y_max"])) for r in rows]
+
+
+def _shifted(ids: np.ndarray, names: dict[int, str]) -> np.ndarray:
+    """``ids`` (-1 = no colour) as values ``id + 1`` where ``names`` has them and 0 elsewhere."""
+    top = max([int(ids.max()) if ids.size else 0] + [k - 1 for k in names])
+    lut = np.zeros(top + 2, dtype=np.int32)
+    for value in names:
+        lut[value] = value
+    return lut.take(ids.astype(np.int32, copy=False) + 1)
+
+
+def semantic_masks(f: Frame) -> tuple[np.ndarray, dict[int, str]] | None:
+    """Semantic segmentation as (values, {value: class}); 0 where no class (background, unlabelled)."""
+    seg = f.segmentation("semantic_segmentation")
+    if seg is None:
+        return None
+    ids, mapping = seg
+    names = {int(k) + 1: label_text(v) for k, v in mapping.items() if label_text(v) not in NOTHING}
+    return _shifted(ids, names), names
+
+
+def instance_masks(f: Frame) -> tuple[np.ndarray, dict[int, str]] | None:
+    """Instance segmentation as (values, {value: "prim path (class)"}); 0 where no instance."""
+    kind = next((k for k in ("instance_segmentation", "instance_id_segmentation") if k in f.files), None)
+    if kind is None:
+        return None
+    ids, mapping = f.segmentation(kind)
+    semantics = f.semantics_of_instances() if kind == "instance_segmentation" else None
+    names = {}
+    for k, path in mapping.items():
+        if str(path) in NOTHING:
+            continue
+        cls = label_text(semantics[k]) if semantics and k in semantics else ""
+        names[int(k) + 1] = f"{path} ({cls})" if cls else str(path)
+    return _shifted(ids, names), names
+
+
+def camera_of(f: Frame) -> PinholeCamera | None:
+    """The pinhole camera of the frame's ``camera_params``, or None (not written, or not a pinhole model)."""
+    params = f.camera_params()
+    if params is None:
+        return None
+    try:
+        return PinholeCamera.from_params(params)
+    except ValueError:   # a fisheye camera model: its depth does not back-project through a pinhole
+        return None
+
+
+def depth_of(f: Frame) -> DepthMap | None:
+    """The frame's depth: ``distance_to_image_plane`` where written, else ``distance_to_camera``."""
+    for kind in DEPTH_KINDS:
+        if kind in f.files:
+            values = np.asarray(f.depth(kind), dtype=np.float32)
+            params = f.camera_params()
+            mpu = float(params.get("metersPerSceneUnit", 1.0)) if params else 1.0
+            return DepthMap(values.reshape(values.shape[:2]), kind, mpu)
+    return None
+
+
+def boxes_3d_of(f: Frame) -> list[ViewBox3D]:
+    """The ``bounding_box_3d`` rows as world-frame oriented boxes."""
+    found = f.boxes("bounding_box_3d")
+    if found is None:
+        return []
+    rows, labels, paths = found
+    out = []
+    for i, r in enumerate(rows):
+        # row vectors: p_world = p_local @ transform = rotation @ (scale * p_local) + translation
+        translation, rotation, scale = decompose(np.asarray(r["transform"], dtype=np.float64).reshape(4, 4))
+        lo = np.array([r["x_min"], r["y_min"], r["z_min"]], dtype=np.float64)
+        hi = np.array([r["x_max"], r["y_max"], r["z_max"]], dtype=np.float64)
+        center = rotation @ ((lo + hi) / 2 * scale) + translation
+        label = label_text(labels.get(str(int(r["semanticId"])), int(r["semanticId"])))
+        out.append(ViewBox3D(label, center, np.abs((hi - lo) / 2 * scale), rotation, "world",
+                             str(paths[i]) if i < len(paths) else ""))
+    return out
+
+
+def point_clouds_of(f: Frame) -> list[PointCloud]:
+    """The ``pointcloud`` annotator's points (world frame) and every point-cloud file (PLY, PCD) of the frame."""
+    out = []
+    pc = f.pointcloud()
+    if pc is not None and len(pc["data"]):
+        names = {k: label_text(v) for k, v in f.semantic_labels().items()} if "semantic" in pc else {}
+        out.append(PointCloud("pointcloud", np.asarray(pc["data"], np.float32).reshape(-1, 3), "world",
+                              colors=pc["rgb"][:, :3] if "rgb" in pc else None,
+                              semantic_ids=pc.get("semantic"), semantic_names=names,
+                              instance_ids=pc.get("instance")))
+    for stem, name in sorted(f.files.items()):
+        ext = name.rsplit(".", 1)[-1].lower()
+        if ext in POINT_CLOUD_EXTENSIONS:
+            out.append(read_point_cloud(f.read(name), ext, stem))
+    return out
+
+
+def basic_frames(location: Location) -> list[ViewFrame]:
+    """Every frame of the BasicWriter output at ``location`` that has an ``rgb`` image."""
+    ds = BasicWriterDataset(location)
+    out = []
+    for key in ds.frame_ids:
+        f = ds.frame(key)
+        if "rgb" not in f.files:
+            continue
+        stream = f.folder or "camera"   # a render product's folder, or the one camera of the dataset
+        has_depth = any(k in f.files for k in DEPTH_KINDS)
+        missing = None
+        if has_depth and "camera_params" not in f.files:
+            missing = f.path(f"camera_params_{f.frame_id}.json")
+        out.append(ViewFrame(
+            f"{f.folder}/{f.frame_id}" if f.folder else f.frame_id, location, f.path(f.files["rgb"]),
+            _boxes(f, "bounding_box_2d_tight"), masks=lambda f=f: semantic_masks(f), stream=stream,
+            loose_boxes=_boxes(f, "bounding_box_2d_loose"),
+            instances=lambda f=f: instance_masks(f), depth=lambda f=f: depth_of(f),
+            camera=lambda f=f: camera_of(f), camera_missing=missing, boxes_3d=lambda f=f: boxes_3d_of(f),
+            point_clouds=lambda f=f: point_clouds_of(f)))
+    return out

@@ -1,0 +1,325 @@
+"""``graphsdg view DIR --rerun``: every frame of a dataset logged to a Rerun recording (``.rrd``) or viewer.
+
+Needs the ``viewer`` extra (``pip install 'graphsdg[viewer]'``: the ``rerun-sdk``
+package). Frames are logged on the ``frame`` timeline (each camera's frames 0, 1,
+...). Entities, for a camera (render product) ``S``::
+
+    /                                  AnnotationContext: every class's id, name and colour (static)
+    world                              ViewCoordinates: right-handed, Z up (static)
+    world/cameras/S                    Transform3D: the camera's pose (camera -> world), where saved
+    world/cameras/S/image              Pinhole: intrinsics, USD camera axes (RUB), where saved
+    world/cameras/S/image/rgb          EncodedImage: the image file's bytes as written
+    world/cameras/S/image/boxes_tight  Boxes2D with class ids (names and colours from the context)
+    world/cameras/S/image/boxes_loose  Boxes2D
+    world/cameras/S/image/semantic     SegmentationImage of class ids
+    world/cameras/S/image/instance     SegmentationImage of instances, with its own AnnotationContext
+                                       (instance -> "prim path (class)")
+    world/cameras/S/image/depth        DepthImage: z-depth; under the pinhole the viewer shows it as a
+                                       3D point cloud in the world
+    world/cameras/S/boxes_3d           Boxes3D in the camera frame (KITTI's label lines)
+    world/boxes_3d/S                   Boxes3D in the world (BasicWriter's bounding_box_3d)
+    world/points/S/NAME                Points3D in the world (the pointcloud annotator), class ids
+    world/sensors/NAME                 Points3D of sensor files (PLY, PCD) with their ids and classes
+
+Each layer is one ``log_*`` function of :data:`LAYERS`; a new kind of data is one
+more. Frames are read and decoded on worker threads ahead of the logging
+thread (decoding releases the GIL); the image files go into the recording as
+written (no decode, no re-encode).
+"""
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from graphsdg.annotate.ids import color_of
+from graphsdg.dataset.class_table import ClassTable
+from graphsdg.dataset.view import read_view_frames
+from graphsdg.dataset.view_frame import DepthMap, PointCloud, ViewBox, ViewBox3D, ViewFrame
+from graphsdg.io.camera_geometry import PinholeCamera
+from graphsdg.io.object_store import S3Url, is_s3_url
+from graphsdg.maths.rotations import matrix_to_quat_wxyz
+
+VIEWER_EXTRA = "pip install 'graphsdg[viewer]'"
+TIMELINE = "frame"
+APPLICATION_ID = "graphsdg"
+
+
+class RerunMissingError(ImportError):
+    """Rerun output asked for without the Rerun SDK installed."""
+
+
+def import_rerun():
+    """The ``rerun`` module, or :class:`RerunMissingError` naming the extra that provides it."""
+    try:
+        import rerun
+    except ImportError as exc:
+        raise RerunMissingError(f"Rerun output needs the Rerun SDK (the rerun-sdk package): {VIEWER_EXTRA}") \
+            from exc
+    return rerun
+
+
+def _part(name: str) -> str:
+    """``name`` as entity-path parts (its ``/`` separate levels; other characters kept, escaped)."""
+    from rerun import escape_entity_path_part
+    return "/".join(escape_entity_path_part(p) for p in name.split("/") if p) or "camera"
+
+
+def camera_path(stream: str) -> str:
+    """The entity of stream ``stream``'s camera (its pose); its image entities are below ``.../image``."""
+    return f"world/cameras/{_part(stream)}"
+
+
+@dataclass
+class PreparedFrame:
+    """What a frame logs, read and decoded (on a worker thread)."""
+
+    frame: ViewFrame
+    image: bytes
+    semantic: tuple[np.ndarray, dict[int, str]] | None = None
+    instances: tuple[np.ndarray, dict[int, str]] | None = None
+    depth: DepthMap | None = None
+    camera: PinholeCamera | None = None
+    boxes_3d: list[ViewBox3D] = field(default_factory=list)
+    clouds: list[PointCloud] = field(default_factory=list)
+
+
+def prepare(frame: ViewFrame) -> PreparedFrame:
+    """Read and decode every layer of ``frame``."""
+    return PreparedFrame(frame, frame.image_bytes(), frame.masks(), frame.instances(), frame.depth(),
+                         frame.camera(), frame.boxes_3d(), frame.point_clouds())
+
+
+class Logger:
+    """Logs prepared frames to a Rerun recording stream, keeping the class table and its context current."""
+
+    def __init__(self, rr, rec, classes: ClassTable) -> None:
+        self.rr, self.rec, self.classes = rr, rec, classes
+        self._context_size = -1
+        self._plane_cosines: dict[tuple, np.ndarray] = {}
+        self.counts: dict[str, int] = {"boxes_tight": 0, "boxes_loose": 0, "boxes_3d": 0, "points": 0}
+
+    def class_ids(self, names: list[str]) -> np.ndarray:
+        return np.array([self.classes.id_of(n) for n in names], dtype=np.uint16)
+
+    def sync_context(self) -> None:
+        """(Re)log the class table as the root's annotation context when classes were added."""
+        if len(self.classes) == self._context_size:
+            return
+        rr = self.rr
+        self.rec.log("/", rr.AnnotationContext([rr.AnnotationInfo(id=self.classes.id_of(n), label=n,
+                                                                  color=self.classes.colour(n))
+                                                for n in self.classes.names]), static=True)
+        self._context_size = len(self.classes)
+
+    def plane_depth(self, depth: DepthMap, camera: PinholeCamera) -> np.ndarray:
+        """Distance along each pixel's ray -> distance to the image plane (what a pinhole back-projects)."""
+        key = (camera.fx, camera.fy, camera.cx, camera.cy, depth.values.shape)
+        cos = self._plane_cosines.get(key)
+        if cos is None:
+            h, w = depth.values.shape
+            x = (np.arange(w) + 0.5 - camera.cx) / camera.fx
+            y = (np.arange(h) + 0.5 - camera.cy) / camera.fy
+            cos = self._plane_cosines[key] = (1.0 / np.sqrt(1.0 + x[None, :] ** 2 + y[:, None] ** 2)).astype(
+                np.float32)
+        return depth.values * cos
+
+    def log(self, p: PreparedFrame) -> None:
+        self.rec.set_time(TIMELINE, sequence=p.frame.index)
+        base = camera_path(p.frame.stream)
+        for layer in LAYERS:
+            layer(self, base, p)
+        self.sync_context()
+
+
+# ---- the layers: each logs one kind of data of a prepared frame --------------------------------------------
+def log_camera(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """The camera's pose and pinhole (USD camera axes: x right, y up, looking down -z)."""
+    cam = p.camera
+    if cam is None:
+        return
+    rr = lg.rr
+    camera_to_world = np.linalg.inv(np.asarray(cam.world_to_camera, dtype=np.float64).T)   # column vectors
+    lg.rec.log(base, rr.Transform3D(translation=camera_to_world[:3, 3], mat3x3=camera_to_world[:3, :3]))
+    lg.rec.log(f"{base}/image", rr.Pinhole(image_from_camera=cam.K, resolution=[cam.width, cam.height],
+                                           camera_xyz=rr.ViewCoordinates.RUB))
+
+
+def log_image(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """The image file's bytes, as written."""
+    lg.rec.log(f"{base}/image/rgb", lg.rr.EncodedImage(contents=p.image, media_type=p.frame.media_type))
+
+
+def _boxes_2d(lg: Logger, boxes: list[ViewBox]):
+    mins = np.array([[b.x0, b.y0] for b in boxes], dtype=np.float32).reshape(-1, 2)
+    sizes = np.array([[b.width, b.height] for b in boxes], dtype=np.float32).reshape(-1, 2)
+    return lg.rr.Boxes2D(mins=mins, sizes=sizes, class_ids=lg.class_ids([b.label for b in boxes]))
+
+
+def log_boxes_2d(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """Tight and loose 2D boxes (inclusive pixel bounds: a box covers whole pixels) with class ids."""
+    for kind, boxes in (("boxes_tight", p.frame.boxes), ("boxes_loose", p.frame.loose_boxes)):
+        if boxes or kind == "boxes_tight":
+            lg.rec.log(f"{base}/image/{kind}", _boxes_2d(lg, boxes))
+            lg.counts[kind] += len(boxes)
+
+
+def log_masks(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """Semantic masks as class ids; instance masks with a per-frame context naming each instance."""
+    rr = lg.rr
+    if p.semantic is not None:
+        values, names = p.semantic
+        lg.rec.log(f"{base}/image/semantic", rr.SegmentationImage(lg.classes.remap(values, names)))
+    if p.instances is not None:
+        values, names = p.instances
+        ids = values.astype(np.uint16 if max(names, default=0) < 65536 else np.uint32, copy=False)
+        lg.rec.log(f"{base}/image/instance", rr.AnnotationContext(
+            [rr.AnnotationInfo(id=v, label=n, color=color_of(v + 1)[:3]) for v, n in names.items()]))
+        lg.rec.log(f"{base}/image/instance", rr.SegmentationImage(ids))
+
+
+def log_depth(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """Depth as a z-depth image (radial depth converted where the camera is known; 0 = no depth)."""
+    if p.depth is None:
+        return
+    values = p.depth.values
+    if p.depth.kind == "distance_to_camera" and p.camera is not None:
+        values = lg.plane_depth(p.depth, p.camera)
+    values = np.nan_to_num(values, nan=0.0, posinf=0.0, neginf=0.0)
+    lg.rec.log(f"{base}/image/depth", lg.rr.DepthImage(values, meter=1.0 / p.depth.meters_per_unit))
+
+
+def _boxes_3d(lg: Logger, boxes: list[ViewBox3D]):
+    quats = matrix_to_quat_wxyz(np.array([b.rotation for b in boxes]).reshape(-1, 3, 3))[:, [1, 2, 3, 0]]
+    return lg.rr.Boxes3D(centers=np.array([b.center for b in boxes]).reshape(-1, 3),
+                         half_sizes=np.array([b.half_size for b in boxes]).reshape(-1, 3),
+                         quaternions=quats, class_ids=lg.class_ids([b.label for b in boxes]),
+                         labels=[b.name or b.label for b in boxes])
+
+
+def log_boxes_3d(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """3D boxes in the world or in the camera frame."""
+    world = [b for b in p.boxes_3d if b.frame == "world"]
+    camera = [b for b in p.boxes_3d if b.frame == "camera"]
+    if world:
+        lg.rec.log(f"world/boxes_3d/{_part(p.frame.stream)}", _boxes_3d(lg, world))
+    if camera:
+        lg.rec.log(f"{base}/boxes_3d", _boxes_3d(lg, camera))
+    lg.counts["boxes_3d"] += len(p.boxes_3d)
+
+
+def log_point_clouds(lg: Logger, base: str, p: PreparedFrame) -> None:
+    """Point clouds with their classes (as class ids) and instance ids (as Rerun's per-point ids)."""
+    rr = lg.rr
+    for cloud in p.clouds:
+        class_ids = None
+        if cloud.semantic_ids is not None:
+            names = cloud.semantic_names or {int(v): f"class {int(v)}" for v in np.unique(cloud.semantic_ids)}
+            class_ids = lg.classes.remap(np.asarray(cloud.semantic_ids, dtype=np.int64), names)
+        points = rr.Points3D(cloud.positions, colors=cloud.colors, class_ids=class_ids,
+                             keypoint_ids=None if cloud.instance_ids is None else
+                             np.asarray(cloud.instance_ids, dtype=np.uint16))
+        if cloud.frame == "world":
+            lg.rec.log(f"world/points/{_part(p.frame.stream)}/{_part(cloud.name)}", points)
+        elif cloud.frame == "camera":
+            lg.rec.log(f"{base}/points/{_part(cloud.name)}", points)
+        else:
+            path = f"world/sensors/{_part(cloud.name)}"
+            if cloud.pose is not None:
+                lg.rec.log(path, rr.Transform3D(translation=cloud.pose[:3, 3], mat3x3=cloud.pose[:3, :3]))
+            lg.rec.log(f"{path}/points", points)
+        lg.counts["points"] += len(cloud.positions)
+
+
+#: what a frame logs, in order; a new kind of data is one more function here
+LAYERS: tuple[Callable[[Logger, str, PreparedFrame], None], ...] = (
+    log_camera, log_image, log_boxes_2d, log_masks, log_depth, log_boxes_3d, log_point_clouds)
+
+
+# ---- the recording -----------------------------------------------------------------------------------------
+def default_rrd_path(root: str) -> str:
+    """``<dataset>.rrd`` beside a folder; ``./<last part of the prefix>.rrd`` for S3."""
+    if is_s3_url(root):
+        url = S3Url.parse(root)
+        return os.path.abspath((url.prefix.rstrip("/").rsplit("/", 1)[-1] or url.bucket) + ".rrd")
+    return os.path.abspath(root).rstrip(os.sep) + ".rrd"
+
+
+def blueprint(rr, streams: list[str]):
+    """The recording's default layout: the 3D world beside each camera's image (boxes and classes over it),
+    its instances and its depth."""
+    import rerun.blueprint as rrb
+    views = []
+    for s in streams:
+        image = f"{camera_path(s)}/image"
+        views.append(rrb.Spatial2DView(origin=image, name=f"{s}: rgb, boxes, classes",
+                                       contents=["$origin/rgb", "$origin/boxes_tight", "$origin/boxes_loose",
+                                                 "$origin/semantic"]))
+        views.append(rrb.Spatial2DView(origin=image, name=f"{s}: instances", contents=["$origin/instance",
+                                                                                          "$origin/rgb"]))
+        views.append(rrb.Spatial2DView(origin=image, name=f"{s}: depth", contents=["$origin/depth"]))
+    return rrb.Blueprint(rrb.Horizontal(rrb.Spatial3DView(origin="world", name="world"), rrb.Grid(*views),
+                                        column_shares=[1, 1]), collapse_panels=True)
+
+
+def _camera_warning(frames: list[ViewFrame]) -> str | None:
+    missing = [f.camera_missing for f in frames if f.camera_missing]
+    if not missing:
+        return None
+    shown = ", ".join(missing[:4]) + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+    return (f"{len(missing)} of {len(frames)} frames have depth but no camera parameters (missing {shown}): "
+            f"their depth is logged as an image only, not as 3D points")
+
+
+def record(root: str, rrd_path: str | None = None, *, spawn: bool = False, connect: str | None = None,
+           max_frames: int | None = None, workers: int = 2) -> dict[str, Any]:
+    """Log every frame of the dataset at ``root`` (a folder or ``s3://bucket/prefix``; BasicWriter, COCO, KITTI
+    or YOLO) to Rerun: into ``rrd_path`` (default :func:`default_rrd_path`), or to a viewer (``spawn`` starts
+    one, ``connect`` is a viewer's gRPC URL). Returns a summary: format, frames, streams, counts, warnings,
+    seconds and frames/s."""
+    rr = import_rerun()
+    fmt, frames = read_view_frames(root)
+    frames = frames[:max_frames] if max_frames else frames
+    warned = _camera_warning(frames)
+    if warned:
+        warnings.warn(warned, UserWarning, stacklevel=2)
+    streams = sorted({f.stream for f in frames})
+    classes = ClassTable(b.label for f in frames for b in [*f.boxes, *f.loose_boxes])
+    rec = rr.RecordingStream(APPLICATION_ID, recording_id=f"graphsdg:{root}")
+    rec.set_log_time_enabled(False)   # the frame timeline only
+    rec.set_log_tick_enabled(False)
+    layout = blueprint(rr, streams)
+    if connect:
+        rec.connect_grpc(connect, default_blueprint=layout)
+        target = connect
+    elif spawn:
+        rec.spawn(default_blueprint=layout)
+        target = "viewer"
+    else:
+        target = rrd_path or default_rrd_path(root)
+        os.makedirs(os.path.dirname(os.path.abspath(target)) or ".", exist_ok=True)
+        rec.save(target, default_blueprint=layout)
+    logger = Logger(rr, rec, classes)
+    start = time.perf_counter()
+    rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    logger.sync_context()
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+        ahead: deque = deque()
+        for f in frames:
+            ahead.append(pool.submit(prepare, f))
+            if len(ahead) > 2 * max(1, workers):
+                logger.log(ahead.popleft().result())
+        while ahead:
+            logger.log(ahead.popleft().result())
+    rec.flush()
+    rec.disconnect()
+    seconds = time.perf_counter() - start
+    return {"format": fmt, "rerun": target, "frames": len(frames), "streams": streams, "classes": len(classes),
+            **logger.counts, "warnings": [warned] if warned else [], "seconds": round(seconds, 3),
+            "frames/s": round(len(frames) / seconds, 1) if seconds > 0 else 0.0}
