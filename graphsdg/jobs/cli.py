@@ -120,6 +120,29 @@ def run_bench(args: argparse.Namespace) -> None:
             f.write("\n" + text)
 
 
+def run_view(args: argparse.Namespace) -> int:
+    """``graphsdg view``: the contact sheet (and gallery page), or the Rerun recording; print the summary and any
+    warning (one ``warning:`` line each, on stderr)."""
+    import warnings
+
+    from graphsdg.dataset.view import summary_lines, write_view
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        if args.rerun is not None:
+            from graphsdg.dataset.rerun_recording import record
+            target = args.rerun
+            result = record(args.dir, None if target in ("", "spawn") or target.startswith("rerun") else target,
+                            spawn=target == "spawn", connect=target if target.startswith("rerun") else None,
+                            max_frames=args.max)
+        else:
+            result = write_view(args.dir, args.out, args.max, args.html, args.page_size)
+    for line in summary_lines(result):
+        print(line)
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
+    return 0
+
+
 def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
     """``graphsdg graph``: build the script's graph (no render, no write); print it, write DOT and PNG."""
     from graphsdg import graph as graphs
@@ -221,6 +244,8 @@ def _hint(exc: BaseException) -> str:
     from graphsdg.jobs.scaleout import RayMissingError, ShardFailedError
     if isinstance(exc, RayMissingError):
         return "install Ray with: pip install 'graphsdg[ray]'"
+    if type(exc).__name__ == "RerunMissingError":
+        return "install the Rerun SDK with: pip install 'graphsdg[viewer]'"
     if isinstance(exc, S3MissingError):
         return "install boto3 with: pip install 'graphsdg[s3]'"
     if isinstance(exc, ShardFailedError):
@@ -422,14 +447,24 @@ def build_parser() -> argparse.ArgumentParser:
     folder.add_argument("--resolution-scale", type=float, metavar="F",
                         help="scale every render product's resolution by F in every script")
     view = sub.add_parser("view", parents=[common],
-                          help="contact sheet (and HTML gallery) of a dataset, with statistics",
+                          help="contact sheet, gallery page or Rerun recording of a dataset, with statistics",
                           description="Draws boxes, class names and masks over the frames of a BasicWriter, "
                                       "COCO, KITTI or YOLO dataset (detected from its files) into a contact "
-                                      "sheet PNG and prints per-class counts, empty frames and box sizes.",
+                                      "sheet PNG and prints per-class counts, empty frames and box sizes; "
+                                      "--html adds a gallery page, --rerun logs every frame to Rerun instead.",
                           epilog=EPILOG)
     view.add_argument("dir")
-    view.add_argument("--html", action="store_true", help="also write an HTML gallery")
-    view.add_argument("--max", type=_positive, default=16, help="frames to show (default 16)")
+    view.add_argument("--html", action="store_true",
+                      help="also write a gallery page (index.html): statistics tables, every frame with toggles "
+                           "for boxes, masks and labels, a class filter, depth beside the image")
+    view.add_argument("--rerun", nargs="?", const="", metavar="OUT.rrd",
+                      help="log every frame to a Rerun recording (default DIR.rrd); 'spawn' opens a Rerun "
+                           "viewer, a rerun+http://... URL streams to a running one (pip install "
+                           "'graphsdg[viewer]')")
+    view.add_argument("--max", type=_positive,
+                      help="frames to show (default: 16 in the contact sheet, every frame in the gallery and "
+                           "the recording)")
+    view.add_argument("--page-size", type=_positive, default=48, help="frames per gallery page (default 48)")
     view.add_argument("--out", help="output folder (default: DIR.view next to the dataset)")
     graph = sub.add_parser("graph", parents=[common],
                            help="build a script's node graph without running it; print and draw it",
@@ -478,10 +513,7 @@ def main(argv: list[str] | None = None) -> int:
         elif args.command == "bench":
             run_bench(args)
         elif args.command == "view":
-            from graphsdg.dataset.view import write_view
-            result = write_view(args.dir, args.out, args.max, args.html)
-            for key, value in result.items():
-                print(f"{key}: {value}")
+            return run_view(args)
         elif args.command == "validate":
             from graphsdg.dataset.validate import validate
             violations = validate(args.dir)
