@@ -131,3 +131,19 @@ def test_scene_queries_name_hits_by_path_integers_and_paused_tracking(stage):
     UsdGeom.Xformable(stage.GetPrimAtPath("/Wall")).GetOrderedXformOps()[0].Set(Gf.Vec3d(5, 0, 0))
     physx.flush_changes()
     assert query.raycast_closest((0, 0, 0), (1, 0, 0), 10.0)[1].distance == pytest.approx(4.9, abs=1e-9)
+
+
+def test_pending_pushes_and_a_tracking_pause_end_with_their_stage(stage):
+    import omni.physics.core
+    import omni.physx
+    from graphsdg.physics import forces
+    _box(stage, "/A", (0, 0, 1))
+    omni.physx.get_physx_simulation_interface().apply_force_at_pos(_stage_id(stage), "/A", (1, 0, 0), (0, 0, 1))
+    interface = omni.physics.core.get_physics_simulation_interface()
+    interface.pause_change_tracking(True)
+    assert len(forces.pending()) == 1
+    new = rep.stage.new_stage()
+    assert forces.pending() == [] and not interface.is_change_tracking_paused()
+    _box(new, "/B", (0, 0, 1))
+    interface.simulate(DT)           # the new stage steps with no stale push and sees its own edits
+    np.testing.assert_allclose(runtime().sim.body_velocity("/B")[0], [0, 0, -9.81 * DT], atol=1e-9)

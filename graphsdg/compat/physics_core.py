@@ -45,7 +45,7 @@ from graphsdg.compat.physx_schema import sdfPathToInt
 from graphsdg.physics import queries
 from graphsdg.runtime import runtime
 from graphsdg.sim import physics_steps
-from graphsdg.stage.context import get_stage
+from graphsdg.stage.context import get_stage, stage_context
 
 
 class PhysicsStepContext(CompatObject):
@@ -150,8 +150,16 @@ class PhysicsStepper:
         """Whether stage edits are kept from the simulation."""
         return self._tracking_pause is not None
 
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """A new stage is attached to nothing and tracked (the pause belonged to the old stage's tracker)."""
+        self._attached = None
+        if self._tracking_pause is not None:
+            self._tracking_pause.__exit__(None, None, None)
+            self._tracking_pause = None
+
 
 stepper = PhysicsStepper()
+stage_context.subscribe_replaced(stepper.on_stage_replaced)
 
 
 class PhysicsSimulationInterface(CompatObject):

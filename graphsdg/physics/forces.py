@@ -12,6 +12,7 @@ mass: the push also turns the body about it. Modes follow PhysX:
 
 Pushes are added to MuJoCo's ``qfrc_applied`` just before the step and taken off
 right after it, so forces that others keep there (joint efforts) stay as they were.
+Pushes still waiting when the stage is replaced are dropped with it.
 
 Example:
     >>> import numpy as np
@@ -37,7 +38,7 @@ import numpy as np
 from graphsdg.runtime import runtime
 from graphsdg.sim import physics_steps
 from graphsdg.sim.rigid_bodies import rigid_root
-from graphsdg.stage.context import get_stage
+from graphsdg.stage.context import get_stage, stage_context
 
 MODES = ("Force", "Impulse", "Velocity", "Acceleration")
 
@@ -133,3 +134,12 @@ def _after_step(dt: float) -> None:
         if generalised.shape == d.qfrc_applied.shape:
             d.qfrc_applied -= generalised
     _applied.clear()
+
+
+def _on_stage_replaced(stage) -> None:
+    """Pushes belong to the stage they were given on."""
+    _queue.clear()
+    _applied.clear()
+
+
+stage_context.subscribe_replaced(_on_stage_replaced)
