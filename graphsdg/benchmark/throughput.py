@@ -529,12 +529,16 @@ def round_summaries(rounds: list[tuple[BenchResult, BenchResult | None]]) -> lis
     return rows
 
 
-def _worker(config_dict: dict, barrier) -> dict:
+def _worker(config_dict: dict, before_timing=None) -> dict:
+    """One benchmark process of :func:`run_processes`: its timing, and the GPU it was given (None: any)."""
     config = BenchConfig(**config_dict)
-    r = run_graphsdg(config, before_timing=barrier.wait)
+    r = run_graphsdg(config, before_timing=before_timing)
     return {"frames": r.frames, "wall": r.wall_seconds, "start": r.started_at, "cpu": r.cpu_seconds,
             "system": r.system_seconds, "page_faults": r.page_faults,
-            "frame_ends": (r.started_at + np.cumsum(r.frame_times)).tolist()}
+            "frame_ends": (r.started_at + np.cumsum(r.frame_times)).tolist(),
+            "gpu": int(os.environ["GRAPHSDG_GPU"]) if os.environ.get("GRAPHSDG_GPU", "").isdigit() else None,
+            "cuda_visible_devices": os.environ.get("CUDA_VISIBLE_DEVICES"),
+            "egl_device": os.environ.get("MUJOCO_EGL_DEVICE_ID")}
 
 
 def _steady_rate(results: list[dict]) -> float:
@@ -557,23 +561,26 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     from the first start to the last finish, so a straggler counts against it;
     the steady rate counts only the frames finished while every process ran.
     """
-    import multiprocessing
+    results, elapsed, config = launch_processes(config, processes)
+    return summarize_processes(results, config, elapsed)
 
+
+def launch_processes(config: BenchConfig, processes: int,
+                     environments: list[dict[str, str]] | None = None) -> tuple[list[dict], float, BenchConfig]:
+    """Run ``processes`` benchmark processes (process i with seed + i, and ``environments[i]`` added to its
+    environment: its GPU, say); return their :func:`_worker` results, the seconds it all took, and the
+    config they ran (the writer and OpenCV threads set to each one's share of the cores)."""
+    from graphsdg.benchmark.process_launch import run_in_processes
     from graphsdg.jobs.cpu_share import cores_per_process
     from graphsdg.io.write_queue import threads_per_process
-    ctx = multiprocessing.get_context("spawn")
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(processes))
     if config.image_threads is None:
         config = dataclasses.replace(config, image_threads=cores_per_process(processes))
-    configs = [dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)) for i in range(processes)]
+    configs = [(dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)),) for i in range(processes)]
     start = time.perf_counter()
-    with ctx.Manager() as manager:
-        barrier = manager.Barrier(processes)
-        with concurrent.futures.ProcessPoolExecutor(processes, mp_context=ctx) as ex:
-            results = list(ex.map(_worker, configs, [barrier] * processes))
-    elapsed = time.perf_counter() - start
-    return summarize_processes(results, config, elapsed)
+    results = run_in_processes(_worker, configs, environments or [{}] * processes)
+    return results, time.perf_counter() - start, config
 
 
 def summarize_processes(results: list[dict], config: BenchConfig, elapsed: float) -> dict[str, float]:

@@ -62,6 +62,12 @@ def run_bench(args: argparse.Namespace) -> None:
     if args.rounds > 1 and args.processes:
         raise ValueError(f"--rounds {args.rounds} alternates the one-process comparison with the hand-written loop; "
                          f"with --processes {args.processes} there is none: run the command again instead")
+    if args.processes_per_gpu and not args.gpus:
+        raise ValueError(f"--processes-per-gpu {args.processes_per_gpu} needs --gpus: it is each GPU's share of the "
+                         f"processes")
+    if args.gpus and args.rounds > 1:
+        raise ValueError(f"--rounds {args.rounds} alternates the one-process comparison with the hand-written loop; "
+                         f"with --gpus there is none: run the command again instead")
     unknown = [a for a in annotators if a not in throughput.ANNOTATOR_FLAGS]
     if unknown:
         raise ValueError(f"unknown benchmark annotator(s) {unknown}; known: {sorted(throughput.ANNOTATOR_FLAGS)}")
@@ -76,7 +82,7 @@ def run_bench(args: argparse.Namespace) -> None:
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
                        f", {args.write_threads} write threads" if args.write_threads is not None else
-                       "" if args.processes else f", {_default_write_threads()} write threads",
+                       "" if args.processes or args.gpus else f", {_default_write_threads()} write threads",
                        f", write processes {args.write_processes}" if args.write_processes is not None else "",
                        ", wait_for_render" if args.wait_for_render else "",
                        f", {args.rendermode}" if args.rendermode else "",
@@ -90,7 +96,9 @@ def run_bench(args: argparse.Namespace) -> None:
                      f"{'skip-write' if args.skip_write else 'written to ' + _written_where(args.temp_dir)}")
     machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}, render backend: " \
               f"{_render_backend(args.backend)}"
-    if args.processes:
+    if args.gpus:
+        table = _bench_on_gpus(args, config)
+    elif args.processes:
         row = throughput.run_processes(config, args.processes)
         table = throughput.format_table([row])
     else:
@@ -141,6 +149,31 @@ def run_view(args: argparse.Namespace) -> int:
     for w in caught:
         print(f"warning: {w.message}", file=sys.stderr)
     return 0
+
+
+def _bench_on_gpus(args: argparse.Namespace, config) -> str:
+    """``graphsdg bench --gpus K [K ...]``: per count, the total and per-GPU tables; with several counts, the
+    scaling table. Every count is checked against the machine before anything runs."""
+    from graphsdg.benchmark import multi_gpu
+    from graphsdg.benchmark.throughput import format_table
+    from graphsdg.jobs.gpu_assignment import check_egl_sees, choose_gpus, default_processes_per_gpu
+    if args.processes and args.processes_per_gpu:
+        raise ValueError(f"--processes {args.processes} and --processes-per-gpu {args.processes_per_gpu} both say "
+                         f"how many processes run: give one of them")
+    chosen = {count: choose_gpus(count) for count in args.gpus}     # GpuCountError before any run
+    if os.environ.get("MUJOCO_GL", "egl").lower() == "egl":
+        from graphsdg.render.egl_device import egl_cuda_devices
+        check_egl_sees(chosen[max(chosen)], egl_cuda_devices())
+    runs, parts = [], []
+    for count, gpus in chosen.items():
+        processes = args.processes or count * (args.processes_per_gpu or default_processes_per_gpu(count))
+        run = multi_gpu.run_on_gpus(config, processes, gpus)
+        runs.append(run)
+        parts.append(f"#### {count} GPU(s), {processes} processes\n\n{format_table([run.total])}\n\n"
+                     f"{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}")
+    if len(runs) > 1:
+        parts.append("#### Scaling\n\n" + format_table(multi_gpu.scaling_rows(runs)))
+    return "\n\n".join(parts)
 
 
 def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
@@ -213,15 +246,24 @@ def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
         raise FileNotFoundError(f"script {args.script!r} does not exist")
     job = JobSpec(script=args.script, args=tuple(script_args), compat=args.compat, seed=args.seed, out=args.out,
                   frames=args.frames, resume=args.resume, resolution_scale=args.resolution_scale)
+    if args.gpus is not None and args.workers is None:
+        raise ValueError(f"--gpus {args.gpus} spreads --workers over GPUs; without --workers the script runs in "
+                         f"this process (its GPU: CUDA_VISIBLE_DEVICES)")
     if args.workers is not None:
         from graphsdg.jobs.scaleout import import_ray, run_sharded
         import_ray()                      # says how to get Ray before anything runs
         check_job_file(job)
-        summary = run_sharded(job, args.workers, address=args.address, gpus_per_worker=args.gpus_per_worker)
+        summary = run_sharded(job, args.workers, address=args.address, gpus_per_worker=args.gpus_per_worker,
+                              gpus=args.gpus)
     else:
         check_job_file(job)
         summary = run_job(job)
     print(f"graphsdg run: {format_summary(summary)}")
+    if args.workers is not None:
+        from graphsdg.jobs.scaleout import format_gpu_rows
+        gpu_line = format_gpu_rows(summary)
+        if gpu_line:
+            print(f"graphsdg run: {gpu_line}")
     if summary.get("index"):
         print(f"graphsdg run: index {summary['index']}")
     return 0
@@ -242,6 +284,10 @@ def _hint(exc: BaseException) -> str:
     from graphsdg.jobs.job import JobMismatchError
     from graphsdg.io.object_store import ObjectStoreError, S3MissingError
     from graphsdg.jobs.scaleout import RayMissingError, ShardFailedError
+    from graphsdg.jobs.gpu_assignment import GpuCountError
+    from graphsdg.render.egl_device import EglDeviceError
+    if isinstance(exc, (GpuCountError, EglDeviceError)):
+        return "nvidia-smi lists this machine's GPUs; CUDA_VISIBLE_DEVICES limits the ones graphsdg sees"
     if isinstance(exc, RayMissingError):
         return "install Ray with: pip install 'graphsdg[ray]'"
     if type(exc).__name__ == "RerunMissingError":
@@ -279,6 +325,12 @@ def _positive(value: str) -> int:
     if n < 1:
         raise argparse.ArgumentTypeError(f"must be a positive integer, got {value}")
     return n
+
+
+def _positive_or_auto(value: str) -> int | str:
+    if value == "auto":
+        return value
+    return _positive(value)
 
 
 def _non_negative(value: str) -> int:
@@ -398,6 +450,13 @@ def build_parser() -> argparse.ArgumentParser:
                        help="run this many graphsdg processes at once and report their aggregate frames/s, "
                             "images/s (frames times cameras) and the cores they kept busy (no hand-written "
                             "loop); 0 runs one process with the loop (default: 0)")
+    bench.add_argument("--gpus", type=_positive, nargs="+", metavar="K",
+                       help="spread the processes over the first K GPUs this process sees (each process's CUDA and "
+                            "EGL device the same GPU) and add a row per GPU; several counts (e.g. 1 2 4) run one "
+                            "after the other and end with a scaling table (no hand-written loop)")
+    bench.add_argument("--processes-per-gpu", type=_positive, metavar="N",
+                       help="with --gpus: N processes on each GPU (default: --processes spread over the GPUs, or "
+                            "the cores' share of each GPU, at most 8)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
     bench.add_argument("--rounds", type=_positive, default=1,
                        help="run graphsdg and the hand-written loop this many times each, alternately, in one "
@@ -421,14 +480,18 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--frames", type=_positive, help="frames for orchestrator.run() calls without num_frames")
     run.add_argument("--resolution-scale", type=float, metavar="F",
                      help="scale every render product's resolution by F (e.g. 0.125 for a quick, small run)")
-    run.add_argument("--workers", type=_positive, metavar="K",
+    run.add_argument("--workers", type=_positive_or_auto, metavar="K",
                      help="shard the run over K Ray worker processes and merge their output (needs --out; "
-                          "pip install 'graphsdg[ray]')")
+                          "pip install 'graphsdg[ray]'); auto: the cores' share of workers on every GPU (at most 8 "
+                          "a GPU), one a core without GPUs")
+    run.add_argument("--gpus", type=_positive, metavar="K",
+                     help="with --workers: use K GPUs (default: every GPU of this machine, or of the cluster with "
+                          "--address); more than there are is an error")
     run.add_argument("--address", help="join this Ray cluster (e.g. ray://host:10001 or auto) instead of "
                                        "starting a local one")
     run.add_argument("--gpus-per-worker", type=_fraction, metavar="F",
-                     help="GPUs per worker, may be a fraction (default: the cluster's GPUs shared evenly, at "
-                          "most 1; 0 without GPUs)")
+                     help="GPUs per worker, may be a fraction (default: 1/ceil(workers/GPUs), so the workers fill "
+                          "every GPU; 1 with fewer workers than GPUs; 0 without GPUs)")
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: frames complete on disk are kept, the rest are captured")
     folder = sub.add_parser("run-folder", parents=[common],

@@ -5,9 +5,13 @@ model. Shard ``i`` runs the whole script with the job's seed and captures the
 frames ``i, i + K, ...`` of its ``orchestrator.run(num_frames)`` (the scheduler
 seeks to each, so every frame holds the values of one uninterrupted run and the
 union of the shards is that run's dataset). Actors ask for one CPU and
-``gpus_per_worker`` GPUs (a fraction shares a GPU); the EGL device follows the
-GPU Ray assigned. The driver then merges the shards (:mod:`graphsdg.dataset.merge`)
-and writes ``graphsdg_index.json``.
+``gpus_per_worker`` GPUs (by default an even share of every GPU of the cluster,
+:func:`~graphsdg.jobs.gpu_assignment.gpu_share`; ``--gpus K`` uses K of them); Ray
+shows each actor its GPU through ``CUDA_VISIBLE_DEVICES`` and the EGL device follows
+it, so CUDA (the pbr backend) and EGL render on the GPU Ray assigned. ``--workers auto``
+puts the cores' share of workers on each GPU (:func:`default_workers`). The driver then
+merges the shards (:mod:`graphsdg.dataset.merge`) and writes ``graphsdg_index.json``;
+its summary has a row per GPU (:func:`gpu_rows`).
 
 With ``address`` the driver joins that Ray cluster; otherwise it starts a local
 one for the job and shuts it down afterwards. Every node needs graphsdg, and
@@ -28,6 +32,7 @@ import time
 from dataclasses import replace
 
 from graphsdg.jobs.cpu_share import cores_per_process
+from graphsdg.jobs.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
 from graphsdg.io import object_store
 from graphsdg.io.location import normalize
 from graphsdg.io.write_queue import threads_per_process
@@ -108,13 +113,20 @@ def script_here(job: JobSpec) -> JobSpec:
     return replace(job, script=path)
 
 
-def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per_worker: float | None = None,
-                num_cpus: int | None = None) -> dict:
-    """Run ``job`` as ``workers`` Ray shards, merge them; return the job summary (with per-shard rows)."""
-    from graphsdg.dataset import merge
+def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gpus_per_worker: float | None = None,
+                num_cpus: int | None = None, gpus: int | None = None) -> dict:
+    """Run ``job`` as ``workers`` Ray shards (``"auto"``: :func:`default_workers`), merge them; return the job
+    summary (with per-shard and per-GPU rows).
 
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"--workers must be a positive integer, got {workers!r}")
+    ``gpus``: use that many GPUs (default: all the cluster's); more than the machine or cluster has is an
+    error naming both counts. Each worker asks for :func:`~graphsdg.jobs.gpu_assignment.gpu_share` of a GPU
+    unless ``gpus_per_worker`` says otherwise.
+    """
+    from graphsdg.dataset import merge
+    from graphsdg.jobs.gpu_assignment import choose_gpus, gpu_share
+
+    if workers != "auto" and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ValueError(f"--workers must be a positive integer or 'auto', got {workers!r}")
     if job.out is None:
         raise ValueError("--workers needs --out DIR: the shards write into one output root (on a shared "
                          "filesystem, or an s3://bucket/prefix, when the cluster has several machines)")
@@ -125,14 +137,27 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
         if address:
             ray.init(address=address, log_to_driver=True)
         else:
+            # this machine's GPUs, checked before Ray starts: the local cluster gets them (or the first --gpus)
+            local_gpus = len(choose_gpus(gpus)) if gpus is not None else _visible_gpu_count()
             # address="local": a new cluster of this process's own, never one another run left on the machine
-            ray.init(address="local", num_cpus=num_cpus or max(workers, os.cpu_count() or 1),
+            cores = num_cpus or os.cpu_count() or 1
+            wanted = default_workers(local_gpus, cores) if workers == "auto" else workers
+            ray.init(address="local", num_cpus=max(wanted, cores), num_gpus=local_gpus,
                      include_dashboard=False, log_to_driver=True)
     try:
-        gpus = float(ray.cluster_resources().get("GPU", 0))
-        per_worker = gpus_per_worker if gpus_per_worker is not None else (min(1.0, gpus / workers) if gpus else 0)
-        if per_worker > gpus:
-            raise ValueError(f"--gpus-per-worker {per_worker} but the cluster has {gpus:g} GPU(s)")
+        cluster_gpus = float(ray.cluster_resources().get("GPU", 0))
+        if gpus is not None and gpus > cluster_gpus:
+            raise GpuCountError(f"--gpus {gpus} asks for {gpus} GPU(s) but the Ray cluster has {cluster_gpus:g}")
+        used_gpus = float(gpus) if gpus is not None else cluster_gpus
+        if workers == "auto":
+            workers = default_workers(int(used_gpus), int(ray.cluster_resources().get("CPU", 1)))
+        per_worker = gpus_per_worker if gpus_per_worker is not None else gpu_share(workers, used_gpus)
+        if per_worker > cluster_gpus:
+            raise GpuCountError(f"--gpus-per-worker {per_worker:g} but the cluster has {cluster_gpus:g} GPU(s)")
+        if per_worker and used_gpus >= 1 and workers % int(used_gpus):
+            log.warning("%d workers on %d GPUs: Ray fills one GPU before the next, so the last GPU gets fewer "
+                        "workers (a multiple of the GPU count, or --workers auto, loads them alike)",
+                        workers, int(used_gpus))
         env = {k: v for k, v in os.environ.items() if k in FORWARDED_ENV}
         with open(job.script, "rb") as f:
             source = f.read()
@@ -170,12 +195,68 @@ def run_sharded(job: JobSpec, workers: int, address: str | None = None, gpus_per
     datasets = merge.merge_shards(results)
     seconds = time.perf_counter() - start
     frames = sum(r["frames"] for r in results)
+    per_gpu = gpu_rows(results)
     summary = {"frames": frames, "files": sum(r["files"] for r in results),
                "bytes": sum(r["bytes"] for r in results), "seconds": round(seconds, 3),
                "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0, "workers": workers,
-               "gpus_per_worker": per_worker,
+               "gpus_per_worker": per_worker, "gpus": len(per_gpu), "per_gpu": per_gpu,
                "shards": [{k: r[k] for k in SHARD_COLUMNS} for r in results]}
     job_info = job.describe()
     summary["index"] = merge.write_index(job.out, {**job_info, "workers": workers, "shards": summary["shards"]},
                                          datasets)
     return summary
+
+
+def _visible_gpu_count() -> int:
+    """The GPUs this process sees (the local cluster gets them all)."""
+    return len(visible_gpus(host_gpus(), os.environ.get("CUDA_VISIBLE_DEVICES")))
+
+
+def default_workers(gpus: int, cores: int) -> int:
+    """``--workers auto``: on GPUs, each GPU's default share of processes
+    (:func:`~graphsdg.jobs.gpu_assignment.default_processes_per_gpu`), a multiple of the GPU count so every
+    GPU gets as many; without GPUs, one a core.
+
+    Example:
+        >>> default_workers(4, 64), default_workers(2, 16), default_workers(0, 16)
+        (32, 16, 16)
+    """
+    if gpus < 1:
+        return max(1, cores)
+    return gpus * default_processes_per_gpu(gpus, cores)
+
+
+def gpu_rows(results: list[dict]) -> list[dict]:
+    """A row per GPU the shards rendered on (node and Ray GPU id): its workers, frames and frames/s (its
+    frames over its slowest shard's seconds). Shards without a GPU make no row.
+
+    Example:
+        >>> shards = [{"node": "n1", "gpu_ids": ["0"], "frames": 50, "seconds": 5.0},
+        ...           {"node": "n1", "gpu_ids": ["0"], "frames": 50, "seconds": 10.0},
+        ...           {"node": "n1", "gpu_ids": ["1"], "frames": 40, "seconds": 4.0}]
+        >>> [(r["gpu"], r["workers"], r["frames/s"]) for r in gpu_rows(shards)]
+        [('0', 2, 10.0), ('1', 1, 10.0)]
+    """
+    groups: dict[tuple, list[dict]] = {}
+    for r in results:
+        if r.get("gpu_ids"):
+            groups.setdefault((r["node"], ",".join(map(str, r["gpu_ids"]))), []).append(r)
+    rows = []
+    for (node, gpu), shards in sorted(groups.items()):
+        seconds = max(s["seconds"] for s in shards)
+        frames = sum(s["frames"] for s in shards)
+        rows.append({"node": node, "gpu": gpu, "workers": len(shards), "frames": frames,
+                     "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0})
+    return rows
+
+
+def format_gpu_rows(summary: dict) -> str | None:
+    """The summary's GPU line: how many GPUs and each one's frames/s (None when no shard had a GPU)."""
+    rows = summary.get("per_gpu") or []
+    if not rows:
+        return None
+    nodes = len({r["node"] for r in rows})
+    where = f" on {nodes} nodes" if nodes > 1 else ""
+    parts = [(f"node {r['node'][:8]} " if nodes > 1 else "") + f"GPU {r['gpu']}: {r['workers']} workers, "
+             f"{r['frames/s']:.2f} frames/s" for r in rows]
+    return f"{len(rows)} GPU(s){where}: " + "; ".join(parts)

@@ -1,0 +1,92 @@
+"""How busy each GPU was during a benchmark: ``nvidia-smi`` sampled in the background.
+
+``graphsdg bench --gpus K`` reports, per GPU, the share of time a kernel or a draw was running on it
+(``utilization.gpu``) and the memory in use, averaged over the window in which every process was timing.
+A GPU that the assignment missed shows 0 %; one held near 100 % is the limit, one well below it is fed
+too slowly by the CPU. Without ``nvidia-smi`` there are no samples and the columns read ``-``.
+
+Example:
+    >>> samples = parse_samples(["0, 97, 5000", "1, 40, 3000", "0, 99, 5100"], stamp=10.0)
+    >>> summarize(samples, 0.0, 20.0)
+    {0: (98.0, 5100.0), 1: (40.0, 3000.0)}
+"""
+from __future__ import annotations
+
+import subprocess
+import threading
+import time
+from dataclasses import dataclass
+
+QUERY = ["nvidia-smi", "--query-gpu=index,utilization.gpu,memory.used", "--format=csv,noheader,nounits"]
+
+
+@dataclass(frozen=True)
+class GpuSample:
+    """One reading of one GPU: when (``time.time()``), its index, busy percent and memory used (MiB)."""
+
+    stamp: float
+    index: int
+    busy_percent: float
+    memory_mib: float
+
+
+def parse_samples(lines: list[str], stamp: float) -> list[GpuSample]:
+    """Samples from lines of :data:`QUERY`'s output taken at ``stamp`` (lines that are not numbers, such as
+    ``[N/A]``, are skipped)."""
+    out = []
+    for line in lines:
+        fields = [f.strip() for f in line.split(",")]
+        try:
+            index, busy, memory = int(fields[0]), float(fields[1]), float(fields[2])
+        except (ValueError, IndexError):
+            continue
+        out.append(GpuSample(stamp, index, busy, memory))
+    return out
+
+
+def summarize(samples: list[GpuSample], start: float, end: float) -> dict[int, tuple[float, float]]:
+    """Per GPU index: (mean busy percent, peak memory MiB) of the samples taken in [start, end]."""
+    by_gpu: dict[int, list[GpuSample]] = {}
+    for s in samples:
+        if start <= s.stamp <= end:
+            by_gpu.setdefault(s.index, []).append(s)
+    return {i: (round(sum(s.busy_percent for s in v) / len(v), 1), max(s.memory_mib for s in v))
+            for i, v in sorted(by_gpu.items())}
+
+
+class GpuSampler:
+    """Polls :data:`QUERY` every ``interval`` seconds on a thread until :meth:`stop`; a context manager."""
+
+    def __init__(self, interval: float = 0.5) -> None:
+        self.interval = interval
+        self.samples: list[GpuSample] = []
+        self.available = True
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._poll, name="graphsdg-gpu-sampler", daemon=True)
+
+    def _poll(self) -> None:
+        while not self._stop.is_set():
+            stamp = time.time()
+            try:
+                done = subprocess.run(QUERY, capture_output=True, text=True, timeout=10, check=False)
+            except (OSError, subprocess.TimeoutExpired):
+                self.available = False
+                return
+            if done.returncode != 0:
+                self.available = False
+                return
+            self.samples += parse_samples(done.stdout.splitlines(), stamp)
+            self._stop.wait(self.interval)
+
+    def __enter__(self) -> "GpuSampler":
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def stop(self) -> None:
+        """Stop polling (waits for the poll under way)."""
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
