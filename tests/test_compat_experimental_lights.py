@@ -167,3 +167,34 @@ def test_camera_focal_length_sets_the_rendered_size(compat):
     # the top face is 9.5 m away: its width in pixels is f / aperture * 64 / 9.5
     assert widths[0] == pytest.approx(64 * 1.0 / 9.5, abs=1.5)
     assert widths[1] == pytest.approx(2 * widths[0], abs=2)
+
+
+def test_display_colors_mesh_creases_and_ground_plane_layouts(compat):
+    from isaacsim.core.experimental.materials import OmniPbrMaterial
+    from isaacsim.core.experimental.objects import Cube, GroundPlane, Mesh
+    cubes = Cube(["/World/A", "/World/B"], colors="orange")
+    np.testing.assert_allclose(cubes.get_colors().numpy(), [[1.0, 165 / 255, 0.0]] * 2, rtol=1e-6)
+    cubes.set_display_colors(["#ff0000", "k"])
+    assert [list(g.GetDisplayColorAttr().Get()[0]) for g in cubes.geoms] == [[1, 0, 0], [0, 0, 0]]
+    mesh = Mesh("/World/M", colors=[0.0, 0.0, 1.0])
+    geom = mesh.geoms[0]
+    geom.CreatePointsAttr().Set([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)])
+    geom.CreateFaceVertexCountsAttr().Set([4])
+    geom.CreateFaceVertexIndicesAttr().Set([0, 1, 2, 3])
+    assert list(geom.GetDisplayColorAttr().Get()[0]) == [0, 0, 1]
+    with pytest.warns(UserWarning, match="Mesh creases"):
+        mesh.set_crease_specs([[0, 1, 2]], [[3]], [[5.0]])
+    indices_, lengths, sharp = mesh.get_crease_specs()
+    assert indices_[0].tolist() == [0, 1, 2] and lengths[0].tolist() == [3] and sharp[0].tolist() == [5.0]
+    with pytest.raises(ValueError, match="crease_lengths sum to 2 but crease_indices has 3 points"):
+        mesh.set_crease_specs([[0, 1, 2]], [[2]], [[1.0]])
+    with pytest.warns(UserWarning, match="Mesh corners"):
+        mesh.set_corner_specs([[0, 2]], [[10.0, 10.0]])
+    assert [[a.tolist() for a in part] for part in mesh.get_corner_specs()] == [[[0, 2]], [[10.0, 10.0]]]
+    with pytest.raises(ValueError, match="one sharpness per corner"):
+        mesh.set_corner_specs([[0, 2]], [[10.0]])
+    ground = GroundPlane("/World/Ground", colors="lightgray")
+    assert list(ground.meshes.geoms[0].GetDisplayColorAttr().Get()[0]) == pytest.approx([211 / 255] * 3)
+    # Isaac Sim 6's ground planes carry their template's visual material as a third child: still a ground plane
+    OmniPbrMaterial("/World/Ground/visualMaterial")
+    assert GroundPlane("/World/Ground").planes.paths == ["/World/Ground/CollisionPlane"]

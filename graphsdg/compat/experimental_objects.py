@@ -18,9 +18,9 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 import numpy as np
-from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, Vt
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade, Vt
 
-from graphsdg.compat.experimental_arguments import as_paths, resolve_indices, rows, tokens, warn_once
+from graphsdg.compat.experimental_arguments import as_paths, color_rows, resolve_indices, rows, tokens, warn_once
 from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.experimental_prims import GeomPrim, XformPrim
 from graphsdg.compat.warp_arrays import WarpLikeArray
@@ -52,6 +52,12 @@ def _wrap_or_define(paths: Any, resolve_paths: bool, schema: type, what: str) ->
     return nonexistent
 
 
+def _set_display_colors(geoms: Sequence[UsdGeom.Gprim], colors: Any, indices: Any) -> None:
+    idx = resolve_indices(indices, len(geoms))
+    for i, rgb in zip(idx, color_rows(colors, len(idx))):
+        geoms[i].CreateDisplayColorAttr().Set(Vt.Vec3fArray([Gf.Vec3f(*(float(c) for c in rgb))]))
+
+
 def _update_extent(geom: UsdGeom.Boundable) -> None:
     extent = UsdGeom.Boundable.ComputeExtentFromPlugins(geom, Usd.TimeCode.Default())
     if extent is not None:
@@ -78,7 +84,7 @@ class Shape(XformPrim):
         for geom in self._geoms:
             _update_extent(geom)
         if colors is not None:
-            self.set_colors(colors)
+            self.set_display_colors(colors)
 
     @property
     def geoms(self) -> list[UsdGeom.Gprim]:
@@ -112,14 +118,13 @@ class Shape(XformPrim):
         return out
 
     # ---- colours -------------------------------------------------------------------------
+    def set_display_colors(self, colors: Any, *, indices: Any = None) -> None:
+        """Set ``primvars:displayColor`` of each prim: rgb rows in [0, 1] or colour strings (``"red"``, ``"#00ff00"``)."""
+        _set_display_colors(self._geoms, colors, indices)
+
     def set_colors(self, colors: Any, indices: Any = None) -> None:
-        """Set ``primvars:displayColor`` (rgb in [0, 1]) of each prim."""
-        idx = resolve_indices(indices, len(self))
-        data = rows(colors, len(idx), 3, "colors")
-        if data.min() < 0 or data.max() > 1:
-            raise ValueError(f"colors {colors!r} must be rgb values in [0, 1]")
-        for i, rgb in zip(idx, data):
-            self._geoms[i].CreateDisplayColorAttr().Set(Vt.Vec3fArray([Gf.Vec3f(*(float(c) for c in rgb))]))
+        """Set ``primvars:displayColor`` of each prim (as :meth:`set_display_colors`)."""
+        _set_display_colors(self._geoms, colors, indices)
 
     def get_colors(self, indices: Any = None) -> WarpLikeArray:
         """``primvars:displayColor`` of each prim, shape (k, 3) (NaN where unset)."""
@@ -305,14 +310,20 @@ class Mesh(XformPrim):
 
     _compat_name = "isaacsim.core.experimental.objects.Mesh"
 
-    def __init__(self, paths: str | Sequence[str], *, resolve_paths: bool = True, positions: Any = None,
-                 translations: Any = None, orientations: Any = None, scales: Any = None,
+    def __init__(self, paths: str | Sequence[str], *, colors: Any = None, resolve_paths: bool = True,
+                 positions: Any = None, translations: Any = None, orientations: Any = None, scales: Any = None,
                  reset_xform_op_properties: bool = True) -> None:
         found = _wrap_or_define(paths, resolve_paths, UsdGeom.Mesh, "Mesh")
         super().__init__(found, resolve_paths=False, positions=positions, translations=translations,
                          orientations=orientations, scales=scales,
                          reset_xform_op_properties=reset_xform_op_properties)
         self._geoms = [UsdGeom.Mesh(p) for p in self._prims]
+        if colors is not None:
+            self.set_display_colors(colors)
+
+    def set_display_colors(self, colors: Any, *, indices: Any = None) -> None:
+        """Set ``primvars:displayColor`` of each mesh: rgb rows in [0, 1] or colour strings."""
+        _set_display_colors(self._geoms, colors, indices)
 
     @property
     def geoms(self) -> list[UsdGeom.Mesh]:
@@ -393,6 +404,61 @@ class Mesh(XformPrim):
                 [str(self._geoms[i].GetFaceVaryingLinearInterpolationAttr().Get()) for i in idx],
                 [_warp(np.array(self._geoms[i].GetHoleIndicesAttr().Get() or [], dtype=np.int32)) for i in idx])
 
+    def _per_mesh_arrays(self, values: Sequence[Any], idx: list[int], name: str, dtype: type) -> list[np.ndarray]:
+        items = [np.asarray(v.numpy() if hasattr(v, "numpy") else v, dtype=dtype).reshape(-1) for v in values]
+        if len(items) not in (1, len(idx)):
+            raise ValueError(f"{name}: {len(items)} arrays for {len(idx)} meshes; expected one for all or one per mesh")
+        return items * len(idx) if len(items) == 1 else items
+
+    def set_crease_specs(self, crease_indices: Sequence[Any], crease_lengths: Sequence[Any],
+                         crease_sharpnesses: Sequence[Any], *, indices: Any = None) -> None:
+        """Set each mesh's creases (point indices in runs of ``crease_lengths``, a sharpness per crease or per
+        edge); authored for subdivision, which graphsdg does not render (warns once)."""
+        idx = resolve_indices(indices, len(self))
+        points = self._per_mesh_arrays(crease_indices, idx, "crease_indices", np.int32)
+        lengths = self._per_mesh_arrays(crease_lengths, idx, "crease_lengths", np.int32)
+        sharp = self._per_mesh_arrays(crease_sharpnesses, idx, "crease_sharpnesses", np.float32)
+        for n, i in enumerate(idx):
+            if int(lengths[n].sum()) != len(points[n]):
+                raise ValueError(f"mesh {self._paths[i]}: crease_lengths sum to {int(lengths[n].sum())} but "
+                                 f"crease_indices has {len(points[n])} points")
+            if len(sharp[n]) not in (len(lengths[n]), int((lengths[n] - 1).sum())):
+                raise ValueError(f"mesh {self._paths[i]}: {len(sharp[n])} crease sharpnesses; expected one per "
+                                 f"crease ({len(lengths[n])}) or one per edge ({int((lengths[n] - 1).sum())})")
+            geom = self._geoms[i]
+            geom.CreateCreaseIndicesAttr().Set(Vt.IntArray(points[n].tolist()))
+            geom.CreateCreaseLengthsAttr().Set(Vt.IntArray(lengths[n].tolist()))
+            geom.CreateCreaseSharpnessesAttr().Set(Vt.FloatArray(sharp[n].tolist()))
+        warn_once("Mesh creases", "graphsdg renders and collides the control mesh as authored")
+
+    def get_crease_specs(self, *, indices: Any = None) -> tuple[list, list, list]:
+        """(crease point indices, crease lengths, crease sharpnesses), one array per mesh."""
+        idx = resolve_indices(indices, len(self))
+        return tuple([_warp(np.array(getattr(self._geoms[i], attr)().Get() or [], dtype=dtype)) for i in idx]
+                     for attr, dtype in (("GetCreaseIndicesAttr", np.int32), ("GetCreaseLengthsAttr", np.int32),
+                                         ("GetCreaseSharpnessesAttr", np.float32)))  # type: ignore[return-value]
+
+    def set_corner_specs(self, corner_indices: Sequence[Any], corner_sharpnesses: Sequence[Any], *,
+                         indices: Any = None) -> None:
+        """Set each mesh's sharp corners (point indices and their sharpnesses); authored for subdivision."""
+        idx = resolve_indices(indices, len(self))
+        points = self._per_mesh_arrays(corner_indices, idx, "corner_indices", np.int32)
+        sharp = self._per_mesh_arrays(corner_sharpnesses, idx, "corner_sharpnesses", np.float32)
+        for n, i in enumerate(idx):
+            if points[n].shape != sharp[n].shape:
+                raise ValueError(f"mesh {self._paths[i]}: {len(points[n])} corner indices but {len(sharp[n])} "
+                                 f"sharpnesses; expected one sharpness per corner")
+            self._geoms[i].CreateCornerIndicesAttr().Set(Vt.IntArray(points[n].tolist()))
+            self._geoms[i].CreateCornerSharpnessesAttr().Set(Vt.FloatArray(sharp[n].tolist()))
+        warn_once("Mesh corners", "graphsdg renders and collides the control mesh as authored")
+
+    def get_corner_specs(self, *, indices: Any = None) -> tuple[list, list]:
+        """(corner point indices, corner sharpnesses), one array per mesh."""
+        idx = resolve_indices(indices, len(self))
+        return ([_warp(np.array(self._geoms[i].GetCornerIndicesAttr().Get() or [], dtype=np.int32)) for i in idx],
+                [_warp(np.array(self._geoms[i].GetCornerSharpnessesAttr().Get() or [], dtype=np.float32))
+                 for i in idx])
+
     def set_subdivision_specs(self, subdivision_schemes: Sequence[str] | None = None,
                               interpolate_boundaries: Sequence[str] | None = None,
                               triangle_subdivision_rules: Sequence[str] | None = None, indices: Any = None) -> None:
@@ -454,23 +520,26 @@ def _ground_plane_parts(stage: Usd.Stage, path: str) -> tuple[str, str]:
     children = prim.GetChildren()
     planes = [str(c.GetPath()) for c in children if c.IsA(UsdGeom.Plane)]
     meshes = [str(c.GetPath()) for c in children if c.IsA(UsdGeom.Mesh)]
-    if len(children) != 2 or len(planes) != 1 or len(meshes) != 1:
+    materials = [c for c in children if c.IsA(UsdShade.Material)]
+    # Isaac Sim 6's layout: a Plane, a Mesh and, from a visual template, a Material
+    if len(children) - len(materials) != 2 or len(materials) > 1 or len(planes) != 1 or len(meshes) != 1:
         raise ValueError(f"the prim at {path} is not a ground plane: it must have exactly one Plane and one Mesh "
-                         f"child, it has {[c.GetName() for c in children]}")
+                         f"child (and at most one Material), it has {[c.GetName() for c in children]}")
     return planes[0], meshes[0]
 
 
 class GroundPlane(XformPrim):
     """``isaacsim.core.experimental.objects.GroundPlane``: ground planes (see the module docstring for the layout).
 
-    ``sizes`` (edge of the rendered square, default 100 m) and ``colors`` apply to new
-    ground planes only; collision and physics-material methods act on their ``planes``.
+    ``sizes`` (edge of the rendered square, default 100 m) and ``colors`` (rgb or a colour string; default
+    50 % grey) apply to new ground planes only; collision and physics-material methods act on their ``planes``.
+    Isaac Sim 6's visual ``templates`` are not mapped (graphsdg's ground is its display colour).
     """
 
     _compat_name = "isaacsim.core.experimental.objects.GroundPlane"
 
     def __init__(self, paths: str | Sequence[str], *, resolve_paths: bool = True, sizes: Any = 100.0,
-                 colors: Any = (0.5, 0.5, 0.5), positions: Any = None, translations: Any = None,
+                 colors: Any = None, positions: Any = None, translations: Any = None,
                  orientations: Any = None, scales: Any = None, reset_xform_op_properties: bool = True) -> None:
         stage = get_stage()
         existent, nonexistent = Prim.resolve_paths(paths) if resolve_paths else (
@@ -483,9 +552,7 @@ class GroundPlane(XformPrim):
             size = rows(sizes, len(found), 1, "sizes")[:, 0]
             if np.any(size <= 0):
                 raise ValueError(f"sizes {sizes!r} must be positive")
-            color = rows(colors, len(found), 3, "colors")
-            if color.min() < 0 or color.max() > 1:
-                raise ValueError(f"colors {colors!r} must be rgb values in [0, 1]")
+            color = color_rows((0.5, 0.5, 0.5) if colors is None else colors, len(found))
             for path, s, c in zip(found, size, color):
                 _define_ground_plane(stage, path, float(s), c)
         parts = [_ground_plane_parts(stage, p) for p in found]
