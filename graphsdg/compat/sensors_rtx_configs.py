@@ -119,7 +119,9 @@ def resolve_config_path(config: str, registry: Iterable[str], *, sensor_type: st
         if config in names:
             return path
         short.append(names[3])
-        aliases += [a for a in names if a not in aliases]
+        for alias in names:
+            if alias not in aliases:
+                aliases.append(alias)
     parts = [f"{sensor_type} config '{config}' not found."]
     near = difflib.get_close_matches(str(config), aliases, n=3, cutoff=0.6)
     if near:

@@ -12,8 +12,8 @@ keyed on the global seed, the sensor and the capture time, so a script gives the
 
 With ``accumulateOutputs`` a capture reports the last scan that completed during its window (none when no scan
 completed: an empty scan), time-stamped at the scan's start; without, it reports the beams of its own window.
-A capture at an unchanged time (a step that does not advance the clock) reports one whole scan fired over the
-scan period ending now.
+A capture at an unchanged time (a step that does not advance the clock) reports one whole scan of the scene as
+it is (nothing moves while the clock stands still), time-stamped as if fired over the scan period from now.
 
 Example:
     >>> import graphsdg as rep
@@ -39,7 +39,7 @@ from graphsdg import rng
 from graphsdg.sensors.lidar_profile import LidarProfile, LidarProfileError, output_settings, read_lidar_profile
 from graphsdg.sensors.ray_backend import ray_caster
 from graphsdg.sensors.scan_pattern import Firings, ScanPattern
-from graphsdg.sensors.scene_motion import GeomMotion, point_velocities
+from graphsdg.sensors.scene_motion import GeomMotion, point_velocities, refresh_velocities
 from graphsdg.sensors.sensor_pose import SensorPose, sensor_pose
 from graphsdg.sensors.surface_materials import surface_table
 from graphsdg.sim.scene import SimScene
@@ -129,17 +129,19 @@ def sensor_prim(stage: Usd.Stage, path: str, api: str, kind: str) -> Usd.Prim:
 
 
 def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Firings, now: float,
-            noise: np.random.Generator, keep_invalid: bool = False) -> LidarReturns:
-    """Cast ``firings`` from ``pose`` into ``sim`` as it is at ``now`` and measure them (module docstring)."""
+            noise: np.random.Generator, keep_invalid: bool = False, frozen: bool = False) -> LidarReturns:
+    """Cast ``firings`` from ``pose`` into ``sim`` as it is at ``now`` and measure them (module docstring);
+    ``frozen``: the clock stands still, so every beam sees the scene as it is now."""
     if len(firings) == 0:
         return _empty_returns()
     m, d = sim.model, sim.data
     mpu = sim.world_transforms.meters_per_unit()
-    dt = firings.time - now
+    dt = np.zeros(len(firings)) if frozen else firings.time - now
     origins, rotations = pose.at(dt)
     dirs_sensor = firings.directions()
     dirs_world = np.einsum("nij,nj->ni", rotations, dirs_sensor)
-    hits = ray_caster().cast(m, d, origins, dirs_world, dt, GeomMotion.of(m, d), cutoff=profile.far_range_m / mpu)
+    motion = GeomMotion.still() if frozen else GeomMotion.of(m, d)
+    hits = ray_caster().cast(m, d, origins, dirs_world, dt, motion, cutoff=profile.far_range_m / mpu)
     true_range = np.where(hits.geom >= 0, hits.distance * mpu, 0.0)
     surface = surface_table(sim)
     cos_incidence = np.abs(np.einsum("ij,ij->i", hits.normal, dirs_world))
@@ -211,15 +213,16 @@ class LidarScanner:
             (self.last_time is None and now <= _EPS)
         start = max(0.0, now - period) if self.last_time is None else self.last_time
         self.last_time = now
+        refresh_velocities(sim.model, sim.data)
         pose = sensor_pose(sim, prim)
         noise = rng.stream("lidar", self.path, int(round(now * 1e9)), self.frames)
         self.frames += 1
         firings = pattern.full_scan(now) if snapshot else pattern.firings(start, now)
-        returns = measure(sim, pose, profile, firings, now, noise, options["keep_invalid"])
+        returns = measure(sim, pose, profile, firings, now, noise, options["keep_invalid"], frozen=snapshot)
         mpu = sim.world_transforms.meters_per_unit()
         if snapshot:
             self.pending = {}
-            return self._scan(returns, now - period, now, True, pose, now, mpu, profile, options)
+            return self._scan(returns, now, now + period, True, pose, now, mpu, profile, options, frozen=True)
         if not options["accumulate"]:
             return self._scan(returns, start, now, False, pose, now, mpu, profile, options)
         for scan in np.unique(returns.scan).tolist():
@@ -235,7 +238,8 @@ class LidarScanner:
         return self._scan(LidarReturns.concat(parts), begin, begin + period, True, pose, now, mpu, profile, options)
 
     def _scan(self, returns: LidarReturns, start: float, end: float, complete: bool, pose: SensorPose, now: float,
-              mpu: float, profile: LidarProfile, options: dict) -> LidarScan:
+              mpu: float, profile: LidarProfile, options: dict, frozen: bool = False) -> LidarScan:
+        begin, finish = (0.0, 0.0) if frozen else (start - now, end - now)
         return LidarScan(returns=returns, start_s=start, end_s=end, complete=complete,
-                         start_pose=_pose_at(pose, start - now, mpu), end_pose=_pose_at(pose, end - now, mpu),
+                         start_pose=_pose_at(pose, begin, mpu), end_pose=_pose_at(pose, finish, mpu),
                          profile=profile, options=options, frame_id=self.frames)

@@ -38,7 +38,7 @@ from graphsdg import rng
 from graphsdg.sensors.lidar_profile import LidarProfileError, aux_level
 from graphsdg.sensors.lidar_scan import sensor_prim
 from graphsdg.sensors.ray_backend import ray_caster
-from graphsdg.sensors.scene_motion import GeomMotion, point_velocities
+from graphsdg.sensors.scene_motion import GeomMotion, point_velocities, refresh_velocities
 from graphsdg.sensors.sensor_pose import SensorPose, sensor_pose
 from graphsdg.sensors.surface_materials import surface_table
 from graphsdg.sim.scene import SimScene
@@ -240,6 +240,7 @@ class RadarScanner:
         """The radar's detections of the scene as it is at ``now``."""
         prim = sensor_prim(stage, self.path, RADAR_API, "radar")
         profile = read_radar_profile(prim)
+        refresh_velocities(sim.model, sim.data)
         pose = sensor_pose(sim, prim)
         noise = rng.stream("radar", self.path, int(round(now * 1e9)), self.frames)
         self.frames += 1

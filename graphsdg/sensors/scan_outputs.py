@@ -119,13 +119,14 @@ def gmo_buffer(scan: "LidarScan | RadarScan", object_ids: np.ndarray | None = No
 def flat_scan(scan: LidarScan) -> dict:
     """A 2D lidar's scan as ranges by increasing azimuth (``IsaacComputeRTXLidarFlatScan``): depths (m, -1 where
     no return), intensities (0-255), the azimuth range, resolution and field of view (degrees), the depth range
-    and rotation rate. A lidar with more than one elevation, or a scan not yet complete, gives an empty one."""
+    and rotation rate, from the returns the scan holds (a whole scan with ``accumulateOutputs``, else the
+    frame's); a lidar with more than one elevation gives an empty one."""
     p = scan.profile
     elevations = np.concatenate([s.elevation_deg for s in p.emitter_states])
     empty = {"azimuthRange": np.zeros(2, np.float32), "depthRange": np.zeros(2, np.float32), "horizontalFov": 0.0,
              "horizontalResolution": 0.0, "intensitiesData": np.zeros(0, np.uint8),
              "linearDepthData": np.zeros(0, np.float32), "numCols": 0, "numRows": 1, "rotationRate": 0.0}
-    if np.any(np.abs(elevations) > 1e-3) or not scan.complete:
+    if np.any(np.abs(elevations) > 1e-3):
         return empty
     if p.scan_type == "SOLID_STATE":
         az = np.concatenate([s.azimuth_deg for s in p.emitter_states])

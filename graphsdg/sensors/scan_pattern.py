@@ -85,11 +85,11 @@ class ScanPattern:
         last = int(np.floor((t1 + _TIME_EPS) / self.tick_period))
         return self._fire(np.arange(first, last + 1, dtype=np.int64), (t0, t1))
 
-    def full_scan(self, end: float) -> Firings:
-        """One whole scan's beams, fired over the scan period that ends at ``end`` (scan 0's schedule moved in
-        time): a snapshot when the clock did not advance."""
+    def full_scan(self, start: float) -> Firings:
+        """One whole scan's beams, scheduled as scan 0's but from ``start``: a snapshot when the clock did not
+        advance."""
         fired = self._fire(np.arange(self.ticks_per_scan, dtype=np.int64), None)
-        fired.time = fired.time + (end - self.scan_period)
+        fired.time = fired.time + start
         return fired
 
     def _fire(self, ticks: np.ndarray, window: tuple[float, float] | None) -> Firings:

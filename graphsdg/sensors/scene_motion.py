@@ -90,6 +90,15 @@ class GeomMotion:
         return new_pos, new_mat
 
 
+def refresh_velocities(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """Recompute the bodies' spatial velocities (``cvel``) from the joint velocities: a script may have set
+    velocities since the last physics step (``set_body_velocity``), and ``cvel`` only follows at the next
+    ``mj_forward``."""
+    if model.nv:
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_comVel(model, data)
+
+
 def point_velocities(model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray, points: np.ndarray
                      ) -> np.ndarray:
     """(N, 3) world velocity (units/s) of ``points`` (N, 3) on geoms ``geoms`` (N,); 0 where ``geoms`` < 0."""
