@@ -542,3 +542,14 @@ def test_simple_room_and_ros_sample_robot_resolve_with_their_layout():
     assert any(p.GetTypeName() == "DomeLight" for p in stage.Traverse())
     ros = _open("/Isaac/Samples/ROS2/Robots/Nova_Carter_ROS.usd")
     assert ros.GetPrimAtPath("/Nova_Carter_ROS/chassis_link").HasAPI(UsdPhysics.ArticulationRootAPI)
+
+
+def test_mdl_material_named_by_a_nucleus_url_reads_the_packs_module():
+    url = ("omniverse://localhost/NVIDIA/Assets/Isaac/6.0/Isaac/Environments/Simple_Warehouse/Materials/"
+           "MI_PaperNotes_01.mdl")
+    cube = rep.functional.create.cube()
+    mat = rep.functional.randomizer.mdl_material(url)
+    matlib.bind(cube, UsdShade.Material(mat))
+    desc = matlib.describe(matlib.bound_material(cube))
+    assert desc.texture == get_assets_root_path() + f"{MATERIALS}/Textures/MI_PaperNotes_01_BaseColor.png"
+    assert rep.functional.randomizer.mdl_material(url).GetPath() == mat.GetPath()      # made once

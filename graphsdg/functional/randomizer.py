@@ -21,6 +21,7 @@ from typing import Any, Sequence
 import numpy as np
 from pxr import Sdf, Usd, UsdGeom, UsdShade
 
+from graphsdg.assets.nucleus import is_nucleus_url, local_path
 from graphsdg.functional import modify
 from graphsdg.functional.per_prim import per_prim
 from graphsdg.rng import ReplicatorRNG, as_generator
@@ -103,6 +104,8 @@ def mdl_material(url: str, looks: str = LOOKS) -> Usd.Prim:
     """The material running the ``.mdl`` file ``url``, made once under ``looks`` (as Replicator does for MDL
     paths given to its material randomizer) and reused while that prim stands."""
     path = os.fspath(url)
+    if is_nucleus_url(path):
+        path = local_path(path)         # its local copy, or an error naming the URL and how to provide one
     if not os.path.isfile(path):
         raise FileNotFoundError(f"MDL material {path!r} does not exist")
     stage = get_stage()

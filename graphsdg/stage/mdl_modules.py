@@ -35,6 +35,8 @@ from typing import Any
 
 from pxr import Usd, UsdShade
 
+from graphsdg.assets.nucleus import find_local, is_nucleus_url
+
 #: the base materials whose arguments graphsdg maps (OmniPBR's inputs; see graphsdg.stage.materials)
 SUPPORTED_BASES = ("OmniPBR",)
 
@@ -155,7 +157,9 @@ def read_module(path: str) -> dict[str, MdlMaterialInstance]:
 def module_file(shader: UsdShade.Shader) -> str | None:
     """The ``.mdl`` file an MDL shader's ``info:mdl:sourceAsset`` names, if it is a file on disk.
 
-    A bare name such as ``OmniPBR.mdl`` (a module of the MDL search path) gives None.
+    An ``omniverse://`` URL is read where graphsdg keeps its local copy (the asset pack or a Nucleus
+    mirror, :mod:`graphsdg.assets.nucleus`). A bare name such as ``OmniPBR.mdl`` (a module of the MDL
+    search path) gives None.
     """
     asset = shader.GetSourceAsset("mdl")
     if not asset or not asset.path or not asset.path.lower().endswith(".mdl"):
@@ -163,6 +167,9 @@ def module_file(shader: UsdShade.Shader) -> str | None:
     if asset.resolvedPath and os.path.isfile(asset.resolvedPath):
         return asset.resolvedPath
     path = asset.path
+    if is_nucleus_url(path):
+        local = find_local(path)                 # an omniverse:// URL read from the pack or a mirror
+        return local if local and os.path.isfile(local) else None
     if os.path.isabs(path):
         return path if os.path.isfile(path) else None
     if "://" in path or os.sep not in path and "/" not in path:
