@@ -98,13 +98,13 @@ def _proc_driver_gpus(root: str = "/proc/driver/nvidia/gpus") -> list[GpuInfo]:
     return gpus
 
 
-def host_gpus(query: Callable[[], str | None] = _query_nvidia_smi) -> list[GpuInfo]:
+def host_gpus(query: Callable[[], str | None] | None = None) -> list[GpuInfo]:
     """This machine's NVIDIA GPUs, whatever ``CUDA_VISIBLE_DEVICES`` says (empty without a GPU or driver).
 
     ``query`` returns nvidia-smi's output (tests pass their own); without it the driver's ``/proc`` files
     are read.
     """
-    text = query()
+    text = (query or _query_nvidia_smi)()
     if text is not None:
         return parse_nvidia_smi(text)
     return _proc_driver_gpus()

@@ -1,0 +1,228 @@
+"""Which GPU each process renders on (issue 37): the host's GPUs, CUDA_VISIBLE_DEVICES, bench --gpus, Ray.
+
+Everything here runs without a GPU: nvidia-smi's output and EGL's device list are given as text and lists,
+the benchmark's processes really start with their own CUDA_VISIBLE_DEVICES (and render with Mesa), and
+Ray gets logical GPUs.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import pytest
+
+from graphsdg.jobs.cli import main
+from graphsdg.jobs.gpu_assignment import (GpuCountError, GpuInfo, check_egl_sees, choose_gpus,
+                                          default_processes_per_gpu, gpu_of_process, gpu_share, parse_nvidia_smi,
+                                          process_environment, visible_gpus)
+from graphsdg.render.egl_device import EglDeviceError, bind_visible_gpu, egl_index_of
+
+SMI = """0, GPU-0a1b2c3d-0000-0000-0000-000000000000, 00000000:18:00.0, NVIDIA H100 80GB HBM3
+1, GPU-1a1b2c3d-0000-0000-0000-000000000000, 00000000:2A:00.0, NVIDIA H100 80GB HBM3
+2, GPU-2a1b2c3d-0000-0000-0000-000000000000, 00000000:3A:00.0, NVIDIA H100 80GB HBM3
+3, GPU-3a1b2c3d-0000-0000-0000-000000000000, 00000000:5D:00.0, NVIDIA H100 80GB HBM3
+"""
+HOST = parse_nvidia_smi(SMI)
+
+
+def test_nvidia_smi_lines_give_index_uuid_address_and_name():
+    assert [g.index for g in HOST] == [0, 1, 2, 3]
+    assert HOST[2] == GpuInfo(2, "GPU-2a1b2c3d-0000-0000-0000-000000000000", "00000000:3A:00.0",
+                              "NVIDIA H100 80GB HBM3")
+    assert HOST[2].label() == "GPU 2 (NVIDIA H100 80GB HBM3)"
+    with pytest.raises(ValueError, match="'No devices were found'"):
+        parse_nvidia_smi("No devices were found")
+
+
+@pytest.mark.parametrize("value, expected", [
+    (None, [0, 1, 2, 3]),              # unset: every GPU
+    ("", []),                          # set and empty: none
+    ("2", [2]),
+    ("3,1", [3, 1]),                   # CUDA's order is the variable's
+    ("GPU-1a1b,0", [1, 0]),            # a UUID prefix names one GPU
+    ("1,7,2", [1]),                    # the list stops at an index no GPU has...
+    ("0,GPU-,3", [0]),                 # ...at a prefix several share...
+    ("2,2,3", [2]),                    # ...at a GPU named twice...
+    ("-1,0", []),                      # ...and at anything else
+    ("MIG-1a1b", []),
+])
+def test_cuda_visible_devices_is_read_as_cuda_reads_it(value, expected):
+    assert [g.index for g in visible_gpus(HOST, value)] == expected
+
+
+def test_gpus_beyond_the_machine_fail_naming_both_counts():
+    assert [g.index for g in choose_gpus(2, HOST, "3,1,0")] == [3, 1]
+    with pytest.raises(GpuCountError, match=r"--gpus 4 asks for 4 GPU\(s\) but this machine has 3 .*lists 4 NVIDIA "
+                                            r"GPU\(s\), CUDA_VISIBLE_DEVICES is '3,1,0'"):
+        choose_gpus(4, HOST, "3,1,0")
+    with pytest.raises(GpuCountError, match=r"--gpus 2 asks for 2 GPU\(s\) but this machine has 0 .*lists 0"):
+        choose_gpus(2, [], None)                     # a machine without a GPU
+    for bad in (0, -1, True, 1.5):
+        with pytest.raises(ValueError, match="positive integer"):
+            choose_gpus(bad, HOST, None)
+
+
+def test_gpus_that_egl_cannot_see_fail_naming_both_counts():
+    check_egl_sees(HOST[:2], [0, 1, None])                      # Mesa's device besides two NVIDIA ones: fine
+    with pytest.raises(GpuCountError, match=r"--gpus 4 asks for 4 GPU\(s\) but EGL sees 2 NVIDIA device\(s\) among "
+                                            r"its 3"):
+        check_egl_sees(HOST, [0, 1, None])
+
+
+@pytest.mark.parametrize("processes, gpus", [(16, 1), (16, 2), (32, 4), (10, 4), (4, 4), (7, 3)])
+def test_processes_are_dealt_out_so_gpu_loads_differ_by_at_most_one(processes, gpus):
+    counts = [0] * gpus
+    for i in range(processes):
+        counts[gpu_of_process(i, gpus)] += 1
+    assert sum(counts) == processes and max(counts) - min(counts) <= 1 and min(counts) >= 1
+
+
+def test_each_process_environment_names_its_gpu_for_cuda_and_egl():
+    env = process_environment(HOST[2])
+    assert env == {"CUDA_VISIBLE_DEVICES": "2", "CUDA_DEVICE_ORDER": "PCI_BUS_ID", "GRAPHSDG_GPU": "2"}
+    assert [g.index for g in visible_gpus(HOST, env["CUDA_VISIBLE_DEVICES"])] == [2]
+
+
+def test_default_processes_share_the_cores_among_the_gpus():
+    assert [default_processes_per_gpu(g, 64) for g in (1, 2, 4, 8)] == [8, 8, 8, 8]
+    assert [default_processes_per_gpu(g, 16) for g in (1, 2, 4)] == [8, 8, 4]
+    assert default_processes_per_gpu(4, 2) == 1
+
+
+# ---- EGL follows CUDA ------------------------------------------------------------------
+def test_the_egl_device_is_the_gpu_cuda_shows():
+    # drivers that number EGL devices over all GPUs, and those that number only the visible one
+    assert egl_index_of([0, 1, 2, 3], 2) == 2
+    assert egl_index_of([3, 2, 1, 0], 2) == 1              # EGL's own order differs from CUDA's
+    assert egl_index_of([None, None, 0, None], 2) == 2
+    assert egl_index_of([0, None], 0) == 0
+    assert egl_index_of([None, None], 1) is None           # Mesa only
+
+
+def test_binding_sets_mujocos_egl_device_and_keeps_one_the_user_set():
+    env = {"CUDA_VISIBLE_DEVICES": "2"}
+    value = bind_visible_gpu(2, env, cuda_ids=[3, 2, 1, 0], host_has_gpu=True)
+    # MuJoCo 4 counts among the GPUs CUDA shows (this one is the first); older MuJoCo counts EGL's list
+    assert value == env["MUJOCO_EGL_DEVICE_ID"] and value in ("0", "1")
+    env = {"CUDA_VISIBLE_DEVICES": "2", "MUJOCO_EGL_DEVICE_ID": "5"}
+    assert bind_visible_gpu(2, env, cuda_ids=[0, 1], host_has_gpu=True) == "5"
+
+
+def test_a_gpu_egl_cannot_see_fails_naming_both_counts():
+    env = {"CUDA_VISIBLE_DEVICES": "3"}
+    with pytest.raises(EglDeviceError, match=r"GPU 3 \(CUDA_VISIBLE_DEVICES='3'\) is not among EGL's 2 device\(s\), "
+                                             r"of which 1 NVIDIA"):
+        bind_visible_gpu(3, env, cuda_ids=[1, None], host_has_gpu=True)
+    assert "MUJOCO_EGL_DEVICE_ID" not in env
+    # logical GPUs on a machine without one (Ray's, in tests): EGL's default device, no error
+    assert bind_visible_gpu(1, env, cuda_ids=[None], host_has_gpu=False) is None
+
+
+# ---- Ray: shares that fill every GPU and never strand a worker -------------------------
+def _first_fit(shares: list[float], gpus: int) -> list[int] | None:
+    """Workers per GPU as Ray's first-fit places requests in its fixed point (1e-4), or None if one is left."""
+    free = [10000] * gpus
+    placed = [0] * gpus
+    for share in shares:
+        need = round(share * 10000)
+        slot = next((g for g in range(gpus) if free[g] >= need), None)
+        if slot is None:
+            return None
+        free[slot] -= need
+        placed[slot] += 1
+    return placed
+
+
+@pytest.mark.parametrize("gpus", [1, 2, 3, 4, 8])
+def test_every_worker_fits_and_a_multiple_of_the_gpus_loads_them_alike(gpus):
+    for workers in range(1, 41):
+        share = gpu_share(workers, gpus)
+        placed = _first_fit([share] * workers, gpus)
+        assert placed is not None and sum(placed) == workers, (workers, gpus, share)
+        if workers % gpus == 0:
+            assert placed == [workers // gpus] * gpus
+        if workers <= gpus:
+            assert share == 1.0
+    assert gpu_share(5, 0) == 0.0 and gpu_share(6, 1) == 0.1666
+
+
+def test_the_gpu_flags_fail_before_anything_runs_on_a_machine_without_that_many(capsys, monkeypatch, job_script):
+    monkeypatch.setattr("graphsdg.jobs.gpu_assignment._query_nvidia_smi", lambda: "")
+    monkeypatch.setattr("graphsdg.jobs.gpu_assignment._proc_driver_gpus", lambda: [])
+    monkeypatch.delenv("CUDA_VISIBLE_DEVICES", raising=False)
+    assert main(["bench", "--gpus", "2", "--num-frames", "1", "--resolution", "16", "16"]) == 1
+    err = capsys.readouterr().err
+    assert "--gpus 2 asks for 2 GPU(s) but this machine has 0" in err and "hint: nvidia-smi" in err
+    pytest.importorskip("ray")
+    assert main(["run", job_script, "--workers", "2", "--gpus", "2", "--out", str(job_script) + ".out"]) == 1
+    assert "--gpus 2 asks for 2 GPU(s) but this machine has 0" in capsys.readouterr().err
+    assert main(["run", job_script, "--gpus", "1"]) == 1
+    assert "without --workers" in capsys.readouterr().err
+
+
+@pytest.fixture
+def job_script(tmp_path):
+    path = tmp_path / "job.py"
+    path.write_text(JOB)
+    return str(path)
+
+
+JOB = '''
+import graphsdg as rep
+rep.stage.new_stage()
+rep.functional.create.xform(name="World")
+rep.functional.create.dome_light(intensity=500, parent="/World")
+rep.functional.create.cube(parent="/World", semantics={"class": "cube"})
+cam = rep.functional.create.camera(position=(3, 3, 3), look_at=(0, 0, 0), parent="/World")
+rp = rep.create.render_product(cam, (32, 24))
+with rep.trigger.on_frame():
+    with rep.get.prims(semantics=[("class", "cube")]):
+        rep.modify.pose(position=rep.distribution.uniform((-1.5, -1.5, 0), (1.5, 1.5, 0)))
+basic = rep.writers.get("BasicWriter")
+basic.initialize(output_dir="basic", rgb=True, bounding_box_2d_tight=True)
+basic.attach(rp)
+rep.orchestrator.run()
+'''
+
+
+def test_ray_spreads_workers_over_every_gpu_and_reports_each(job_script, tmp_path, capsys):
+    ray = pytest.importorskip("ray")
+    from graphsdg.jobs.job import JobSpec, run_job
+    from graphsdg.jobs.scaleout import format_gpu_rows, run_sharded
+    import graphsdg as rep
+    single = JobSpec(job_script, seed=3, out=str(tmp_path / "single"), frames=8)
+    run_job(single)
+    rep.orchestrator.wait_until_complete()
+    ray.init(address="local", num_cpus=4, num_gpus=2, include_dashboard=False)   # two logical GPUs
+    try:
+        summary = run_sharded(JobSpec(job_script, seed=3, out=str(tmp_path / "sharded"), frames=8), 4)
+    finally:
+        ray.shutdown()
+    assert summary["gpus_per_worker"] == 0.5 and summary["gpus"] == 2
+    assert sorted(tuple(s["gpu_ids"]) for s in summary["shards"]) == [("0",), ("0",), ("1",), ("1",)]
+    rows = summary["per_gpu"]
+    assert [(r["gpu"], r["workers"], r["frames"]) for r in rows] == [("0", 2, 4), ("1", 2, 4)]
+    assert all(math.isclose(r["frames/s"], r["frames"] / max(s["seconds"] for s in summary["shards"]
+                                                             if s["gpu_ids"] == [r["gpu"]]), rel_tol=0.01)
+               for r in rows)
+    assert format_gpu_rows(summary).startswith("2 GPU(s): GPU 0: 2 workers, ")
+    files = {}
+    for root in ("single", "sharded"):
+        base = tmp_path / root / "basic"
+        files[root] = {p: (base / p).read_bytes() for p in os.listdir(base)}
+    assert files["single"] == files["sharded"]
+    assert len([p for p in files["single"] if p.startswith("rgb_")]) == 8
+
+
+def test_bench_processes_each_start_on_their_own_gpu(monkeypatch):
+    from graphsdg.benchmark.multi_gpu import run_on_gpus
+    from graphsdg.benchmark.throughput import BenchConfig
+    config = BenchConfig(frames=2, warmup=1, resolution=(32, 24), asset_count=1, skip_write=True,
+                         render_backend="classic")
+    gpus = [GpuInfo(0, name="first"), GpuInfo(3, name="fourth")]
+    run = run_on_gpus(config, 3, gpus)          # no NVIDIA GPU here: each renders with Mesa, bound to nothing
+    assert run.total["GPUs"] == 2 and run.total["processes"] == 3
+    assert [(r["GPU"], r["processes"]) for r in run.per_gpu] == [("GPU 0 (first)", 2), ("GPU 3 (fourth)", 1)]
+    assert all(r["frames/s"] > 0 and r["GPU busy %"] == "-" for r in run.per_gpu)
+    with pytest.raises(ValueError, match="--processes 1 cannot keep --gpus 2 busy"):
+        run_on_gpus(config, 1, gpus)
