@@ -97,7 +97,8 @@ def build_hawk(root: str) -> list[str]:
     look = authoring.define_textured_material(stage, "/Hawk/Looks/Housing", "./Textures/hawk_Housing.png",
                                               roughness=0.5)
     dx, dy, dz = HAWK_SIZE
-    housing = authoring.define_mesh(stage, "/Hawk/housing", geometry.box((-dx, -dy / 2, -dz / 2), (0.0, dy / 2, dz / 2)),
+    housing = authoring.define_mesh(stage, "/Hawk/housing",
+                                    geometry.box((-dx, -dy / 2, -dz / 2), (0.0, dy / 2, dz / 2)),
                                     authoring.COMPACT_DECIMALS)
     authoring.bind_material(housing.GetPrim(), look)
     for side, sign in (("left", 1.0), ("right", -1.0)):

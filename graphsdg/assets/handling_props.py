@@ -120,9 +120,10 @@ def dolly_mesh() -> geometry.MeshData:
     deck_t = 0.03
     deck = geometry.box((-length / 2, -width / 2, height - deck_t), (length / 2, width / 2, height),
                         geometry.planar_uv(0.5))
+    under = height - deck_t                       # the deck's underside: the rim frame hangs 6 cm below it
     frame = geometry.merge([
-        geometry.box((-length / 2, -width / 2, height - deck_t - 0.06), (length / 2, -width / 2 + 0.04, height - deck_t)),
-        geometry.box((-length / 2, width / 2 - 0.04, height - deck_t - 0.06), (length / 2, width / 2, height - deck_t)),
+        geometry.box((-length / 2, -width / 2, under - 0.06), (length / 2, -width / 2 + 0.04, under)),
+        geometry.box((-length / 2, width / 2 - 0.04, under - 0.06), (length / 2, width / 2, under)),
     ])
     casters = [m for x in (-length / 2 + 0.08, length / 2 - 0.08) for y in (-width / 2 + 0.08, width / 2 - 0.08)
                for m in _caster(x, y, height - deck_t - 0.06)]

@@ -90,15 +90,18 @@ class _RoomWriter:
         self.written = [self.rel]
 
     def look(self, name: str, color) -> object:
+        """The room's material ``name`` (made with a small ``color`` texture on first use)."""
         if name not in self.looks:
             tex_rel = f"{ROOMS_DIR}/textures/{self.room.name}_{name}.png"
-            textures.write_png(pack_file(self.root, tex_rel), part_texture(color, self.room.seed * 17 + len(self.looks)))
+            seed = self.room.seed * 17 + len(self.looks)
+            textures.write_png(pack_file(self.root, tex_rel), part_texture(color, seed))
             self.written.append(tex_rel)
             self.looks[name] = authoring.define_textured_material(
                 self.stage, f"{self.base}/Looks/{name}", f"./textures/{os.path.basename(tex_rel)}", roughness=0.6)
         return self.looks[name]
 
     def group(self, name: str, xyz=(0.0, 0.0, 0.0), yaw: float = 0.0) -> str:
+        """An Xform ``name`` under the room's root, moved and turned about Z; returns its path."""
         x = UsdGeom.Xform.Define(self.stage, f"{self.base}/{name}")
         x.AddTranslateOp().Set(Gf.Vec3d(*map(float, xyz)))
         if yaw:
@@ -106,6 +109,7 @@ class _RoomWriter:
         return f"{self.base}/{name}"
 
     def mesh(self, path: str, mesh: geometry.MeshData, look: str, color) -> Usd.Prim:
+        """A mesh at ``path`` bound to the room's material ``look``."""
         m = authoring.define_mesh(self.stage, path, mesh, authoring.COMPACT_DECIMALS)
         authoring.bind_material(m.GetPrim(), self.look(look, color))
         return m.GetPrim()
@@ -179,9 +183,9 @@ ASSETS: list[UsdAsset] = [
     UsdAsset("infinigen_furniture", f"{FURNITURE_DIR}/dining_table.usd", (1.6, 0.9, 0.75),
              "the dining rooms' table (and, beside it, dining_chair.usd)", build_furniture),
     *[UsdAsset(r.name, f"{ROOMS_DIR}/{r.name}.usd", room_size(r),
-             f"{r.size[0]:g} x {r.size[1]:g} m dining room named as Infinigen's exports: TableDiningFactory (table, 0.75 m "
-             f"top) with four chairs, sideboard, ceiling lamp (001_SPLIT_GLA shade, sphere light), *_exterior walls, "
-             f"*_ceiling", lambda root, r=r: build_room(r, root))
+             f"{r.size[0]:g} x {r.size[1]:g} m dining room named as Infinigen's exports: TableDiningFactory "
+             f"(table, 0.75 m top) with four chairs, sideboard, ceiling lamp (001_SPLIT_GLA shade, sphere light), "
+             f"*_exterior walls, *_ceiling", lambda root, r=r: build_room(r, root))
       for r in DINING_ROOMS]]
 
 __all__ = ["ASSETS", "DINING_ROOMS", "ROOMS_DIR", "build_room"]

@@ -1,4 +1,4 @@
-"""Stand-in for Replicator's sample stage ``/Isaac/Samples/Replicator/Stage/full_warehouse_worker_and_anim_cameras.usd``.
+"""Stand-in for Replicator's sample stage ``Samples/Replicator/Stage/full_warehouse_worker_and_anim_cameras.usd``.
 
 The stage the Cosmos warehouse example opens: the full warehouse with a worker
 walking across the main floor and two animated cameras. Its default prim ``/World`` holds
@@ -44,6 +44,7 @@ WALK = ((-1.0, 5.5), (6.0, 5.5))          # the worker's path, walked there and 
 def worker_parts() -> list[Part]:
     """A standing worker (origin between the feet, facing +X): legs, boots, torso in a vest, arms, head, hat."""
     def cyl(x, y, r, z0, z1, seg=10):
+        """A closed cylinder standing at (x, y) from z0 to z1."""
         m = geometry.lathe([(0.0, z0), (r, z0), (r, z1), (0.0, z1)], segments=seg)
         t = np.eye(4)
         t[3, :2] = (x, y)

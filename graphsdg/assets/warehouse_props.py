@@ -52,6 +52,7 @@ def traffic_cone_parts() -> list[Part]:
     r0, r1 = 0.15, 0.028          # cone radius at the base and at the top
 
     def radius(z: float) -> float:
+        """The cone's radius at height z."""
         return r0 + (r1 - r0) * (z - base_h) / (top - base_h)
 
     base = geometry.box((-half, -half, 0.0), (half, half, base_h), geometry.planar_uv(0.4))
