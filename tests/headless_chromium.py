@@ -99,10 +99,12 @@ class HeadlessChromium:
             self.events.append(json.loads(self.ws.recv()))
 
     def goto(self, url: str) -> None:
-        """Load ``url`` and wait for its load event."""
-        self.events.clear()
-        self.call("Page.navigate", url=url)
-        self.wait_event("Page.loadEventFired")
+        """Load ``url`` afresh and wait for its load event (by way of a blank page, so that a URL differing only
+        in its fragment from the one shown is loaded again, not scrolled to)."""
+        for target in ("about:blank", url):
+            self.events.clear()
+            self.call("Page.navigate", url=target)
+            self.wait_event("Page.loadEventFired")
 
     def evaluate(self, expression: str):
         """The value of a JavaScript expression in the page (promises awaited)."""

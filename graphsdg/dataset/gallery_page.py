@@ -21,7 +21,7 @@ from __future__ import annotations
 
 CSS = """
 *{box-sizing:border-box}
-html,body{margin:0;padding:0;max-width:100%;overflow-x:hidden}
+html,body{margin:0;padding:0}
 body{font:14px/1.4 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;color:#1d2330;background:#f4f5f7}
 header{padding:14px 20px 6px}
 h1{font-size:20px;margin:0 0 4px;overflow-wrap:anywhere}
@@ -29,18 +29,21 @@ h2{font-size:16px;margin:18px 0 8px}
 .sub{color:#5b6475;overflow-wrap:anywhere}
 main{padding:0 20px 40px}
 .stats{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}
+.stats>div{min-width:0;max-width:100%}
 .table-wrap{max-width:100%;overflow-x:auto;background:#fff;border:1px solid #dde1e8;border-radius:6px}
 table{border-collapse:collapse;font-variant-numeric:tabular-nums}
 th,td{padding:4px 10px;text-align:right;border-bottom:1px solid #eceef2;white-space:nowrap}
 th{background:#f8f9fb;font-weight:600}
 th:first-child,td:first-child{text-align:left}
+#per-class td:first-child{white-space:normal;overflow-wrap:anywhere;min-width:10em}
 .swatch{display:inline-block;width:11px;height:11px;border-radius:2px;margin-right:6px;vertical-align:-1px}
 details{max-width:100%;overflow-wrap:anywhere}
 .toolbar{position:sticky;top:0;z-index:5;background:#fff;border-bottom:1px solid #dde1e8;padding:8px 20px;
  display:flex;flex-wrap:wrap;gap:6px 16px;align-items:center}
-.toolbar .group{display:flex;flex-wrap:wrap;gap:4px 10px;align-items:center}
+.toolbar .group{display:flex;flex-wrap:wrap;gap:4px 10px;align-items:center;min-width:0;max-width:100%}
 .toolbar label{white-space:nowrap;cursor:pointer}
-.chip{border:1px solid #ccd2dc;border-radius:12px;padding:1px 8px;background:#fff;white-space:nowrap}
+.toolbar label.chip{border:1px solid #ccd2dc;border-radius:12px;padding:1px 8px;background:#fff;white-space:normal;
+ overflow-wrap:anywhere;max-width:100%}
 .chip.off{opacity:.45}
 .pager button{padding:2px 10px}
 .grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(400px,1fr));gap:14px;margin-top:14px}
@@ -51,12 +54,13 @@ details{max-width:100%;overflow-wrap:anywhere}
 .frame h3 .own{margin-left:auto;font-weight:400;display:flex;gap:8px}
 .views{display:grid;grid-template-columns:1fr;gap:6px}
 .frame.with-depth .views{grid-template-columns:1fr 1fr}
-.stack{position:relative;line-height:0;min-width:0}
+.stack{position:relative;line-height:0;min-width:0;overflow:hidden}
 .stack img{display:block;width:100%;height:auto}
 .stack .mask{position:absolute;inset:0;height:100%;image-rendering:pixelated;filter:url(#classmask);opacity:.5}
 .box{position:absolute;border:2px solid;pointer-events:none}
 .label{position:absolute;transform:translateY(-100%);font:11px/1.3 system-ui,sans-serif;color:#fff;padding:0 3px;
  white-space:nowrap;pointer-events:none;max-width:100%;overflow:hidden;text-overflow:ellipsis}
+.label.inside{transform:none}
 .depth figcaption{line-height:1.3;font-size:12px;color:#5b6475;margin-top:3px}
 .depth{margin:0;min-width:0}
 .depth img{display:block;width:100%;height:auto}
@@ -133,7 +137,9 @@ SCRIPT = r"""
       const pos = "left:" + (100 * x0 / frame.w) + "%;top:" + (100 * y0 / frame.h) + "%;";
       stack.appendChild(el("div", {class: "box k" + k, style: pos + "width:" + (100 * (x1 - x0 + 1) / frame.w) +
                                    "%;height:" + (100 * (y1 - y0 + 1) / frame.h) + "%;border-color:" + cls.colour}));
-      stack.appendChild(el("span", {class: "label k" + k, text: cls.name, style: pos + "background:" + cls.colour}));
+      // a label sits above its box, or inside it where the box touches the image's top edge
+      stack.appendChild(el("span", {class: "label k" + k + (y0 < 0.06 * frame.h ? " inside" : ""), text: cls.name,
+                                    style: pos + "background:" + cls.colour}));
     }
     const views = el("div", {class: "views"}, [stack]);
     if (frame.depth) {
