@@ -1,4 +1,4 @@
-"""The ``graphsdg`` command line: ``demo``, ``run``, ``graph``, ``view``, ``validate``, ``bench``.
+"""The ``graphsdg`` command line: ``demo``, ``run``, ``graph``, ``view``, ``validate``, ``bench``, ``warmup``.
 
 ``graphsdg COMMAND --help`` describes each; docs/cli.md has examples and the
 semantics of ``run --workers`` (sharding on Ray) and ``run --resume``.
@@ -466,6 +466,23 @@ def build_parser() -> argparse.ArgumentParser:
                        help="also print milliseconds per frame of each phase (randomize, render passes, "
                             "annotators, writing) for both runs")
     bench.add_argument("--report", metavar="MD", help="append the printed tables to this Markdown file")
+    warmup = sub.add_parser("warmup", parents=[common],
+                            help="compile the pbr backend's kernels into this node's cache ahead of a job",
+                            description="Renders one small frame of each scene with the pbr backend so that its "
+                                        "Warp kernels are compiled into the node's kernel cache "
+                                        "(GRAPHSDG_KERNEL_CACHE, else Warp's): a job's first frame then loads "
+                                        "them. --arch also compiles them for a GPU architecture, without a GPU "
+                                        "(with --device cpu), e.g. while building a container image. "
+                                        "docs/performance.md has the cold-start numbers.", epilog=EPILOG)
+    warmup.add_argument("--scenes", nargs="+", default=["demo", "bench"], choices=["demo", "bench"],
+                        help="scenes to render one frame of (default: demo bench)")
+    warmup.add_argument("--resolution", type=_positive, nargs=2, default=(64, 64), metavar=("W", "H"),
+                        help="their size; the kernels do not depend on it (default: 64 64)")
+    warmup.add_argument("--arch", type=_positive, nargs="+", default=[], metavar="SM",
+                        help="also compile every kernel the frames launched for these CUDA architectures "
+                             "(90: H100, H200), which needs no GPU")
+    warmup.add_argument("--device", help="Warp device to render the frames on: cuda:N (default: the setting "
+                                         "/graphsdg/render/pbrDevice, cuda:0) or cpu (no GPU; slow)")
     run = sub.add_parser("run", parents=[common],
                          help="run a graphsdg (or, with --compat isaac, an Isaac Sim Replicator) script",
                          usage="graphsdg run SCRIPT [options] [-- SCRIPT_ARGS ...]",
@@ -575,6 +592,13 @@ def main(argv: list[str] | None = None) -> int:
             return run_folder_command(args, script_args)
         elif args.command == "bench":
             run_bench(args)
+        elif args.command == "warmup":
+            from graphsdg.jobs.warmup import warm_up
+            done = warm_up(tuple(args.scenes), tuple(args.resolution), tuple(args.arch), args.device)
+            print(f"warmed {', '.join(f'{k} ({v} s)' for k, v in done['scenes'].items())} in {done['seconds']} s: "
+                  f"{done['compiled']} module(s) compiled, {done['cached']} found cached"
+                  + (f", {done['compiled ahead']} CUBIN(s) for sm_{'/'.join(map(str, done['archs']))}"
+                     if done["archs"] else "") + f"; cache {done['cache']}")
         elif args.command == "view":
             return run_view(args)
         elif args.command == "validate":

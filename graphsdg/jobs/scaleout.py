@@ -43,8 +43,10 @@ RAY_HINT = "pip install 'graphsdg[ray]'"
 SHARD_COLUMNS = ("shard", "frames", "seconds", "node", "pid", "gpu_ids", "egl_device", "write_threads",
                  "image_threads")   # per-shard summary
 # what the shards need from the driver's environment: rendering, reproducible dates, and where S3 is (the
-# endpoint and region; credentials come from each node's own AWS chain, never through Ray)
-FORWARDED_ENV = ("MUJOCO_GL", "PYOPENGL_PLATFORM", "SOURCE_DATE_EPOCH") + object_store.ENVIRONMENT
+# endpoint and region; credentials come from each node's own AWS chain, never through Ray), and the node's
+# Warp kernel cache (graphsdg.render.kernel_cache: a worker loads what another compiled)
+FORWARDED_ENV = ("MUJOCO_GL", "PYOPENGL_PLATFORM", "SOURCE_DATE_EPOCH", "GRAPHSDG_KERNEL_CACHE",
+                 "WARP_CACHE_PATH") + object_store.ENVIRONMENT
 
 
 class RayMissingError(ImportError):

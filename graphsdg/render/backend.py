@@ -205,7 +205,9 @@ def pbr_missing(has_module: Callable[[str], bool] | None = None,
 def _cuda_device_count() -> int:
     try:
         import warp as wp
-        wp.init()
+
+        from graphsdg.render.kernel_cache import configure_warp
+        configure_warp()              # Warp's first start: the node's kernel cache (graphsdg.render.kernel_cache)
         return int(wp.get_cuda_device_count())
     except Exception:   # a broken driver or toolkit is "no usable GPU", said by pbr_missing
         return 0

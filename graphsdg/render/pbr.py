@@ -110,6 +110,8 @@ class PbrRenderer:
         lacks = pbr_missing()
         if lacks and device != "cpu":
             raise PbrUnavailableError("the pbr backend needs " + "; and ".join(lacks))
+        from graphsdg.render.kernel_cache import configure_warp
+        configure_warp()      # the node's kernel cache, each kernel compiled once (before Warp compiles any)
         import mujoco_warp as mjw
         import mujoco_warp_pbr as mjpbr
         import warp as wp

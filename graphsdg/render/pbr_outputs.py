@@ -79,6 +79,13 @@ def _code_boxes(codes: wp.array(dtype=Any), width: int, boxes: wp.array2d[wp.int
             code = here
 
 
+# Every code type's instance of both generic kernels, declared before the first launch: an instance added at
+# a launch changes the module, which Warp then compiles again whole (it did, once per process, for the boxes).
+for _code in (wp.uint8, wp.uint16, wp.uint32):
+    wp.overload(_classic_layout, {"codes": wp.array(dtype=_code)})
+    wp.overload(_code_boxes, {"codes": wp.array(dtype=_code)})
+
+
 def code_format(ngeom: int) -> tuple[type, int]:
     """(NumPy type of the id codes, length of their code -> geom table) for a model of ``ngeom`` geoms: codes
     run from 0 (background) to ``ngeom``, in uint8 or uint16 when they fit, as the classic path reads them."""
