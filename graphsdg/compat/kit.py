@@ -23,7 +23,7 @@ import unittest
 import warnings
 from typing import Any, Callable
 
-from pxr import Gf, Sdf, Usd, UsdGeom, UsdUtils
+from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg import orchestrator, stage
 from graphsdg import settings_store as settings
@@ -377,7 +377,6 @@ class UsdContext(CompatObject):
     def _listen(self) -> None:
         if stage.stage_context.stage is not None:
             viewport.author_viewport_cameras(stage.stage_context.stage)
-            UsdUtils.StageCache.Get().Insert(stage.stage_context.stage)
         if not self._listening:
             stage.stage_context.subscribe_replacing(self._on_replacing)
             stage.stage_context.subscribe_replaced(self._on_replaced)
@@ -390,14 +389,10 @@ class UsdContext(CompatObject):
 
     def _on_replacing(self, old: Usd.Stage) -> None:
         self._stream.push(StageEventType.CLOSING)
-        cache = UsdUtils.StageCache.Get()
-        if old is not None and cache.Contains(old):
-            cache.Erase(old)
 
     def _on_replaced(self, new: Usd.Stage | None) -> None:
         if new is not None:
             viewport.author_viewport_cameras(new)   # as Kit does for every stage it opens
-            UsdUtils.StageCache.Get().Insert(new)   # Kit's context stage has an id in USD's stage cache
         self._stream.push(StageEventType.OPENED if new is not None else StageEventType.CLOSED)
 
     def new_stage(self) -> bool:

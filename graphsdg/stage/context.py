@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 from typing import Callable
 
-from pxr import Sdf, Usd, UsdGeom
+from pxr import Sdf, Usd, UsdGeom, UsdUtils
 
 from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.assets.root import builtin_pack_root
@@ -22,7 +22,8 @@ from graphsdg.stage.changes import ChangeTracker
 
 
 class StageContext:
-    """Holds the current ``Usd.Stage`` and notifies listeners when it is replaced."""
+    """Holds the current ``Usd.Stage`` (kept in USD's stage cache while current) and notifies listeners when it is
+    replaced."""
 
     def __init__(self) -> None:
         self.stage: Usd.Stage | None = None
@@ -51,6 +52,11 @@ class StageContext:
                 cb(self.stage)
         if self.tracker is not None:
             self.tracker.revoke()
+        cache = UsdUtils.StageCache.Get()
+        if self.stage is not None and cache.Contains(self.stage):
+            cache.Erase(self.stage)   # closes it, as Kit's context closes the stage it replaces
+        if stage is not None and not cache.Contains(stage):
+            cache.Insert(stage)   # the current stage has an id in USD's stage cache, as Kit's context stage does
         self.stage = stage
         self.tracker = ChangeTracker(stage) if stage is not None else None
         self.generation += 1
