@@ -30,6 +30,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.errors import closest
 from graphsdg.sim.colliders import APPROXIMATIONS, check_approximation
+from graphsdg.stage import physx_schemas
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prims
 
@@ -125,13 +126,37 @@ def apply_rigid_body(prims: Any, with_collider: bool = False, kinematicEnabled: 
 
 def create_physics_scene(path: str = "/physicsScene", gravity_direction: Sequence[float] | None = None,
                          gravity_magnitude: float | None = None,
-                         time_steps_per_second: float | None = None) -> Usd.Prim:
+                         time_steps_per_second: float | None = None, **physx_scene: Any) -> Usd.Prim:
     """Define (or edit) the ``UsdPhysics.Scene`` at ``path``.
 
     ``gravity_direction`` defaults to down the stage's up axis and
     ``gravity_magnitude`` to 9.81 m/s²; ``time_steps_per_second`` sets the physics
-    rate (``physxScene:timeStepsPerSecond``; 60 by default).
+    rate (``physxScene:timeStepsPerSecond``; 60 by default). Other keywords are
+    Replicator's: the scene's own attributes by USD name (``gravityDirection``,
+    ``gravityMagnitude``) and ``PhysxSceneAPI`` attributes by their base name
+    (``timeStepsPerSecond=60``, ``enableCCD=True``, ``broadphaseType="MBP"``), which
+    apply the API and author ``physxScene:<name>`` (docs/physics.md says which of
+    them the MuJoCo simulation uses).
+
+    Example:
+        >>> create_physics_scene("/PhysicsScene", timeStepsPerSecond=60, enableCCD=True)   # doctest: +SKIP
+
+    Raises:
+        TypeError: a keyword that is neither a scene attribute nor a ``PhysxSceneAPI`` attribute.
     """
+    renamed = {"gravityDirection": "gravity_direction", "gravityMagnitude": "gravity_magnitude"}
+    for usd_name, argument in renamed.items():
+        if usd_name in physx_scene:
+            value = physx_scene.pop(usd_name)
+            gravity_direction = value if argument == "gravity_direction" else gravity_direction
+            gravity_magnitude = value if argument == "gravity_magnitude" else gravity_magnitude
+    definition = physx_schemas.schema("PhysxSceneAPI")
+    known = {a.name: a for a in definition.attributes}
+    unknown = sorted(set(physx_scene) - set(known))
+    if unknown:
+        raise TypeError(f"create_physics_scene got {unknown[0]!r}, which is neither a physics scene attribute "
+                        f"(gravityDirection, gravityMagnitude) nor a PhysxSceneAPI attribute; those are: "
+                        f"{', '.join(sorted(known))}")
     stage = get_stage()
     scene = UsdPhysics.Scene.Define(stage, path)
     if gravity_direction is not None:
@@ -145,6 +170,15 @@ def create_physics_scene(path: str = "/physicsScene", gravity_direction: Sequenc
             raise ValueError(f"gravity_magnitude must be a number >= 0, got {gravity_magnitude!r}")
         scene.CreateGravityMagnitudeAttr().Set(float(gravity_magnitude))
     if time_steps_per_second is not None:
-        scene.GetPrim().CreateAttribute("physxScene:timeStepsPerSecond", Sdf.ValueTypeNames.UInt).Set(
-            int(_positive("time_steps_per_second", time_steps_per_second)))
-    return scene.GetPrim()
+        physx_scene["timeStepsPerSecond"] = int(_positive("time_steps_per_second", time_steps_per_second))
+    if "timeStepsPerSecond" in physx_scene:
+        physx_scene["timeStepsPerSecond"] = int(_positive("timeStepsPerSecond", physx_scene["timeStepsPerSecond"]))
+    prim = scene.GetPrim()
+    if physx_scene:
+        physx_schemas.apply_api(prim, "PhysxSceneAPI")
+    for name, value in physx_scene.items():
+        attribute = known[name]
+        prim.CreateAttribute(definition.full_name(name), attribute.value_type, custom=False,
+                             variability=Sdf.VariabilityUniform if attribute.uniform else Sdf.VariabilityVarying
+                             ).Set(value)
+    return prim
