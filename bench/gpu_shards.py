@@ -1,0 +1,155 @@
+"""Issue 37's byte checks on a multi-GPU host, without Ray: a job sharded over K GPUs writes the bytes of one
+process, and a shard killed half way resumes to the same bytes.
+
+Each shard is its own process started as ``graphsdg bench --gpus`` starts its processes
+(:func:`graphsdg.jobs.gpu_assignment.process_environment`: ``CUDA_VISIBLE_DEVICES`` naming one GPU, EGL bound
+to it at import) and runs :func:`graphsdg.jobs.job.run_job` for its frame plan, as a Ray shard does; the
+parent merges the shards (:func:`graphsdg.dataset.merge.merge_shards`) and compares every file with a
+one-process run of the same job on GPU 0. ``--kill-after S`` SIGKILLs shard 1 that many seconds into its
+run, then reruns every shard with ``--resume`` and compares again.
+
+Usage (on the GPU host): python3 bench/gpu_shards.py --gpus 4 --frames 48 [--kill-after 20] [--backend pbr]
+Prints one Markdown table row per check; exits 1 if any check fails.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+JOB = '''
+import graphsdg as rep
+rep.settings.set("/graphsdg/render/backend", "{backend}")
+rep.stage.new_stage()
+rep.functional.create.xform(name="World")
+rep.functional.create.dome_light(intensity=450, parent="/World", name="Sky")
+rep.functional.create.distant_light(intensity=900, parent="/World", name="Sun", rotation=(35, 20, 0))
+rep.functional.create.plane(parent="/World", name="Floor", scale=(8, 8, 1), semantics={{"class": "floor"}})
+for kind in ("cube", "sphere", "cylinder", "cone", "torus"):
+    getattr(rep.functional.create_batch, kind)(count=2, parent="/World", name=kind.capitalize(),
+                                               semantics={{"class": kind}})
+cam = rep.functional.create.camera(position=(4.5, -4.5, 3.5), look_at=(0, 0, 0.3), parent="/World")
+rp = rep.create.render_product(cam, ({size}, {size}))
+with rep.trigger.on_frame():
+    with rep.get.prims(semantics=[("class", k) for k in ("cube", "sphere", "cylinder", "cone", "torus")]):
+        rep.modify.pose(position=rep.distribution.uniform((-1.8, -1.8, 0.3), (1.8, 1.8, 0.3)),
+                        rotation=rep.distribution.uniform((0, 0, 0), (0, 0, 360)))
+        rep.randomizer.color(colors=rep.distribution.uniform((0, 0, 0), (1, 1, 1)))
+writer = rep.writers.get("BasicWriter")
+writer.initialize(output_dir="basic", rgb=True, semantic_segmentation=True, bounding_box_2d_tight=True,
+                  distance_to_image_plane=True)
+writer.attach(rp)
+rep.orchestrator.run()
+'''
+
+
+def _shard_main(script: str, out: str, frames: int, index: int, count: int, resume: bool) -> None:
+    """Inside a shard process: run the job's frames of shard ``index``; print its summary as JSON."""
+    from graphsdg import orchestrator
+    from graphsdg.jobs.frame_plan import FramePlan
+    from graphsdg.jobs.job import JobSpec, run_job
+    job = JobSpec(script, seed=7, out=out, frames=frames, resume=resume)
+    summary = run_job(job, FramePlan(index, count, resume) if count > 1 else None)
+    orchestrator.wait_until_complete()
+    print("SHARD " + json.dumps(summary, default=str), flush=True)
+
+
+def _start(script, out, frames, index, count, resume, gpu):
+    from graphsdg.jobs.gpu_assignment import process_environment
+    env = {**os.environ, **process_environment(gpu)}
+    args = [sys.executable, __file__, "--shard", str(index), "--count", str(count), "--script", script, "--out", out,
+            "--frames", str(frames)] + (["--resume"] if resume else [])
+    return subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _summary(process) -> dict:
+    out, err = process.communicate()
+    if process.returncode != 0:
+        raise RuntimeError(f"shard failed ({process.returncode}): {err[-2000:]}")
+    return json.loads([line for line in out.splitlines() if line.startswith("SHARD ")][-1][6:])
+
+
+def _run(script, out, frames, gpus, resume=False, kill_after=None) -> tuple[list[dict], float]:
+    """Every shard at once, one GPU each (dealt in turn); shard 1 killed after ``kill_after`` s if given."""
+    from graphsdg.dataset import merge
+    from graphsdg.jobs.job import JobSpec, check_job_file
+    check_job_file(JobSpec(script, seed=7, out=out, frames=frames, resume=resume))
+    count = len(gpus) if len(gpus) > 1 else 1
+    start = time.perf_counter()
+    procs = [_start(script, out, frames, i, count, resume, gpus[i % len(gpus)]) for i in range(count)]
+    if kill_after is not None:
+        time.sleep(kill_after)
+        procs[1].send_signal(signal.SIGKILL)
+        procs[1].wait()
+        for p in procs[:1] + procs[2:]:
+            p.communicate()
+        return [], time.perf_counter() - start
+    results = sorted((_summary(p) for p in procs), key=lambda r: r["shard"] or 0)
+    seconds = time.perf_counter() - start
+    if count > 1:
+        merge.merge_shards(results)
+    return results, seconds
+
+
+def _digest(root: str) -> dict[str, str]:
+    out = {}
+    base = os.path.join(root, "basic")
+    for name in sorted(os.listdir(base)):
+        with open(os.path.join(base, name), "rb") as f:
+            out[name] = hashlib.sha256(f.read()).hexdigest()
+    return out
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--gpus", type=int, default=4)
+    parser.add_argument("--frames", type=int, default=48)
+    parser.add_argument("--size", type=int, default=512)
+    parser.add_argument("--backend", default="pbr", choices=("pbr", "classic"))
+    parser.add_argument("--kill-after", type=float)
+    parser.add_argument("--shard", type=int)
+    parser.add_argument("--count", type=int)
+    parser.add_argument("--script")
+    parser.add_argument("--out")
+    parser.add_argument("--resume", action="store_true")
+    args = parser.parse_args()
+    if args.shard is not None:
+        _shard_main(args.script, args.out, args.frames, args.shard, args.count, args.resume)
+        return 0
+    from graphsdg.jobs.gpu_assignment import choose_gpus
+    gpus = choose_gpus(args.gpus)
+    work = tempfile.mkdtemp(prefix="graphsdg-gpu-shards-", dir="/dev/shm" if os.path.isdir("/dev/shm") else None)
+    script = os.path.join(work, "job.py")
+    with open(script, "w") as f:
+        f.write(JOB.format(backend=args.backend, size=args.size))
+    _, one_s = _run(script, os.path.join(work, "one"), args.frames, gpus[:1])
+    one = _digest(os.path.join(work, "one"))
+    results, many_s = _run(script, os.path.join(work, "many"), args.frames, gpus)
+    many = _digest(os.path.join(work, "many"))
+    ok = one == many and len(one) > 0
+    differ = sorted(k for k in one if one.get(k) != many.get(k))
+    print("| check | GPUs | frames | files | seconds | result |\n|---|---|---|---|---|---|")
+    print(f"| one process on GPU 0 | 1 | {args.frames} | {len(one)} | {one_s:.1f} | reference |")
+    print(f"| {len(gpus)} shards, one a GPU | {len(gpus)} | {sum(r['frames'] for r in results)} | {len(many)} | "
+          f"{many_s:.1f} | {'byte-identical' if ok else f'DIFFERENT: {len(differ)} files, e.g. {differ[:3]}'} |")
+    if args.kill_after is not None and len(gpus) > 1:
+        out = os.path.join(work, "killed")
+        _run(script, out, args.frames, gpus, kill_after=args.kill_after)
+        partial = len(os.listdir(os.path.join(out, "basic"))) if os.path.isdir(os.path.join(out, "basic")) else 0
+        _, resume_s = _run(script, out, args.frames, gpus, resume=True)
+        resumed = _digest(out)
+        same = resumed == one
+        ok = ok and same
+        print(f"| shard 1 killed after {args.kill_after:g} s ({partial} files), all resumed | {len(gpus)} | "
+              f"{args.frames} | {len(resumed)} | {resume_s:.1f} | {'byte-identical' if same else 'DIFFERENT'} |")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
