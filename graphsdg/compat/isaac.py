@@ -220,6 +220,10 @@ def uninstall() -> None:
                 _installed[name]:
             delattr(sys.modules[parent], leaf)
     _installed.clear()
+    for name in [n for n in sys.modules if n.split(".")[0] in ROOTS]:
+        # submodules imported by dotted path while installed (``omni.replicator.core.example`` is
+        # graphsdg.example's stand-in, entered by the import system) and Isaac test packages
+        del sys.modules[name]
     kit.get_context()._stop_listening()
     for area in AREAS:   # areas that hooked graphsdg's runtime let go of it
         release = getattr(importlib.import_module(area), "uninstall", None)

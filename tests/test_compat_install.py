@@ -1,4 +1,4 @@
-"""Isaac capabilities left out on purpose fail at import or enable time, saying why."""
+"""Installing compat mode: out-of-scope Isaac capabilities say why, modules at their Isaac 6 paths, a clean uninstall."""
 import importlib
 
 import pytest
@@ -47,3 +47,12 @@ def test_palletizing_example_imports_from_its_isaac_6_path(compat):
     from isaacsim.examples.interactive.ur10_palletizing.ur10_palletizing import BinStacking as older
     from graphsdg.scenarios.palletizing import BinStacking as scenario
     assert BinStacking is older is scenario
+
+
+def test_uninstall_leaves_no_isaac_module_behind():
+    import sys
+    isaac.install()
+    import omni.replicator.core.functional.create   # noqa: F401 - a submodule entered by dotted import
+    importlib.import_module("omni.replicator.core.scripts.functional.utils")
+    isaac.uninstall()
+    assert [n for n in sys.modules if n.split(".")[0] in ("omni", "carb", "isaacsim")] == []
