@@ -52,6 +52,8 @@ OUT_OF_SCOPE = {
     "deprecated/isaacsim.sensors.rtx/": "RTX sensors (issue 35)",
     "extensions/isaacsim.replicator.synthetic_recorder/isaacsim/replicator/synthetic_recorder/tests/test_recorder_ui.py":
         "Kit UI windows",
+    "standalone_examples/benchmarks/workflows/benchmark_workflow_manipulation_vision_cumotion.py":
+        "cuMotion motion generation (NVIDIA's closed CUDA library)",
 }
 
 # script (relative to source/standalone_examples/) -> its arguments for a short run

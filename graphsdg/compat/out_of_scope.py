@@ -23,6 +23,8 @@ _NUREC = "NuRec neural reconstruction: it needs NVIDIA's RTX neural renderer, wh
 _TELEOP = ("teleoperation devices (XR headsets, hand tracking, spacemouse) and their recorded episodes; script the "
            "robot's motion instead")
 _UI = "Kit's UI windows and menus: graphsdg has no GUI"
+_MOTION = ("cuMotion and Lula motion generation: NVIDIA's closed CUDA motion-planning libraries, which are not "
+           "published on a package index; plan with an open planner and drive the joints through Articulation")
 
 # module or extension name prefix -> why it is out of scope
 OUT_OF_SCOPE: dict[str, str] = {
@@ -43,6 +45,10 @@ OUT_OF_SCOPE: dict[str, str] = {
     "omni.kit.window": _UI,
     "isaacsim.gui": _UI,
     "isaacsim.test.utils.menu_utils": _UI,
+    "isaacsim.robot_motion.cumotion": _MOTION,
+    "isaacsim.robot_motion.lula": _MOTION,
+    "isaacsim.robot_motion.experimental.motion_generation": _MOTION,
+    "omni.isaac.motion_generation": _MOTION,
 }
 
 
