@@ -45,9 +45,7 @@ OUT_OF_SCOPE: dict[str, str] = {
     "omni.kit.window": _UI,
     "isaacsim.gui": _UI,
     "isaacsim.test.utils.menu_utils": _UI,
-    "isaacsim.robot_motion.cumotion": _MOTION,
-    "isaacsim.robot_motion.lula": _MOTION,
-    "isaacsim.robot_motion.experimental.motion_generation": _MOTION,
+    "isaacsim.robot_motion": _MOTION,
     "omni.isaac.motion_generation": _MOTION,
 }
 
