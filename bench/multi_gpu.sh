@@ -18,6 +18,8 @@ set -euo pipefail
 part=${1:?"usage: bash bench/multi_gpu.sh cold|bake|scale|classic|procs|shards [REPORT.md]"}
 report=${2:-multi_gpu.md}
 export MUJOCO_GL=egl PYTHONUNBUFFERED=1
+vendor=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json     # NVIDIA's EGL on the device hosts
+[ -f "$vendor" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=${__EGL_VENDOR_LIBRARY_FILENAMES:-$vendor}
 gsdg=(python3 -m graphsdg.jobs.cli)
 four=(--resolution 512 512 --annotators rgb distance_to_image_plane semantic_segmentation bounding_box_2d_tight
       --temp-dir /dev/shm --no-baseline)
