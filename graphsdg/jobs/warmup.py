@@ -27,7 +27,7 @@ FOUR_ANNOTATORS = ("rgb", "distance_to_image_plane", "semantic_segmentation", "b
 def _render_scene(scene: str, resolution: tuple[int, int], folder: str) -> None:
     """One frame of ``scene`` written under ``folder``."""
     if scene == "demo":
-        from graphsdg.jobs.cli import run_demo
+        from graphsdg.jobs.demo_scene import run_demo
         run_demo(os.path.join(folder, "demo"), 1, resolution, 0)
     elif scene == "bench":
         from graphsdg.benchmark.throughput import BenchConfig, run_graphsdg
