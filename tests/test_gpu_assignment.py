@@ -6,6 +6,8 @@ Ray gets logical GPUs.
 """
 from __future__ import annotations
 
+import doctest
+import importlib
 import math
 import os
 
@@ -226,3 +228,11 @@ def test_bench_processes_each_start_on_their_own_gpu(monkeypatch):
     assert all(r["frames/s"] > 0 and r["GPU busy %"] == "-" for r in run.per_gpu)
     with pytest.raises(ValueError, match="--processes 1 cannot keep --gpus 2 busy"):
         run_on_gpus(config, 1, gpus)
+
+
+@pytest.mark.parametrize("name", ["graphsdg.jobs.gpu_assignment", "graphsdg.render.egl_device",
+                                  "graphsdg.benchmark.multi_gpu", "graphsdg.benchmark.gpu_sampler",
+                                  "graphsdg.jobs.scaleout"])
+def test_the_docstring_examples_run(name):
+    result = doctest.testmod(importlib.import_module(name))
+    assert result.attempted > 0 and result.failed == 0

@@ -43,6 +43,12 @@ def _stats(process: subprocess.Popen, timeout: float = 240.0) -> dict:
     return {**json.loads(out.strip().splitlines()[-1]), "warp": said}
 
 
+def test_the_docstring_examples_run():
+    import doctest
+    from graphsdg.render import kernel_cache
+    assert doctest.testmod(kernel_cache).failed == 0
+
+
 def test_the_cache_folder_is_graphsdgs_then_warps_own(tmp_path):
     assert cache_root({"GRAPHSDG_KERNEL_CACHE": "/a", "WARP_CACHE_PATH": "/b"}) == "/a"
     assert cache_root({"WARP_CACHE_PATH": "/b"}) == "/b" and cache_root({}) is None
