@@ -97,12 +97,12 @@ def test_unsupported_call_in_a_script_run_prints_one_clear_line(tmp_path, capsys
         from isaacsim import SimulationApp
         simulation_app = SimulationApp({"headless": True})
         import omni.replicator.core as rep
-        from omni.kit.window.file import save
+        from omni.kit.no_such_module import save
         save()
     '''))
     assert main(["run", "--compat", "isaac", str(script)]) == 1
     err = capsys.readouterr().err
-    assert "graphsdg: error: omni.kit.window is not available in graphsdg's compat mode" in err
+    assert "graphsdg: error: omni.kit.no_such_module is not available in graphsdg's compat mode" in err
     assert "omni.kit provides: " in err and "app, commands, " in err
     assert "omni" not in sys.modules                        # the names lived for that script only
 
