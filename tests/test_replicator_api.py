@@ -166,7 +166,7 @@ def test_usd_files_and_file_groups(tmp_path):
     assert [list(g) for g in groups] == [["rock"], ["wood"]]
     assert sorted(groups[1]["wood"]) == ["_D", "_N"] and groups[1]["wood"]["_N"].endswith("wood_N.png")
     with pytest.raises(ValueError, match="is a URL"):
-        rep.utils.get_usd_files("omniverse://localhost/NVIDIA/Assets")
+        rep.utils.get_usd_files("https://example.com/NVIDIA/Assets")   # omniverse:// reads the pack
     with pytest.raises(FileNotFoundError, match="is not a folder"):
         rep.utils.get_usd_files(str(tmp_path / "missing"))
 

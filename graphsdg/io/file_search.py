@@ -1,8 +1,9 @@
 """Finding asset files in a folder: USD files (``rep.utils.get_usd_files``) and texture sets grouped by suffix
 (``rep.utils.get_files_group``).
 
-Local folders are listed with :mod:`os`; ``omniverse://`` and other URLs are not listed (nothing is fetched
-at run time) and raise, naming the URL.
+Local folders are listed with :mod:`os`; an ``omniverse://`` URL lists the local folder holding it (the asset
+pack or a Nucleus mirror) and names its files by URL; other URLs are not listed (nothing is fetched at run time)
+and raise, naming the URL.
 
 Example:
     >>> import os, tempfile
@@ -20,12 +21,19 @@ import os
 import re
 from pathlib import Path
 
+from graphsdg.assets import nucleus
+
 USD_FILE = re.compile(r"^.*\.(usd|usda|usdc|usdz)$", re.IGNORECASE)
 
 
 def _local_folder(path: str, what: str) -> str:
-    """``path`` as a local folder, or an error naming it (URLs are not listed, missing folders not guessed)."""
+    """``path`` as a local folder, or an error naming it (URLs are not listed, missing folders not guessed).
+
+    An ``omniverse://`` URL is the local folder holding it (the asset pack or a configured Nucleus mirror).
+    """
     text = os.fspath(path)
+    if nucleus.is_nucleus_url(text):
+        return nucleus.local_path(text)
     if "://" in text and not text.startswith("file://"):
         raise ValueError(f"{what}: {text!r} is a URL; graphsdg lists local folders only (nothing is fetched at run "
                          f"time): point it at a local copy")
@@ -45,11 +53,15 @@ def get_usd_files(path: str, recursive: bool = False, path_filter: str | None = 
     if os.path.isfile(text) and USD_FILE.match(text):
         return [text] if path_filter is None or re.search(path_filter, text) else []
     folder = _local_folder(text, "get_usd_files")
+    # A URL's files are named by URL too (as Replicator lists a Nucleus folder), so from_usd and the script's own
+    # string handling see the paths they asked for.
+    prefix = text.rstrip("/") if nucleus.is_nucleus_url(text) else folder.rstrip(os.sep).replace(os.sep, "/")
     found: list[str] = []
     for root, dirs, files in os.walk(folder):
         dirs.sort()
+        relative_root = os.path.relpath(root, folder).replace(os.sep, "/")
         for name in sorted(files):
-            full = os.path.join(root, name).replace(os.sep, "/")
+            full = f"{prefix}/{name}" if relative_root == "." else f"{prefix}/{relative_root}/{name}"
             if USD_FILE.match(name) and (path_filter is None or re.search(path_filter, full)):
                 found.append(full)
         if not recursive:
