@@ -14,7 +14,8 @@ name do:
   (ns) / ids / normals / velocities (the scan buffer gives those its ``output*`` parameters ask for);
 * ``IsaacComputeRTXLidarFlatScan``: a 2D lidar's depths and intensities by increasing azimuth;
 * ``sensor_point_cloud`` (graphsdg's): the points with intensity, range, time, and each point's stable,
-  instance and semantic id and labels (``idToLabels``), in the sensor's or the world frame, for writers.
+  instance and semantic id and labels (``idToLabels``), in the sensor's or the world frame, for writers;
+  ``fresh`` says whether the report is new (a lidar repeats its last report between its ticks).
 
 On a camera's render product they give empty outputs.
 
@@ -90,9 +91,8 @@ def _per_point(frame: FrameView, scan, wanted: set[str]) -> dict:
               "intensity": (pts.intensity if lidar else pts.rcs_dbsm).astype(np.float32)}
     if lidar:
         r = pts
-        start = int(round(scan.start_s * 1e9))
         values.update({
-            "timestamp": (start + np.round((r.time_s - scan.start_s) * 1e9).astype(np.int64)).astype(np.uint64),
+            "timestamp": r.time_ns.astype(np.uint64),
             "emitterId": r.emitter.astype(np.uint32), "channelId": r.channel.astype(np.uint32),
             "materialId": r.material_id.astype(np.uint32), "tickId": r.tick.astype(np.uint32),
             "hitNormal": r.normal_world.astype(np.float32), "velocity": r.velocity_world.astype(np.float32),
@@ -174,7 +174,7 @@ def sensor_point_cloud(frame: FrameView, params: dict) -> dict:
         if sid not in labels:
             labels[sid] = {"path": paths.get(sid, ""), "labels": imap.labels[k] if k >= 0 else {}}
     info = {"modality": "lidar" if lidar else "radar", "frame": which,
-            "scanComplete": bool(scan.complete) if lidar else True,
+            "scanComplete": bool(scan.complete) if lidar else True, "fresh": bool(scan.fresh) if lidar else True,
             "timestampNs": int(round((scan.start_s if lidar else scan.time_s) * 1e9)),
             "intensity": (pts.intensity if lidar else pts.rcs_dbsm).astype(np.float32),
             "range": pts.range_m.astype(np.float32), "azimuth": pts.azimuth_deg.astype(np.float32),
@@ -182,7 +182,7 @@ def sensor_point_cloud(frame: FrameView, params: dict) -> dict:
             "instanceId": instance.astype(np.uint32), "semanticId": semantic.astype(np.uint32),
             "idToLabels": labels, "transform": _transform(scan)}
     if lidar:
-        info["timeOffsetNs"] = np.round((pts.time_s - scan.start_s) * 1e9).astype(np.int64)
+        info["timeOffsetNs"] = pts.time_ns - int(round(scan.start_s * 1e9))
     else:
         info["radialVelocity"] = pts.radial_velocity_mps.astype(np.float32)
     return {"data": xyz.astype(np.float32), "info": info}

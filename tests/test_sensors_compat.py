@@ -78,7 +78,7 @@ def test_lidar_sensor_gives_gmo_and_stable_ids_that_resolve_to_prims(compat):
                          aux_output_level="FULL")
     sensor = LidarSensor(lidar, annotators=["generic-model-output", "stable-id-map"])
     assert sensor.annotators == ["generic-model-output", "stable-id-map"]
-    run_frames(4)                       # the 4th frame turns the beams from azimuth 0 to 60 degrees
+    run_frames(7)                       # Example_Rotary reports a whole scan every 0.1 s
     data, info = sensor.get_data("generic-model-output")
     gmo = parse_generic_model_output_data(data)
     assert gmo.numElements > 0 and gmo.hitNormals.size == 3 * gmo.numElements

@@ -32,6 +32,7 @@ from typing import Any, Callable
 import graphsdg
 from graphsdg.compat import sensors_rtx_runtime as runtime_api
 from graphsdg.compat.modules import CompatError, CompatModule
+from graphsdg.compat.sensors_checker import CHECKER_NAMES
 from graphsdg.compat.sensors_debug_draw import DEBUG_DRAW_WRITERS
 from graphsdg.compat.sensors_rtx_authoring import Lidar, Radar
 from graphsdg.compat.sensors_rtx_configs import (SUPPORTED_ACOUSTIC_CONFIGS, SUPPORTED_ACOUSTIC_VARIANT_SET_NAME,
@@ -98,12 +99,15 @@ def modules() -> list[types.ModuleType]:
         unregister_annotator_spec=runtime_api.unregister_annotator_spec,
         register_writer_spec=runtime_api.register_writer_spec,
         unregister_writer_spec=runtime_api.unregister_writer_spec,
-        SUPPORTED_LIDAR_CONFIGS=SUPPORTED_LIDAR_CONFIGS, SUPPORTED_LIDAR_VARIANT_SET_NAME=SUPPORTED_LIDAR_VARIANT_SET_NAME,
-        SUPPORTED_RADAR_CONFIGS=SUPPORTED_RADAR_CONFIGS, SUPPORTED_RADAR_VARIANT_SET_NAME=SUPPORTED_RADAR_VARIANT_SET_NAME,
+        SUPPORTED_LIDAR_CONFIGS=SUPPORTED_LIDAR_CONFIGS,
+        SUPPORTED_LIDAR_VARIANT_SET_NAME=SUPPORTED_LIDAR_VARIANT_SET_NAME,
+        SUPPORTED_RADAR_CONFIGS=SUPPORTED_RADAR_CONFIGS,
+        SUPPORTED_RADAR_VARIANT_SET_NAME=SUPPORTED_RADAR_VARIANT_SET_NAME,
         SUPPORTED_ACOUSTIC_CONFIGS=SUPPORTED_ACOUSTIC_CONFIGS,
         SUPPORTED_ACOUSTIC_VARIANT_SET_NAME=SUPPORTED_ACOUSTIC_VARIANT_SET_NAME, **refused)
     return [CompatModule(EXPERIMENTAL, **names),
             generic_model_output_module(f"{EXPERIMENTAL}.generic_model_output"),
+            CompatModule(f"{EXPERIMENTAL}.sensor_checker", **CHECKER_NAMES),
             CompatModule(NODES)]
 
 

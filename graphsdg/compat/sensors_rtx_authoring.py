@@ -28,7 +28,9 @@ from typing import Any
 from pxr import Sdf, Usd
 
 from graphsdg import functional
+from graphsdg import settings_store
 from graphsdg.compat.experimental_prims import XformPrim
+from graphsdg.functional.sensors import set_sensor_attributes
 from graphsdg.compat.sensors_rtx_configs import (SUPPORTED_LIDAR_CONFIGS, SUPPORTED_RADAR_CONFIGS, check_variant,
                                                  config_key, resolve_config_path)
 from graphsdg.sensors.lidar_profile import author_lidar_profile
@@ -39,6 +41,22 @@ from graphsdg.stage.context import get_stage
 
 log = logging.getLogger(__name__)
 CHANNELS_ATTR = "_replicator:rendervar:GenericModelOutput:channels"
+MOTION_BVH = "/renderer/raytracingMotion/enabled"
+
+
+def config_prim(path: str, config_path: str, prim_type: str) -> Usd.Prim:
+    """A new sensor prim for Isaac asset ``config_path`` at ``path``: the prim itself for a ``.usda`` asset (a
+    bare sensor), else an Xform at ``path`` holding the sensor as a child named after the asset, as Isaac's
+    ``.usd`` sensor assets do."""
+    create = functional.create.omni_lidar if prim_type == "OmniLidar" else functional.create.omni_radar
+    parent, _, name = path.rpartition("/")
+    stage = get_stage()
+    if parent and not stage.GetPrimAtPath(parent).IsValid():
+        stage.DefinePrim(parent, "Xform")
+    if config_path.endswith(".usda"):
+        return create(name=name, parent=parent or None)
+    holder = functional.create.xform(name=name, parent=parent or None)
+    return create(name=config_key(config_path), parent=holder)
 
 
 class _SensorAuthoring(XformPrim):
@@ -194,8 +212,7 @@ class Lidar(_SensorAuthoring):
         if config is not None:
             found = resolve_config_path(config, SUPPORTED_LIDAR_CONFIGS, sensor_type="Lidar")
             check_variant(found, variant, SUPPORTED_LIDAR_CONFIGS, "Lidar")
-            parent, name = Lidar._split(path)
-            prim = functional.create.omni_lidar(name=name, parent=parent)
+            prim = config_prim(path, found, "OmniLidar")
             author_lidar_profile(prim, lidar_profile(config_key(found), variant))
             path = str(prim.GetPath())
         elif usd_path is not None:
@@ -218,7 +235,8 @@ def radar_profile_attributes(config: str) -> dict[str, Any]:
 
 class Radar(_SensorAuthoring):
     """``isaacsim.sensors.experimental.rtx.Radar`` (module docstring). graphsdg's radar takes its Doppler from the
-    simulated bodies' velocities, so it does not need Isaac's Motion BVH setting."""
+    simulated bodies' velocities, so it does not need Isaac's Motion BVH; as in Isaac, creating one while the
+    setting ``/renderer/raytracingMotion/enabled`` is set to False raises ``RuntimeError``."""
 
     _compat_name = "isaacsim.sensors.experimental.rtx.Radar"
     _PRIM_TYPE = "OmniRadar"
@@ -226,6 +244,10 @@ class Radar(_SensorAuthoring):
     _VALID_AUX_OUTPUT_LEVELS = ("NONE", "BASIC")
 
     def _create_prim(self, path: str, attributes: dict[str, Any] | None) -> str:
+        if settings_store.get(MOTION_BVH) is False:
+            raise RuntimeError(f"RTX Radar requires Motion BVH to be enabled: the setting {MOTION_BVH} is False. "
+                               f"graphsdg's radar reads its Doppler from the simulated velocities and needs no "
+                               f"Motion BVH; unset the setting or set it to true.")
         parent, name = self._split(path)
         return str(functional.create.omni_radar(name=name, parent=parent).GetPath())
 
@@ -240,9 +262,8 @@ class Radar(_SensorAuthoring):
         if config is not None:
             found = resolve_config_path(config, SUPPORTED_RADAR_CONFIGS, sensor_type="Radar")
             check_variant(found, variant, SUPPORTED_RADAR_CONFIGS, "Radar")
-            parent, name = Radar._split(path)
-            prim = functional.create.omni_radar(name=name, parent=parent,
-                                                **radar_profile_attributes(config_key(found)))
+            prim = config_prim(path, found, "OmniRadar")
+            set_sensor_attributes(prim, radar_profile_attributes(config_key(found)))
             path = str(prim.GetPath())
         elif usd_path is not None:
             path = Radar._create_from_usd(path=path, usd_path=usd_path, variant=variant)

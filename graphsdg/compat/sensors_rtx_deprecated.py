@@ -35,8 +35,9 @@ import graphsdg
 from graphsdg import functional
 from graphsdg.compat import kit_command_registry
 from graphsdg.compat.modules import CompatError, CompatModule
+from graphsdg.compat.sensors_checker import CHECKER_NAMES
 from graphsdg.compat.sensors_rtx import generic_model_output_module
-from graphsdg.compat.sensors_rtx_authoring import radar_profile_attributes
+from graphsdg.compat.sensors_rtx_authoring import config_prim, radar_profile_attributes
 from graphsdg.compat.sensors_rtx_configs import (SUPPORTED_LIDAR_CONFIGS, SUPPORTED_LIDAR_VARIANT_SET_NAME,
                                                  SUPPORTED_RADAR_CONFIGS, check_variant, config_key,
                                                  resolve_config_path)
@@ -112,7 +113,7 @@ class IsaacSensorCreateRtxSensorCommand(kit_command_registry.Command):
                                  f"{path}. USD path: {self._usd_path}")
         else:
             prim = self._create(path)
-        xf = UsdGeom.Xformable(prim)
+        xf = UsdGeom.Xformable(get_stage().GetPrimAtPath(path))   # the asset's top prim, as Isaac places it
         xf.ClearXformOpOrder()
         t, q = self._translation, self._orientation
         if t is not None:
@@ -150,11 +151,12 @@ class IsaacSensorCreateRtxLidarCommand(IsaacSensorCreateRtxSensorCommand):
     _sensor_type = "lidar"
 
     def _create(self, path: Sdf.Path) -> Usd.Prim:
-        prim = functional.create.omni_lidar(name=path.name, parent=_parent_or_root(path))
-        if self._config:
-            found = resolve_config_path(self._config, SUPPORTED_LIDAR_CONFIGS, sensor_type="Lidar")
-            check_variant(found, self._variant, SUPPORTED_LIDAR_CONFIGS, "Lidar")
-            author_lidar_profile(prim, lidar_profile(config_key(found), self._variant))
+        if not self._config:
+            return functional.create.omni_lidar(name=path.name, parent=_parent_or_root(path))
+        found = resolve_config_path(self._config, SUPPORTED_LIDAR_CONFIGS, sensor_type="Lidar")
+        check_variant(found, self._variant, SUPPORTED_LIDAR_CONFIGS, "Lidar")
+        prim = config_prim(str(path), found, "OmniLidar")
+        author_lidar_profile(prim, lidar_profile(config_key(found), self._variant))
         return prim
 
 
@@ -164,10 +166,11 @@ class IsaacSensorCreateRtxRadarCommand(IsaacSensorCreateRtxSensorCommand):
     _sensor_type = "radar"
 
     def _create(self, path: Sdf.Path) -> Usd.Prim:
-        prim = functional.create.omni_radar(name=path.name, parent=_parent_or_root(path))
-        if self._config:
-            found = resolve_config_path(self._config, SUPPORTED_RADAR_CONFIGS, sensor_type="Radar")
-            set_sensor_attributes(prim, radar_profile_attributes(config_key(found)))
+        if not self._config:
+            return functional.create.omni_radar(name=path.name, parent=_parent_or_root(path))
+        found = resolve_config_path(self._config, SUPPORTED_RADAR_CONFIGS, sensor_type="Radar")
+        prim = config_prim(str(path), found, "OmniRadar")
+        set_sensor_attributes(prim, radar_profile_attributes(config_key(found)))
         return prim
 
 
@@ -489,7 +492,8 @@ def modules() -> list[types.ModuleType]:
                          SUPPORTED_LIDAR_CONFIGS=SUPPORTED_LIDAR_CONFIGS,
                          SUPPORTED_LIDAR_VARIANT_SET_NAME=SUPPORTED_LIDAR_VARIANT_SET_NAME,
                          IsaacSensorCreateRtxSensor=IsaacSensorCreateRtxSensorCommand, **commands),
-            generic_model_output_module(f"{NAME}.generic_model_output")]
+            generic_model_output_module(f"{NAME}.generic_model_output"),
+            CompatModule(f"{NAME}.sensor_checker", **CHECKER_NAMES)]
 
 
 def install() -> None:

@@ -130,7 +130,8 @@ class IDSAuxHas(enum.IntFlag):
 
 
 # lidar aux members: (flag, name, dtype, values per element), in buffer order
-LIDAR_MEMBERS = ((LidarAuxHas.EMITTER_ID, "emitterId", np.uint32, 1), (LidarAuxHas.CHANNEL_ID, "channelId", np.uint32, 1),
+LIDAR_MEMBERS = ((LidarAuxHas.EMITTER_ID, "emitterId", np.uint32, 1),
+                 (LidarAuxHas.CHANNEL_ID, "channelId", np.uint32, 1),
                  (LidarAuxHas.MAT_ID, "matId", np.uint32, 1), (LidarAuxHas.TICK_ID, "tickId", np.uint32, 1),
                  (LidarAuxHas.HIT_NORMALS, "hitNormals", np.float32, 3),
                  (LidarAuxHas.VELOCITIES, "velocities", np.float32, 3), (LidarAuxHas.OBJ_ID, "objId", np.uint8, 16),

@@ -10,10 +10,13 @@ range gets Gaussian noise of ``rangeAccuracyM`` and is rounded to ``rangeResolut
 the profile's azimuth / elevation error (mean and standard deviation, degrees). Noise is drawn from a stream
 keyed on the global seed, the sensor and the capture time, so a script gives the same returns every run.
 
-With ``accumulateOutputs`` a capture reports the last scan that completed during its window (none when no scan
-completed: an empty scan), time-stamped at the scan's start; without, it reports the beams of its own window.
-A capture at an unchanged time (a step that does not advance the clock) reports one whole scan of the scene as
-it is (nothing moves while the clock stands still), time-stamped as if fired over the scan period from now.
+A lidar reports at its tick rate (``omni:sensor:tickRate``; with ``accumulateOutputs``, at least once a scan
+so that each report is a whole scan): report ``q`` holds the beams fired in ``[q, q + 1)`` report periods and is
+time-stamped at its start. A capture reports the newest period that ended by its time; a capture in which
+none ended reports the previous report again (``fresh`` False). A tick rate of 0 reports every capture's own
+beams. A capture at an unchanged time (a step that does not advance the clock) reports one whole scan of the
+scene as it is (nothing moves while the clock stands still), time-stamped as if fired over the scan period from
+now.
 
 Example:
     >>> import graphsdg as rep
@@ -30,7 +33,7 @@ Example:
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 from pxr import Usd
@@ -44,7 +47,6 @@ from graphsdg.sensors.sensor_pose import SensorPose, sensor_pose
 from graphsdg.sensors.surface_materials import surface_table
 from graphsdg.sim.scene import SimScene
 
-_EPS = 1e-9
 VALID_FLAG = 1 << 6
 
 
@@ -53,6 +55,7 @@ class LidarReturns:
     """One entry per return (aligned arrays); lengths in metres, angles in degrees, times in seconds."""
 
     time_s: np.ndarray
+    time_ns: np.ndarray            # int64, the firing time in nanoseconds
     scan: np.ndarray
     tick: np.ndarray
     emitter: np.ndarray
@@ -107,11 +110,13 @@ class LidarScan:
     profile: LidarProfile
     options: dict = field(default_factory=dict)
     frame_id: int = 0
+    fresh: bool = True             # made by this capture (False: the previous report repeated)
 
 
 def _empty_returns() -> LidarReturns:
     i, f, v = np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 3))
-    return LidarReturns(time_s=f, scan=i, tick=i, emitter=i, channel=i, azimuth_deg=f, elevation_deg=f, range_m=f,
+    return LidarReturns(time_s=f, time_ns=i, scan=i, tick=i, emitter=i, channel=i, azimuth_deg=f, elevation_deg=f,
+                        range_m=f,
                         intensity=f, geom=i.astype(np.int32), material_id=i.astype(np.uint32),
                         flags=i.astype(np.uint8), direction_world=v, sensor_position=v, hit_world=v,
                         normal_world=v, velocity_world=v)
@@ -168,7 +173,8 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
     hit_units = origins + dirs_world * np.where(hits.geom >= 0, hits.distance, 0.0)[:, None]
     velocity = point_velocities(m, d, hits.geom, hit_units) * mpu
     returns = LidarReturns(
-        time_s=firings.time, scan=firings.scan, tick=firings.tick, emitter=firings.emitter, channel=firings.channel,
+        time_s=firings.time, time_ns=firings.time_ns, scan=firings.scan, tick=firings.tick, emitter=firings.emitter,
+        channel=firings.channel,
         azimuth_deg=azimuth, elevation_deg=elevation, range_m=reported, intensity=np.where(valid, intensity, 0.0),
         geom=np.where(valid, hits.geom, -1).astype(np.int32),
         material_id=np.where(valid, surface.material_id[hits.geom], 0).astype(np.uint32),
@@ -187,59 +193,92 @@ def _pose_at(pose: SensorPose, dt: float, mpu: float) -> tuple[np.ndarray, np.nd
     return positions[0] * mpu, moved.quaternion_xyzw()
 
 
+def output_period_ns(profile: LidarProfile, accumulate: bool, scan_ns: int) -> int | None:
+    """How often the lidar reports, in ns: its tick period (``omni:sensor:tickRate``), at least its scan period
+    when it accumulates whole scans; None (every capture) for a tick rate of 0."""
+    tick = profile.tick_rate_hz
+    period = int(round(1e9 / tick)) if tick and tick > 0 else None
+    if accumulate and (period is None or period < scan_ns):
+        period = scan_ns
+    return period
+
+
 class LidarScanner:
-    """The scanning state of one lidar prim: when it last captured and the scan it is accumulating."""
+    """The scanning state of one lidar prim: its clock, the returns of the reports it is filling, its last report."""
 
     def __init__(self, path: str) -> None:
         self.path = str(path)
-        self.last_time: float | None = None
+        self.last_ns: int | None = None
         self.pending: dict[int, list[LidarReturns]] = {}
+        self.latest: LidarScan | None = None
         self.frames = 0
 
     def reset(self) -> None:
-        """Forget the clock and the partial scan (the timeline restarted)."""
-        self.last_time, self.pending = None, {}
+        """Forget the clock, the reports being filled and the last report (the timeline restarted)."""
+        self.last_ns, self.pending, self.latest = None, {}, None
 
     def capture(self, sim: SimScene, stage: Usd.Stage, now: float) -> LidarScan:
-        """Fire the beams due since the last capture and report what the lidar outputs now."""
+        """Fire the beams due since the last capture and report what the lidar outputs now: the last report
+        period that ended (a new report), or the previous report again while none ended."""
         prim = sensor_prim(stage, self.path, "OmniSensorGenericLidarCoreAPI", "lidar")
         profile = read_lidar_profile(prim)
         options = output_settings(prim)
         pattern = ScanPattern(profile)
-        period = pattern.scan_period
-        if self.last_time is not None and now < self.last_time - _EPS:
+        report_ns = output_period_ns(profile, options["accumulate"], pattern.scan_ns)
+        now_ns = int(round(now * 1e9))
+        if self.last_ns is not None and now_ns < self.last_ns:
             self.reset()
-        snapshot = (self.last_time is not None and now <= self.last_time + _EPS) or \
-            (self.last_time is None and now <= _EPS)
-        start = max(0.0, now - period) if self.last_time is None else self.last_time
-        self.last_time = now
+        snapshot = now_ns <= (self.last_ns if self.last_ns is not None else 0)
+        start_ns = self.last_ns if self.last_ns is not None else max(0, now_ns - (report_ns or pattern.scan_ns))
+        self.last_ns = now_ns
         refresh_velocities(sim.model, sim.data)
         pose = sensor_pose(sim, prim)
-        noise = rng.stream("lidar", self.path, int(round(now * 1e9)), self.frames)
+        noise = rng.stream("lidar", self.path, now_ns, self.frames)
         self.frames += 1
-        firings = pattern.full_scan(now) if snapshot else pattern.firings(start, now)
+        firings = pattern.full_scan(now) if snapshot else pattern.firings(start_ns * 1e-9, now)
         returns = measure(sim, pose, profile, firings, now, noise, options["keep_invalid"], frozen=snapshot)
-        mpu = sim.world_transforms.meters_per_unit()
+        report = _Report(self, pose, now, sim.world_transforms.meters_per_unit(), profile, options)
         if snapshot:
             self.pending = {}
-            return self._scan(returns, now, now + period, True, pose, now, mpu, profile, options, frozen=True)
-        if not options["accumulate"]:
-            return self._scan(returns, start, now, False, pose, now, mpu, profile, options)
-        for scan in np.unique(returns.scan).tolist():
-            self.pending.setdefault(int(scan), []).append(returns.take(returns.scan == scan))
-        done = [s for s in self.pending if (s + 1) * period <= now + _EPS]
+            self.latest = report.make(returns, now_ns, now_ns + pattern.scan_ns, True, frozen=True)
+            return self.latest
+        if report_ns is None:
+            return report.make(returns, start_ns, now_ns, now_ns - start_ns >= pattern.scan_ns)
+        period = returns.time_ns // report_ns
+        for index in np.unique(period).tolist():
+            self.pending.setdefault(int(index), []).append(returns.take(period == index))
+        done = [q for q in self.pending if (q + 1) * report_ns <= now_ns]
         if not done:
-            return self._scan(_empty_returns(), start, now, False, pose, now, mpu, profile, options)
-        latest = max(done)
-        parts = self.pending.pop(latest)
-        for s in done:
-            self.pending.pop(s, None)
-        begin = float(pattern.scan_start(latest))
-        return self._scan(LidarReturns.concat(parts), begin, begin + period, True, pose, now, mpu, profile, options)
+            if self.latest is not None:
+                return report.repeat(self.latest)
+            return report.make(_empty_returns(), start_ns, now_ns, False, fresh=False)
+        newest = max(done)
+        parts = self.pending.pop(newest)
+        for q in done:
+            self.pending.pop(q, None)
+        self.latest = report.make(LidarReturns.concat(parts), newest * report_ns, (newest + 1) * report_ns,
+                                  report_ns >= pattern.scan_ns)
+        return self.latest
 
-    def _scan(self, returns: LidarReturns, start: float, end: float, complete: bool, pose: SensorPose, now: float,
-              mpu: float, profile: LidarProfile, options: dict, frozen: bool = False) -> LidarScan:
-        begin, finish = (0.0, 0.0) if frozen else (start - now, end - now)
+
+class _Report:
+    """Makes the :class:`LidarScan` reports of one capture (its pose, time and settings)."""
+
+    def __init__(self, scanner: LidarScanner, pose: SensorPose, now: float, mpu: float, profile: LidarProfile,
+                 options: dict) -> None:
+        self.scanner, self.pose, self.now, self.mpu = scanner, pose, now, mpu
+        self.profile, self.options = profile, options
+
+    def make(self, returns: LidarReturns, start_ns: int, end_ns: int, complete: bool, frozen: bool = False,
+             fresh: bool = True) -> LidarScan:
+        start, end = start_ns * 1e-9, end_ns * 1e-9
+        begin, finish = (0.0, 0.0) if frozen else (start - self.now, end - self.now)
         return LidarScan(returns=returns, start_s=start, end_s=end, complete=complete,
-                         start_pose=_pose_at(pose, begin, mpu), end_pose=_pose_at(pose, finish, mpu),
-                         profile=profile, options=options, frame_id=self.frames)
+                         start_pose=_pose_at(self.pose, begin, self.mpu),
+                         end_pose=_pose_at(self.pose, finish, self.mpu),
+                         profile=self.profile, options=self.options, frame_id=self.scanner.frames, fresh=fresh)
+
+    @staticmethod
+    def repeat(previous: LidarScan) -> LidarScan:
+        """The previous report again, marked as not new."""
+        return replace(previous, fresh=False)

@@ -83,7 +83,7 @@ def lidar_content(scan: LidarScan, object_ids: np.ndarray) -> GmoContent:
            "objId": object_id_bytes(object_ids), "echoId": np.zeros(n, np.uint8),
            "tickStates": np.zeros(n, np.uint8)}
     return GmoContent(modality=Modality.LIDAR, x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], scalar=r.intensity,
-                      time_offset_ns=np.round((r.time_s - scan.start_s) * 1e9).astype(np.int32), flags=r.flags,
+                      time_offset_ns=(r.time_ns - int(round(scan.start_s * 1e9))).astype(np.int32), flags=r.flags,
                       timestamp_ns=int(round(scan.start_s * 1e9)), frame_id=scan.frame_id,
                       coords=CoordsType[coords], frame_of_reference=FrameOfReference[frame],
                       frame_start=_frame_pose(scan.start_s, scan.start_pose),

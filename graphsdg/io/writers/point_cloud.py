@@ -1,9 +1,9 @@
 """PointCloudWriter: each lidar or radar scan as a point cloud file, with intensities, ids and labels.
 
 Attach it to render products of ``OmniLidar`` / ``OmniRadar`` prims (``rep.functional.create.omni_lidar``,
-Isaac's ``LidarSensor``, ...). For each render product and each capture that reports points (a lidar that
-accumulates whole scans reports one every scan period; ``skip_empty_frames=False`` also writes the empty
-ones), numbered ``{n}`` per render product::
+Isaac's ``LidarSensor``, ...). For each render product and each new report with points (a lidar reports at
+its tick rate and repeats its last report in between; repeats are not written again, and
+``skip_empty_frames=False`` also writes empty reports), numbered ``{n}`` per render product::
 
     <output_dir>/<rp_name>/pointcloud_{n}.npy       structured array (below)
     <output_dir>/<rp_name>/pointcloud_{n}.ply       the same, binary PLY (``formats``)
@@ -96,8 +96,8 @@ class PointCloudWriter(Writer):
             if not out:
                 continue
             points = np.asarray(out["data"]).reshape(-1, 3)
-            if self._skip_empty and len(points) == 0:
-                continue
+            if not out.get("fresh", True) or (self._skip_empty and len(points) == 0):
+                continue   # a lidar between its reports repeats the last one: written once
             self.write_cloud(rp_name, points, out)
 
     def write_cloud(self, rp_name: str, points: np.ndarray, info: dict) -> str:
