@@ -14,13 +14,16 @@ Example:
 """
 from __future__ import annotations
 
+import contextlib
 from math import gcd
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
+from graphsdg.errors import GraphBuildError
 from graphsdg.events import send_og_event
+from graphsdg.graph.current import current_graph
 from graphsdg.io.file_search import get_files_group, get_usd_files
 from graphsdg.physics.timeline import get_timeline_interface
 from graphsdg.sim import bounds
@@ -106,6 +109,26 @@ def find_prims(prim_paths: list[str | Sdf.Path], mode: str = "instances") -> lis
     raise ValueError(f"find_prims: mode {mode!r} is not one of 'prims', 'instances', 'meshes', 'materials'")
 
 
-__all__ = ["send_og_event", "get_usd_files", "get_files_group", "compute_aabb", "get_prim_variant_values",
+@contextlib.contextmanager
+def sequential() -> Iterator[None]:
+    """A block whose graph nodes run one after another, in the order they are built (``rep.utils.sequential``).
+
+    graphsdg runs a trigger's nodes in topological order with ties broken by build order, and a node can only
+    take inputs from nodes built before it, so the nodes of the block already run in build order; on leaving
+    the block that order is checked against the graph's evaluation order, which raises if it ever differs.
+    """
+    graph = current_graph(create=True)
+    before = {id(n) for n in graph}
+    yield
+    built = [n for n in graph if id(n) not in before]
+    inside = {id(n) for n in built}
+    evaluated = [n for n in graph.order if id(n) in inside]
+    if evaluated != built:
+        raise GraphBuildError(f"rep.utils.sequential: the block's nodes would run as "
+                              f"{[n.name for n in evaluated]}, not in the order they were built "
+                              f"{[n.name for n in built]}")
+
+
+__all__ = ["send_og_event", "sequential", "get_usd_files", "get_files_group", "compute_aabb", "get_prim_variant_values",
            "parse_semantics", "legacy_semantics_arg_to_new", "read_prim_transform", "get_reduced_ref_time",
            "find_prims", "open_stage"]

@@ -122,3 +122,30 @@ def test_uninstall_gives_pxr_its_own_has_api_back():
         assert Usd.Prim.HasAPI is not has_api and Semantics.SemanticsAPI
         isaac.uninstall()
         assert Usd.Prim.HasAPI is has_api and Usd.Prim.RemoveAPI is remove_api
+
+
+# ---- bounds helpers given a prim's Sdf.Path (prim.GetPrimPath()) ---------------------------------------------
+def test_obb_of_a_prim_given_by_its_sdf_path(compat):
+    from isaacsim.core.utils.bounds import compute_obb, create_bbox_cache
+    from isaacsim.core.utils.prims import create_prim
+    box = create_prim("/World/Box", "Cube", position=(1.0, 2.0, 0.5), scale=(2.0, 1.0, 0.5))
+    centroid, axes, half_extent = compute_obb(create_bbox_cache(), box.GetPrimPath())
+    # a 2-unit cube scaled (2, 1, 0.5): centred on its position, axes along the world's with the scale on them
+    np.testing.assert_allclose(centroid, (1.0, 2.0, 0.5), atol=1e-6)
+    np.testing.assert_allclose(np.abs(axes), np.diag((2.0, 1.0, 0.5)), atol=1e-6)
+    np.testing.assert_allclose(half_extent, (1.0, 1.0, 1.0), atol=1e-6)
+
+
+# ---- rep.utils.sequential --------------------------------------------------------------------------------------
+def test_nodes_of_a_sequential_block_run_in_the_order_they_are_built(compat):
+    import omni.replicator.core as rep
+    cube = rep.create.cube(position=(0, 0, 0))
+    with rep.trigger.on_frame():
+        with rep.utils.sequential():
+            with cube:
+                rep.modify.pose(position=rep.distribution.uniform((5, 5, 5), (6, 6, 6)))
+                rep.modify.pose(position=(1, 2, 3))      # built last, so it runs last: its value stays
+    rep.orchestrator.step()
+    prim = cube.get_output("prims")[0]
+    translate = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(0).ExtractTranslation())
+    np.testing.assert_allclose(translate, (1, 2, 3), atol=1e-9)

@@ -27,7 +27,7 @@ import types
 from typing import Any, Sequence
 
 import numpy as np
-from pxr import Gf, Usd, UsdGeom
+from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg.compat.experimental_stage_scope import current_stage
 from graphsdg.compat.modules import CompatModule
@@ -42,8 +42,8 @@ def create_bbox_cache(time: Usd.TimeCode = Usd.TimeCode.Default(), *, use_extent
     return UsdGeom.BBoxCache(time, [UsdGeom.Tokens.default_], useExtentsHint=use_extents_hint)
 
 
-def _prim(prim: str | Usd.Prim, caller: str) -> Usd.Prim:
-    found = current_stage().GetPrimAtPath(prim) if isinstance(prim, str) else prim
+def _prim(prim: str | Sdf.Path | Usd.Prim, caller: str) -> Usd.Prim:
+    found = current_stage().GetPrimAtPath(str(prim)) if isinstance(prim, (str, Sdf.Path)) else prim
     if not isinstance(found, Usd.Prim) or not found.IsValid():
         raise ValueError(f"{caller}: no valid prim: {prim!r}")
     return found
