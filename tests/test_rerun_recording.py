@@ -27,8 +27,8 @@ CUBE_X = (0.0, 0.3, 0.6)           # the cube's centre x per frame (z = 0.5) ...
 CUBE_YAW = (0.0, 20.0, 40.0)       # ... and its yaw in degrees
 
 
-def write_scene_dataset(out: str, frames: int = FRAMES, camera_params: bool = True) -> None:
-    """A floor, a cube and a ball seen by one 64x48 camera; BasicWriter with every layer the viewer logs."""
+def write_scene_dataset(out: str, frames: int = FRAMES, camera_params: bool = True, resolution=(64, 48)) -> None:
+    """A floor, a cube and a ball seen by one camera (64x48); BasicWriter with every layer the viewer logs."""
     rep.functional.create.xform(name="World")
     rep.functional.create.dome_light(intensity=600, parent="/World")
     rep.functional.create.plane(parent="/World", name="Floor", scale=(4, 4, 1), semantics={"class": "floor"})
@@ -37,7 +37,7 @@ def write_scene_dataset(out: str, frames: int = FRAMES, camera_params: bool = Tr
     rep.functional.create.sphere(parent="/World", name="Ball", position=(1.0, 0.8, 0.4), scale=0.8,
                                  semantics={"class": "ball"})
     cam = rep.functional.create.camera(position=(3, -3, 2.5), look_at=(0, 0, 0.3), parent="/World", name="Camera")
-    rp = rep.create.render_product(cam, (64, 48))
+    rp = rep.create.render_product(cam, resolution)
     writer = rep.writers.get("BasicWriter")
     writer.initialize(output_dir=out, rgb=True, bounding_box_2d_tight=True, bounding_box_2d_loose=True,
                       semantic_segmentation=True, instance_segmentation=True, distance_to_image_plane=True,
@@ -73,6 +73,13 @@ def read_recording(path: str) -> dict:
                 if value is not None:
                     out.setdefault(chunk.entity_path, {}).setdefault(name, {})[frame] = value
     return out
+
+
+def latest(values: dict, frame: int):
+    """A component's value at ``frame`` as the viewer shows it: the last one logged at or before it (or static)."""
+    if None in values:
+        return values[None]
+    return values[max(f for f in values if f <= frame)]
 
 
 def image_of(buffer: list, fmt: dict, kind: str) -> np.ndarray:
@@ -155,7 +162,7 @@ def test_masks_equal_the_datasets_pixel_for_pixel(recording, dataset):
         truth[np.isin(truth, ["UNLABELLED", ""])] = "BACKGROUND"
         assert (logged == truth).all() and {"floor", "cube", "ball"} <= set(truth.ravel())
         ids = image_of(instance["SegmentationImage:buffer"][i], instance["SegmentationImage:format"][i], "u")
-        per_frame = context_names(instance["AnnotationContext:context"][i])
+        per_frame = context_names(instance["AnnotationContext:context"][None])   # static: ids shared by frames
         logged = np.vectorize(lambda v: per_frame.get(int(v), "BACKGROUND").split(" (")[0], otypes=[object])(ids)
         truth = colour_labels(os.path.join(dataset, f"instance_segmentation_{i:04d}.png"),
                               json.load(open(os.path.join(dataset, f"instance_segmentation_mapping_{i:04d}.json"))))
@@ -172,14 +179,14 @@ def _depth_points(rec: dict, i: int) -> tuple[np.ndarray, np.ndarray]:
     depth_entity = rec["/world/cameras/camera/image/depth"]
     depth = image_of(depth_entity["DepthImage:buffer"][i], depth_entity["DepthImage:format"][i], "f")
     depth = depth / depth_entity["DepthImage:meter"][i][0]
-    k = np.array(pin["Pinhole:image_from_camera"][i][0], dtype=np.float64).reshape(3, 3, order="F")  # column-major
-    assert list(pin["Pinhole:camera_xyz"][i][0]) == [3, 1, 6]     # Rerun's codes: Right 3, Up 1, Back 6 (USD)
+    k = np.array(latest(pin["Pinhole:image_from_camera"], i)[0], dtype=np.float64).reshape(3, 3, order="F")
+    assert list(latest(pin["Pinhole:camera_xyz"], i)[0]) == [3, 1, 6]   # Rerun's codes: Right 3, Up 1, Back 6
     h, w = depth.shape
     u, v = np.meshgrid(np.arange(w) + 0.5, np.arange(h) + 0.5)
     rays_rdf = np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1], np.ones_like(u)], -1)
     points_rub = rays_rdf * depth[..., None] * np.array([1.0, -1.0, -1.0])
-    rotation = np.array(cam["Transform3D:mat3x3"][i][0], dtype=np.float64).reshape(3, 3, order="F")
-    translation = np.array(cam["Transform3D:translation"][i][0], dtype=np.float64)
+    rotation = np.array(latest(cam["Transform3D:mat3x3"], i)[0], dtype=np.float64).reshape(3, 3, order="F")
+    translation = np.array(latest(cam["Transform3D:translation"], i)[0], dtype=np.float64)
     return points_rub @ rotation.T + translation, depth > 0
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from graphsdg.dataset.basic_writer import BasicWriterDataset, Frame
 from graphsdg.dataset.point_cloud_files import POINT_CLOUD_EXTENSIONS, read_point_cloud
-from graphsdg.dataset.view_frame import DepthMap, PointCloud, ViewBox, ViewBox3D, ViewFrame
+from graphsdg.dataset.view_frame import DepthMap, IdOf, PointCloud, ViewBox, ViewBox3D, ViewFrame
 from graphsdg.io.camera_geometry import PinholeCamera
 from graphsdg.io.location import Location
 from graphsdg.maths.rotations import decompose
@@ -41,39 +41,52 @@ def _boxes(f: Frame, kind: str) -> list[ViewBox]:
                     int(r["x_min"]), int(r["y_min"]), int(r["x_max"]), int(r["y_max"])) for r in rows]
 
 
-def _shifted(ids: np.ndarray, names: dict[int, str]) -> np.ndarray:
-    """``ids`` (-1 = no colour) as values ``id + 1`` where ``names`` has them and 0 elsewhere."""
-    top = max([int(ids.max()) if ids.size else 0] + [k - 1 for k in names])
-    lut = np.zeros(top + 2, dtype=np.int32)
-    for value in names:
-        lut[value] = value
-    return lut.take(ids.astype(np.int32, copy=False) + 1)
-
-
-def semantic_masks(f: Frame) -> tuple[np.ndarray, dict[int, str]] | None:
-    """Semantic segmentation as (values, {value: class}); 0 where no class (background, unlabelled)."""
-    seg = f.segmentation("semantic_segmentation")
+def semantic_masks(f: Frame, ids: IdOf | None = None) -> tuple[np.ndarray, dict[int, str]] | None:
+    """Semantic segmentation as (values, {value: class}); 0 where no class (background, unlabelled). With
+    ``ids`` the values are ``ids(class)``, straight from the decoded colours."""
+    if ids is None:
+        seg = f.segmentation("semantic_segmentation", shift=True, keep=lambda v: label_text(v) not in NOTHING)
+        if seg is None:
+            return None
+        values, mapping = seg
+        return values, {k: label_text(v) for k, v in mapping.items() if label_text(v) not in NOTHING}
+    seg = f.segmentation("semantic_segmentation", value_of=lambda v, _: 0 if label_text(v) in NOTHING
+                         else ids(label_text(v)))
     if seg is None:
         return None
-    ids, mapping = seg
-    names = {int(k) + 1: label_text(v) for k, v in mapping.items() if label_text(v) not in NOTHING}
-    return _shifted(ids, names), names
+    values, mapping = seg
+    names = {label_text(v) for v in mapping.values() if label_text(v) not in NOTHING}
+    return values, {ids(n): n for n in names}
 
 
-def instance_masks(f: Frame) -> tuple[np.ndarray, dict[int, str]] | None:
-    """Instance segmentation as (values, {value: "prim path (class)"}); 0 where no instance."""
+def instance_masks(f: Frame, ids: IdOf | None = None) -> tuple[np.ndarray, dict[int, str]] | None:
+    """Instance segmentation as (values, {value: "prim path (class)"}); 0 where no instance. With ``ids`` the
+    values are ``ids("prim path (class)")``."""
     kind = next((k for k in ("instance_segmentation", "instance_id_segmentation") if k in f.files), None)
     if kind is None:
         return None
-    ids, mapping = f.segmentation(kind)
     semantics = f.semantics_of_instances() if kind == "instance_segmentation" else None
-    names = {}
-    for k, path in mapping.items():
-        if str(path) in NOTHING:
-            continue
+    names: dict[int, str] = {}
+
+    def name_of(k: int, path) -> str:
         cls = label_text(semantics[k]) if semantics and k in semantics else ""
-        names[int(k) + 1] = f"{path} ({cls})" if cls else str(path)
-    return _shifted(ids, names), names
+        return f"{path} ({cls})" if cls else str(path)
+
+    if ids is None:
+        values, mapping = f.segmentation(kind, shift=True, keep=lambda v: str(v) not in NOTHING)
+        for k, path in mapping.items():
+            if str(path) not in NOTHING:
+                names[k] = name_of(k - 1, path)
+        return values, names
+    keyed = {}
+
+    def value_of(path, k: int) -> int:
+        if str(path) in NOTHING:
+            return 0
+        keyed[k] = name_of(k, path)
+        return ids(keyed[k])
+    values, _ = f.segmentation(kind, value_of=value_of)
+    return values, {ids(n): n for n in keyed.values()}
 
 
 def camera_of(f: Frame) -> PinholeCamera | None:
@@ -149,9 +162,9 @@ def basic_frames(location: Location) -> list[ViewFrame]:
             missing = f.path(f"camera_params_{f.frame_id}.json")
         out.append(ViewFrame(
             f"{f.folder}/{f.frame_id}" if f.folder else f.frame_id, location, f.path(f.files["rgb"]),
-            _boxes(f, "bounding_box_2d_tight"), masks=lambda f=f: semantic_masks(f), stream=stream,
+            _boxes(f, "bounding_box_2d_tight"), masks=lambda ids=None, f=f: semantic_masks(f, ids), stream=stream,
             loose_boxes=_boxes(f, "bounding_box_2d_loose"),
-            instances=lambda f=f: instance_masks(f), depth=lambda f=f: depth_of(f),
+            instances=lambda ids=None, f=f: instance_masks(f, ids), depth=lambda f=f: depth_of(f),
             camera=lambda f=f: camera_of(f), camera_missing=missing, boxes_3d=lambda f=f: boxes_3d_of(f),
             point_clouds=lambda f=f: point_clouds_of(f)))
     return out

@@ -17,6 +17,7 @@ import posixpath
 import re
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Callable
 
 import numpy as np
 from PIL import Image
@@ -92,11 +93,15 @@ class Frame:
         rows = np.load(io.BytesIO(self.read(name)))
         return rows, self._json(self.companion(kind, "_labels")), self._json(self.companion(kind, "_prim_paths"))
 
-    def segmentation(self, kind: str) -> tuple[np.ndarray, dict] | None:
+    def segmentation(self, kind: str, shift: bool = False, keep: Callable[[object], bool] | None = None,
+                     value_of: Callable[[object, int], int] | None = None) -> tuple[np.ndarray, dict] | None:
         """(ids (H, W) int, id -> value mapping) for semantic/instance segmentation, colorized or not.
 
         Colorized images give each pixel the index of its colour among the mapping's ``"(r, g, b, a)"`` keys
-        (-1 for a colour the mapping lacks).
+        (-1 for a colour the mapping lacks). ``shift``: ids + 1 instead, 0 for a colour the mapping lacks and
+        for a mapping value ``keep`` rejects (background, unlabelled), so that 0 means nothing. ``value_of``:
+        each pixel holds ``value_of(mapping value, id)`` instead (0 for a colour the mapping lacks), the mapping
+        still keyed by the ids.
         """
         name = self.files.get(kind)
         if not name:
@@ -106,22 +111,39 @@ class Frame:
         img = decode_image(self.read(name), rgb_order=False)
         if img.ndim == 3:   # colorized: pixel colours index the mapping's "(r, g, b, a)" keys
             keys = [k for k in mapping if _color_key(k) is not None]
-            return colour_ids(img, [_color_key(k) for k in keys], bgr=True), {i: mapping[k] for i, k in enumerate(keys)}
-        return img.astype(np.int64), {int(k): v for k, v in mapping.items()}
+            colours = [_color_key(k) for k in keys]
+            if value_of is not None:
+                values = [value_of(mapping[k], i) for i, k in enumerate(keys)]
+                return colour_ids(img, colours, bgr=True, values=values, missing=0), dict(enumerate(mapping[k]
+                                                                                                  for k in keys))
+            values = [i + 1 if keep is None or keep(mapping[k]) else 0 for i, k in enumerate(keys)] if shift else None
+            ids = colour_ids(img, colours, bgr=True, values=values, missing=0 if shift else -1)
+            return ids, {i + shift: mapping[k] for i, k in enumerate(keys)}
+        ids = img.astype(np.int64)
+        mapping = {int(k): v for k, v in mapping.items()}
+        if not shift and value_of is None:
+            return ids, mapping
+        lut = np.zeros(max([int(ids.max(initial=0)), *mapping]) + 1, dtype=np.int64)
+        for k, v in mapping.items():
+            lut[k] = value_of(v, k) if value_of is not None else k + 1 if keep is None or keep(v) else 0
+        if value_of is not None:
+            return lut[ids], mapping
+        return lut[ids], {k + 1: v for k, v in mapping.items()}
 
     def semantics_of_instances(self) -> dict[int, object] | None:
-        """Instance segmentation's id -> semantic labels (its ``_semantics_mapping`` file), ids as in
-        :meth:`segmentation`; None if not written."""
+        """Instance segmentation's id -> semantic labels (its ``_semantics_mapping`` file), ids as
+        :meth:`segmentation` gives them (unshifted); None if not written."""
         if "instance_segmentation" not in self.files:
             return None
         try:
-            mapping = self._json(self.companion("instance_segmentation", "_semantics_mapping"))
+            semantics = self._json(self.companion("instance_segmentation", "_semantics_mapping"))
         except FileNotFoundError:
             return None
+        mapping = self._json(self.companion("instance_segmentation", "_mapping"))
         keys = [k for k in mapping if _color_key(k) is not None]
-        if keys:
-            return {i: mapping[k] for i, k in enumerate(keys)}
-        return {int(k): v for k, v in mapping.items()}
+        if keys:   # colorized: both files are keyed by colour; ids are the colour's place in the mapping
+            return {i: semantics[k] for i, k in enumerate(keys) if k in semantics}
+        return {int(k): v for k, v in semantics.items()}
 
     def semantic_labels(self) -> dict[int, object]:
         """semanticId -> labels, from every ``_labels`` file of this frame's box annotators (the ids the

@@ -18,6 +18,7 @@ from typing import Iterable
 import numpy as np
 
 from graphsdg.annotate.ids import color_of
+from graphsdg.dataset.view_frame import relabel
 from graphsdg.rng import stable_key
 
 
@@ -52,14 +53,9 @@ class ClassTable:
         return class_colour(name)
 
     def remap(self, values: np.ndarray, names: dict[int, str]) -> np.ndarray:
-        """A mask of per-frame values (0 = nothing, ``names``: value -> class) as class ids (uint16)."""
-        lut = np.zeros(max([0, *names]) + 1, dtype=np.uint16)
-        for value, name in names.items():
-            lut[value] = self.id_of(name)
-        top = int(values.max()) if values.size else 0
-        if top >= len(lut):   # values without a name: no class
-            lut = np.concatenate([lut, np.zeros(top + 1 - len(lut), np.uint16)])
-        return lut.take(values)
+        """A mask of per-frame values (0 = nothing, ``names``: value -> class) as class ids (smallest unsigned
+        type)."""
+        return relabel((values, names), self.id_of)[0]
 
     def __len__(self) -> int:
         return len(self.names)

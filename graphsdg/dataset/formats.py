@@ -32,7 +32,7 @@ from PIL import Image
 
 from graphsdg.dataset.basic_frames import basic_frames
 from graphsdg.dataset.label_images import decode_image
-from graphsdg.dataset.view_frame import DepthMap, ViewBox, ViewBox3D, ViewFrame
+from graphsdg.dataset.view_frame import DepthMap, ViewBox, ViewBox3D, ViewFrame, relabel
 from graphsdg.io.camera_geometry import USD_TO_OPENCV
 from graphsdg.io.location import Location, open_location
 
@@ -143,9 +143,10 @@ def _coco(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
             rel = image["file_name"].replace(os.sep, "/")
             stream = str(image.get("render_product") or posixpath.dirname(rel) or "camera")
             out.append(ViewFrame(posixpath.splitext(rel)[0], location, rel, boxes,
-                                 masks=lambda anns=anns, image=image: _coco_classes(anns, image, names),
-                                 stream=stream, instances=lambda anns=anns, image=image: _coco_instances(
-                                     anns, image, names)))
+                                 masks=lambda ids=None, anns=anns, image=image: relabel(
+                                     _coco_classes(anns, image, names), ids),
+                                 stream=stream, instances=lambda ids=None, anns=anns, image=image: relabel(
+                                     _coco_instances(anns, image, names), ids)))
     return out
 
 
@@ -226,11 +227,11 @@ def _kitti(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
             instance = under(KITTI_INSTANCE_DIRS[label_dir], f"{stem}.png")
             depth = under("depth", f"{stem}.png")
 
-            def masks(instance=instance, boxes=boxes, classes_only=True):
+            def masks(ids=None, instance=instance, boxes=boxes, classes_only=True):
                 if instance not in listing:
                     return None
-                ids, instances, classes = _kitti_instances(location.read(instance), boxes)
-                return (ids // 256, classes) if classes_only else (ids, instances)
+                values, instances, classes = _kitti_instances(location.read(instance), boxes)
+                return relabel((values // 256, classes) if classes_only else (values, instances), ids)
 
             def depth_map(depth=depth):
                 if depth not in listing:
@@ -240,7 +241,8 @@ def _kitti(location: Location, listing: dict[str, int]) -> list[ViewFrame]:
                 return DepthMap(values, "distance_to_camera")
             out.append(ViewFrame(f"{parent}/{stem}" if parent else stem, location,
                                  under(KITTI_IMAGE_DIRS[label_dir], image[0]), boxes, masks, stream=parent or "camera",
-                                 instances=lambda masks=masks: masks(classes_only=False), depth=depth_map,
+                                 instances=lambda ids=None, masks=masks: masks(ids, classes_only=False),
+                                 depth=depth_map,
                                  camera_missing=under("calib", f"{stem}.txt") if depth in listing else None,
                                  boxes_3d=lambda boxes_3d=boxes_3d: boxes_3d))
     return out

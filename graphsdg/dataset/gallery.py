@@ -66,9 +66,9 @@ def _frame_files(frame: ViewFrame, classes: ClassTable, out_dir: str) -> dict:
              "depthRange": None, "boxes": [[classes.id_of(b.label), b.x0, b.y0, b.x1, b.y1] for b in frame.boxes]}
     h, w = _image_size(data)
     entry["w"], entry["h"] = w, h
-    masks = frame.masks()
+    masks = frame.masks(classes.id_of)
     if masks is not None:
-        ids = classes.remap(*masks)
+        ids = masks[0].copy()
         ids[ids > MASK_CLASSES] = 0
         entry["classes"] = sorted(int(v) for v in np.unique(ids) if v)
         with open(os.path.join(out_dir, "frames", stem + ".mask.png"), "wb") as fh:

@@ -58,36 +58,42 @@ def _pack_colours(colours: Sequence[Sequence[int]]) -> np.ndarray:
     return c[:, 0] | (c[:, 1] << 8) | (c[:, 2] << 16) | (c[:, 3] << 24)
 
 
-def _hash_table(keys: np.ndarray) -> tuple[int, int, np.ndarray]:
-    """``(multiplier, bits, table)``: ``table[(key * multiplier) >> (32 - bits)]`` is each key's index."""
+def _hash_slots(keys: np.ndarray) -> tuple[int, int, np.ndarray]:
+    """``(multiplier, bits, slots)``: ``slots = (keys * multiplier) >> (32 - bits)`` differ for every key."""
     for bits in range(max(4, int(len(keys)).bit_length() + 1), 17):
         for mult in _MULTIPLIERS:
             slots = (keys * np.uint32(mult)) >> np.uint32(32 - bits)
             if len(np.unique(slots)) == len(keys):
-                table = np.zeros(1 << bits, dtype=np.int16 if len(keys) < 2 ** 15 else np.int32)
-                table[slots] = np.arange(len(keys))
-                return mult, bits, table
+                return mult, bits, slots
     raise ValueError(f"no collision-free hash for {len(keys)} colours")   # not reached for distinct colours
 
 
-def colour_ids(img: np.ndarray, colours: Sequence[Sequence[int]], bgr: bool = False) -> np.ndarray:
-    """(H, W) int16 (int32 past 32767 colours): the index in ``colours`` of each pixel's colour, -1 for a colour
-    not listed.
+def colour_ids(img: np.ndarray, colours: Sequence[Sequence[int]], bgr: bool = False,
+               values: Sequence[int] | None = None, missing: int = -1) -> np.ndarray:
+    """(H, W): for each pixel, ``values[i]`` of the colour ``colours[i]`` it has (default: ``i``), ``missing``
+    for a colour not listed. int16 by default; the smallest integer type holding ``values`` and ``missing``.
 
     ``colours`` are RGBA (or RGB, taken as opaque) tuples; ``img`` is (H, W, 4) uint8 RGBA, or (H, W, 3) RGB;
     ``bgr``: its channels are in OpenCV's order (BGRA / BGR), which saves reordering a decoded image.
     """
     if img.ndim == 3 and img.shape[2] == 3:
         img = np.concatenate([img, np.full(img.shape[:2] + (1,), 255, np.uint8)], axis=2)
+    values = np.arange(len(colours)) if values is None else np.asarray(values, dtype=np.int64)
+    dtype = np.result_type(np.min_scalar_type(int(values.min(initial=missing))),
+                           np.min_scalar_type(int(values.max(initial=missing))), np.min_scalar_type(missing))
     if not len(colours):
-        return np.full(img.shape[:2], -1, dtype=np.int16)
+        return np.full(img.shape[:2], missing, dtype=dtype)
     keys = _pack_colours([(c[2], c[1], c[0], *c[3:]) for c in colours] if bgr else colours)
     if len(np.unique(keys)) != len(keys):
         raise ValueError(f"the mapping lists a colour twice: {list(colours)}")
+    mult, bits, slots = _hash_slots(keys)
+    # per hash slot: the colour that lands there and its value; an empty slot holds a colour that lands elsewhere
+    slot_keys = np.full(1 << bits, keys[0], dtype=np.uint32)
+    slot_values = np.full(1 << bits, missing, dtype=dtype)
+    slot_keys[slots], slot_values[slots] = keys, values
     packed = pack_rgba(img)
-    mult, bits, table = _hash_table(keys)
-    slots = np.multiply(packed, np.uint32(mult))
-    np.right_shift(slots, np.uint32(32 - bits), out=slots)
-    ids = table.take(slots)
-    ids[keys.take(ids) != packed] = -1
-    return ids
+    hashed = np.multiply(packed, np.uint32(mult))
+    np.right_shift(hashed, np.uint32(32 - bits), out=hashed)
+    out = slot_values[hashed]
+    out[slot_keys[hashed] != packed] = missing
+    return out

@@ -86,7 +86,30 @@ class DepthMap:
     meters_per_unit: float = 1.0
 
 
-def _none():
+#: class name -> id, handed to the mask loaders so that they produce a dataset-wide table's ids directly
+IdOf = Callable[[str], int]
+
+
+def smallest_uint(top: int) -> type:
+    """The smallest unsigned integer type that holds ``top``."""
+    return np.uint8 if top < 256 else np.uint16 if top < 65536 else np.uint32
+
+
+def relabel(found: tuple[np.ndarray, dict[int, str]] | None, ids: IdOf | None
+            ) -> tuple[np.ndarray, dict[int, str]] | None:
+    """A mask's per-frame values (0 = nothing, ``names``: value -> name) as ``ids(name)`` (unnamed values: 0), in
+    the smallest unsigned type, with the names keyed by those ids; unchanged without ``ids``."""
+    if found is None or ids is None:
+        return found
+    values, names = found
+    lut = np.zeros(max([int(values.max(initial=0)), *names]) + 1, dtype=np.int64)
+    for value, name in names.items():
+        lut[value] = ids(name)
+    out = lut[values]
+    return out.astype(smallest_uint(int(lut.max(initial=0))), copy=False), {ids(n): n for n in names.values()}
+
+
+def _none(*_):
     return None
 
 
@@ -106,13 +129,14 @@ class ViewFrame:
     location: Location
     image: str
     boxes: list[ViewBox] = field(default_factory=list)
-    # () -> (H, W) int array (0 = nothing) and {value: class name}; None if the format has no masks
-    masks: Callable[[], tuple[np.ndarray, dict[int, str]] | None] = _none
+    # (ids=None) -> (H, W) int array (0 = nothing) and {value: class name}, None if the format has no masks;
+    # with ``ids`` (class name -> id) the values are those ids
+    masks: Callable[..., tuple[np.ndarray, dict[int, str]] | None] = _none
     stream: str = "camera"
     index: int = 0
     loose_boxes: list[ViewBox] = field(default_factory=list)
-    # () -> (H, W) int array (0 = nothing) and {value: "instance (class)"}; None if not written
-    instances: Callable[[], tuple[np.ndarray, dict[int, str]] | None] = _none
+    # (ids=None) -> (H, W) int array (0 = nothing) and {value: "instance (class)"}; None if not written
+    instances: Callable[..., tuple[np.ndarray, dict[int, str]] | None] = _none
     depth: Callable[[], DepthMap | None] = _none
     camera: Callable[[], PinholeCamera | None] = _none
     # the files that would hold this frame's camera parameters, when the format can hold them but they are absent
