@@ -13,6 +13,7 @@ import os
 import shutil
 import struct
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -392,3 +393,39 @@ def test_s3_dataset(tmp_path, monkeypatch, capsys):
         assert main(["view", "s3://views/runs/basic", "--html", "--out", str(tmp_path / "g")]) == 0
         assert (tmp_path / "g" / "index.html").exists() and len(os.listdir(tmp_path / "g" / "frames")) == 6
         object_store.forget_stores()
+
+
+# ---- streaming to a running Rerun process ---------------------------------------------------------------
+def test_streams_to_a_running_rerun(dataset, tmp_path):
+    """``--rerun rerun+http://...``: the frames go to a Rerun process listening for SDKs (here Rerun's own
+    ``rerun --port P --save FILE``, which writes what it receives)."""
+    import signal
+    import socket
+    import subprocess
+    import time
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    exe = os.path.join(os.path.dirname(sys.executable), "rerun")
+    saved = str(tmp_path / "streamed.rrd")
+    server = subprocess.Popen([exe, "--port", str(port), "--save", saved], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=1).close()
+                break
+            except OSError:
+                assert time.monotonic() < deadline and server.poll() is None, "rerun did not listen"
+                time.sleep(0.1)
+        assert main(["view", dataset, "--rerun", f"rerun+http://127.0.0.1:{port}/proxy"]) == 0
+    finally:
+        time.sleep(1)
+        server.send_signal(signal.SIGINT)
+        server.wait(timeout=30)
+    with warnings.catch_warnings():   # a streamed file has no footer, which Rerun's reader warns about
+        warnings.simplefilter("ignore")
+        rec = read_recording(saved)
+    assert set(rec["/world/cameras/camera/image/boxes_tight"]["Boxes2D:centers"]) == set(range(FRAMES))
+    assert "Pinhole:image_from_camera" in rec["/world/cameras/camera/image"]

@@ -287,6 +287,16 @@ def blueprint(rr, streams: list[str]):
                                         column_shares=[3, 2]), collapse_panels=True)
 
 
+def _viewer_on_path() -> None:
+    """Put the ``rerun`` executable that came with the SDK on PATH (Rerun's spawn looks there), for a virtual
+    environment used without activating it."""
+    import shutil
+    import sys
+    here = os.path.join(os.path.dirname(sys.executable), "rerun")
+    if shutil.which("rerun") is None and os.path.exists(here):
+        os.environ["PATH"] = os.path.dirname(here) + os.pathsep + os.environ.get("PATH", "")
+
+
 def _camera_warning(frames: list[ViewFrame]) -> str | None:
     missing = [f.camera_missing for f in frames if f.camera_missing]
     if not missing:
@@ -319,6 +329,7 @@ def record(root: str, rrd_path: str | None = None, *, spawn: bool = False, conne
         rec.connect_grpc(connect, default_blueprint=layout)
         target = connect
     elif spawn:
+        _viewer_on_path()
         rec.spawn(default_blueprint=layout)
         target = "viewer"
     else:
