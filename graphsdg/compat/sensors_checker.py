@@ -114,10 +114,10 @@ class SensorCheckerUtil(CompatObject):
         self._model = ModelInfo()
         self._validated: Parameters | None = None
 
-    def init(self, modelInfo: ModelInfo, checkerImplPath: str | None = None) -> str:
-        """Remember the model checked against; returns an empty message (ready)."""
+    def init(self, modelInfo: ModelInfo, checkerImplPath: str | None = None) -> str | None:
+        """Remember the model checked against; None: ready."""
         self._model = modelInfo
-        return ""
+        return None
 
     def validateParams(self, prim: Any, *args: Any) -> str | None:
         """None when ``prim``'s sensor attributes describe a sensor graphsdg can scan, else the error."""

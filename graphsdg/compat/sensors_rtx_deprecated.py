@@ -44,7 +44,9 @@ from graphsdg.compat.sensors_rtx_configs import (SUPPORTED_LIDAR_CONFIGS, SUPPOR
 from graphsdg.compat.sensors_rtx_runtime import parse_generic_model_output_data, parse_object_ids, \
     parse_stable_id_map_data
 from graphsdg.functional.sensors import set_sensor_attributes
+from graphsdg.render.product_prims import sync_product_prims
 from graphsdg.runtime import runtime
+from graphsdg.sim.timeline import TimelineEventType
 from graphsdg.sensors.lidar_profile import author_lidar_profile
 from graphsdg.sensors import surface_materials
 from graphsdg.sensors.profile_catalog import lidar_profile
@@ -228,6 +230,14 @@ def get_material_id(prim: Usd.Prim) -> int:
     return surface_materials.encode_material_id(*labels) if labels else 0
 
 
+def _label_constants() -> dict[str, str]:
+    """``ATTR_PREFIX``, ``ATTR_BASE``, ``ATTR_COATING``, ``ATTR_ATTRIBUTE``: the label attribute names (read from
+    the prefix setting when compat mode is installed, as Isaac reads it when its extension loads)."""
+    base, coating, attribute = surface_materials.label_attribute_names()
+    return {"ATTR_PREFIX": base.rsplit(":", 1)[0], "ATTR_BASE": base, "ATTR_COATING": coating,
+            "ATTR_ATTRIBUTE": attribute}
+
+
 def get_gmo_data(dataPtr: Any) -> Any:
     """The :class:`GenericModelOutput` of a GMO buffer (an array, or the address of one); an empty one for
     None or 0."""
@@ -250,11 +260,17 @@ class LidarRtx:
         stage = get_stage()
         prim = stage.GetPrimAtPath(prim_path)
         if prim and prim.IsValid():
-            if prim.GetTypeName() != "OmniLidar":
+            if prim.GetTypeName() == "Camera":
+                # Isaac still accepts the Isaac Sim 4 camera-based lidar with a deprecation warning; graphsdg
+                # places it and gives it a render product, and refuses to scan with it (_refuse_camera_lidar)
+                log.warning("LidarRtx(%s): a Camera prim as a lidar is deprecated; graphsdg poses it but scans only "
+                            "OmniLidar prims", prim_path)
+            elif prim.GetTypeName() != "OmniLidar":
                 raise ValueError(f"Prim at {prim_path} is not an OmniLidar.")
-            if not prim.HasAPI("OmniSensorGenericLidarCoreAPI"):
+            elif not prim.HasAPI("OmniSensorGenericLidarCoreAPI"):
                 raise ValueError(f"Prim at {prim_path} does not have the OmniSensorGenericLidarCoreAPI schema.")
-            prim.GetAttribute("omni:sensor:Core:accumulateOutputs").Set(True)
+            if prim.GetTypeName() == "OmniLidar":
+                prim.GetAttribute("omni:sensor:Core:accumulateOutputs").Set(True)
             for key, value in kwargs.items():
                 if prim.HasAttribute(key):
                     prim.GetAttribute(key).Set(value)
@@ -323,8 +339,15 @@ class LidarRtx:
 
     # ---- annotators and writers ---------------------------------------------------------------------------
     def get_render_product_path(self) -> str:
-        """The lidar's render product path."""
+        """The lidar's render product path (its ``RenderProduct`` prim is authored in the session layer)."""
+        sync_product_prims()
         return self._render_product.path
+
+    def _refuse_camera_lidar(self, what: str) -> None:
+        if self._prim.GetTypeName() == "Camera":
+            raise CompatError(f"LidarRtx({self.prim_path!r}): {what} needs an OmniLidar prim; a Camera prim as a "
+                              f"lidar is Isaac Sim 4's deprecated form, which graphsdg does not scan with "
+                              f"(docs/sensors.md)")
 
     def get_annotators(self) -> dict:
         """The attached annotators by name."""
@@ -332,6 +355,7 @@ class LidarRtx:
 
     def attach_annotator(self, annotator_name: str, **kwargs: Any) -> None:
         """Attach annotator ``annotator_name`` (initialized with ``kwargs``) to the lidar's render product."""
+        self._refuse_camera_lidar(f"annotator {annotator_name!r}")
         if annotator_name in self._annotators:
             log.warning("Annotator %s already attached to %s", annotator_name, self._render_product.path)
             return
@@ -358,6 +382,7 @@ class LidarRtx:
 
     def attach_writer(self, writer_name: str, **kwargs: Any) -> None:
         """Attach writer ``writer_name`` (initialized with ``kwargs``) to the lidar's render product."""
+        self._refuse_camera_lidar(f"writer {writer_name!r}")
         if writer_name in self._writers:
             log.warning("Writer %s already attached to %s", writer_name, self._render_product.path)
             return
@@ -389,8 +414,14 @@ class LidarRtx:
 
     # ---- data ---------------------------------------------------------------------------------------------
     def initialize(self, physics_sim_view: Any = None) -> None:
-        """Start reporting the annotators' data in :meth:`get_current_frame`."""
+        """Start reporting the annotators' data in :meth:`get_current_frame`; the timeline pausing or stopping
+        pauses the lidar, playing resumes it."""
         self._initialized = True
+        timeline = runtime().timeline
+        self._timeline_subscriptions = [
+            timeline.subscribe(lambda event: self.pause(), TimelineEventType.PAUSE),
+            timeline.subscribe(lambda event: self.pause(), TimelineEventType.STOP),
+            timeline.subscribe(lambda event: self.resume(), TimelineEventType.PLAY)]
 
     def post_reset(self) -> None:
         """Nothing to reset."""
@@ -423,6 +454,8 @@ class LidarRtx:
         return self._current_frame
 
     def _flat(self, key: str) -> Any:
+        if "IsaacComputeRTXLidarFlatScan" not in self._annotators:
+            return None
         flat = self.get_current_frame().get("IsaacComputeRTXLidarFlatScan")
         return flat.get(key) if isinstance(flat, dict) else None
 
@@ -488,7 +521,7 @@ def modules() -> list[types.ModuleType]:
                          apply_nonvisual_material=apply_nonvisual_material, get_material_id=get_material_id,
                          decode_material_id=surface_materials.decode_material_id,
                          BASE_MATERIALS=dict(surface_materials.BASES), COATINGS=dict(surface_materials.COATINGS),
-                         ATTRIBUTES=dict(surface_materials.ATTRIBUTES),
+                         ATTRIBUTES=dict(surface_materials.ATTRIBUTES), **_label_constants(),
                          SUPPORTED_LIDAR_CONFIGS=SUPPORTED_LIDAR_CONFIGS,
                          SUPPORTED_LIDAR_VARIANT_SET_NAME=SUPPORTED_LIDAR_VARIANT_SET_NAME,
                          IsaacSensorCreateRtxSensor=IsaacSensorCreateRtxSensorCommand, **commands),
