@@ -56,6 +56,29 @@ def test_grid_offsets_and_errors(compat):
         GridCloner(spacing=1.0, num_per_row=0).get_clone_transforms(2)
     assert cloner.generate_paths("/World/envs/env", 3) == ["/World/envs/env_0", "/World/envs/env_1",
                                                            "/World/envs/env_2"]
+    # without offsets the positions are plain lists, as Isaac's (scripts compare them with ==)
+    rep.stage.new_stage()
+    positions, _ = GridCloner(spacing=2.0).get_clone_transforms(9)
+    assert positions[0] == [2.0, -2.0, 0] and positions[-1] == [-2.0, 2.0, 0]
+    assert GridCloner(spacing=2.0).get_clone_transforms(0) == ([], [])
+
+
+def test_clone_pauses_the_change_listener_around_its_work(compat):
+    from unittest import mock
+
+    from isaacsim.core.cloner import Cloner
+    stage = rep.stage.new_stage()
+    UsdGeom.Cube.Define(stage, "/World/Cube_0")
+    cloner = Cloner()
+    with mock.patch.object(cloner, "disable_change_listener") as pause, \
+            mock.patch.object(cloner, "enable_change_listener") as resume:
+        with pytest.raises(ValueError, match="positions"):
+            cloner.clone("/World/Cube_0", ["/World/Cube_0"], positions=np.zeros((2, 3)))
+    assert pause.call_count == 1 and resume.call_count == 1
+    with pytest.raises(TypeError, match="source_prim_path"):
+        cloner.clone(None, [])
+    with pytest.raises(ValueError, match="valid SdfPath"):
+        cloner.clone("not a valid path!!!", [])
 
 
 def test_clone_places_inheriting_copies_on_the_grid(compat):

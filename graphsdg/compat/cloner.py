@@ -138,6 +138,16 @@ class Cloner(CompatObject):
             raise TypeError(f"source_prim_path must be a str, got {type(source_prim_path).__name__}")
         if not Sdf.Path.IsValidPathString(source_prim_path):
             raise ValueError(f"source_prim_path {source_prim_path!r} is not a valid SdfPath")
+        self.disable_change_listener()
+        try:
+            self._clone(source_prim_path, prim_paths, positions, orientations, replicate_physics, base_env_path,
+                        root_path, copy_from_source, enable_env_ids, clone_in_fabric)
+        finally:
+            self.enable_change_listener()
+
+    def _clone(self, source_prim_path: str, prim_paths: list[str], positions: Any, orientations: Any,
+               replicate_physics: bool, base_env_path: str | None, root_path: str | None, copy_from_source: bool,
+               enable_env_ids: bool, clone_in_fabric: bool) -> None:
         prim_paths = list(prim_paths)
         pos = None if positions is None else _as_array(positions, len(prim_paths), 3, "positions")
         quat = None if orientations is None else _as_array(orientations, len(prim_paths), 4, "orientations")
@@ -232,8 +242,8 @@ class GridCloner(Cloner):
             for i in range(num_clones):
                 row, col = i // cols, i % cols
                 x, y = row_offset - row * self._spacing, col * self._spacing - col_offset
-                position = np.array([x, y, 0.0] if z_up else [x, 0.0, y])
-                positions.append(position + offsets[i] if offsets is not None else position)
+                position = [x, y, 0] if z_up else [x, 0, y]     # lists, as Isaac's (offsets make arrays)
+                positions.append(offsets[i] + position if offsets is not None else position)
                 q = Gf.Quatd.GetIdentity()
                 if turns is not None:
                     q = Gf.Quatd(float(turns[i][0]), Gf.Vec3d(*turns[i][1:].tolist())) * q
