@@ -106,7 +106,10 @@ def _pose_cameras(targets: list, position_value: Any, rotation_value: Any, look_
 
 
 def _pose_width(value: Any) -> int:
-    """4 for quaternions (rows of 4 numbers), else 3."""
+    """4 for quaternions (rows of 4 numbers, or Gf quaternions), else 3."""
+    if isinstance(value, (Gf.Quatd, Gf.Quatf, Gf.Quath)) or (isinstance(value, (list, tuple)) and value and
+                                                           isinstance(value[0], (Gf.Quatd, Gf.Quatf, Gf.Quath))):
+        return 4
     return 4 if np.ndim(value) and np.shape(value)[-1] == 4 else 3
 
 

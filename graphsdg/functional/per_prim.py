@@ -15,6 +15,18 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pxr import Gf
+
+_GF_QUATERNIONS = (Gf.Quatd, Gf.Quatf, Gf.Quath)
+
+
+def _plain_numbers(value: Any) -> Any:
+    """``value`` with Gf quaternions as (w, x, y, z) rows (a ``Gf.Quatf`` rotation, or a list of them)."""
+    if isinstance(value, _GF_QUATERNIONS):
+        return (value.GetReal(), *value.GetImaginary())
+    if isinstance(value, (list, tuple)) and value and isinstance(value[0], _GF_QUATERNIONS):
+        return [_plain_numbers(v) for v in value]
+    return value
 
 
 def per_prim_array(value: Any, count: int, what: str, width: int = 3, uniform: bool = False,
@@ -22,7 +34,7 @@ def per_prim_array(value: Any, count: int, what: str, width: int = 3, uniform: b
     """``value`` as ``count`` rows of ``width`` numbers: its rows, or one shared row repeated.
 
     A shared row is ``width`` numbers (3 or 4 for pose vectors: a 4-vector is a
-    quaternion). ``uniform`` lets one number fill every row (a uniform scale);
+    quaternion, also given as a ``Gf.Quatf`` / ``Gf.Quatd``). ``uniform`` lets one number fill every row (a uniform scale);
     ``uniform_per_prim`` lets ``count`` numbers (flat, or one column) fill one row
     each. A flat vector as long as a row is one shared row even when ``count``
     equals its length (``scale=(1, 2, 3)`` on three prims scales each by (1, 2, 3),
@@ -33,7 +45,7 @@ def per_prim_array(value: Any, count: int, what: str, width: int = 3, uniform: b
     """
     if value is None:
         raise ValueError(f"{what} is None; expected one {width}-vector or an (N, {width}) array")
-    arr = np.asarray(value, dtype=np.float64)
+    arr = np.asarray(_plain_numbers(value), dtype=np.float64)
     if arr.ndim == 2:
         if arr.shape[0] != count:
             raise ValueError(f"{what} has {arr.shape[0]} rows but count/prims is {count}")

@@ -1,4 +1,4 @@
-"""rep.functional.physics.create_physics_scene takes Replicator's PhysX scene keywords."""
+"""rep.functional calls take the argument forms Isaac's scripts pass: PhysX scene keywords, Gf quaternions."""
 import pytest
 from pxr import UsdPhysics
 
@@ -28,3 +28,19 @@ def test_an_unknown_keyword_names_itself_and_the_valid_ones():
         rep.functional.physics.create_physics_scene("/PhysicsScene", enableCDD=True)
     with pytest.raises(ValueError, match="timeStepsPerSecond"):
         rep.functional.physics.create_physics_scene("/PhysicsScene", timeStepsPerSecond=0)
+
+
+def test_pose_takes_gf_quaternions_as_w_x_y_z():
+    import numpy as np
+    from pxr import Gf, UsdGeom
+    rep.stage.new_stage()
+    a = rep.functional.create.cube(name="A")
+    b = rep.functional.create.cube(name="B")
+    half = np.sqrt(0.5)
+    rep.functional.modify.pose(a, position_value=(1, 2, 3), rotation_value=Gf.Quatf(half, 0, 0, half))
+    rep.functional.modify.pose([a, b], rotation_value=[Gf.Quatd(1, 0, 0, 0), Gf.Quatd(half, half, 0, 0)])
+    rep.functional.modify.pose(a, rotation_value=Gf.Quatf(half, 0, 0, half))
+    m = np.array(UsdGeom.Xformable(a).GetLocalTransformation()).T   # row-vector matrices, transposed
+    assert np.allclose(m[:3, :3] @ [1, 0, 0], [0, 1, 0], atol=1e-6)   # 90 degrees about z
+    mb = np.array(UsdGeom.Xformable(b).GetLocalTransformation()).T
+    assert np.allclose(mb[:3, :3] @ [0, 1, 0], [0, 0, 1], atol=1e-6)  # 90 degrees about x
