@@ -33,7 +33,7 @@ def label_text(labels) -> str:
 
 
 def _boxes(f: Frame, kind: str) -> list[ViewBox]:
-    found = f.boxes(kind)
+    found = f.boxes(kind, paths=False)
     if found is None:
         return []
     rows, labels, _ = found

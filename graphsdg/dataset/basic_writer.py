@@ -85,13 +85,16 @@ class Frame:
         name = self.files.get("rgb")
         return np.array(Image.open(io.BytesIO(self.read(name))).convert("RGB")) if name else None
 
-    def boxes(self, kind: str = "bounding_box_2d_tight") -> tuple[np.ndarray, dict, list[str]] | None:
-        """(rows, idToLabels, primPaths) of a box annotator, or None if not written."""
+    def boxes(self, kind: str = "bounding_box_2d_tight",
+              paths: bool = True) -> tuple[np.ndarray, dict, list[str]] | None:
+        """(rows, idToLabels, primPaths) of a box annotator, or None if not written (``paths=False``: the prim
+        paths file is not read and the list is empty)."""
         name = self.files.get(kind)
         if not name:
             return None
         rows = np.load(io.BytesIO(self.read(name)))
-        return rows, self._json(self.companion(kind, "_labels")), self._json(self.companion(kind, "_prim_paths"))
+        return rows, self._json(self.companion(kind, "_labels")), \
+            self._json(self.companion(kind, "_prim_paths")) if paths else []
 
     def segmentation(self, kind: str, shift: bool = False, keep: Callable[[object], bool] | None = None,
                      value_of: Callable[[object, int], int] | None = None) -> tuple[np.ndarray, dict] | None:

@@ -89,7 +89,8 @@ SCRIPT = r"""
 
   function visibleFrames() {
     if (!state.onlyWith) return G.frames;
-    return G.frames.filter(f => f.boxes.some(b => state.shown.has(b[0])) || (f.classes || []).some(c => state.shown.has(c)));
+    return G.frames.filter(f => f.boxes.some(b => state.shown.has(b[0])) ||
+                                (f.classes || []).some(c => state.shown.has(c)));
   }
   function pages() { return Math.max(1, Math.ceil(visibleFrames().length / G.pageSize)); }
 
@@ -191,8 +192,9 @@ SCRIPT = r"""
       });
     }
     $("#only-with").addEventListener("change", e => { state.onlyWith = e.target.checked; state.page = 0; render(); });
-    $("#prev").addEventListener("click", () => { state.page -= 1; render(); window.scrollTo(0, $("#frames").offsetTop - 60); });
-    $("#next").addEventListener("click", () => { state.page += 1; render(); window.scrollTo(0, $("#frames").offsetTop - 60); });
+    const turn = step => () => { state.page += step; render(); window.scrollTo(0, $("#frames").offsetTop - 60); };
+    $("#prev").addEventListener("click", turn(-1));
+    $("#next").addEventListener("click", turn(1));
     const m = /page=(\d+)/.exec(location.hash);
     state.page = m ? +m[1] - 1 : 0;
     window.addEventListener("hashchange", () => {
