@@ -429,3 +429,31 @@ def test_streams_to_a_running_rerun(dataset, tmp_path):
         rec = read_recording(saved)
     assert set(rec["/world/cameras/camera/image/boxes_tight"]["Boxes2D:centers"]) == set(range(FRAMES))
     assert "Pinhole:image_from_camera" in rec["/world/cameras/camera/image"]
+
+
+def test_kitti_dataset_3d_boxes_and_depth(tmp_path):
+    """KITTI label lines' 3D boxes (KITTI camera frame) land in the USD camera frame: a unit cube 4 m straight
+    ahead of a level camera is centred at (0, 0, -4) with half sizes 0.5; KITTI has no camera file, so depth is
+    logged as an image only, with a warning naming calib/<frame>.txt."""
+    from conftest import unit_cube_scene
+    _, _, rp = unit_cube_scene(resolution=(96, 72))
+    writer = rep.writers.get("KittiWriter")
+    writer.initialize(output_dir=str(tmp_path / "kitti"), bbox_height_threshold=0)
+    writer.attach(rp)
+    rep.orchestrator.step()
+    rep.orchestrator.wait_until_complete()
+    writer.detach()
+    with pytest.warns(UserWarning, match=r"missing calib/0.txt"):
+        summary = record(str(tmp_path / "kitti"), str(tmp_path / "k.rrd"))
+    assert summary["format"] == "kitti" and summary["boxes_3d"] == 1
+    rec = read_recording(str(tmp_path / "k.rrd"))
+    boxes = rec["/world/cameras/camera/boxes_3d"]
+    np.testing.assert_allclose(boxes["Boxes3D:centers"][0][0], [0, 0, -4], atol=1e-3)
+    np.testing.assert_allclose(boxes["Boxes3D:half_sizes"][0][0], [0.5, 0.5, 0.5], atol=1e-3)
+    depth = rec["/world/cameras/camera/image/depth"]
+    values = image_of(depth["DepthImage:buffer"][0], depth["DepthImage:format"][0], "f")
+    assert abs(values[36, 48] - 3.5) < 0.01             # the cube's front face, straight ahead (KITTI: 1/256 m)
+    classes = context_names(rec["/"]["AnnotationContext:context"][None])
+    semantic = rec["/world/cameras/camera/image/semantic"]
+    ids = image_of(semantic["SegmentationImage:buffer"][0], semantic["SegmentationImage:format"][0], "u")
+    assert classes[int(ids[36, 48])] == "cube"        # the instance image's class, named by its box
