@@ -44,7 +44,9 @@ SCRIPT = textwrap.dedent('''
         rep.functional.create.camera(position=(0, -4.5, 2.5), name="Camera_01", parent="/Root")
         target = stage.DefinePrim("/Root/Target", "Xform")
         target.GetReferences().AddReference(get_assets_root_path() + "/Isaac/Props/YCB/Axis_Aligned/035_power_drill.usd")
-        UsdGeom.Xformable(target).AddTranslateOp().Set((0.0, 0.5, 1.2))
+        if not target.HasAttribute("xformOp:translate"):
+            UsdGeom.Xformable(target).AddTranslateOp()
+        target.GetAttribute("xformOp:translate").Set((0.0, 0.5, 1.2))
         semantics_utils.remove_all_labels(target, include_descendants=True)
         semantics_utils.add_labels(target, labels=["power_drill"], taxonomy="class")
         return stage
