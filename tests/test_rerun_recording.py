@@ -457,3 +457,47 @@ def test_kitti_dataset_3d_boxes_and_depth(tmp_path):
     semantic = rec["/world/cameras/camera/image/semantic"]
     ids = image_of(semantic["SegmentationImage:buffer"][0], semantic["SegmentationImage:format"][0], "u")
     assert classes[int(ids[36, 48])] == "cube"        # the instance image's class, named by its box
+
+
+def test_lidar_scans_of_point_cloud_writer(tmp_path):
+    """PointCloudWriter's scans (sensor frame): the points under the sensor's logged pose land on the scene (the
+    crate's near face at x = 3.5), each point's class is its object's label, its per-point id the object id; the
+    contact sheet and the gallery show each scan from above."""
+    from graphsdg.dataset.class_table import class_colour
+    from graphsdg.dataset.view import write_view
+    from graphsdg.sensors.lidar_profile import EmitterState, LidarProfile, author_lidar_profile
+    rep.functional.create.cube(position=(0, 0, -0.5), scale=(20, 20, 1), name="Floor", semantics={"class": "floor"})
+    rep.functional.create.cube(position=(4, 0, 1), scale=(1, 2, 2), name="Crate", semantics={"class": "crate"})
+    lidar = rep.functional.create.omni_lidar(position=(0, 0, 1), name="Lidar")
+    author_lidar_profile(lidar, LidarProfile(name="t", scan_type="ROTARY", scan_rate_hz=10, firing_rate_hz=10 * 72,
+                                             emitter_states=(EmitterState.uniform(8, 10.0, -30.0),),
+                                             min_reflectance_range_m=1000.0, range_accuracy_m=0.0))
+    rp = rep.create.render_product(lidar, (1, 1))
+    writer = rep.writers.get("PointCloudWriter")
+    writer.initialize(output_dir=str(tmp_path / "lidar"), formats=["npy", "ply"], frame="sensor")
+    writer.attach(rp)
+    for _ in range(2):
+        rep.orchestrator.step(delta_time=0.1)
+    rep.orchestrator.wait_until_complete()
+    writer.detach()
+    summary = record(str(tmp_path / "lidar"), str(tmp_path / "l.rrd"))
+    assert summary["format"] == "pointcloud" and summary["frames"] == 2
+    rec = read_recording(str(tmp_path / "l.rrd"))
+    entity = f"/world/sensors/{rp.name}"
+    classes = context_names(rec["/"]["AnnotationContext:context"][None])
+    for i in range(2):
+        scan = np.load(tmp_path / "lidar" / rp.name / f"pointcloud_{i:04d}.npy")
+        meta = json.load(open(tmp_path / "lidar" / rp.name / f"pointcloud_{i:04d}.json"))
+        points = np.array(rec[f"{entity}/points"]["Points3D:positions"][i], dtype=np.float64)
+        rotation = np.array(latest(rec[entity]["Transform3D:mat3x3"], i)[0]).reshape(3, 3, order="F")
+        world = points @ rotation.T + np.array(latest(rec[entity]["Transform3D:translation"], i)[0])
+        names = [classes[c] for c in rec[f"{entity}/points"]["Points3D:class_ids"][i]]
+        assert names == [meta["objects"][str(o)]["labels"]["class"][0] for o in scan["object_id"]]
+        assert rec[f"{entity}/points"]["Points3D:keypoint_ids"][i] == scan["object_id"].tolist()
+        crate = np.array(names) == "crate"
+        assert crate.sum() > 5 and np.all(np.abs(world[crate, 0] - 3.5) < 1e-3)
+        assert np.all(np.abs(world[np.array(names) == "floor", 2]) < 1e-3)    # the floor's top face, z = 0
+    result = write_view(str(tmp_path / "lidar"), str(tmp_path / "view"), html_gallery=True)
+    assert result["format"] == "pointcloud" and os.path.exists(result["html"])
+    seen = np.array(Image.open(tmp_path / "view" / "frames" / f"{rp.name}_pointcloud_0000.png").convert("RGB"))
+    assert (np.abs(seen.astype(int) - class_colour("crate")).sum(-1) == 0).sum() > 5   # crate points, from above

@@ -32,11 +32,12 @@ from PIL import Image
 
 from graphsdg.dataset.basic_frames import basic_frames
 from graphsdg.dataset.label_images import decode_image
+from graphsdg.dataset.sensor_frames import sensor_frames
 from graphsdg.dataset.view_frame import DepthMap, ViewBox, ViewBox3D, ViewFrame, relabel
 from graphsdg.io.camera_geometry import USD_TO_OPENCV
 from graphsdg.io.location import Location, open_location
 
-FORMATS = ("basic", "coco", "kitti", "yolo")
+FORMATS = ("basic", "coco", "kitti", "yolo", "pointcloud")
 KITTI_LABEL_DIRS = ("label_02", "object_detection")
 KITTI_IMAGE_DIRS = {"label_02": "image_02", "object_detection": "rgb"}
 KITTI_INSTANCE_DIRS = {"label_02": "instance", "object_detection": "instance_segmentation"}
@@ -92,8 +93,13 @@ def read_dataset(root: str | Location, fmt: str | None = None) -> tuple[str, lis
     fmt = fmt or _detect(listing)
     if fmt not in FORMATS:
         raise ValueError(f"unknown dataset format {fmt!r}; known: {FORMATS}")
-    frames = {"basic": lambda loc, _: basic_frames(loc), "coco": _coco, "kitti": _kitti,
-              "yolo": _yolo}[fmt](location, listing)
+    frames = {"basic": lambda loc, _: basic_frames(loc), "coco": _coco, "kitti": _kitti, "yolo": _yolo,
+              "pointcloud": lambda loc, _: []}[fmt](location, listing)
+    if fmt in ("basic", "pointcloud"):   # PointCloudWriter's scans, beside the images or alone
+        scans = sensor_frames(location, listing)
+        if scans and not frames:
+            fmt = "pointcloud"
+        frames += scans
     frames = sorted(frames, key=lambda f: natural_key(f.name))
     index: dict[str, int] = {}
     for f in frames:   # each stream's frames, in name order, are its timeline

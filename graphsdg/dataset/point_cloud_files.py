@@ -32,18 +32,22 @@ _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short":
               "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
 
 
-def read_point_cloud(data: bytes, ext: str, name: str) -> PointCloud:
-    """The cloud in file bytes ``data`` of type ``ext`` (``ply``, ``pcd`` or ``npy``), named ``name``."""
+def read_point_table(data: bytes, ext: str) -> dict[str, np.ndarray]:
+    """Every per-point field (name -> (N,) array) of file bytes ``data`` of type ``ext`` (``ply``, ``pcd`` or
+    ``npy``)."""
     ext = ext.lower().lstrip(".")
     if ext == "ply":
-        table = _read_ply(data)
-    elif ext == "pcd":
-        table = _read_pcd(data)
-    elif ext == "npy":
-        table = _from_array(np.load(io.BytesIO(data)))
-    else:
-        raise ValueError(f"unknown point-cloud file type {ext!r}; known: ply, pcd, npy")
-    return _cloud(table, name)
+        return _read_ply(data)
+    if ext == "pcd":
+        return _read_pcd(data)
+    if ext == "npy":
+        return _from_array(np.load(io.BytesIO(data)))
+    raise ValueError(f"unknown point-cloud file type {ext!r}; known: ply, pcd, npy")
+
+
+def read_point_cloud(data: bytes, ext: str, name: str) -> PointCloud:
+    """The cloud in file bytes ``data`` of type ``ext`` (``ply``, ``pcd`` or ``npy``), named ``name``."""
+    return point_cloud(read_point_table(data, ext), name)
 
 
 def _from_array(arr: np.ndarray) -> dict[str, np.ndarray]:
@@ -55,7 +59,8 @@ def _from_array(arr: np.ndarray) -> dict[str, np.ndarray]:
     return {"x": arr[:, 0], "y": arr[:, 1], "z": arr[:, 2]}
 
 
-def _cloud(table: dict[str, np.ndarray], name: str) -> PointCloud:
+def point_cloud(table: dict[str, np.ndarray], name: str) -> PointCloud:
+    """A :class:`PointCloud` (frame ``"sensor"``) of a table of per-point fields."""
     lower = {k.lower(): v for k, v in table.items()}
     missing = [k for k in ("x", "y", "z") if k not in lower]
     if missing:

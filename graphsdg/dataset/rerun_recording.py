@@ -19,7 +19,9 @@ package). Frames are logged on the ``frame`` timeline (each camera's frames 0, 1
     world/cameras/S/boxes_3d           Boxes3D in the camera frame (KITTI's label lines)
     world/boxes_3d/S                   Boxes3D in the world (BasicWriter's bounding_box_3d)
     world/points/S/NAME                Points3D in the world (the pointcloud annotator), class ids
-    world/sensors/NAME                 Points3D of sensor files (PLY, PCD) with their ids and classes
+    world/sensors/NAME                 Transform3D: a scanning sensor's pose (its points in its own frame)
+    world/sensors/NAME/points          Points3D of PointCloudWriter scans and of point-cloud files beside the
+                                       frames (PLY, PCD): class ids, object ids as per-point ids
 
 Each layer is one ``log_*`` function of :data:`LAYERS`; a new kind of data is one
 more. Frames are read and decoded on worker threads ahead of the logging
@@ -95,7 +97,8 @@ def prepare(frame: ViewFrame, classes: ClassTable, instances: ClassTable) -> Pre
     """Read and decode every layer of ``frame``, its arrays made ready to log: class masks as ``classes``' ids,
     instance masks as ``instances``' ids (both straight from the decoded pixels), depth as z-depth with 0 where
     there is none (Rerun's "no depth")."""
-    p = PreparedFrame(frame, frame.image_bytes(), frame.masks(classes.id_of), frame.instances(instances.id_of),
+    p = PreparedFrame(frame, frame.image_bytes() if frame.has_image else b"", frame.masks(classes.id_of),
+                      frame.instances(instances.id_of),
                       frame.depth(), frame.camera(), frame.boxes_3d(), frame.point_clouds())
     if p.depth is not None:
         values, kind = np.asarray(p.depth.values, dtype=np.float32), p.depth.kind
@@ -177,8 +180,9 @@ def log_camera(lg: Logger, base: str, p: PreparedFrame) -> None:
 
 
 def log_image(lg: Logger, base: str, p: PreparedFrame) -> None:
-    """The image file's bytes, as written."""
-    lg.rec.log(f"{base}/image/rgb", lg.rr.EncodedImage(contents=p.image, media_type=p.frame.media_type))
+    """The image file's bytes, as written (a scan has none: its points are its data)."""
+    if p.frame.has_image:
+        lg.rec.log(f"{base}/image/rgb", lg.rr.EncodedImage(contents=p.image, media_type=p.frame.media_type))
 
 
 def _boxes_2d(lg: Logger, boxes: list[ViewBox]):
@@ -190,7 +194,7 @@ def _boxes_2d(lg: Logger, boxes: list[ViewBox]):
 def log_boxes_2d(lg: Logger, base: str, p: PreparedFrame) -> None:
     """Tight and loose 2D boxes (inclusive pixel bounds: a box covers whole pixels) with class ids."""
     for kind, boxes in (("boxes_tight", p.frame.boxes), ("boxes_loose", p.frame.loose_boxes)):
-        if boxes or kind == "boxes_tight":
+        if boxes or (kind == "boxes_tight" and p.frame.has_image):
             lg.rec.log(f"{base}/image/{kind}", _boxes_2d(lg, boxes))
             lg.counts[kind] += len(boxes)
 
@@ -318,7 +322,7 @@ def record(root: str, rrd_path: str | None = None, *, spawn: bool = False, conne
     warned = _camera_warning(frames)
     if warned:
         warnings.warn(warned, UserWarning, stacklevel=2)
-    streams = sorted({f.stream for f in frames})
+    streams = sorted({f.stream for f in frames if f.has_image})
     classes = ClassTable(b.label for f in frames for b in [*f.boxes, *f.loose_boxes])
     instances = ClassTable()   # "prim path (class)" -> an id shared by every frame (same object, same colour)
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=f"graphsdg:{root}")

@@ -7,7 +7,8 @@ called, so listing a dataset of thousands of frames reads only its boxes.
 
 Frames: ``"world"`` is the stage's frame (Z up); ``"camera"`` is the USD camera
 frame of the frame's stream (x right, y up, looking down -z), placed in the
-world by :attr:`ViewFrame.camera`'s pose where known.
+world by :attr:`ViewFrame.camera`'s pose where known. A lidar or radar scan is a
+frame without an image file: its point cloud, and a drawn bird's-eye view.
 """
 from __future__ import annotations
 
@@ -143,11 +144,18 @@ class ViewFrame:
     camera_missing: str | None = None
     boxes_3d: Callable[[], list[ViewBox3D]] = _empty
     point_clouds: Callable[[], list[PointCloud]] = _empty
+    # a frame without an image file (``image == ""``: a lidar scan) draws one: () -> PNG bytes
+    render: Callable[[], bytes] | None = None
+
+    @property
+    def has_image(self) -> bool:
+        """Whether the frame has an image file (a camera's), as opposed to a drawn view (a scan's)."""
+        return bool(self.image)
 
     @property
     def image_path(self) -> str:
-        """The image as a path or ``s3://`` URL."""
-        return self.location.path_of(self.image)
+        """The image as a path or ``s3://`` URL (the frame's name where it has no image file)."""
+        return self.location.path_of(self.image or self.name)
 
     @property
     def media_type(self) -> str:
@@ -156,7 +164,11 @@ class ViewFrame:
         return IMAGE_MEDIA_TYPES.get(ext, "image/png")
 
     def image_bytes(self) -> bytes:
-        """The image file's bytes, as written."""
+        """The image file's bytes, as written (a drawn PNG for a frame without an image file)."""
+        if not self.image:
+            if self.render is None:
+                raise ValueError(f"frame {self.name!r} has neither an image file nor a view to draw")
+            return self.render()
         return self.location.read(self.image)
 
     def rgb(self) -> np.ndarray:
