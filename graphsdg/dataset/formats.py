@@ -8,7 +8,9 @@
 bounds and class name) and, where the format has them, loaders for class and
 instance masks, depth, the camera, 3D boxes and point clouds (BasicWriter:
 :mod:`graphsdg.dataset.basic_frames`; KITTI: instance images, ``depth/`` and the
-label lines' 3D boxes; COCO: masks from RLE or polygons). A dataset is a folder
+label lines' 3D boxes; COCO: masks from RLE or polygons). PointCloudWriter's
+lidar and radar scans are frames too, beside BasicWriter's or alone (format
+``pointcloud``; :mod:`graphsdg.dataset.sensor_frames`). A dataset is a folder
 or an ``s3://bucket/prefix`` (:mod:`graphsdg.io.location`), listed once.
 
 Example:

@@ -128,7 +128,7 @@ def plane_depth(distance: np.ndarray, camera: PinholeCamera) -> np.ndarray:
     return distance / np.sqrt(1.0 + x[None, :] ** 2 + y[:, None] ** 2).astype(np.float32)
 
 
-class Logger:
+class FrameLogger:
     """Logs prepared frames to a Rerun recording stream, keeping the class and instance tables' annotation
     contexts current (static: a context names ids over the whole timeline)."""
 
@@ -163,7 +163,7 @@ class Logger:
 
 
 # ---- the layers: each logs one kind of data of a prepared frame --------------------------------------------
-def log_camera(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_camera(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """The camera's pose and pinhole (USD camera axes: x right, y up, looking down -z)."""
     cam = p.camera
     if cam is None:
@@ -179,19 +179,19 @@ def log_camera(lg: Logger, base: str, p: PreparedFrame) -> None:
                                            camera_xyz=rr.ViewCoordinates.RUB))
 
 
-def log_image(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_image(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """The image file's bytes, as written (a scan has none: its points are its data)."""
     if p.frame.has_image:
         lg.rec.log(f"{base}/image/rgb", lg.rr.EncodedImage(contents=p.image, media_type=p.frame.media_type))
 
 
-def _boxes_2d(lg: Logger, boxes: list[ViewBox]):
+def _boxes_2d(lg: FrameLogger, boxes: list[ViewBox]):
     mins = np.array([[b.x0, b.y0] for b in boxes], dtype=np.float32).reshape(-1, 2)
     sizes = np.array([[b.width, b.height] for b in boxes], dtype=np.float32).reshape(-1, 2)
     return lg.rr.Boxes2D(mins=mins, sizes=sizes, class_ids=lg.class_ids([b.label for b in boxes]))
 
 
-def log_boxes_2d(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_boxes_2d(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """Tight and loose 2D boxes (inclusive pixel bounds: a box covers whole pixels) with class ids."""
     for kind, boxes in (("boxes_tight", p.frame.boxes), ("boxes_loose", p.frame.loose_boxes)):
         if boxes or (kind == "boxes_tight" and p.frame.has_image):
@@ -199,7 +199,7 @@ def log_boxes_2d(lg: Logger, base: str, p: PreparedFrame) -> None:
             lg.counts[kind] += len(boxes)
 
 
-def log_masks(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_masks(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """Semantic masks as class ids; instance masks as dataset-wide instance ids, named ("prim path (class)") by
     the instance entity's own context."""
     rr = lg.rr
@@ -210,13 +210,13 @@ def log_masks(lg: Logger, base: str, p: PreparedFrame) -> None:
         lg.sync_context(f"{base}/image/instance", lg.instances, lambda i, _: color_of(i + 1)[:3])
 
 
-def log_depth(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_depth(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """Depth as a z-depth image (radial depth converted where the camera is known; 0 = no depth)."""
     if p.depth is not None:
         lg.rec.log(f"{base}/image/depth", lg.rr.DepthImage(p.depth.values, meter=1.0 / p.depth.meters_per_unit))
 
 
-def _boxes_3d(lg: Logger, boxes: list[ViewBox3D]):
+def _boxes_3d(lg: FrameLogger, boxes: list[ViewBox3D]):
     quats = matrix_to_quat_wxyz(np.array([b.rotation for b in boxes]).reshape(-1, 3, 3))[:, [1, 2, 3, 0]]
     return lg.rr.Boxes3D(centers=np.array([b.center for b in boxes]).reshape(-1, 3),
                          half_sizes=np.array([b.half_size for b in boxes]).reshape(-1, 3),
@@ -224,7 +224,7 @@ def _boxes_3d(lg: Logger, boxes: list[ViewBox3D]):
                          labels=[b.name or b.label for b in boxes])
 
 
-def log_boxes_3d(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_boxes_3d(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """3D boxes in the world or in the camera frame."""
     world = [b for b in p.boxes_3d if b.frame == "world"]
     camera = [b for b in p.boxes_3d if b.frame == "camera"]
@@ -235,7 +235,7 @@ def log_boxes_3d(lg: Logger, base: str, p: PreparedFrame) -> None:
     lg.counts["boxes_3d"] += len(p.boxes_3d)
 
 
-def log_point_clouds(lg: Logger, base: str, p: PreparedFrame) -> None:
+def log_point_clouds(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """Point clouds with their classes (as class ids) and instance ids (as Rerun's per-point ids)."""
     rr = lg.rr
     for cloud in p.clouds:
@@ -259,7 +259,7 @@ def log_point_clouds(lg: Logger, base: str, p: PreparedFrame) -> None:
 
 
 #: what a frame logs, in order; a new kind of data is one more function here
-LAYERS: tuple[Callable[[Logger, str, PreparedFrame], None], ...] = (
+LAYERS: tuple[Callable[[FrameLogger, str, PreparedFrame], None], ...] = (
     log_camera, log_image, log_boxes_2d, log_masks, log_depth, log_boxes_3d, log_point_clouds)
 
 
@@ -340,7 +340,7 @@ def record(root: str, rrd_path: str | None = None, *, spawn: bool = False, conne
         target = rrd_path or default_rrd_path(root)
         os.makedirs(os.path.dirname(os.path.abspath(target)) or ".", exist_ok=True)
         rec.save(target, default_blueprint=layout)
-    logger = Logger(rr, rec, classes, instances)
+    logger = FrameLogger(rr, rec, classes, instances)
     start = time.perf_counter()
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     logger.sync_context()
