@@ -310,7 +310,7 @@ def test_sensor_point_cloud_files_are_logged(dataset, tmp_path):
     for i in range(FRAMES):
         points = rng.uniform(-5, 5, size=(40 + i, 3)).astype(np.float32)
         labels = rng.integers(1, 4, size=len(points))
-        objects = rng.integers(0, 9, size=len(points))
+        objects = rng.integers(0, 9, size=len(points)) + (70000 if i == 2 else 0)   # frame 2: past 16 bits
         clouds[i] = (points, labels, objects)
         (tmp_path / "with_lidar" / f"lidar_{i:04d}.ply").write_bytes(_ply_binary(points, labels, objects))
         (tmp_path / "with_lidar" / f"radar_{i:04d}.pcd").write_bytes(_pcd_ascii(points[:10], labels[:10]))
@@ -321,7 +321,11 @@ def test_sensor_point_cloud_files_are_logged(dataset, tmp_path):
     for i, (points, labels, objects) in clouds.items():
         np.testing.assert_array_equal(np.array(lidar["Points3D:positions"][i], np.float32), points)
         assert [classes[c] for c in lidar["Points3D:class_ids"][i]] == [f"class {c}" for c in labels]
-        assert lidar["Points3D:keypoint_ids"][i] == objects.tolist()
+        if i < 2:
+            assert lidar["Points3D:keypoint_ids"][i] == objects.tolist()
+        else:   # Rerun's per-point ids are 16-bit: the object ids go along as their own column
+            assert i not in lidar["Points3D:keypoint_ids"]
+            assert lidar["instance_id"][i] == objects.tolist()
         assert lidar["Points3D:colors"][i][0] == (200 << 24) | (100 << 16) | (50 << 8) | 255   # RGBA packed
         np.testing.assert_allclose(np.array(radar["Points3D:positions"][i]), points[:10], atol=1e-5)
     assert summary["points"] >= sum(len(c[0]) + 10 for c in clouds.values())

@@ -144,15 +144,16 @@ class FrameLogger:
     def sync_context(self, entity: str = "/", table: ClassTable | None = None,
                      colour: Callable[[int, str], tuple] | None = None) -> None:
         """(Re)log ``table`` (default: the classes) as ``entity``'s annotation context if it grew since."""
-        table = table or self.classes
-        if self._logged_size.get(entity) == len(table):
+        table = self.classes if table is None else table
+        names = list(table.names)   # a snapshot: reader threads may add names meanwhile
+        if self._logged_size.get(entity) == len(names):
             return
         rr = self.rr
         colour = colour or (lambda _, name: self.classes.colour(name))
         self.rec.log(entity, rr.AnnotationContext([rr.AnnotationInfo(id=table.id_of(n), label=n,
                                                                      color=colour(table.id_of(n), n))
-                                                   for n in table.names]), static=True)
-        self._logged_size[entity] = len(table)
+                                                   for n in names]), static=True)
+        self._logged_size[entity] = len(names)
 
     def log(self, p: PreparedFrame) -> None:
         self.rec.set_time(TIMELINE, sequence=p.frame.index)
@@ -243,18 +244,21 @@ def log_point_clouds(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
         if cloud.semantic_ids is not None:
             names = cloud.semantic_names or {int(v): f"class {int(v)}" for v in np.unique(cloud.semantic_ids)}
             class_ids = lg.classes.remap(np.asarray(cloud.semantic_ids, dtype=np.int64), names)
+        ids = None if cloud.instance_ids is None else np.asarray(cloud.instance_ids, dtype=np.int64)
+        small = ids is not None and (ids.size == 0 or (ids.min() >= 0 and ids.max() < 65536))
         points = rr.Points3D(cloud.positions, colors=cloud.colors, class_ids=class_ids,
-                             keypoint_ids=None if cloud.instance_ids is None else
-                             np.asarray(cloud.instance_ids, dtype=np.uint16))
+                             keypoint_ids=ids.astype(np.uint16) if small else None)
+        # Rerun's per-point ids are 16-bit: larger object ids go along as a plain "instance_id" column
+        extra = [rr.AnyValues(instance_id=ids.astype(np.uint64))] if ids is not None and not small else []
         if cloud.frame == "world":
-            lg.rec.log(f"world/points/{_part(p.frame.stream)}/{_part(cloud.name)}", points)
+            lg.rec.log(f"world/points/{_part(p.frame.stream)}/{_part(cloud.name)}", points, *extra)
         elif cloud.frame == "camera":
-            lg.rec.log(f"{base}/points/{_part(cloud.name)}", points)
+            lg.rec.log(f"{base}/points/{_part(cloud.name)}", points, *extra)
         else:
             path = f"world/sensors/{_part(cloud.name)}"
             if cloud.pose is not None:
                 lg.rec.log(path, rr.Transform3D(translation=cloud.pose[:3, 3], mat3x3=cloud.pose[:3, :3]))
-            lg.rec.log(f"{path}/points", points)
+            lg.rec.log(f"{path}/points", points, *extra)
         lg.counts["points"] += len(cloud.positions)
 
 
