@@ -503,5 +503,5 @@ def test_lidar_scans_of_point_cloud_writer(tmp_path):
         assert np.all(np.abs(world[np.array(names) == "floor", 2]) < 1e-3)    # the floor's top face, z = 0
     result = write_view(str(tmp_path / "lidar"), str(tmp_path / "view"), html_gallery=True)
     assert result["format"] == "pointcloud" and os.path.exists(result["html"])
-    seen = np.array(Image.open(tmp_path / "view" / "frames" / f"{rp.name}_pointcloud_0000.png").convert("RGB"))
+    seen = np.array(Image.open(tmp_path / "view" / "frames" / f"000000_{rp.name}_pointcloud_0000.png").convert("RGB"))
     assert (np.abs(seen.astype(int) - class_colour("crate")).sum(-1) == 0).sum() > 5   # crate points, from above

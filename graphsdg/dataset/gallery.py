@@ -5,9 +5,9 @@ Writes into the output folder::
     index.html          the statistics (totals, a per-class table, empty frames) and the frame browser
     gallery_data.js     every frame's image files, size, boxes (class id and inclusive pixel bounds) and
                         classes, and the class table (id, name, colour)
-    frames/             per frame: the image as written, its class mask (greyscale PNG of class ids, where
-                        the dataset has masks) and its depth coloured (turbo, near red, far blue; where it
-                        has depth)
+    frames/             per frame (``<position>_<name>``): the image as written, its class mask (greyscale
+                        PNG of class ids, where the dataset has masks) and its depth coloured (turbo, near
+                        red, far blue; where it has depth)
 
 The page shows a page of frames at a time (``#page=N``); its script and layout
 are :mod:`graphsdg.dataset.gallery_page`. Frames are prepared on worker
@@ -55,9 +55,9 @@ def colour_depth(values: np.ndarray) -> tuple[np.ndarray, tuple[float, float] | 
     return out, (lo, hi)
 
 
-def _frame_files(frame: ViewFrame, classes: ClassTable, out_dir: str) -> dict:
+def _frame_files(position: int, frame: ViewFrame, classes: ClassTable, out_dir: str) -> dict:
     """Write ``frame``'s image, mask and depth files; return its entry of ``gallery_data.js``."""
-    stem = safe_name(frame.name)
+    stem = f"{position:06d}_{safe_name(frame.name)}"   # the position keeps "a/b" and "a_b" apart
     ext = posixpath.splitext(frame.image)[1].lower() or ".png"
     data = frame.image_bytes()
     with open(os.path.join(out_dir, "frames", stem + ext), "wb") as fh:
@@ -132,7 +132,7 @@ def write_gallery(frames: list[ViewFrame], out_dir: str, title: str, fmt: str, p
     stats = statistics(frames)
     classes = ClassTable(b.label for f in frames for b in f.boxes)
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-        entries = list(pool.map(lambda f: _frame_files(f, classes, out_dir), frames))
+        entries = list(pool.map(lambda i: _frame_files(i, frames[i], classes, out_dir), range(len(frames))))
     table = [{"id": classes.id_of(n), "name": n, "colour": _hex(classes.colour(n))} for n in classes.names]
     data = {"title": title, "format": fmt, "pageSize": int(page_size), "classes": table, "frames": entries}
     with open(os.path.join(out_dir, "gallery_data.js"), "w", encoding="utf-8") as fh:
