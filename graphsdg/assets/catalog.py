@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from pxr import Gf, Kind, UsdGeom, UsdLux, UsdPhysics
+from pxr import Gf, Kind, Usd, UsdGeom, UsdLux, UsdPhysics
 
 from graphsdg.assets import (authoring, camera_calibration, forklift, franka, geometry, grid_rooms, handling_props,
                              infinigen_rooms, interior_props, mdl_materials, nova_carter, outdoor_skies, packing_table,
@@ -292,4 +292,24 @@ def build_all(root: str) -> list[str]:
     written: list[str] = []
     for build in BUILD_ORDER:
         written.extend(build(root))
+    for relative in written:
+        if relative.endswith(".usd"):
+            give_root_pose_ops(os.path.join(root, relative.lstrip("/")))
     return written
+
+
+def give_root_pose_ops(path: str) -> None:
+    """Author identity ``translate``, ``orient`` and ``scale`` ops on the default prim of the USD file ``path``
+    where it has none, as Isaac's assets carry them: scripts set ``xformOp:translate`` on the prim that
+    references an asset without adding the op first."""
+    stage = Usd.Stage.Open(path)
+    root = stage.GetDefaultPrim()
+    if not root or not root.IsA(UsdGeom.Xformable):
+        return
+    xformable = UsdGeom.Xformable(root)
+    if xformable.GetOrderedXformOps():
+        return
+    xformable.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(0.0, 0.0, 0.0))
+    xformable.AddOrientOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Quatd(1.0, 0.0, 0.0, 0.0))
+    xformable.AddScaleOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(1.0, 1.0, 1.0))
+    stage.GetRootLayer().Save()

@@ -43,6 +43,7 @@ from graphsdg.compat.extensions import get_extension_manager
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.functional import create
 from graphsdg.stage import get_stage, semantics
+from graphsdg.stage.xform import set_local_pose
 
 EXPLORER = "omni.simready.explorer"
 TOGGLE_WINDOW = "toggle_window"
@@ -200,7 +201,7 @@ def add_asset_to_stage(url: str, parent_path: Sdf.Path | str = Sdf.Path.emptyPat
         prim.GetPayloads().AddPayload(os.fspath(url))
     else:
         prim = create.reference(usd_path=url, parent=parent, name=name)
-    UsdGeom.XformCommonAPI(prim).SetTranslate(Gf.Vec3d(*[float(v) for v in position]))
+    set_local_pose(prim, position=[float(v) for v in position])   # keeps the asset's own pose ops
     select_variants(prim, variants or {})
     if instanceable:
         prim.SetInstanceable(True)
