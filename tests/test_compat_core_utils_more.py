@@ -85,7 +85,8 @@ def test_prims_helpers(compat):
     joint.CreateBody1Rel().SetTargets(["/World/Robot/link"])
     assert is_prim_non_root_articulation_link("/World/Robot/link")
     assert not is_prim_non_root_articulation_link("/World")
-    assert get_prim_object_type("/World/Robot") == "articulation" and get_prim_object_type("/World/Robot/joint") == "joint"
+    assert get_prim_object_type("/World/Robot") == "articulation"
+    assert get_prim_object_type("/World/Robot/joint") == "joint"
     assert get_articulation_root_api_prim_path("/World") == "/World/Robot"
     assert [str(p.GetPath()) for p in get_all_matching_child_prims("/World", lambda p: p.endswith("base"))] == \
         ["/World/Robot/base"]

@@ -1,5 +1,5 @@
-"""Isaac compat area: ``isaacsim.core.prims.Articulation`` / ``SingleArticulation``, ``isaacsim.core.api.robots.Robot``
-and ``isaacsim.core.api.controllers.ArticulationController`` over MuJoCo joints.
+"""Isaac compat area: ``isaacsim.core.prims.Articulation`` over MuJoCo joints (``SingleArticulation``, ``Robot`` and
+``ArticulationController``: :mod:`graphsdg.compat.core_single_articulation`).
 
 An articulation is a prim with ``ArticulationRootAPI`` (or a tree's root body):
 the path expression is resolved to the root-API prims below it, as Isaac does.
@@ -38,22 +38,23 @@ import types
 from typing import Any
 
 import numpy as np
-from pxr import Sdf
+from pxr import Sdf, UsdPhysics
 
+from graphsdg.compat.core_articulation_properties import ArticulationProperties
 from graphsdg.compat.core_prims import XFormPrim, _array, _unit_quats
-from graphsdg.compat.core_single_prims import _row, _SinglePrimWrapper
-from graphsdg.compat.core_types import ArticulationAction, ArticulationActions, JointsState, XFormPrimViewState
+from graphsdg.compat.core_types import ArticulationActions, JointsState, XFormPrimViewState
 from graphsdg.compat.core_utils_prims import get_articulation_root_api_prim_path
-from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.compat.modules import CompatError, CompatModule
 from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.physics.articulation_tensor_view import ArticulationTensorView
 from graphsdg.physics.articulations import ArticulationView
 from graphsdg.runtime import runtime
+from graphsdg.stage.context import get_stage
 
 log = logging.getLogger("carb")
 
 
-class Articulation(XFormPrim):
+class Articulation(ArticulationProperties, XFormPrim):
     """``isaacsim.core.prims.Articulation``: a view of articulations (see the module docstring)."""
 
     _compat_name = "isaacsim.core.prims.Articulation"
@@ -308,6 +309,73 @@ class Articulation(XFormPrim):
         if kds is not None:
             self._set("get_dof_dampings", "set_dof_dampings", kds, indices, joint_indices, joint_names)
 
+    # ---- control modes ---------------------------------------------------------------------------------------------
+    def switch_control_mode(self, mode: str, indices: Any = None, joint_indices: Any = None,
+                            joint_names: Any = None) -> None:
+        """Isaac's rule, through :meth:`set_gains`: ``"position"``: the default gains (kp, kd); ``"velocity"``:
+        (0, kd); ``"effort"``: (0, 0) (the drive's PD terms vanish; efforts act alone). Another mode raises
+        ValueError (Isaac ignores it)."""
+        if self._view() is None:
+            return
+        self._switch(mode, self._indices(indices), self._joint_indices(joint_indices, joint_names))
+
+    def switch_dof_control_mode(self, mode: str, dof_index: int, indices: Any = None) -> None:
+        """:meth:`switch_control_mode` for one joint."""
+        if self._view() is None:
+            return
+        self._switch(mode, self._indices(indices), np.array([int(dof_index)]))
+
+    def _switch(self, mode: str, rows: np.ndarray, cols: np.ndarray) -> None:
+        zeros = np.zeros((len(rows), len(cols)), dtype=np.float32)
+        kps, kds = self._default_kps[np.ix_(rows, cols)], self._default_kds[np.ix_(rows, cols)]
+        gains = {"position": (kps, kds), "velocity": (zeros, kds), "effort": (zeros, zeros)}
+        if mode not in gains:
+            raise ValueError(f"control mode {mode!r} is not one of 'position', 'velocity', 'effort'")
+        self.set_gains(*gains[mode], indices=rows, joint_indices=cols)
+
+    def _drive_prims(self, indices: Any, joint_indices: Any, joint_names: Any) -> list[list[tuple[Any, str]]]:
+        """(joint prim, drive instance: "linear" for prismatic joints, else "angular") per row and column."""
+        view = self._view()
+        stage = get_stage()
+        cols = self._joint_indices(joint_indices, joint_names)
+        out = []
+        for i in self._indices(indices):
+            row = []
+            for k in cols:
+                prim = stage.GetPrimAtPath(view.dof_paths[i][k])
+                row.append((prim, "linear" if prim.IsA(UsdPhysics.PrismaticJoint) else "angular"))
+            out.append(row)
+        return out
+
+    def get_effort_modes(self, indices: Any = None, joint_indices: Any = None,
+                         joint_names: Any = None) -> list[list[str]] | None:
+        """(M, K) drive types: the drive's ``physics:type`` (``"force"`` unless authored), ``"acceleration"``
+        for a joint without a drive (Isaac's answer)."""
+        if self._view() is None:
+            return None
+        return [[UsdPhysics.DriveAPI(prim, kind).GetTypeAttr().Get() if prim.HasAPI(UsdPhysics.DriveAPI)
+                 else "acceleration" for prim, kind in row] for row in self._drive_prims(indices, joint_indices,
+                                                                                          joint_names)]
+
+    def set_effort_modes(self, mode: str, indices: Any = None, joint_indices: Any = None,
+                         joint_names: Any = None) -> None:
+        """``"force"``: author the drives' type (applying ``DriveAPI`` where missing, as Isaac); graphsdg's
+        drives are force drives. ``"acceleration"`` raises: MuJoCo's actuators do not scale by the joint's
+        inertia."""
+        if self._view() is None:
+            return
+        if mode not in ("force", "acceleration"):
+            raise ValueError(f"Effort Mode specified {mode} is not recognized")
+        if mode == "acceleration":
+            raise CompatNotMapped("Articulation.set_effort_modes('acceleration')",
+                                  "graphsdg's drives are force drives (MuJoCo actuators whose gains are not scaled "
+                                  "by the joint's inertia)")
+        for row in self._drive_prims(indices, joint_indices, joint_names):
+            for prim, kind in row:
+                drive = UsdPhysics.DriveAPI(prim, kind) if prim.HasAPI(UsdPhysics.DriveAPI) else \
+                    UsdPhysics.DriveAPI.Apply(prim, kind)
+                drive.CreateTypeAttr().Set(mode)
+
     def get_armatures(self, indices: Any = None, joint_indices: Any = None, clone: bool = True) -> np.ndarray | None:
         """Joint armatures (M, K)."""
         return self._get("get_dof_armatures", indices, joint_indices)
@@ -325,13 +393,106 @@ class Articulation(XFormPrim):
         """Set joint friction (M, K)."""
         self._set("get_dof_friction_coefficients", "set_dof_friction_coefficients", values, indices, joint_indices)
 
-    def get_body_masses(self, indices: Any = None, body_indices: Any = None, clone: bool = True) -> np.ndarray | None:
-        """Link masses (M, B) kg."""
+    # ---- joint descriptions -------------------------------------------------------------------------------------
+    def get_dof_types(self, dof_names: Any = None) -> list | None:
+        """``omni.physics.tensors.DofType`` per joint: ``Rotation`` (revolute), ``Translation`` (prismatic)."""
         view = self._view()
         if view is None:
             return None
-        cols = self._backend_utils.resolve_indices(body_indices, view.max_links)
-        return view.get_masses()[np.ix_(self._indices(indices), cols)].astype(np.float32)
+        from graphsdg.compat.experimental_articulation import DofType
+        stage = get_stage()
+        types_ = [DofType.Translation if stage.GetPrimAtPath(p).IsA(UsdPhysics.PrismaticJoint) else DofType.Rotation
+                  for p in view.dof_paths[0]]
+        return types_ if dof_names is None else [types_[self.get_dof_index(n)] for n in dof_names]
+
+    def get_drive_types(self) -> np.ndarray | None:
+        """(M, K) PhysX drive types: 0 no drive, 1 force, 2 acceleration (the joint's ``DriveAPI`` type)."""
+        modes = self.get_effort_modes()
+        if modes is None:
+            return None
+        view = self._view()
+        stage = get_stage()
+        out = np.zeros((len(modes), len(modes[0]) if modes else 0), dtype=np.uint8)
+        for i, row in enumerate(modes):
+            for k, mode in enumerate(row):
+                driven = stage.GetPrimAtPath(view.dof_paths[i][k]).HasAPI(UsdPhysics.DriveAPI)
+                out[i, k] = 0 if not driven else (2 if mode == "acceleration" else 1)
+        return out
+
+    def get_joint_max_velocities(self, indices: Any = None, joint_indices: Any = None, joint_names: Any = None,
+                                 clone: bool = True) -> np.ndarray | None:
+        """(M, K): inf (MuJoCo has no joint velocity limit)."""
+        return self._get("get_dof_max_velocities", indices, joint_indices, joint_names)
+
+    def set_max_joint_velocities(self, values: Any, indices: Any = None, joint_indices: Any = None,
+                                 joint_names: Any = None) -> None:
+        """Not mapped: MuJoCo has no joint velocity limit (raises naming it)."""
+        raise CompatNotMapped("Articulation.set_max_joint_velocities", "MuJoCo has no joint velocity limit "
+                              "(PhysX's maxJointVelocity has no counterpart in graphsdg's simulation)")
+
+    # ---- pausing ----------------------------------------------------------------------------------------------------
+    def pause_motion(self) -> None:
+        """Hold every joint where it is (velocities 0, position targets the current positions, velocity targets 0),
+        keeping what :meth:`resume_motion` restores."""
+        view = self._view()
+        if view is None:
+            return
+        self._paused = (view.get_dof_position_targets(), self._velocity_targets(), view.get_dof_velocities())
+        zeros = np.zeros((self.count, self.num_dof), dtype=np.float32)
+        self.set_joint_velocities(zeros)
+        driven = self._driven_columns()
+        if driven:
+            self.set_joint_position_targets(self.get_joint_positions()[:, driven], joint_indices=driven)
+            self.set_joint_velocity_targets(zeros[:, driven], joint_indices=driven)
+
+    def resume_motion(self) -> None:
+        """Restore the targets and velocities :meth:`pause_motion` kept."""
+        view = self._view()
+        if view is None:
+            return
+        paused = getattr(self, "_paused", None)
+        if paused is None:
+            log.warning("Articulation needs to be paused in order to use resume_motion.")
+            return
+        targets, velocity_targets, velocities = paused
+        self.set_joint_velocities(velocities)
+        driven = self._driven_columns()
+        if driven:
+            self.set_joint_position_targets(targets[:, driven], joint_indices=driven)
+            self.set_joint_velocity_targets(velocity_targets[:, driven], joint_indices=driven)
+        self._paused = None
+
+    def _driven_columns(self) -> list[int]:
+        return [k for k, j in enumerate(self._view()._resolve()[0].joints) if j.actuator_id >= 0]
+
+    def _velocity_targets(self) -> np.ndarray:
+        """(M, K) drive velocity targets (``bias0 / kd`` of each drive; 0 for undriven joints or kd = 0)."""
+        view = self._view()
+        model = runtime().sim.compiled.model
+        out = np.zeros((view.count, view.max_dofs), dtype=np.float32)
+        for i, row in enumerate(view._resolve()):
+            for k, binding in enumerate(row.joints):
+                if binding.actuator_id >= 0:
+                    kd = -model.actuator_biasprm[binding.actuator_id, 2]
+                    out[i, k] = model.actuator_biasprm[binding.actuator_id, 0] / kd if kd else 0.0
+        return out
+
+    def set_linear_velocities(self, velocities: Any, indices: Any = None) -> None:
+        """Set root linear velocities (M, 3) (angular kept)."""
+        self._set_root_velocity_part(velocities, indices, slice(0, 3))
+
+    def set_angular_velocities(self, velocities: Any, indices: Any = None) -> None:
+        """Set root angular velocities (M, 3) rad/s (linear kept)."""
+        self._set_root_velocity_part(velocities, indices, slice(3, 6))
+
+    def _set_root_velocity_part(self, velocities: Any, indices: Any, part: slice) -> None:
+        view = self._view()
+        if view is None:
+            return
+        rows = self._indices(indices)
+        table = view.get_root_velocities()
+        table[rows, part] = _array(velocities, len(rows), 3, "velocities")
+        view.set_root_velocities(table, rows)
 
     # ---- actions ---------------------------------------------------------------------------------------------------
     def apply_action(self, control_actions: ArticulationActions, indices: Any = None) -> None:
@@ -448,229 +609,13 @@ class Articulation(XFormPrim):
             self.set_gains(self._default_kps, self._default_kds)
 
 
-class CompatNotMapped(AttributeError):
+class CompatNotMapped(CompatError):
     """An articulation behaviour graphsdg cannot provide (named, with the reason)."""
 
     def __init__(self, what: str, why: str) -> None:
         super().__init__(f"{what} is not available in graphsdg's compat mode: {why}. See docs/porting.md.")
 
 
-class ArticulationController(CompatObject):
-    """``isaacsim.core.api.controllers.ArticulationController``: applies ``ArticulationAction`` to one articulation."""
-
-    _compat_name = "isaacsim.core.api.controllers.ArticulationController"
-
-    def __init__(self) -> None:
-        self._articulation_view: Articulation | None = None
-
-    def initialize(self, articulation_view: Articulation) -> None:
-        """Bind to an :class:`Articulation` view (of one articulation)."""
-        self._articulation_view = articulation_view
-
-    def _view(self) -> Articulation:
-        if self._articulation_view is None:
-            raise RuntimeError("ArticulationController is not initialized; call initialize(articulation_view) (or "
-                               "initialize the robot) first")
-        return self._articulation_view
-
-    def apply_action(self, control_actions: ArticulationAction) -> None:
-        """Apply the action's position / velocity targets and efforts (None entries skip a joint)."""
-        view = self._view()
-        view.apply_action(ArticulationActions(
-            joint_positions=None if control_actions.joint_positions is None else [control_actions.joint_positions],
-            joint_velocities=None if control_actions.joint_velocities is None else [control_actions.joint_velocities],
-            joint_efforts=None if control_actions.joint_efforts is None else [control_actions.joint_efforts],
-            joint_indices=control_actions.joint_indices))
-
-    def set_gains(self, kps: Any = None, kds: Any = None, save_to_usd: bool = False) -> None:
-        """Set drive stiffnesses / dampings (one value per joint)."""
-        self._view().set_gains(None if kps is None else _row(kps, len(np.ravel(kps)), "kps"),
-                               None if kds is None else _row(kds, len(np.ravel(kds)), "kds"), save_to_usd=save_to_usd)
-
-    def get_gains(self) -> tuple[np.ndarray, np.ndarray]:
-        """(stiffnesses, dampings) per joint."""
-        kps, kds = self._view().get_gains()
-        return kps[0], kds[0]
-
-    def set_max_efforts(self, values: Any, joint_indices: Any = None) -> None:
-        """Set drive force limits."""
-        self._view().set_max_efforts(np.atleast_2d(values), joint_indices=joint_indices)
-
-    def get_max_efforts(self) -> np.ndarray:
-        """Drive force limits per joint."""
-        return self._view().get_max_efforts()[0]
-
-    def get_joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lower, upper) joint limits."""
-        limits = self._view().get_dof_limits()[0]
-        return limits[:, 0], limits[:, 1]
-
-    def get_applied_action(self) -> ArticulationAction:
-        """The current targets and efforts as an ``ArticulationAction``."""
-        actions = self._view().get_applied_actions()
-        return ArticulationAction(actions.joint_positions[0], actions.joint_velocities[0], actions.joint_efforts[0])
-
-    def switch_control_mode(self, mode: str) -> None:
-        """Not mapped: graphsdg's drives are PD position drives (raises naming it)."""
-        raise CompatNotMapped(f"ArticulationController.switch_control_mode({mode!r})",
-                              "MuJoCo drives are compiled from UsdPhysics.DriveAPI as PD actuators")
-
-
-class SingleArticulation(_SinglePrimWrapper):
-    """``isaacsim.core.prims.SingleArticulation``: one articulation through a one-row :class:`Articulation`."""
-
-    _compat_name = "isaacsim.core.prims.SingleArticulation"
-
-    def __init__(self, prim_path: str, name: str = "articulation", position: Any = None, translation: Any = None,
-                 orientation: Any = None, scale: Any = None, visible: bool | None = None,
-                 articulation_controller: ArticulationController | None = None) -> None:
-        self._articulation_view = Articulation(
-            prim_path, name=name, positions=_row(position, 3, "position"),
-            translations=_row(translation, 3, "translation"), orientations=_row(orientation, 4, "orientation"),
-            scales=_row(scale, 3, "scale"), visibilities=None if visible is None else np.array([bool(visible)]))
-        self._articulation_controller = articulation_controller or ArticulationController()
-        _SinglePrimWrapper.__init__(self, self._articulation_view)
-
-    @property
-    def handles_initialized(self) -> bool:
-        """Whether the articulation is bound to running physics."""
-        return self._articulation_view.is_physics_handle_valid()
-
-    @property
-    def num_dof(self) -> int | None:
-        """Moving joints."""
-        return self._articulation_view.num_dof
-
-    @property
-    def num_bodies(self) -> int | None:
-        """Links."""
-        return self._articulation_view.num_bodies
-
-    @property
-    def dof_names(self) -> list[str] | None:
-        """Joint names."""
-        return self._articulation_view.dof_names
-
-    def initialize(self, physics_sim_view: Any = None) -> None:
-        """Bind to running physics and initialise the controller."""
-        self._articulation_view.initialize(physics_sim_view)
-        self._articulation_controller.initialize(self._articulation_view)
-
-    def get_dof_index(self, dof_name: str) -> int:
-        """The index of joint ``dof_name``."""
-        return self._articulation_view.get_dof_index(dof_name)
-
-    def get_articulation_controller(self) -> ArticulationController:
-        """The articulation's controller."""
-        return self._articulation_controller
-
-    def _first(self, value: Any) -> Any:
-        return None if value is None else value[0]
-
-    def get_joint_positions(self, joint_indices: Any = None) -> np.ndarray | None:
-        """Joint positions."""
-        return self._first(self._articulation_view.get_joint_positions(joint_indices=joint_indices))
-
-    def set_joint_positions(self, positions: Any, joint_indices: Any = None) -> None:
-        """Teleport joints."""
-        self._articulation_view.set_joint_positions(np.atleast_2d(positions), joint_indices=joint_indices)
-
-    def get_joint_velocities(self, joint_indices: Any = None) -> np.ndarray | None:
-        """Joint velocities."""
-        return self._first(self._articulation_view.get_joint_velocities(joint_indices=joint_indices))
-
-    def set_joint_velocities(self, velocities: Any, joint_indices: Any = None) -> None:
-        """Set joint velocities."""
-        self._articulation_view.set_joint_velocities(np.atleast_2d(velocities), joint_indices=joint_indices)
-
-    def set_joint_efforts(self, efforts: Any, joint_indices: Any = None) -> None:
-        """Apply joint forces until changed."""
-        self._articulation_view.set_joint_efforts(np.atleast_2d(efforts), joint_indices=joint_indices)
-
-    def get_applied_joint_efforts(self, joint_indices: Any = None) -> np.ndarray | None:
-        """Forces applied to the joints in the last step."""
-        return self._first(self._articulation_view.get_applied_joint_efforts(joint_indices=joint_indices))
-
-    def apply_action(self, control_actions: ArticulationAction) -> None:
-        """Apply an action through the controller."""
-        self._articulation_controller.apply_action(control_actions)
-
-    def get_applied_action(self) -> ArticulationAction:
-        """The current targets and efforts."""
-        return self._articulation_controller.get_applied_action()
-
-    def get_joints_state(self) -> JointsState | None:
-        """The current joint state."""
-        state = self._articulation_view.get_joints_state()
-        return None if state is None else JointsState(state.positions[0], state.velocities[0], state.efforts[0])
-
-    def get_joints_default_state(self) -> JointsState | None:
-        """The joint state post_reset restores."""
-        state = self._articulation_view.get_joints_default_state()
-        return None if state is None else JointsState(*(None if v is None else v[0] for v in (
-            state.positions, state.velocities, state.efforts)))
-
-    def set_joints_default_state(self, positions: Any = None, velocities: Any = None, efforts: Any = None) -> None:
-        """Set the joint state post_reset restores."""
-        self._articulation_view.set_joints_default_state(positions, velocities, efforts)
-
-    def get_linear_velocity(self) -> np.ndarray | None:
-        """Root linear velocity."""
-        return self._first(self._articulation_view.get_linear_velocities())
-
-    def get_angular_velocity(self) -> np.ndarray | None:
-        """Root angular velocity (rad/s)."""
-        return self._first(self._articulation_view.get_angular_velocities())
-
-    def set_solver_position_iteration_count(self, count: int) -> None:
-        """Author ``physxArticulation:solverPositionIterationCount`` (no MuJoCo counterpart)."""
-        self.prim.CreateAttribute("physxArticulation:solverPositionIterationCount", Sdf.ValueTypeNames.Int).Set(
-            int(count))
-
-    def set_solver_velocity_iteration_count(self, count: int) -> None:
-        """Author ``physxArticulation:solverVelocityIterationCount`` (no MuJoCo counterpart)."""
-        self.prim.CreateAttribute("physxArticulation:solverVelocityIterationCount", Sdf.ValueTypeNames.Int).Set(
-            int(count))
-
-    def set_enabled_self_collisions(self, flag: bool) -> None:
-        """Author ``physxArticulation:enabledSelfCollisions`` (False excludes link-link contacts in MuJoCo)."""
-        self.prim.CreateAttribute("physxArticulation:enabledSelfCollisions", Sdf.ValueTypeNames.Bool).Set(bool(flag))
-
-    def get_enabled_self_collisions(self) -> bool:
-        """``physxArticulation:enabledSelfCollisions`` (True where unset)."""
-        attr = self.prim.GetAttribute("physxArticulation:enabledSelfCollisions")
-        return True if not attr or attr.Get() is None else bool(attr.Get())
-
-
-class Robot(SingleArticulation):
-    """``isaacsim.core.api.robots.Robot``: an articulation with attached sensors (initialised and reset with it)."""
-
-    _compat_name = "isaacsim.core.api.robots.Robot"
-
-    def __init__(self, prim_path: str, name: str = "robot", position: Any = None, translation: Any = None,
-                 orientation: Any = None, scale: Any = None, visible: bool | None = None,
-                 articulation_controller: ArticulationController | None = None) -> None:
-        super().__init__(prim_path, name, position, translation, orientation, scale, visible, articulation_controller)
-        self._sensors: list = []
-
-    def initialize(self, physics_sim_view: Any = None) -> None:
-        """Initialise the articulation and its sensors."""
-        super().initialize(physics_sim_view)
-        for sensor in self._sensors:
-            sensor.initialize(physics_sim_view)
-
-    def post_reset(self) -> None:
-        """Reset the articulation and its sensors."""
-        super().post_reset()
-        for sensor in self._sensors:
-            sensor.post_reset()
-
-
 def modules() -> list[types.ModuleType]:
-    """Articulations of ``isaacsim.core.prims``; ``isaacsim.core.api.robots`` and ``.controllers``."""
-    return [CompatModule("isaacsim.core.prims", Articulation=Articulation, SingleArticulation=SingleArticulation),
-            CompatModule("isaacsim.core.api.robots", Robot=Robot),
-            CompatModule("isaacsim.core.api.robots.robot", Robot=Robot),
-            CompatModule("isaacsim.core.api.controllers", ArticulationController=ArticulationController),
-            CompatModule("isaacsim.core.api.controllers.articulation_controller",
-                         ArticulationController=ArticulationController)]
+    """``isaacsim.core.prims.Articulation``."""
+    return [CompatModule("isaacsim.core.prims", Articulation=Articulation)]

@@ -180,7 +180,8 @@ def _matrices_to_euler(r: np.ndarray, degrees: bool, extrinsic: bool) -> np.ndar
 
 def quats_to_euler_angles(quaternions: Any, degrees: bool = False, extrinsic: bool = True,
                           device: Any = None) -> np.ndarray:
-    """(N, 4) or (4,) quaternions (w, x, y, z) -> X, Y, Z Euler angles (the inverse of :func:`euler_angles_to_quats`)."""
+    """X, Y, Z Euler angles of (N, 4) or (4,) quaternions (w, x, y, z): the inverse of
+    :func:`euler_angles_to_quats`."""
     return _matrices_to_euler(quat_wxyz_to_matrix(_quats(quaternions)), degrees, extrinsic)
 
 

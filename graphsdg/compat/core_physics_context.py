@@ -80,7 +80,8 @@ class PhysicsContext(CompatObject):
             self.set_physics_dt(physics_dt)
 
     def _apply_sim_params(self, sim_params: dict) -> None:
-        """Isaac's ``sim_params`` keys: gravity, dt (and time codes per second), substeps, solver and buffer settings."""
+        """Apply Isaac's ``sim_params`` keys: gravity, dt (and time codes per second), substeps, solver and
+        buffer settings."""
         stage = get_stage()
         if "gravity" in sim_params:
             self.set_gravity(float(sim_params["gravity"][_AXES[str(UsdGeom.GetStageUpAxis(stage))]]))
@@ -281,6 +282,25 @@ class PhysicsContext(CompatObject):
     def get_invert_collision_group_filter(self) -> bool:
         """``physxScene:invertCollisionGroupFilter``."""
         return bool(self._read("invertCollisionGroupFilter"))
+
+    def set_solve_articulation_contact_last(self, solve_articulation_contact_last: bool) -> None:
+        """Author ``physxScene:solveArticulationContactLast`` (a PhysX solver ordering; MuJoCo solves all
+        constraints together)."""
+        prim = self._scene_prim()
+        attribute = prim.GetAttribute("physxScene:solveArticulationContactLast")
+        if attribute.Get() is None:
+            attribute = prim.CreateAttribute("physxScene:solveArticulationContactLast", Sdf.ValueTypeNames.Bool,
+                                             False)
+        attribute.Set(bool(solve_articulation_contact_last))
+
+    def get_solve_articulation_contact_last(self) -> bool:
+        """``physxScene:solveArticulationContactLast`` (False, authored, where unset, as Isaac)."""
+        prim = self._scene_prim()
+        attribute = prim.GetAttribute("physxScene:solveArticulationContactLast")
+        if attribute.Get() is None:
+            attribute = prim.CreateAttribute("physxScene:solveArticulationContactLast", Sdf.ValueTypeNames.Bool,
+                                             False)
+        return attribute.Get()
 
     def set_enable_scene_query_support(self, enable_scene_query_support: bool) -> None:
         """Author ``physxScene:enableSceneQuerySupport`` (graphsdg's scene queries always work)."""

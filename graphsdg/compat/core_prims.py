@@ -99,8 +99,9 @@ class XFormPrim(CompatObject):
         self._applied_visual_materials: list[VisualMaterial | None] = [None] * self._count
         self._non_root_link = is_prim_non_root_articulation_link(self._prim_paths[0])
         self._default_state: XFormPrimViewState | None = None
-        not_xformable = [p for p, prim in zip(self._prim_paths, self._prims) if not prim.IsA(UsdGeom.Xformable)]
-        if not_xformable:
+        not_xformable = [f"{p} ({prim.GetTypeName() or 'typeless'})" for p, prim in zip(self._prim_paths, self._prims)
+                         if not prim.IsA(UsdGeom.Xformable)]
+        if not_xformable:   # Isaac authors xform ops that no transform reads on such prims; graphsdg refuses
             raise ValueError(f"prims {not_xformable} are not Xformable; {type(self).__name__} wraps prims with "
                              f"a transform")
         if not self._non_root_link and reset_xform_properties:
@@ -211,7 +212,8 @@ class XFormPrim(CompatObject):
             orient_op = (UsdGeom.XformOp(prim.GetAttribute("xformOp:orient")) if "xformOp:orient" in names
                          else xformable.AddXformOp(UsdGeom.XformOp.TypeOrient, UsdGeom.XformOp.PrecisionDouble, ""))
             for name in names:   # a units-resolve rotation would otherwise sit outside the op order
-                if name.startswith("xformOp:") and name.endswith(":unitsResolve") and name != "xformOp:scale:unitsResolve":
+                if name.startswith("xformOp:") and name.endswith(":unitsResolve") and \
+                        name != "xformOp:scale:unitsResolve":
                     prim.RemoveProperty(name)
             xformable.SetXformOpOrder([translate_op, orient_op, scale_op])
         XFormPrim.set_world_poses(self, positions, orientations)
@@ -405,9 +407,9 @@ def _wrap_bound_material(prim: Usd.Prim) -> VisualMaterial | None:
     return None
 
 
-class CompatNotSupported(AttributeError):
-    """A core-API behaviour graphsdg cannot provide (named, with the reason); an ``AttributeError`` as
-    :class:`graphsdg.compat.modules.CompatError` is."""
+class CompatNotSupported(CompatError):
+    """A core-API behaviour graphsdg cannot provide (named, with the reason): a
+    :class:`graphsdg.compat.modules.CompatError` (an ``AttributeError``)."""
 
     def __init__(self, what: str, why: str) -> None:
         super().__init__(f"{what} is not available in graphsdg's compat mode: {why}. See docs/porting.md.")

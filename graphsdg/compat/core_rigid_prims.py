@@ -93,7 +93,7 @@ class RigidPrim(XFormPrim):
 
     def initialize(self, physics_sim_view: Any = None) -> None:
         """Bind the view to the running simulation and take the default velocities (the current ones) if unset."""
-        if self._view() is None:
+        if self._view() is None or self._non_root_link:     # a link's state is its articulation's
             return
         state = self._dynamics_default_state
         state.positions, state.orientations = self._default_state.positions, self._default_state.orientations
@@ -370,6 +370,8 @@ class RigidPrim(XFormPrim):
                           angular_velocities: Any = None, indices: Any = None) -> None:
         """Set the poses and velocities :meth:`post_reset` restores."""
         XFormPrim.set_default_state(self, positions, orientations, indices)
+        if self._non_root_link:     # XFormPrim warned: a link's state is its articulation's
+            return
         state = self._dynamics_default_state
         idx = self._indices(indices)
         for attr, values in (("linear_velocities", linear_velocities), ("angular_velocities", angular_velocities)):
@@ -384,7 +386,8 @@ class RigidPrim(XFormPrim):
     def get_default_state(self) -> DynamicsViewState:
         """The poses and velocities :meth:`post_reset` restores."""
         state = self._dynamics_default_state
-        state.positions, state.orientations = self._default_state.positions, self._default_state.orientations
+        if self._default_state is not None:     # None for non-root articulation links (Isaac's too)
+            state.positions, state.orientations = self._default_state.positions, self._default_state.orientations
         return state
 
     def get_current_dynamic_state(self) -> DynamicsViewState:

@@ -27,7 +27,8 @@ import numpy as np
 from pxr import Usd, UsdGeom
 
 from graphsdg.compat import experimental_bounds_utils
-from graphsdg.compat.experimental_bounds_utils import create_bbox_cache, get_obb_corners  # noqa: F401 - the example uses it
+from graphsdg.compat.experimental_bounds_utils import (  # noqa: F401 - the example uses create_bbox_cache
+    create_bbox_cache, get_obb_corners)
 from graphsdg.compat.modules import CompatModule
 
 log = logging.getLogger("carb")

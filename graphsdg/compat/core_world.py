@@ -1,4 +1,4 @@
-"""Isaac compat area: ``isaacsim.core.api.World``, its ``Scene``, tasks (``BaseTask``), ``DataLogger`` and ``BaseSensor``.
+"""Isaac compat area: ``isaacsim.core.api.World``, its ``Scene``, tasks (``BaseTask``), ``DataLogger``, ``BaseSensor``.
 
 ``World`` is :class:`~graphsdg.compat.core_simulation_context.SimulationContext`
 with a :class:`Scene` (a registry of objects by name) and tasks:
@@ -40,7 +40,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
-from graphsdg.compat.core_articulations import Articulation, Robot, SingleArticulation
+from graphsdg.compat.core_articulations import Articulation
+from graphsdg.compat.core_single_articulation import Robot, SingleArticulation
 from graphsdg.compat.core_materials import PhysicsMaterial
 from graphsdg.compat.core_objects import GroundPlane
 from graphsdg.compat.core_geometry_prims import GeometryPrim
@@ -72,73 +73,110 @@ class BaseSensor(SingleXFormPrim):
                                  orientation=orientation, scale=scale, visible=visible)
 
 
-# registry category -> the types it holds, checked in this order (a DynamicCuboid is a rigid object first)
-_CATEGORIES: tuple[tuple[str, tuple[type, ...]], ...] = (
-    ("rigid_objects", (SingleRigidPrim,)),
-    ("rigid_prim_views", (RigidPrim,)),
-    ("geometry_objects", (SingleGeometryPrim, GroundPlane)),
-    ("geometry_prim_views", (GeometryPrim,)),
-    ("robots", (Robot,)),
-    ("articulated_systems", (SingleArticulation,)),
-    ("articulated_views", (Articulation,)),
-    ("sensors", (BaseSensor,)),
-    ("xforms", (SingleXFormPrim,)),
-    ("xform_prim_views", (XFormPrim,)),
+# Scene.add's dispatch: (the types, the registry's add method), checked in Isaac's order (a DynamicCuboid is a
+# rigid object first, a GroundPlane a geometry object)
+_DISPATCH: tuple[tuple[tuple[type, ...], str], ...] = (
+    ((SingleRigidPrim,), "add_rigid_object"),
+    ((RigidPrim,), "add_rigid_prim_view"),
+    ((SingleGeometryPrim, GroundPlane), "add_geometry_object"),
+    ((GeometryPrim,), "add_geometry_prim_view"),
+    ((Robot,), "add_robot"),
+    ((SingleArticulation,), "add_articulated_system"),
+    ((Articulation,), "add_articulated_view"),
+    ((BaseSensor,), "add_sensor"),
+    ((SingleXFormPrim,), "add_xform"),
+    ((XFormPrim,), "add_xform_view"),
+)
+
+# SceneRegistry's categories in Isaac's lookup order: (category, add method, its object argument's name)
+_REGISTRY: tuple[tuple[str, str, str], ...] = (
+    ("rigid_objects", "add_rigid_object", "rigid_object"),
+    ("geometry_objects", "add_geometry_object", "geometry_object"),
+    ("articulated_systems", "add_articulated_system", "articulated_system"),
+    ("robots", "add_robot", "robot"),
+    ("xforms", "add_xform", "xform"),
+    ("sensors", "add_sensor", "sensor"),
+    ("xform_prim_views", "add_xform_view", "xform_prim_view"),
+    ("deformable_prims", "add_deformable", "deformable"),
+    ("deformable_prim_views", "add_deformable_view", "deformable_prim_view"),
+    ("deformable_materials", "add_deformable_material", "deformable_material"),
+    ("deformable_material_views", "add_deformable_material_view", "deformable_material_view"),
+    ("cloth_prims", "add_cloth", "cloth"),
+    ("cloth_prim_views", "add_cloth_view", "cloth_prim_view"),
+    ("particle_systems", "add_particle_system", "particle_system"),
+    ("particle_system_views", "add_particle_system_view", "particle_system_view"),
+    ("particle_materials", "add_particle_material", "particle_material"),
+    ("particle_material_views", "add_particle_material_view", "particle_material_view"),
+    ("geometry_prim_views", "add_geometry_prim_view", "geometry_prim_view"),
+    ("rigid_prim_views", "add_rigid_prim_view", "rigid_prim_view"),
+    ("rigid_contact_views", "add_rigid_contact_view", "rigid_contact_view"),
+    ("articulated_views", "add_articulated_view", "articulated_view"),
+    ("robot_views", "add_robot_view", "robot_view"),
 )
 
 
 class SceneRegistry(CompatObject):
-    """Objects of a scene by name, in categories (``rigid_objects``, ``xform_prim_views``, ...)."""
+    """``isaacsim.core.api.scenes.SceneRegistry``: named objects in categories (``rigid_objects``,
+    ``xform_prim_views``, ...; each a dict property), one ``add_*`` method per category; names are unique
+    across all of them."""
 
     _compat_name = "isaacsim.core.api.scenes.SceneRegistry"
 
     def __init__(self) -> None:
-        self._objects: dict[str, dict[str, Any]] = {category: {} for category, _ in _CATEGORIES}
+        self._dicts: dict[str, dict[str, Any]] = {category: {} for category, _, _ in _REGISTRY}
+        for category, _, _ in _REGISTRY:     # Isaac's private names (Isaac's Scene reads some of them)
+            self.__dict__[f"_{category}"] = self._dicts[category]
+        self._all_object_dicts = list(self._dicts.values())
 
-    def __getattr__(self, item: str) -> Any:
-        objects = self.__dict__.get("_objects", {})
-        if item in objects:
-            return objects[item]
-        if item.startswith("_") and item[1:] in objects:
-            return objects[item[1:]]
-        return super().__getattr__(item)
-
-    @staticmethod
-    def category_of(obj: Any) -> str:
-        """The registry category of ``obj``; TypeError for a type the scene does not hold."""
-        for category, types_ in _CATEGORIES:
-            if isinstance(obj, types_):
-                return category
-        raise TypeError(f"object type {type(obj).__name__} is not supported by the scene registry")
-
-    def add(self, obj: Any) -> None:
-        """Register ``obj`` under its name."""
-        if self.name_exists(obj.name):
-            raise ValueError(f"Cannot add the object {obj.name} to the scene since its name is not unique")
-        self._objects[self.category_of(obj)][obj.name] = obj
+    def _register_object(self, name: str, obj: Any, object_dict: dict) -> None:
+        if self.name_exists(name):
+            raise ValueError(f"Cannot add the object {name} to the scene since its name is not unique")
+        object_dict[name] = obj
 
     def name_exists(self, name: str) -> bool:
-        """Whether an object of that name is registered."""
-        return any(name in objects for objects in self._objects.values())
-
-    def get_object(self, name: str) -> Any:
-        """The object of that name, or None."""
-        for objects in self._objects.values():
-            if name in objects:
-                return objects[name]
-        return None
+        """Whether an object of that name is registered (in any category)."""
+        return any(name in objects for objects in self._all_object_dicts)
 
     def remove_object(self, name: str) -> None:
-        """Forget the object of that name (a missing name raises)."""
-        for objects in self._objects.values():
+        """Forget the object of that name (the registry only; a missing name raises)."""
+        for objects in self._all_object_dicts:
             if name in objects:
                 del objects[name]
                 return
         raise ValueError(f"Cannot remove object {name} from the scene since it doesn't exist")
 
-    def all_objects(self) -> list[Any]:
+    def get_object(self, name: str) -> Any:
+        """The object of that name, or None."""
+        for objects in self._all_object_dicts:
+            if name in objects:
+                return objects[name]
+        return None
+
+    def _all_objects(self) -> list[Any]:
         """Every registered object, category by category."""
-        return [obj for objects in self._objects.values() for obj in objects.values()]
+        return [obj for objects in self._all_object_dicts for obj in list(objects.values())]
+
+
+def _registry_members(category: str, method: str, argument: str) -> tuple[property, Any]:
+    def getter(self: SceneRegistry) -> dict:
+        return self._dicts[category]
+
+    def add(self: SceneRegistry, name: str, *args: Any, **kwargs: Any) -> None:
+        if len(args) + len(kwargs) != 1 or (kwargs and argument not in kwargs):
+            raise TypeError(f"SceneRegistry.{method}() takes (name, {argument})")
+        self._register_object(name, args[0] if args else kwargs[argument], self._dicts[category])
+
+    getter.__doc__ = f"Registered {category.replace('_', ' ')} by name."
+    add.__name__ = add.__qualname__ = method
+    add.__doc__ = f"Register ``{argument}`` under ``name`` among the {category.replace('_', ' ')}."
+    return property(getter), add
+
+
+for _category, _method, _argument in _REGISTRY:
+    _property, _add = _registry_members(_category, _method, _argument)
+    setattr(SceneRegistry, _category, _property)
+    setattr(SceneRegistry, _method, _add)
+del _category, _method, _argument, _property, _add
 
 
 class Scene(CompatObject):
@@ -158,13 +196,19 @@ class Scene(CompatObject):
 
     def add(self, obj: Any) -> Any:
         """Register ``obj`` (a prim wrapper, view, ground plane, robot or sensor) under its unique name; returns it."""
-        self._scene_registry.add(obj)
-        return obj
+        if self._scene_registry.name_exists(obj.name):
+            raise ValueError(f"Cannot add the object {obj.name} to the scene since its name is not unique")
+        for types_, method in _DISPATCH:
+            if isinstance(obj, types_):
+                getattr(self._scene_registry, method)(obj.name, obj)
+                return obj
+        raise TypeError(f"object type {type(obj).__name__} is not supported")
 
     def add_ground_plane(self, size: float | None = None, z_position: float = 0, name: str = "ground_plane",
                          prim_path: str = "/World/groundPlane", static_friction: float = 0.5,
                          dynamic_friction: float = 0.5, restitution: float = 0.8, color: Any = None) -> GroundPlane:
-        """A :class:`GroundPlane` with its own physics material, registered (an existing one of that name is returned)."""
+        """Add a :class:`GroundPlane` with its own physics material, registered (an existing one of that name is
+        returned)."""
         if self.object_exists(name):
             log.info(f"ground floor already created with name {name}.")
             return self.get_object(name)
@@ -194,12 +238,12 @@ class Scene(CompatObject):
 
     def _finalize(self, physics_sim_view: Any = None) -> None:
         """Initialise every registered object against the running physics."""
-        for obj in self._scene_registry.all_objects():
+        for obj in self._scene_registry._all_objects():
             obj.initialize(physics_sim_view)
 
     def post_reset(self) -> None:
         """Return every registered object to its default state (objects whose prims are gone are forgotten)."""
-        for obj in self._scene_registry.all_objects():
+        for obj in self._scene_registry._all_objects():
             if not obj.is_valid():
                 self._scene_registry.remove_object(obj.name)
                 continue
@@ -240,7 +284,7 @@ class Scene(CompatObject):
     def clear(self, registry_only: bool = False) -> None:
         """Remove every registered object (and its prims unless ``registry_only``)."""
         with Sdf.ChangeBlock():
-            for obj in self._scene_registry.all_objects():
+            for obj in self._scene_registry._all_objects():
                 self.remove_object(obj.name, registry_only=registry_only)
 
     def enable_bounding_boxes_computations(self) -> None:
@@ -516,18 +560,27 @@ class World(SimulationContext):
         SimulationContext.reset(self, soft=soft)
         self._reset_tasks_and_scene()
 
-    async def reset_async(self, soft: bool = False) -> None:
-        """:meth:`reset` for coroutines."""
-        if not self._task_scene_built:
-            for task in self._current_tasks.values():
-                task.set_up_scene(self._scene)
-            self._task_scene_built = True
+    async def reset_async_set_up_scene(self, soft: bool = False) -> None:
+        """Every task's ``set_up_scene`` (the first half of :meth:`reset_async`; ``soft`` unused, as Isaac's)."""
+        for task in self._current_tasks.values():
+            task.set_up_scene(self._scene)
+
+    async def reset_async_no_set_up_scene(self, soft: bool = False) -> None:
+        """:meth:`reset_async` without setting the tasks' scenes up: stop, tasks' ``cleanup``, play, objects and
+        tasks back to their default states."""
         if not soft:
             await self.stop_async()
         for task in self._current_tasks.values():
             task.cleanup()
         await SimulationContext.reset_async(self, soft=soft)
         self._reset_tasks_and_scene()
+
+    async def reset_async(self, soft: bool = False) -> None:
+        """:meth:`reset` for coroutines."""
+        if not self._task_scene_built:
+            await self.reset_async_set_up_scene()
+            self._task_scene_built = True
+        await self.reset_async_no_set_up_scene(soft=soft)
 
     def _before_step(self) -> None:
         if self._task_scene_built:
@@ -556,7 +609,8 @@ class World(SimulationContext):
         self._log_frame()
 
     def clear(self) -> None:
-        """Remove the scene's objects, forget the tasks and logger, and clear the stage (``SimulationContext.clear``)."""
+        """Remove the scene's objects, forget the tasks and logger, and clear the stage
+        (``SimulationContext.clear``)."""
         self._scene.clear(registry_only=False)
         self._current_tasks = {}
         self._task_scene_built = False
