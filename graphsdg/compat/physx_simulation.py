@@ -29,11 +29,12 @@ Example:
 from __future__ import annotations
 
 import types
+import warnings
 from typing import Any
 
 from pxr import Sdf, UsdPhysics
 
-from graphsdg.compat.modules import CompatModule, CompatObject
+from graphsdg.compat.modules import CompatError, CompatModule, CompatObject
 from graphsdg.compat.physics_core import stepper
 from graphsdg.compat.physx_schema import intToSdfPath
 from graphsdg.physics import forces
@@ -112,6 +113,63 @@ def get_physx_simulation_interface() -> PhysxSimulationInterface:
     return _interface
 
 
+class PhysxInterface(CompatObject):
+    """omni.physx's main interface: starting and stepping the simulation by hand, reading a body's pose."""
+
+    _compat_name = "omni.physx.PhysX"
+
+    def start_simulation(self) -> None:
+        """Parse the stage into the simulation (graphsdg compiles it; nothing is stepped)."""
+        stepper.initialize(stepper.stage_id(get_stage()))
+
+    def force_load_physics_from_usd(self) -> None:
+        """Bring the simulation up to date with the stage now."""
+        self.start_simulation()
+
+    def update_simulation(self, elapsedStep: float, currentTime: float = 0.0) -> None:  # noqa: N803 - PhysX's names
+        """Advance physics by ``elapsedStep`` seconds and write the poses back to the stage."""
+        stepper.simulate(elapsedStep, currentTime)
+
+    def reset_simulation(self) -> None:
+        """Not mapped: raises, saying to stop the timeline (which puts bodies back where the stage had them)."""
+        raise CompatError("omni.physx.get_physx_interface().reset_simulation() is not available in graphsdg's "
+                          "compat mode: stop the timeline (omni.timeline.get_timeline_interface().stop()), which "
+                          "puts simulated bodies back where the stage had them")
+
+    def release_physics_objects(self) -> None:
+        """Detach the simulation from the stage (stepping by hand needs :meth:`start_simulation` again)."""
+        stepper.close()
+
+    def overwrite_gpu_setting(self, gpu_setting: int) -> None:
+        """PhysX's GPU dynamics switch: MuJoCo simulates on the CPU here, so it warns once that it has no effect."""
+        if not self._warned_gpu:
+            warnings.warn(f"omni.physx.get_physx_interface().overwrite_gpu_setting({gpu_setting!r}) has no effect: "
+                          f"graphsdg simulates with MuJoCo on the CPU", stacklevel=2)
+            self._warned_gpu = True
+
+    _warned_gpu = False
+
+    def get_rigidbody_transformation(self, path: Any) -> dict[str, Any]:
+        """``{"ret_val", "position", "rotation"}`` of the rigid body ``path`` in the running simulation
+        (rotation as PhysX gives it: x, y, z, w); ``ret_val`` False when ``path`` is not a simulated body."""
+        from graphsdg.physics.bodies import RigidBodyView
+        try:
+            position, orientation = RigidBodyView([_path(path, "path")]).get_world_poses()
+        except ValueError:
+            return {"ret_val": False, "position": (0.0, 0.0, 0.0), "rotation": (0.0, 0.0, 0.0, 1.0)}
+        w, x, y, z = (float(v) for v in orientation[0])
+        return {"ret_val": True, "position": tuple(float(v) for v in position[0]), "rotation": (x, y, z, w)}
+
+
+_physx = PhysxInterface()
+
+
+def get_physx_interface() -> PhysxInterface:
+    """omni.physx.get_physx_interface()."""
+    return _physx
+
+
 def modules() -> list[types.ModuleType]:
     """The compat modules of this area (merged into the ``omni.physx`` isaac.py maps)."""
-    return [CompatModule("omni.physx", get_physx_simulation_interface=get_physx_simulation_interface)]
+    return [CompatModule("omni.physx", get_physx_simulation_interface=get_physx_simulation_interface,
+                         get_physx_interface=get_physx_interface)]

@@ -126,6 +126,64 @@ class ViewportAPI(CompatObject):
 _viewport = ViewportAPI()
 
 
+class ViewportWindow(CompatObject):
+    """The viewport's window: graphsdg has no window, only the viewport it would show (``viewport_api``)."""
+
+    _compat_name = "omni.kit.viewport.window.ViewportWindow"
+
+    def __init__(self, viewport_api: ViewportAPI) -> None:
+        self.viewport_api = viewport_api
+        self.name = "Viewport"
+        self.title = "Viewport"
+
+
+class ViewportCapture(CompatObject):
+    """What :func:`capture_viewport_to_file` returns: the file is already written when it is returned."""
+
+    _compat_name = "omni.kit.widget.viewport.capture.FileCapture"
+
+    def __init__(self, file_path: str) -> None:
+        self.file_path = file_path
+
+    async def wait_for_result(self, completion_frames: int = 2) -> bool:
+        """True: the capture was written synchronously."""
+        return True
+
+
+def get_active_viewport_window(window_name: str | None = None, usd_context_name: str = "") -> ViewportWindow:
+    """omni.kit.viewport.utility.get_active_viewport_window: the one viewport's window."""
+    return ViewportWindow(_viewport)
+
+
+def capture_viewport_to_file(viewport_api: ViewportAPI | None = None, file_path: str | None = None,
+                             is_hdr: bool = False, render_product_path: str | None = None,
+                             format_desc: dict | None = None) -> ViewportCapture:
+    """omni.kit.viewport.utility.capture_viewport_to_file: render the viewport's camera now and write it.
+
+    The image is the viewport's render product drawn outside any capture (no annotators, writers or time
+    advance, as Kit's viewport redraw), written as an 8-bit image whose format the file's extension picks.
+
+    Raises:
+        ValueError: no ``file_path``, or ``is_hdr`` (graphsdg's viewport draws LDR colour only).
+    """
+    from PIL import Image
+
+    from graphsdg import orchestrator
+    from graphsdg.render.render_product import registry
+
+    if not file_path:
+        raise ValueError("capture_viewport_to_file needs file_path, the image file to write")
+    if is_hdr:
+        raise ValueError("capture_viewport_to_file(is_hdr=True): graphsdg's viewport draws LDR colour only; "
+                         "attach the HdrColor annotator to a render product for HDR data")
+    viewport_api = viewport_api or _viewport
+    product = registry.find(render_product_path or viewport_api.render_product_path)
+    color = orchestrator.draw([product])[0].get("color")
+    pixels = (color if color.dtype == "uint8" else (color.clip(0, 1) * 255 + 0.5).astype("uint8"))[..., :3]
+    Image.fromarray(pixels).save(file_path)
+    return ViewportCapture(str(file_path))
+
+
 def get_active_viewport(usd_context_name: str = "") -> ViewportAPI:
     """omni.kit.viewport.utility.get_active_viewport."""
     return _viewport
@@ -148,7 +206,9 @@ def modules() -> list[types.ModuleType]:
     return [CompatModule("omni.kit.viewport.utility", get_active_viewport=get_active_viewport,
                          get_active_viewport_camera_path=get_active_viewport_camera_path,
                          get_active_viewport_camera_string=get_active_viewport_camera_string,
-                         get_num_viewports=get_num_viewports)]
+                         get_num_viewports=get_num_viewports,
+                         get_active_viewport_window=get_active_viewport_window,
+                         capture_viewport_to_file=capture_viewport_to_file)]
 
 
 def _reset(_: Any = None) -> None:
