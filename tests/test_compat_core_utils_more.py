@@ -168,6 +168,12 @@ def test_stage_additions(compat):
     assert get_current_stage() is current
     with pytest.raises(CompatError, match="set_livesync_stage"):
         set_livesync_stage("/tmp/x.usd", True)
+    from isaacsim.core.utils.stage import add_reference_to_stage
+    prim = add_reference_to_stage("", "/World/Empty")          # no file: only the prim, as Isaac's
+    assert prim.GetTypeName() == "Xform" and not prim.HasAuthoredReferences()
+    with pytest.raises(FileNotFoundError):
+        add_reference_to_stage("/no/such/file.usd", "/World/Missing")
+    assert not current.GetPrimAtPath("/World/Missing")
 
 
 def test_bounds_obb_follows_isaacs_contract(compat):

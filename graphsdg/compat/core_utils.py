@@ -153,12 +153,15 @@ def clear_stage(predicate: Callable[[str], bool] | None = None) -> None:
 
 
 def add_reference_to_stage(usd_path: str, prim_path: str, prim_type: str = "Xform") -> Usd.Prim:
-    """Reference ``usd_path`` at ``prim_path`` (defined as ``prim_type`` if it does not exist)."""
+    """Reference ``usd_path`` at ``prim_path`` (defined as ``prim_type`` if it does not exist); an empty
+    ``usd_path`` only defines the prim, as Isaac's."""
     stage = get_current_stage()
     prim = stage.GetPrimAtPath(prim_path)
     created = not prim
     if created:
         prim = stage.DefinePrim(Sdf.Path(prim_path), prim_type)
+    if not usd_path:
+        return prim
     try:
         return add_reference(prim, usd_path)
     except (FileNotFoundError, ValueError):
