@@ -227,20 +227,25 @@ CASES: list[Case] = [
     C("graph", "a frame interval of 0", "rep.trigger.on_frame(interval=0)",
       "ValueError", "on_frame interval must be an integer >= 1, got 0"),
     C("graph", "a misspelt node type", 'rep.graph.NodeRegistry.create("distribution.unifrom")',
-      "UnknownNameError", "unknown node type 'distribution.unifrom' (did you mean 'distribution.uniform'?); known "
-                          "node types: create.camera, create.capsule, create.cone, create.cube, create.cylinder, "
-                          "create.disk, create.from_usd, create.group, create.light, create.material_omnipbr, "
-                          "create.plane, create.sphere, create.torus, create.xform, distribution.choice, "
-                          "distribution.combine, distribution.log_uniform, distribution.normal, distribution.sequence, "
-                          "distribution.uniform, gate.environments, get.prim_at_path, get.prims, modify.attribute, "
-                          "modify.material, modify.pose, modify.pose_camera_relative, modify.pose_orbit, "
-                          "modify.semantics, modify.timeline, modify.variant, modify.visibility, physics.collider, "
-                          "physics.drive_properties, physics.mass, physics.physics_material, physics.reset, "
-                          "physics.rigid_body, physics.simulate, randomizer.color, randomizer.instantiate, "
-                          "randomizer.materials, randomizer.rotation, randomizer.scatter_2d, randomizer.scatter_3d, "
-                          "randomizer.texture, randomizer.write_articulation_view, randomizer.write_rigid_body_view, "
-                          "randomizer.write_simulation, trigger.on_condition, trigger.on_custom_event, "
-                          "trigger.on_frame, trigger.on_rl_frame, trigger.on_time, trigger.on_time_end"),
+      "UnknownNameError", "unknown node type 'distribution.unifrom' (did you mean "
+                          "'distribution.uniform'?); known node types: create.camera, create.capsule,"
+                          ' create.cone, create.cube, create.cylinder, create.disk, create.from_usd, '
+                          'create.group, create.light, create.material_omnipbr, create.omni_lidar, '
+                          'create.omni_radar, create.plane, create.sphere, create.torus, '
+                          'create.xform, distribution.choice, distribution.combine, '
+                          'distribution.log_uniform, distribution.normal, distribution.sequence, '
+                          'distribution.uniform, gate.environments, get.prim_at_path, get.prims, '
+                          'modify.attribute, modify.material, modify.pose, '
+                          'modify.pose_camera_relative, modify.pose_orbit, modify.semantics, '
+                          'modify.timeline, modify.variant, modify.visibility, physics.collider, '
+                          'physics.drive_properties, physics.mass, physics.physics_material, '
+                          'physics.reset, physics.rigid_body, physics.simulate, randomizer.color, '
+                          'randomizer.instantiate, randomizer.materials, randomizer.rotation, '
+                          'randomizer.scatter_2d, randomizer.scatter_3d, randomizer.texture, '
+                          'randomizer.write_articulation_view, randomizer.write_rigid_body_view, '
+                          'randomizer.write_simulation, trigger.on_condition, '
+                          'trigger.on_custom_event, trigger.on_frame, trigger.on_rl_frame, '
+                          'trigger.on_time, trigger.on_time_end'),
     C("graph", "an invalid regular expression in get.prims", 'rep.get.prims(path_pattern="[")',
       "ValueError", "path_pattern '[' is not a valid regular expression: unterminated character set at position 0"),
     C("graph", "a distribution of 2-vectors for a 3-vector position",
@@ -252,20 +257,34 @@ CASES: list[Case] = [
       "ValueError", "seek frame must be a non-negative integer, got -1"),
     # ---- annotators --------------------------------------------------------------------------------------------
     C("annotators", "a misspelt annotator name", 'rep.annotators.get("semantic_segmentaton")',
-      "AnnotatorRegistryError", "unknown annotator 'semantic_segmentaton' (did you mean 'semantic_segmentation'?); "
-                                "known annotators: CameraParams, HdrColor, HdrColorSD, HdrColor_fast, IsaacNoop, "
-                                "IsaacNoop_fast, IsaacReadSimulationTime, IsaacReadSimulationTime_fast, "
-                                "IsaacReadSystemTime, IsaacReadSystemTime_fast, LdrColor, LdrColorSD, "
-                          "MotionVectors, Occlusion, ReferenceTime, ReferenceTime_fast, StableIdMap, StableIdMap_fast, "
-                          "bounding_box_2d_loose, "
-                          "bounding_box_2d_loose_fast, bounding_box_2d_tight, bounding_box_2d_tight_fast, "
-                          "bounding_box_3d, bounding_box_3d_360, bounding_box_3d_360_fast, bounding_box_3d_fast, "
-                          "camera_params, camera_params_fast, distance_to_camera, distance_to_camera_fast, "
-                          "distance_to_image_plane, distance_to_image_plane_fast, instance_id_segmentation, "
-                          "instance_id_segmentation_fast, instance_segmentation, instance_segmentation_fast, "
-                          "motion_vectors, motion_vectors_fast, normals, normals_fast, occlusion, occlusion_fast, "
-                          "pointcloud, pointcloud_fast, rgb, rgb_fast, semantic_segmentation, "
-                          "semantic_segmentation_fast, skeleton_data, skeleton_data_fast"),
+      "AnnotatorRegistryError", "unknown annotator 'semantic_segmentaton' (did you mean "
+                                "'semantic_segmentation'?); known annotators: CameraParams, "
+                                'GenericModelOutput, GenericModelOutput_fast, HdrColor, HdrColorSD, '
+                                'HdrColor_fast, IsaacComputeRTXLidarFlatScan, '
+                                'IsaacComputeRTXLidarFlatScan_fast, IsaacCreateRTXLidarScanBuffer, '
+                                'IsaacCreateRTXLidarScanBufferForFlatScan, '
+                                'IsaacCreateRTXLidarScanBufferForFlatScan_fast, '
+                                'IsaacCreateRTXLidarScanBuffer_fast, IsaacCreateRTXRadarPointCloud, '
+                                'IsaacCreateRTXRadarPointCloud_fast, IsaacExtractRTXSensorPointCloud,'
+                                ' IsaacExtractRTXSensorPointCloudNoAccumulator, '
+                                'IsaacExtractRTXSensorPointCloudNoAccumulator_fast, '
+                                'IsaacExtractRTXSensorPointCloud_fast, IsaacNoop, IsaacNoop_fast, '
+                                'IsaacReadSimulationTime, IsaacReadSimulationTime_fast, '
+                                'IsaacReadSystemTime, IsaacReadSystemTime_fast, LdrColor, LdrColorSD,'
+                                ' MotionVectors, Occlusion, ReferenceTime, ReferenceTime_fast, '
+                                'StableIdMap, StableIdMap_fast, bounding_box_2d_loose, '
+                                'bounding_box_2d_loose_fast, bounding_box_2d_tight, '
+                                'bounding_box_2d_tight_fast, bounding_box_3d, bounding_box_3d_360, '
+                                'bounding_box_3d_360_fast, bounding_box_3d_fast, camera_params, '
+                                'camera_params_fast, distance_to_camera, distance_to_camera_fast, '
+                                'distance_to_image_plane, distance_to_image_plane_fast, dope, '
+                                'dope_fast, instance_id_segmentation, instance_id_segmentation_fast, '
+                                'instance_segmentation, instance_segmentation_fast, motion_vectors, '
+                                'motion_vectors_fast, normals, normals_fast, occlusion, '
+                                'occlusion_fast, pointcloud, pointcloud_fast, pose, pose_fast, rgb, '
+                                'rgb_fast, semantic_segmentation, semantic_segmentation_fast, '
+                                'sensor_point_cloud, sensor_point_cloud_fast, skeleton_data, '
+                                'skeleton_data_fast'),
     C("annotators", "an annotator name that is not a string", "rep.annotators.get(3)",
       "TypeError", "annotator name must be a string, got int"),
     C("annotators", "a misspelt init parameter",
@@ -293,8 +312,10 @@ CASES: list[Case] = [
                           "LdrColor, LdrColorSD, Motion2d, MotionVectorsSD, NormalSD, SmoothNormal, TargetMotionSD"),
     # ---- writers -------------------------------------------------------------------------------------------------
     C("writers", "a misspelt writer name", 'rep.writers.get("BasicWritter")',
-      "UnknownNameError", "unknown writer 'BasicWritter' (did you mean 'BasicWriter'?); known writers: BasicWriter, "
-                          "BopWriter, CocoWriter, CosmosWriter, KittiWriter, PoseWriter, WebDatasetWriter, YoloWriter"),
+      "UnknownNameError", "unknown writer 'BasicWritter' (did you mean 'BasicWriter'?); known "
+                          'writers: BasicWriter, BopWriter, CocoWriter, CosmosWriter, DOPEWriter, '
+                          'KittiWriter, PointCloudWriter, PoseWriter, PytorchWriter, '
+                          'WebDatasetWriter, YCBVideoWriter, YoloWriter'),
     C("writers", "a misspelt writer flag", 'rep.writers.get("BasicWriter").initialize(output_dir=tmp, rgb=True, '
                                            'bounding_box_2d_thight=True)',
       "TypeError", "BasicWriter.initialize() got unknown parameter(s) ['bounding_box_2d_thight'] (did you mean "
@@ -368,7 +389,8 @@ CASES: list[Case] = [
       "ValueError", "resolution 100000x10 exceeds the largest supported edge 4096 (setting "
                     "/graphsdg/render/maxResolution)"),
     C("render products", "a render product of a prim that is not a camera", "rep.create.render_product(cube, (32, 32))",
-      "InvalidPrimError", "render product camera '/World/Cube' is a Cube prim, not a UsdGeom.Camera"),
+      "InvalidPrimError", "render product camera '/World/Cube' is a Cube prim, not a UsdGeom.Camera "
+                          '(or an OmniLidar / OmniRadar sensor)'),
     C("render products", "stepping after destroying a product an annotator still uses",
       'a = rep.annotators.get("rgb")\na.attach(rp)\nrp.destroy()\nrep.orchestrator.step()',
       "RenderProductDestroyedError", "render product 'Replicator' (/Render/RenderProduct_Replicator) was destroyed "
