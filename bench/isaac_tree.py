@@ -52,6 +52,8 @@ OUT_OF_SCOPE = {
     "deprecated/isaacsim.sensors.rtx/": "RTX sensors (issue 35)",
     "extensions/isaacsim.replicator.synthetic_recorder/isaacsim/replicator/synthetic_recorder/tests/test_recorder_ui.py":
         "Kit UI windows",
+    "standalone_examples/testing/doc_snippets/test_snippets_async.py":
+        "its snippets (docs/isaacsim/snippets) are not in the repository",
     "standalone_examples/benchmarks/workflows/benchmark_workflow_manipulation_vision_cumotion.py":
         "cuMotion motion generation (NVIDIA's closed CUDA library)",
 }
