@@ -249,3 +249,49 @@ def test_articulation_roots_and_base_paths(compat):
     assert find_all_articulation_base_paths() == []
     move_articulation_root(root, stage.GetPrimAtPath("/World/ur10"))     # root is no longer a root: nothing moves
     assert not stage.GetPrimAtPath("/World/ur10").HasAPI(UsdPhysics.ArticulationRootAPI)
+
+
+def test_isaac_sim_commands_spawn_teleport_scale_destroy(compat, tmp_path):
+    import omni.kit.commands
+    asset = tmp_path / "block.usda"
+    asset.write_text('#usda 1.0\n(\n    defaultPrim = "Block"\n)\ndef Cube "Block"\n{\n    double size = 0.5\n}\n')
+    stage = rep.stage.new_stage()
+    h = math.sqrt(0.5)
+    # rotations are (x, y, z, w): 90 degrees about z
+    assert omni.kit.commands.execute("IsaacSimSpawnPrim", usd_path=str(asset), prim_path="/Block",
+                                     translation=(1, 2, 0), rotation=(0, 0, h, h)) == (True, True)
+    block = stage.GetPrimAtPath("/Block")
+    assert block.GetTypeName() == "Xform" and block.HasAuthoredReferences()
+    np.testing.assert_allclose(world(block)[:3, 3], [1, 2, 0], atol=1e-9)
+    np.testing.assert_allclose(world(block)[:3, :3], quat_matrix([h, 0, 0, h]), atol=1e-6)
+    omni.kit.commands.execute("IsaacSimTeleportPrim", prim_path="/Block", translation=(-1, -1, 3))
+    np.testing.assert_allclose(world(block)[:3, 3], [-1, -1, 3], atol=1e-9)
+    np.testing.assert_allclose(world(block)[:3, :3], np.eye(3), atol=1e-6)     # the default rotation: identity
+    for _ in range(2):                                                           # scales compose in the prim's frame
+        omni.kit.commands.execute("IsaacSimScalePrim", prim_path="/Block", scale=(1.5, 1.5, 1.0))
+    np.testing.assert_allclose(Gf.Transform(Gf.Matrix4d(world(block).T.tolist())).GetScale(), [2.25, 2.25, 1.0],
+                               atol=1e-9)
+    np.testing.assert_allclose(world(block)[:3, 3], [-1, -1, 3], atol=1e-9)
+    omni.kit.commands.execute("IsaacSimDestroyPrim", prim_path="/Block")
+    assert not stage.GetPrimAtPath("/Block")
+
+
+def test_teleporting_a_simulated_body_stops_it_and_scaling_leaves_it(compat):
+    import omni.kit.commands
+    from graphsdg.physics.bodies import RigidBodyView
+    rep.stage.new_stage()
+    rep.functional.physics.create_physics_scene("/PhysicsScene")
+    cube = rep.functional.create.cube(name="Falling", position=(0, 0, 5))
+    rep.functional.physics.apply_rigid_body(cube)
+    timeline = rep.timeline.get_timeline_interface()
+    timeline.play()
+    for _ in range(10):
+        rep.orchestrator.update()
+    assert RigidBodyView(["/Falling"]).get_velocities()[0][0, 2] < -0.5
+    omni.kit.commands.execute("IsaacSimTeleportPrim", prim_path="/Falling", translation=(2, 0, 5))
+    linear, angular = RigidBodyView(["/Falling"]).get_velocities()
+    assert np.abs(linear).max() == 0 and np.abs(angular).max() == 0
+    np.testing.assert_allclose(world(cube)[:3, 3], [2, 0, 5], atol=1e-9)
+    omni.kit.commands.execute("IsaacSimScalePrim", prim_path="/Falling", scale=(3, 3, 3))
+    np.testing.assert_allclose(Gf.Transform(Gf.Matrix4d(world(cube).T.tolist())).GetScale(), [1, 1, 1], atol=1e-9)
+    timeline.stop()
