@@ -264,6 +264,13 @@ def test_rendering_manager_frame_length_and_render_only_updates(compat):
     timeline.stop()
     with pytest.raises(ValueError, match="positive"):
         RenderingManager.set_dt(0.0)
+    import carb.settings
+    settings = carb.settings.get_settings()
+    settings.set_bool("/app/runLoops/main/rateLimitEnabled", True)   # Kit's rate-limit frequency: 120 Hz
+    assert RenderingManager.get_dt() == pytest.approx(1 / 120)
+    RenderingManager.set_dt(1 / 99)
+    assert RenderingManager.get_dt() == pytest.approx(1 / 99)
+    settings.set_bool("/app/runLoops/main/rateLimitEnabled", False)
     uid = RenderingManager.register_callback(RenderingEvent.NEW_FRAME, callback=lambda event: None)
     RenderingManager.deregister_callback(uid)
     camera = ViewportManager.get_camera()

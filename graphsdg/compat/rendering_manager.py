@@ -51,6 +51,7 @@ log = logging.getLogger("carb")
 
 RATE_LIMIT_ENABLED = "/app/runLoops/main/rateLimitEnabled"
 RATE_LIMIT_FREQUENCY = "/app/runLoops/main/rateLimitFrequency"
+KIT_RATE_LIMIT_FREQUENCY = 120.0   # Kit's default for the setting (what Isaac reads until a script sets it)
 
 
 class _LoopRunner:
@@ -60,10 +61,10 @@ class _LoopRunner:
 
 
 def app_dt() -> float:
-    """The application's frame length: the rate limit's when it is on, else the loop runner's, else the
-    timeline's frame (``1 / time codes per second``)."""
+    """The application's frame length: the rate limit's when it is on (Kit's 120 Hz unless set), else the loop
+    runner's, else the timeline's frame (``1 / time codes per second``)."""
     if settings.get(RATE_LIMIT_ENABLED, False):
-        frequency = float(settings.get(RATE_LIMIT_FREQUENCY, 0.0) or 0.0)
+        frequency = float(settings.get(RATE_LIMIT_FREQUENCY, KIT_RATE_LIMIT_FREQUENCY) or 0.0)
         return 1.0 / frequency if frequency else 0.0
     if _LoopRunner.manual_step_size is not None:
         return _LoopRunner.manual_step_size
