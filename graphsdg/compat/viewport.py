@@ -213,3 +213,8 @@ def modules() -> list[types.ModuleType]:
 
 def _reset(_: Any = None) -> None:
     _viewport.__init__()
+
+
+def install() -> None:
+    """A fresh viewport for each install (Kit's app starts with its default camera and resolution)."""
+    _reset()
