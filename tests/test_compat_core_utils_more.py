@@ -209,6 +209,7 @@ def test_camera_view_and_viewport_intrinsics(compat):
         .ComputeLocalToWorldTransform(0)
     np.testing.assert_allclose(list(m.GetRow3(2)), [0.0, 0.0, 1.0], atol=1e-9)
     viewport = vp_utils.get_active_viewport()
+    default = viewport.resolution
     viewport.resolution = (640, 480)
     k = get_intrinsics_matrix(viewport)
     focal = 18.147562
@@ -219,6 +220,7 @@ def test_camera_view_and_viewport_intrinsics(compat):
     np.testing.assert_allclose(points[240 * 640 + 320], [0.0, 0.0, 2.0])
     np.testing.assert_allclose(points[0], [-320 * 2.0 / k[0, 0], -240 * 2.0 / k[1, 1], 2.0])
     assert get_viewport_names() == ["Viewport"]
+    viewport.resolution = default               # the viewport outlives the stage: leave it as found
 
 
 def test_render_product_helpers_change_the_capture(compat):
@@ -279,8 +281,10 @@ def test_rendering_manager_frame_length_and_render_only_updates(compat):
     m = UsdGeom.Xformable(camera.GetPrim()).ComputeLocalToWorldTransform(0)
     np.testing.assert_allclose(list(m.GetRow3(2)), [1.0, 0.0, 0.0], atol=1e-9)
     assert ViewportManager.wait_for_viewport() == (True, 0)
+    default = ViewportManager.get_resolution()
     ViewportManager.set_resolution((320, 240))
     assert ViewportManager.get_resolution() == (320, 240)
+    ViewportManager.set_resolution(default)       # the viewport outlives the stage: leave it as found
 
 
 def test_version_and_deprecation_manager(compat, monkeypatch, tmp_path):
