@@ -84,9 +84,35 @@ def render_product_tiled(cameras: Any, tile_resolution: Any, force_new: bool = F
         f"rep.create.render_product(cameras, tile_resolution) returns one per camera of a list")
 
 
+def omni_lidar(position: Any = None, rotation: Any = None, look_at: Any = None, look_at_up_axis: Any = None,
+               count: int = 1, parent: Any = None, name: str | None = None, config: str | None = None,
+               variant: Any = None, **attributes: Any) -> ReplicatorItem:
+    """``count`` ray-cast lidars (``OmniLidar`` prims, docs/sensors.md): ``config`` / ``variant`` pick a profile,
+    keyword arguments set ``omni:sensor:Core:*`` attributes by name; pose arguments may be distributions."""
+    return _sensor_call("create.omni_lidar", name, dict(
+        position=position, rotation=rotation, look_at=look_at, look_at_up_axis=look_at_up_axis, count=count,
+        parent=parent, config=config, variant=variant, attributes=attributes))
+
+
+def omni_radar(position: Any = None, rotation: Any = None, look_at: Any = None, look_at_up_axis: Any = None,
+               count: int = 1, parent: Any = None, name: str | None = None, **attributes: Any) -> ReplicatorItem:
+    """``count`` ray-cast radars (``OmniRadar`` prims, docs/sensors.md); keyword arguments set
+    ``omni:sensor:WpmDmat:*`` attributes by name; pose arguments may be distributions."""
+    return _sensor_call("create.omni_radar", name, dict(
+        position=position, rotation=rotation, look_at=look_at, look_at_up_axis=look_at_up_axis, count=count,
+        parent=parent, attributes=attributes))
+
+
+def _sensor_call(type_name: str, name: str | None, values: dict[str, Any]) -> ReplicatorItem:
+    from graphsdg.graph.builder import add_node
+    from graphsdg.graph.registry import NodeRegistry
+
+    return add_node(NodeRegistry.get(type_name)(name=name, **values))
+
+
 def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None = None) -> None:
     """Add ``fn`` as ``rep.create.<fn_name>``."""
     register_function(sys.modules[__name__], fn, override, fn_name)
 
 
-__all__ = [*_calls, "from_dir", "stereo_camera", "register", "render_product"]
+__all__ = [*_calls, "from_dir", "stereo_camera", "omni_lidar", "omni_radar", "register", "render_product"]

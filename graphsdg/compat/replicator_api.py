@@ -41,8 +41,6 @@ REFUSED: dict[str, dict[str, str]] = {
         "mesh_decal": "RTX mesh decals are not rendered by MuJoCo's rasteriser",
         "tiled_sensor": "it is Replicator's deprecated RTX-sensor tiling (RTX sensors do not exist here); use "
                         "one render product per camera",
-        "omni_lidar": "RTX lidar sensors are not available in graphsdg (no RTX sensor models)",
-        "omni_radar": "RTX radar sensors are not available in graphsdg (no RTX sensor models)",
         "render_product_tiled": "tiled render products are not available in this build",
     },
     "get": {

@@ -40,6 +40,7 @@ from pxr import Usd
 
 from graphsdg import rng
 from graphsdg.sensors.lidar_profile import LidarProfile, LidarProfileError, output_settings, read_lidar_profile
+from graphsdg.sensors.mesh_bounds import sync_mesh_trees
 from graphsdg.sensors.ray_backend import ray_caster
 from graphsdg.sensors.scan_pattern import Firings, ScanPattern
 from graphsdg.sensors.scene_motion import GeomMotion, point_velocities, refresh_velocities
@@ -146,7 +147,9 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
     dirs_sensor = firings.directions()
     dirs_world = np.einsum("nij,nj->ni", rotations, dirs_sensor)
     motion = GeomMotion.still() if frozen else GeomMotion.of(m, d)
-    hits = ray_caster().cast(m, d, origins, dirs_world, dt, motion, cutoff=profile.far_range_m / mpu)
+    sync_mesh_trees(sim)
+    hits = ray_caster().cast(m, d, origins, dirs_world, dt, motion, cutoff=profile.far_range_m / mpu,
+                             mesh_stamps=sim.mesh_stamps)
     true_range = np.where(hits.geom >= 0, hits.distance * mpu, 0.0)
     surface = surface_table(sim)
     cos_incidence = np.abs(np.einsum("ij,ij->i", hits.normal, dirs_world))

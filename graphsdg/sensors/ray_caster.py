@@ -92,9 +92,11 @@ class CpuRayCaster:
 
     def cast(self, model: mujoco.MjModel, data: mujoco.MjData, origins: np.ndarray, directions: np.ndarray,
              dt: np.ndarray, motion: GeomMotion | None = None, cutoff: float = 1e30,
-             geomgroup: np.ndarray | None = None) -> RayHits:
+             geomgroup: np.ndarray | None = None, mesh_stamps: np.ndarray | None = None) -> RayHits:
         """Cast rays from ``origins`` (N, 3) along unit ``directions`` (N, 3) at times ``dt`` (N,) seconds from
-        the capture, against the geoms drawn (``geomgroup``), no farther than ``cutoff`` model units."""
+        the capture, against the geoms drawn (``geomgroup``), no farther than ``cutoff`` model units.
+        ``mesh_stamps`` (the scene's per-mesh change counts) is for casters that keep their own mesh copies;
+        ``mj_multiRay`` reads the model's (trees synced by :mod:`graphsdg.sensors.mesh_bounds`)."""
         count = len(directions)
         hits = RayHits.empty(count)
         if count == 0:
@@ -133,6 +135,11 @@ class CpuRayCaster:
                 pool = self._executor()
                 for future in [pool.submit(run, k, share) for k, share in enumerate(shares)]:
                     future.result()
+        # mj_multiRay's cutoff culls geoms by their bounds, so a hit past it can still come back: drop it
+        far = (geom >= 0) & (dist > cutoff)
+        if far.any():
+            dist[far], geom[far] = -1.0, -1
+            normal.reshape(-1, 3)[far] = 0.0
         hits.distance[order] = dist
         hits.geom[order] = geom
         hits.normal[order] = normal.reshape(-1, 3)

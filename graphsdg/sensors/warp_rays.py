@@ -35,28 +35,81 @@ class WarpRayCaster:
         self._model: mujoco.MjModel | None = None
         self._lock = threading.Lock()
 
-    def _prepare(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
-        """Put ``model`` on the device (when it changed) and ``data``'s geom and flex poses."""
+    def _prepare(self, model: mujoco.MjModel, data: mujoco.MjData, mesh_stamps: np.ndarray | None = None) -> None:
+        """Put ``model`` on the device (when it changed), the meshes whose stamps moved, and ``data``'s geom and
+        flex poses."""
         wp, mjw = self._wp, self._mjw
         with wp.ScopedDevice(self.device):
             if self._model is not model:
+                self._stamps = np.array(mesh_stamps if mesh_stamps is not None else [], dtype=np.int64)
+                self._sizes = None
                 self._m = mjw.put_model(model)
                 self._d = mjw.put_data(model, data)
                 groups = [g for g in range(6) if drawn_group_mask()[g]]
                 self._rc = mjw.create_render_context(model, nworld=1, cam_active=[], enabled_geom_groups=groups,
                                                      render_rgb=False, render_depth=False, render_seg=False)
                 self._model = model
+            elif mesh_stamps is not None:
+                self._refit_meshes(model, np.asarray(mesh_stamps, dtype=np.int64))
+            self._sync_geom_sizes(model)
             self._d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
             self._d.geom_xmat.assign(np.asarray(data.geom_xmat, dtype=np.float32).reshape(1, -1, 3, 3))
             if model.nflex:
                 self._d.flexvert_xpos.assign(np.asarray(data.flexvert_xpos, dtype=np.float32)[None])
             mjw.refit_bvh(self._m, self._d, self._rc)
 
+    def _sync_geom_sizes(self, model: mujoco.MjModel) -> None:
+        """The geoms' sizes and bounds as the model holds them now (rescales edit them in place)."""
+        sizes = np.asarray(model.geom_size, dtype=np.float32)
+        if getattr(self, "_sizes", None) is not None and np.array_equal(sizes, self._sizes):
+            return
+        self._m.geom_size.assign(sizes[None])
+        self._m.geom_rbound.assign(np.asarray(model.geom_rbound, dtype=np.float32)[None])
+        self._m.geom_aabb.assign(np.asarray(model.geom_aabb, dtype=np.float32).reshape(1, -1, 2, 3))
+        self._sizes = sizes
+
+    def _refit_meshes(self, model: mujoco.MjModel, stamps: np.ndarray) -> None:
+        """New vertices, BVH and bounds for the meshes whose stamps moved since the last cast (rescaled in
+        place, :mod:`graphsdg.sim.mesh_scaling`)."""
+        seen = np.zeros(model.nmesh, dtype=np.int64)
+        seen[:min(model.nmesh, len(self._stamps))] = self._stamps[:model.nmesh]
+        now = np.zeros(model.nmesh, dtype=np.int64)
+        now[:min(model.nmesh, len(stamps))] = stamps[:model.nmesh]
+        changed = np.flatnonzero(now != seen)
+        if not changed.size:
+            return
+        ids = self._rc.mesh_bvh_id.numpy()
+        bounds = self._rc.mesh_bounds_size.numpy()
+        for mesh_id in changed.tolist():
+            v0, nv = int(model.mesh_vertadr[mesh_id]), int(model.mesh_vertnum[mesh_id])
+            verts = np.asarray(model.mesh_vert[v0:v0 + nv], dtype=np.float32)
+            mesh = self._rc.mesh_registry.get(int(ids[mesh_id]))
+            if mesh is None or not nv:
+                continue
+            mesh.points.assign(verts)
+            mesh.refit()
+            bounds[mesh_id] = np.abs(verts).max(axis=0)
+        self._rc.mesh_bounds_size.assign(bounds)
+        self._stamps = now
+
+    def device_scene(self, model: mujoco.MjModel, data: mujoco.MjData) -> tuple:
+        """(MuJoCo Warp model, data, render context) on the device, posed as ``data`` (for batched kernels)."""
+        with self._lock:
+            self._prepare(model, data)
+            return self._m, self._d, self._rc
+
+    def group_mask(self, geomgroup: np.ndarray | None = None):
+        """``rays``' geom-group mask: the drawn groups, or ``geomgroup``."""
+        group = drawn_group_mask() if geomgroup is None else np.asarray(geomgroup)
+        vec6 = self._mjw.vec6 if hasattr(self._mjw, "vec6") else self._wp.types.vector(6, int)
+        return vec6(*[int(g) for g in group])
+
     def cast(self, model: mujoco.MjModel, data: mujoco.MjData, origins: np.ndarray, directions: np.ndarray,
              dt: np.ndarray, motion: GeomMotion | None = None, cutoff: float = 1e30,
-             geomgroup: np.ndarray | None = None) -> RayHits:
+             geomgroup: np.ndarray | None = None, mesh_stamps: np.ndarray | None = None) -> RayHits:
         """Cast rays from ``origins`` along unit ``directions`` at times ``dt`` from the capture (as the CPU
-        caster does); hits farther than ``cutoff`` model units count as misses."""
+        caster does); hits farther than ``cutoff`` model units count as misses. The meshes whose
+        ``mesh_stamps`` moved since the last cast get their vertices and BVHs anew first."""
         count = len(directions)
         hits = RayHits.empty(count)
         if count == 0:
@@ -65,11 +118,9 @@ class WarpRayCaster:
         motion = motion if motion is not None else GeomMotion.still()
         origins = np.asarray(origins, dtype=np.float64)
         order, bounds = slice_bounds(origins, np.asarray(dt, dtype=np.float64), motion)
-        group = drawn_group_mask() if geomgroup is None else np.asarray(geomgroup)
-        vec6 = mjw.vec6 if hasattr(mjw, "vec6") else wp.types.vector(6, int)
-        mask = vec6(*[int(g) for g in group])
+        mask = self.group_mask(geomgroup)
         with self._lock, wp.ScopedDevice(self.device):
-            self._prepare(model, data)
+            self._prepare(model, data, mesh_stamps)
             pnt = wp.array(origins[order].astype(np.float32)[None], dtype=wp.vec3)
             vec = wp.array(np.asarray(directions, dtype=np.float32)[order][None], dtype=wp.vec3)
             dist = wp.empty((1, count), dtype=float)
