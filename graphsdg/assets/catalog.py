@@ -309,7 +309,9 @@ def give_root_pose_ops(path: str) -> None:
     xformable = UsdGeom.Xformable(root)
     if xformable.GetOrderedXformOps():
         return
-    xformable.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(0.0, 0.0, 0.0))
-    xformable.AddOrientOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Quatd(1.0, 0.0, 0.0, 0.0))
-    xformable.AddScaleOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(1.0, 1.0, 1.0))
+    # USD's default precisions (double translate, float orient and scale), which scripts that add the ops
+    # themselves when missing also get, so one Set() call fits either way
+    xformable.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 0.0))
+    xformable.AddOrientOp().Set(Gf.Quatf(1.0, 0.0, 0.0, 0.0))
+    xformable.AddScaleOp().Set(Gf.Vec3f(1.0, 1.0, 1.0))
     stage.GetRootLayer().Save()
