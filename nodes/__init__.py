@@ -4,6 +4,7 @@ Importing this package registers the node types with the runtime's registries;
 ``import graphsdg`` does so. The runtime itself never imports a concrete node.
 """
 from . import annotators, isaac_annotators, sensor_annotators  # noqa: F401  (register annotator types)
+from . import depth_sensor_annotators  # noqa: F401  (single-view depth sensor annotator types)
 from . import create, distributions, get, modify, physics, randomizers, triggers  # noqa: F401  (register node types)
 from . import domain_randomization  # noqa: F401  (physics domain-randomization node types)
 from . import sensor_creators  # noqa: F401  (rep.create.omni_lidar / omni_radar node types)

@@ -48,7 +48,7 @@ def test_rescaled_mesh_returns_match_a_mesh_built_at_that_scale(scale: float, st
 
 @pytest.mark.parametrize("module", ["mesh_bounds", "scan_pattern", "ray_caster", "scene_motion", "sensor_pose",
                                     "surface_materials", "generic_model_output", "scan_outputs", "lidar_scan",
-                                    "radar_scan", "ray_backend"])
+                                    "radar_scan", "ray_backend", "stereo_depth"])
 def test_sensor_room_examples(module: str) -> None:
     import doctest
     import importlib
