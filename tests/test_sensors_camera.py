@@ -151,3 +151,17 @@ def test_single_view_depth_sensor_stereo_model(kit) -> None:
     app.update()
     app.update()
     assert not sensor.get_current_frame()["DepthSensorDistance"].any()
+
+
+def test_camera_module_distortion_helpers() -> None:
+    from graphsdg.compat import sensors_camera as cam
+
+    k = [[100.0, 0.0, 50.0], [0.0, 100.0, 40.0], [0.0, 0.0, 1.0]]
+    assert np.isclose(cam.point_to_theta(k, 150.0, 40.0), np.pi / 4)
+    # rational model, k1 only: a point one focal length off axis moves out by (1 + k1)
+    moved = cam.distort_point_rational_polynomial(k, [0.1, 0, 0, 0, 0, 0, 0, 0], np.array([150.0]), np.array([40.0]))
+    np.testing.assert_allclose(moved.ravel(), [160.0, 40.0])
+    # Kannala-Brandt without coefficients: the equidistant fisheye, radius f * theta
+    fisheye = cam.distort_point_kannala_brandt(k, [0, 0, 0, 0], np.array([150.0]), np.array([40.0]))
+    np.testing.assert_allclose(fisheye.ravel(), [50.0 + 100.0 * np.pi / 4, 40.0])
+    np.testing.assert_array_equal(cam.W_U_TRANSFORM[:3, :3] @ cam.U_W_TRANSFORM[:3, :3], np.eye(3))

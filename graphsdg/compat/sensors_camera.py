@@ -76,6 +76,51 @@ FISHEYE_KEYS = ("fthetaWidth", "fthetaHeight", "fthetaCx", "fthetaCy", "fthetaMa
 POLY_KEYS = tuple(f"fthetaPoly{letter}" for letter in "ABCDEF")
 
 
+# 4x4 changes of camera axes, read right to left: X_Y_TRANSFORM takes points in Y's axes to X's (R: ROS,
+# U: USD, W: world camera axes; the 3x3 blocks are CAMERA_AXES and their transposes)
+U_R_TRANSFORM = np.diag([1, -1, -1, 1])
+R_U_TRANSFORM = np.diag([1, -1, -1, 1])
+U_W_TRANSFORM = np.eye(4, dtype=int)
+U_W_TRANSFORM[:3, :3] = CAMERA_AXES["world"].astype(int)
+W_U_TRANSFORM = U_W_TRANSFORM.T.copy()
+
+
+def _normalised(camera_matrix: Any, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, float, float, float, float]:
+    k = np.asarray(camera_matrix, dtype=np.float64)
+    fx, fy, cx, cy = k[0, 0], k[1, 1], k[0, 2], k[1, 2]
+    return (np.asarray(x, dtype=np.float64) - cx) / fx, (np.asarray(y, dtype=np.float64) - cy) / fy, fx, fy, cx, cy
+
+
+def point_to_theta(camera_matrix: Any, x: Any, y: Any) -> Any:
+    """Angle (radians) between the optical axis and the ray through pixel(s) ``(x, y)`` of a pinhole camera."""
+    u, v, *_ = _normalised(camera_matrix, x, y)
+    return np.arctan(np.hypot(u, v))
+
+
+def distort_point_rational_polynomial(camera_matrix: Any, distortion_model: Any, x: Any, y: Any) -> np.ndarray:
+    """Pixel(s) ``(x, y)`` of an ideal pinhole moved by OpenCV's rational model (k1 k2 p1 p2 k3 k4 k5 k6), as
+    ``cv2.projectPoints``; returns ``[x', y']``."""
+    import cv2
+
+    u, v, *_ = _normalised(camera_matrix, x, y)
+    points = np.stack([np.ravel(u), np.ravel(v), np.ones(np.size(u))], axis=-1)
+    out, _ = cv2.projectPoints(points, np.zeros(3), np.zeros(3), np.asarray(camera_matrix, dtype=np.float64),
+                               np.asarray(distortion_model, dtype=np.float64))
+    return np.array([out[:, 0, 0].reshape(np.shape(u)), out[:, 0, 1].reshape(np.shape(u))])
+
+
+def distort_point_kannala_brandt(camera_matrix: Any, distortion_model: Any, x: Any, y: Any) -> np.ndarray:
+    """Pixel(s) ``(x, y)`` of an ideal pinhole moved by the Kannala-Brandt fisheye model (k1..k4), as
+    ``cv2.fisheye.projectPoints``; returns ``[x', y']``."""
+    import cv2
+
+    u, v, *_ = _normalised(camera_matrix, x, y)
+    points = np.stack([np.ravel(u), np.ravel(v), np.ones(np.size(u))], axis=-1)[:, None, :]
+    out, _ = cv2.fisheye.projectPoints(points, np.zeros(3), np.zeros(3), np.asarray(camera_matrix, dtype=np.float64),
+                                       np.asarray(distortion_model, dtype=np.float64)[:4])
+    return np.array([out[:, 0, 0].reshape(np.shape(u)), out[:, 0, 1].reshape(np.shape(u))])
+
+
 def carb_warn(message: str) -> None:
     """``carb.log_warn`` as scripts see it (tests patch it), else the ``carb`` logger."""
     carb = sys.modules.get("carb")
@@ -665,8 +710,12 @@ class Camera(BaseSensor):
 
 def modules() -> list:
     """The ``isaacsim.sensors.camera`` modules."""
-    return [CompatModule("isaacsim.sensors.camera", Camera=Camera),
-            CompatModule("isaacsim.sensors.camera.camera", Camera=Camera)]
+    names = dict(Camera=Camera, R_U_TRANSFORM=R_U_TRANSFORM, U_R_TRANSFORM=U_R_TRANSFORM,
+                 U_W_TRANSFORM=U_W_TRANSFORM, W_U_TRANSFORM=W_U_TRANSFORM, point_to_theta=point_to_theta,
+                 distort_point_rational_polynomial=distort_point_rational_polynomial,
+                 distort_point_kannala_brandt=distort_point_kannala_brandt,
+                 USD_CAMERA_TENTHS_TO_STAGE_UNIT=TENTHS)
+    return [CompatModule("isaacsim.sensors.camera", **names), CompatModule("isaacsim.sensors.camera.camera", **names)]
 
 
 EXTENSIONS = {"isaacsim.sensors.camera": ("isaacsim.sensors.camera",)}
