@@ -18,7 +18,7 @@ import sys
 from typing import Any, Callable
 
 from graphsdg import modify
-from graphsdg.graph.calls import family_calls
+from graphsdg.graph.calls import add_family_node, family_calls
 from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function
 from graphsdg.io.file_search import get_usd_files
@@ -89,25 +89,18 @@ def omni_lidar(position: Any = None, rotation: Any = None, look_at: Any = None, 
                variant: Any = None, **attributes: Any) -> ReplicatorItem:
     """``count`` ray-cast lidars (``OmniLidar`` prims, docs/sensors.md): ``config`` / ``variant`` pick a profile,
     keyword arguments set ``omni:sensor:Core:*`` attributes by name; pose arguments may be distributions."""
-    return _sensor_call("create.omni_lidar", name, dict(
-        position=position, rotation=rotation, look_at=look_at, look_at_up_axis=look_at_up_axis, count=count,
-        parent=parent, config=config, variant=variant, attributes=attributes))
+    return add_family_node("create", "omni_lidar", name=name, position=position, rotation=rotation,
+                           look_at=look_at, look_at_up_axis=look_at_up_axis, count=count, parent=parent,
+                           config=config, variant=variant, attributes=attributes)
 
 
 def omni_radar(position: Any = None, rotation: Any = None, look_at: Any = None, look_at_up_axis: Any = None,
                count: int = 1, parent: Any = None, name: str | None = None, **attributes: Any) -> ReplicatorItem:
     """``count`` ray-cast radars (``OmniRadar`` prims, docs/sensors.md); keyword arguments set
     ``omni:sensor:WpmDmat:*`` attributes by name; pose arguments may be distributions."""
-    return _sensor_call("create.omni_radar", name, dict(
-        position=position, rotation=rotation, look_at=look_at, look_at_up_axis=look_at_up_axis, count=count,
-        parent=parent, attributes=attributes))
-
-
-def _sensor_call(type_name: str, name: str | None, values: dict[str, Any]) -> ReplicatorItem:
-    from graphsdg.graph.builder import add_node
-    from graphsdg.graph.registry import NodeRegistry
-
-    return add_node(NodeRegistry.get(type_name)(name=name, **values))
+    return add_family_node("create", "omni_radar", name=name, position=position, rotation=rotation,
+                           look_at=look_at, look_at_up_axis=look_at_up_axis, count=count, parent=parent,
+                           attributes=attributes)
 
 
 def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None = None) -> None:

@@ -59,6 +59,17 @@ def family_calls(family: str) -> dict[str, Callable[..., ReplicatorItem]]:
     return calls
 
 
+def add_family_node(family: str, name_in_family: str, **values: Any) -> ReplicatorItem:
+    """Build the node of ``family``'s type called ``name_in_family`` with ``values`` (for a face's hand-written call
+    whose node type declares no generated call, e.g. ``rep.create.omni_lidar`` with its attribute keywords)."""
+    for type_name in NodeRegistry.types(family):
+        node_cls = NodeRegistry.get(type_name)
+        if call_name(node_cls) == name_in_family:
+            return add_node(node_cls(**values))
+    raise GraphBuildError(f"no {family} node type is called {name_in_family!r}; {family} has: "
+                          f"{', '.join(sorted(call_name(NodeRegistry.get(t)) for t in NodeRegistry.types(family)))}")
+
+
 def call_name(node_cls: type[Node]) -> str:
     """``pose`` for ``modify.pose``: the name of the node type's call in its family's namespace."""
     return node_cls.type_name.split(".", 1)[1]
