@@ -259,9 +259,13 @@ CASES: list[Case] = [
     C("annotators", "a misspelt annotator name", 'rep.annotators.get("semantic_segmentaton")',
       "AnnotatorRegistryError", "unknown annotator 'semantic_segmentaton' (did you mean "
                                 "'semantic_segmentation'?); known annotators: CameraParams, "
-                                'GenericModelOutput, GenericModelOutput_fast, HdrColor, HdrColorSD, '
-                                'HdrColor_fast, IsaacComputeRTXLidarFlatScan, '
-                                'IsaacComputeRTXLidarFlatScan_fast, IsaacCreateRTXLidarScanBuffer, '
+                                'DepthSensorDistance, DepthSensorDistance_fast, DepthSensorImager, '
+                                'DepthSensorImager_fast, DepthSensorPointCloudColor, '
+                                'DepthSensorPointCloudColor_fast, DepthSensorPointCloudPosition, '
+                                'DepthSensorPointCloudPosition_fast, GenericModelOutput, '
+                                'GenericModelOutput_fast, HdrColor, HdrColorSD, HdrColor_fast, '
+                                'IsaacComputeRTXLidarFlatScan, IsaacComputeRTXLidarFlatScan_fast, '
+                                'IsaacCreateRTXLidarScanBuffer, '
                                 'IsaacCreateRTXLidarScanBufferForFlatScan, '
                                 'IsaacCreateRTXLidarScanBufferForFlatScan_fast, '
                                 'IsaacCreateRTXLidarScanBuffer_fast, IsaacCreateRTXRadarPointCloud, '
