@@ -116,6 +116,8 @@ def test_camera_view_batches_and_tiles(kit) -> None:
         view.get_data("normals")
     view.set_focal_lengths([2.0, 3.0, 4.0])
     np.testing.assert_allclose(view.get_focal_lengths(), [2.0, 3.0, 4.0])
+    view.set_shutter_properties([(0.0, 0.01), (0.0, 0.02), (0.005, 0.03)])
+    assert view.get_shutter_properties(indices=[2]) == [(0.005, pytest.approx(0.03))]
 
 
 def test_single_view_depth_sensor_stereo_model(kit) -> None:
@@ -165,3 +167,30 @@ def test_camera_module_distortion_helpers() -> None:
     fisheye = cam.distort_point_kannala_brandt(k, [0, 0, 0, 0], np.array([150.0]), np.array([40.0]))
     np.testing.assert_allclose(fisheye.ravel(), [50.0 + 100.0 * np.pi / 4, 40.0])
     np.testing.assert_array_equal(cam.W_U_TRANSFORM[:3, :3] @ cam.U_W_TRANSFORM[:3, :3], np.eye(3))
+
+
+def test_experimental_camera_sensor(kit) -> None:
+    app, timeline, rep = kit
+    from isaacsim.sensors.experimental.rtx import CameraSensor, RtxCamera, TiledCameraSensor
+
+    from graphsdg.compat.modules import CompatError
+
+    sensor = CameraSensor(RtxCamera("/World/Sensor", positions=[(0.0, 0.0, 2.0)], orientations=[(1.0, 0, 0, 0)]),
+                          resolution=(24, 32), annotators=["rgb", "distance_to_image_plane", "normals"])
+    assert sensor.get_data("rgb") == (None, {})                    # nothing rendered yet
+    timeline.play()
+    app.update()
+    app.update()
+    depth, _ = sensor.get_data("distance_to_image_plane")
+    rgb, _ = sensor.get_data("rgb")
+    normals, _ = sensor.get_data("normals")
+    assert depth.shape == (24, 32, 1) and rgb.shape == (24, 32, 3) and normals.shape == (24, 32, 3)
+    np.testing.assert_allclose(depth.numpy(), 2.0, atol=2e-4)
+    np.testing.assert_allclose(normals.numpy()[..., 2], 1.0, atol=1e-3)   # the floor faces up
+    with pytest.raises(ValueError, match="was not configured"):
+        sensor.get_data("semantic_segmentation")
+    rep.functional.create.camera(position=(0, 0, 1), parent="/World", name="Plain")
+    with pytest.raises(ValueError, match="OmniSensorAPI"):
+        RtxCamera("/World/Plain")
+    with pytest.raises(CompatError, match="CameraView"):
+        TiledCameraSensor("/World/Plain")

@@ -619,7 +619,7 @@ class Camera(BaseSensor):
             if model != "pinhole" and self.prim.HasAPI(model):
                 self.prim.RemoveAPI(model)
         if value != "pinhole":
-            self.prim.AddAppliedSchema(value)
+            self.prim.ApplyAPI(value)
             carb_warn(f"Camera {self.prim_path}: lens distortion {value!r} is authored; graphsdg renders pinhole "
                       f"images (docs/sensors.md)")
 

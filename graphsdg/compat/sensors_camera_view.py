@@ -363,13 +363,16 @@ class CameraView(XFormPrim):
         """Set stereo roles."""
         self._write("stereoRole", values, indices, type_name=Sdf.ValueTypeNames.Token)
 
-    def get_shutter_properties(self, indices: Any = None) -> tuple[list[float], list[float]]:
-        """(open delays, close delays) in seconds."""
-        return self._read("shutter:open", indices, 0.0), self._read("shutter:close", indices, 0.0)
+    def get_shutter_properties(self, indices: Any = None) -> list[tuple[float, float]]:
+        """(open delay, close delay) in seconds per camera."""
+        return list(zip(self._read("shutter:open", indices, 0.0), self._read("shutter:close", indices, 0.0)))
 
-    def set_shutter_properties(self, values: Any = None, indices: Any = None) -> None:
-        """Set (open, close) delays per camera: ``values`` is a list of pairs."""
-        pairs = list(values or [])
+    def set_shutter_properties(self, values: Any, indices: Any = None) -> None:
+        """Set (open delay, close delay) per camera (one pair per selected camera)."""
+        pairs = [tuple(pair) for pair in values]
+        rows = self._rows(indices)
+        if len(pairs) != len(rows):
+            raise ValueError(f"set_shutter_properties: {len(pairs)} (open, close) pairs for {len(rows)} cameras")
         self._write("shutter:open", [p[0] for p in pairs], indices)
         self._write("shutter:close", [p[1] for p in pairs], indices)
 
