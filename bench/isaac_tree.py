@@ -43,13 +43,14 @@ OUT_OF_SCOPE = {
     "standalone_examples/api/isaacsim.replicator.teleop/": "teleop devices (a recorded XR teleop episode)",
     "extensions/isaacsim.replicator.teleop/": "teleop devices (a recorded XR teleop episode)",
     "standalone_examples/replicator/infinigen/": "Infinigen-generated scenes that are not in the repository",
-    "standalone_examples/api/isaacsim.sensors.experimental.rtx/": "RTX sensors (issue 35)",
-    "standalone_examples/deprecated/api/isaacsim.sensors.rtx/": "RTX sensors (issue 35)",
-    "standalone_examples/benchmarks/benchmark_rtx_lidar.py": "RTX sensors (issue 35)",
-    "standalone_examples/benchmarks/benchmark_rtx_radar.py": "RTX sensors (issue 35)",
-    "extensions/isaacsim.sensors.experimental.rtx/": "RTX sensors (issue 35)",
-    "extensions/isaacsim.sensors.rtx.nodes/": "RTX sensors (issue 35)",
-    "deprecated/isaacsim.sensors.rtx/": "RTX sensors (issue 35)",
+    "extensions/isaacsim.sensors.experimental.rtx/python/tests/test_acoustic.py":
+        "acoustic sensors (CompatError: not modelled yet, docs/sensors.md)",
+    "extensions/isaacsim.sensors.experimental.rtx/python/tests/test_acoustic_sensor.py":
+        "acoustic sensors (CompatError: not modelled yet, docs/sensors.md)",
+    "extensions/isaacsim.sensors.experimental.rtx/python/tests/test_rtx_acoustic_configs.py":
+        "acoustic sensors (CompatError: not modelled yet, docs/sensors.md)",
+    "extensions/isaacsim.sensors.experimental.rtx/python/tests/test_structured_light_camera.py":
+        "structured-light camera (CompatError: not modelled yet, docs/sensors.md)",
     "extensions/isaacsim.replicator.synthetic_recorder/isaacsim/replicator/synthetic_recorder/tests/test_recorder_ui.py":
         "Kit UI windows",
     "standalone_examples/testing/doc_snippets/test_snippets_async.py":
@@ -62,6 +63,8 @@ OUT_OF_SCOPE = {
 SCRIPT_ARGS = {
     "api/isaacsim.replicator.experimental.domain_randomization/randomization_demo.py": ["--max-frames", "30"],
     "benchmarks/benchmark_camera.py": ["--num-frames", "5", "--num-cameras", "2"],
+    "benchmarks/benchmark_rtx_lidar.py": ["--num-frames", "5"],
+    "benchmarks/benchmark_rtx_radar.py": ["--num-frames", "5"],
     "benchmarks/benchmark_sdg.py": ["--num-frames", "5", "--num-cameras", "2", "--delete-data-when-done"],
     "benchmarks/validation/benchmark_sdg_validation.py": ["--num-frames", "5", "--num-cameras", "2"],
     "benchmarks/workflows/benchmark_workflow_manipulation_vision_cumotion.py": ["--num-frames", "5"],
