@@ -194,3 +194,23 @@ def test_experimental_camera_sensor(kit) -> None:
         RtxCamera("/World/Plain")
     with pytest.raises(CompatError, match="CameraView"):
         TiledCameraSensor("/World/Plain")
+
+
+def test_camera_lens_distortion_models_are_authored(kit) -> None:
+    _, _, rep = kit
+    from isaacsim.sensors.camera import Camera
+
+    camera = Camera("/World/Lens", resolution=(64, 48))
+    camera.set_opencv_fisheye_properties(cx=32.0, cy=24.0, fx=40.0, fy=40.0, fisheye=[0.1, -0.02, 0.0, 0.001])
+    assert camera.get_lens_distortion_model() == "OmniLensDistortionOpenCvFisheyeAPI"
+    cx, cy, fx, fy, coefficients = camera.get_opencv_fisheye_properties()
+    assert (cx, cy, fx, fy) == (32.0, 24.0, 40.0, 40.0)
+    np.testing.assert_allclose(coefficients, [0.1, -0.02, 0.0, 0.001], atol=1e-7)
+    camera.set_ftheta_properties(nominal_height=48, nominal_width=64, optical_center=(32, 24), max_fov=200,
+                                 distortion_coefficients=[0, 1e-3, 0, 0, 0])
+    assert camera.get_lens_distortion_model() == "OmniLensDistortionFthetaAPI"   # one model at a time
+    assert camera.get_opencv_fisheye_properties() is None
+    height, width, centre, fov, k = camera.get_ftheta_properties()
+    assert (height, width, centre, fov) == (48, 64, (32, 24), 200) and k[1] == pytest.approx(1e-3)
+    with pytest.raises(Exception, match="pinhole model"):
+        camera.get_intrinsics_matrix()

@@ -35,7 +35,6 @@ from __future__ import annotations
 import copy
 import logging
 import math
-import sys
 from typing import Any
 
 import numpy as np
@@ -48,6 +47,7 @@ from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.event_names import StageEventType, StageRenderingEventType, stage_event_name, \
     stage_rendering_event_name
 from graphsdg.compat.modules import CompatModule
+from graphsdg.compat.sensors_camera_lenses import CameraLenses, carb_warn
 from graphsdg.maths.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.runtime import runtime
 from graphsdg.stage.context import get_stage
@@ -121,12 +121,6 @@ def distort_point_kannala_brandt(camera_matrix: Any, distortion_model: Any, x: A
     return np.array([out[:, 0, 0].reshape(np.shape(u)), out[:, 0, 1].reshape(np.shape(u))])
 
 
-def carb_warn(message: str) -> None:
-    """``carb.log_warn`` as scripts see it (tests patch it), else the ``carb`` logger."""
-    carb = sys.modules.get("carb")
-    (carb.log_warn if carb is not None and hasattr(carb, "log_warn") else log.warning)(message)
-
-
 def rendering_frequency() -> float | None:
     """``/app/runLoops/main/rateLimitFrequency``, None where unset."""
     value = graphsdg.settings_store.get(RATE_LIMIT, None)
@@ -139,7 +133,7 @@ def as_quat_matrix(orientation: Any) -> np.ndarray:
     return quat_wxyz_to_matrix(q / np.linalg.norm(q))
 
 
-class Camera(BaseSensor):
+class Camera(CameraLenses, BaseSensor):
     """``isaacsim.sensors.camera.Camera`` (module docstring)."""
 
     _compat_name = "isaacsim.sensors.camera.Camera"
@@ -406,8 +400,6 @@ class Camera(BaseSensor):
             carb_warn(f"Annotator {annotator_name!r} is already attached to {self._render_product_path}")
             return
         options = dict(kwargs)
-        if self._annotator_device is not None and "device" not in options:
-            options["device"] = self._annotator_device
         annotator = graphsdg.AnnotatorRegistry.get_annotator(annotator_name, init_params=options or None)
         annotator.attach([self._render_product_path])
         self._custom_annotators[annotator_name] = annotator
@@ -428,7 +420,7 @@ class Camera(BaseSensor):
             carb_warn(f"Annotator {name!r} is not attached to {self._render_product_path}")
             return None
         try:
-            data = annotator.get_data(device=device)
+            data = annotator.get_data(device=device if device is not None else self._annotator_device)
         except Exception:   # nothing captured yet
             data = None
         data = data.get("data") if isinstance(data, dict) else data

@@ -201,16 +201,16 @@ class CameraView(XFormPrim):
         frames = [f.get("data") if isinstance(f, dict) else f for f in frames]
         if any(f is None or np.size(f) == 0 for f in frames):
             return None
-        width, height = self.camera_resolution
-        batch = np.stack([np.asarray(f).reshape(height, width, -1)[..., :channels] for f in frames])
+        frames = [np.asarray(f) for f in frames]
+        batch = np.stack([(f[..., None] if f.ndim == 2 else f)[..., :channels] for f in frames])
         if kind == "rgb":
             batch = batch[..., :3]
         return batch.astype(dtype, copy=False)
 
     def _tiled(self, batch: np.ndarray) -> np.ndarray:
-        width, height = self.camera_resolution
-        columns = self.tiled_resolution[0] // width
-        rows = self.tiled_resolution[1] // height
+        height, width = batch.shape[1:3]          # as rendered (a run may scale render products)
+        columns = self.tiled_resolution[0] // self.camera_resolution[0]
+        rows = self.tiled_resolution[1] // self.camera_resolution[1]
         tiled = np.zeros((rows * height, columns * width, batch.shape[-1]), dtype=batch.dtype)
         for i, image in enumerate(batch):
             r, c = divmod(i, columns)

@@ -154,7 +154,8 @@ class CameraSensor(_SensorRuntime):
         if channels is None:
             info["resolution"] = self._resolution
             return data, info
-        array = np.asarray(data).reshape(*self._resolution, -1)[..., :kept].astype(dtype, copy=False)
+        array = np.asarray(data)
+        array = (array[..., None] if array.ndim == 2 else array)[..., :kept].astype(dtype, copy=False)
         device = str(out.device) if out is not None else default_device()
         result = wp.array(np.ascontiguousarray(array), dtype=getattr(wp, dtype), device=device)
         if out is None:
