@@ -21,6 +21,7 @@ import os
 import sys
 from dataclasses import dataclass
 
+from graphsdg.compat import isaac as _isaac_areas  # noqa: F401 - its areas register their settings keys, which case 102 lists
 from graphsdg.settings import KNOWN_KEYS
 
 DOC = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs", "errors.md")

@@ -371,7 +371,11 @@ def test_porting_guide_lists_every_mapped_module_and_name(compat):
         module = isaac.installed_module(name)
         leaf_names = [] if isinstance(module, ForwardingModule) else available_names(module)
         for attr in leaf_names:
-            if not isinstance(getattr(module, attr), type(sys)) and attr not in text:
+            value = getattr(module, attr)
+            if not str(getattr(value, "__module__", "graphsdg")).startswith(("graphsdg", "pxr", "builtins", "enum",
+                                                                              "numpy", "typing")):
+                continue   # registered by another test (a writer class defined in a test file)
+            if not isinstance(value, type(sys)) and attr not in text:
                 missing.append(f"{name}.{attr}")
         if name.count(".") >= 1 and name.split(".")[-1] not in text:
             missing.append(name)
