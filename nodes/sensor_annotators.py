@@ -6,7 +6,8 @@ name do:
 
 * ``GenericModelOutput``: the GMO byte buffer (uint8) Isaac's ``parse_generic_model_output_data`` /
   ``get_gmo_data`` read (:mod:`graphsdg.sensors.generic_model_output`); object ids are the stable ids of
-  ``StableIdMap`` and ``instance_id_segmentation``;
+  ``StableIdMap`` and ``instance_id_segmentation``; a lidar's buffer has no elements in the frames between its
+  reports (RTX's behaviour; the point-cloud annotators hold the last report);
 * ``IsaacExtractRTXSensorPointCloud`` (and ``...NoAccumulator``), ``IsaacCreateRTXLidarScanBuffer`` (and
   ``...ForFlatScan``), ``IsaacCreateRTXRadarPointCloud``: ``data`` the (N, 3) float32 Cartesian points in the
   sensor's output frame, ``transform`` the sensor-to-world matrix at the scan's end (16 float64, row-vector
@@ -25,6 +26,8 @@ Example:
     True
 """
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -70,6 +73,9 @@ def generic_model_output(frame: FrameView, params: dict) -> dict:
     scan = frame_scan(frame)
     if scan is None:
         return {"data": np.zeros(0, dtype=np.uint8)}
+    if isinstance(scan, LidarScan) and not scan.fresh:
+        # between a lidar's ticks RTX hands over a GMO with no elements (the point-cloud annotators hold the last)
+        scan = replace(scan, returns=scan.returns.take(np.zeros(0, dtype=np.int64)))
     ids = object_ids(frame, scan.returns.geom) if isinstance(scan, LidarScan) else None
     return {"data": gmo_buffer(scan, ids)}
 
