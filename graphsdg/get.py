@@ -16,6 +16,7 @@ from __future__ import annotations
 import sys
 from typing import Any, Callable
 
+from graphsdg.functional.get import LIGHT_TYPES, TYPED_GETTERS  # noqa: F401 - LIGHT_TYPES re-exported
 from graphsdg.graph.calls import family_calls
 from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function
@@ -24,7 +25,9 @@ _calls = family_calls("get")
 globals().update(_calls)
 
 
-def _typed(types: tuple[str, ...], what: str) -> Callable[..., ReplicatorItem]:
+def _typed(what: str) -> Callable[..., ReplicatorItem]:
+    types = TYPED_GETTERS[what]
+
     def getter(path_pattern: str | None = None, path_pattern_exclusion: str | None = None, semantics: Any = None,
                semantics_exclusion: Any = None, cache_result: bool = True, name: str | None = None,
                path_match: str | None = None) -> ReplicatorItem:
@@ -38,25 +41,24 @@ def _typed(types: tuple[str, ...], what: str) -> Callable[..., ReplicatorItem]:
     return getter
 
 
-LIGHT_TYPES = ("DistantLight", "SphereLight", "RectLight", "DiskLight", "CylinderLight", "DomeLight")
-camera = _typed(("Camera",), "camera")
-light = _typed(LIGHT_TYPES, "light")
-material = _typed(("Material",), "material")
-mesh = _typed(("Mesh",), "mesh")
-xform = _typed(("Xform",), "xform")
-shader = _typed(("Shader",), "shader")
-curve = _typed(("BasisCurves",), "curve")
-geomsubset = _typed(("GeomSubset",), "geomsubset")
-skeleton = _typed(("Skeleton",), "skeleton")
-shape = _typed(("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh"), "shape")
-scope = _typed(("Scope",), "scope")
-graph = _typed(("OmniGraph",), "graph")
-physics = _typed(("PhysicsScene",), "physics")
-renderproduct = _typed(("RenderProduct",), "renderproduct")
-rendervar = _typed(("RenderVar",), "rendervar")
-listener = _typed(("Listener", "OmniListener"), "listener")
-sound = _typed(("Sound", "OmniSound"), "sound")
-skelanimation = _typed(("SkelAnimation",), "skelanimation")
+camera = _typed("camera")
+light = _typed("light")
+material = _typed("material")
+mesh = _typed("mesh")
+xform = _typed("xform")
+shader = _typed("shader")
+curve = _typed("curve")
+geomsubset = _typed("geomsubset")
+skeleton = _typed("skeleton")
+shape = _typed("shape")
+scope = _typed("scope")
+graph = _typed("graph")
+physics = _typed("physics")
+renderproduct = _typed("renderproduct")
+rendervar = _typed("rendervar")
+listener = _typed("listener")
+sound = _typed("sound")
+skelanimation = _typed("skelanimation")
 
 
 def register(fn: Callable[..., Any], override: bool = True, fn_name: str | None = None) -> None:

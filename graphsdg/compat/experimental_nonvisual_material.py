@@ -30,48 +30,26 @@ from typing import Any, Sequence
 import numpy as np
 from pxr import Sdf, Usd, UsdShade
 
-from graphsdg import settings_store
+from graphsdg.sensors import surface_materials
+from graphsdg.sensors.surface_materials import ATTRIBUTES, BASES, COATINGS
 from graphsdg.compat.experimental_arguments import resolve_indices
 from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.experimental_stage_scope import current_stage
 from graphsdg.compat.warp_arrays import WarpLikeArray
 from graphsdg.compat.warp_arrays import as_warp_like as _warp
 
-PREFIX_SETTING = "/rtx/materialDb/nonVisualMaterialSemantics/prefix"
-DEFAULT_PREFIX = "omni:simready:nonvisual"
-
-# name -> index, as the RTX non-visual material specification numbers them (its reserved rows left out)
-BASES: dict[str, int] = {name: i for i, name in enumerate((
-    "none", "aluminum", "steel", "oxidized_steel", "iron", "oxidized_iron", "silver", "brass", "bronze",
-    "oxidized_Bronze_Patina", "tin", "plastic", "fiberglass", "carbon_fiber", "vinyl", "plexiglass", "pvc", "nylon",
-    "polyester", "clear_glass", "frosted_glass", "one_way_mirror", "mirror", "ceramic_glass", "asphalt", "concrete",
-    "leaf_grass", "dead_leaf_grass", "rubber", "wood", "bark", "cardboard", "paper", "fabric", "skin", "fur_hair",
-    "leather", "marble", "brick", "stone", "gravel", "dirt", "mud", "water", "salt_water", "snow", "ice",
-    "calibration_lambertion"))}
-COATINGS: dict[str, int] = {"none": 0, "paint": 1, "clearcoat": 2, "paint_clearcoat": 3}
-ATTRIBUTES: dict[str, int] = {"none": 0, "emissive": 1, "retroreflective": 2, "single_sided": 4,
-                              "visually_transparent": 8}
-
-
 def attribute_names() -> tuple[str, str, str]:
     """The (base, coating, attributes) attribute names under the current prefix setting."""
-    prefix = settings_store.get(PREFIX_SETTING) or DEFAULT_PREFIX
-    return f"{prefix}:base", f"{prefix}:coating", f"{prefix}:attributes"
+    return tuple(surface_materials.label_attribute_names())
 
 
 def _encode(prim: Usd.Prim) -> int:
-    base, coating, attribute = attribute_names()
-
-    def index(name: str, table: dict[str, int]) -> int:
+    def label(name: str) -> str:
         attr = prim.GetAttribute(name)
-        return table.get(attr.Get(), 0) if attr and attr.IsValid() else 0
+        value = attr.Get() if attr and attr.IsValid() else None
+        return value if isinstance(value, str) else "none"
 
-    return (index(base, BASES) & 0xFF) + ((index(coating, COATINGS) & 0x7) << 8) + \
-        ((index(attribute, ATTRIBUTES) & 0x1F) << 11)
-
-
-def _name_of(table: dict[str, int], value: int) -> str:
-    return next((name for name, index in table.items() if index == value), "none")
+    return surface_materials.encode_material_id(*(label(name) for name in attribute_names()))
 
 
 class NonVisualMaterial(Prim):
@@ -189,7 +167,5 @@ class NonVisualMaterial(Prim):
         for value in raw.tolist():
             if not float(value).is_integer() or not 0 <= value <= 0xFFFF:
                 raise ValueError(f"The given material ID ({value}) is outside valid unsigned integer 16-bit range")
-            value = int(value)
-            out.append((_name_of(BASES, value & 0xFF), _name_of(COATINGS, (value >> 8) & 0x7),
-                        _name_of(ATTRIBUTES, (value >> 11) & 0x1F)))
+            out.append(surface_materials.decode_material_id(int(value)))
         return out

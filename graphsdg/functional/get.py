@@ -39,7 +39,23 @@ def prim_at_path(path: Any) -> list[Usd.Prim]:
     return resolve_prims(path)
 
 
-def _typed(types: tuple[str, ...], what: str) -> Callable[..., list[Usd.Prim]]:
+#: the typed getters of ``rep.get`` and ``rep.functional.get``: getter name -> the prim types it returns
+TYPED_GETTERS: dict[str, tuple[str, ...]] = {
+    "camera": ("Camera",),
+    "light": ("DistantLight", "SphereLight", "RectLight", "DiskLight", "CylinderLight", "DomeLight"),
+    "material": ("Material",), "mesh": ("Mesh",), "xform": ("Xform",), "shader": ("Shader",),
+    "curve": ("BasisCurves",), "geomsubset": ("GeomSubset",), "skeleton": ("Skeleton",),
+    "shape": ("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh"), "scope": ("Scope",),
+    "graph": ("OmniGraph",), "physics": ("PhysicsScene",), "renderproduct": ("RenderProduct",),
+    "rendervar": ("RenderVar",), "listener": ("Listener", "OmniListener"), "sound": ("Sound", "OmniSound"),
+    "skelanimation": ("SkelAnimation",),
+}
+LIGHT_TYPES = TYPED_GETTERS["light"]
+
+
+def _typed(what: str) -> Callable[..., list[Usd.Prim]]:
+    types = TYPED_GETTERS[what]
+
     def getter(path_pattern: str | Sequence[str] | None = None,
                path_pattern_exclusion: str | Sequence[str] | None = None, semantics: Any = None,
                semantics_exclusion: Any = None,
@@ -52,22 +68,21 @@ def _typed(types: tuple[str, ...], what: str) -> Callable[..., list[Usd.Prim]]:
     return getter
 
 
-LIGHT_TYPES = ("DistantLight", "SphereLight", "RectLight", "DiskLight", "CylinderLight", "DomeLight")
-camera = _typed(("Camera",), "camera")
-light = _typed(LIGHT_TYPES, "light")
-material = _typed(("Material",), "material")
-mesh = _typed(("Mesh",), "mesh")
-xform = _typed(("Xform",), "xform")
-shader = _typed(("Shader",), "shader")
-curve = _typed(("BasisCurves",), "curve")
-geomsubset = _typed(("GeomSubset",), "geomsubset")
-skeleton = _typed(("Skeleton",), "skeleton")
-shape = _typed(("Cube", "Sphere", "Cylinder", "Cone", "Capsule", "Plane", "Mesh"), "shape")
-scope = _typed(("Scope",), "scope")
-physics = _typed(("PhysicsScene",), "physics")
-rendervar = _typed(("RenderVar",), "rendervar")
-skelanimation = _typed(("SkelAnimation",), "skelanimation")
-_render_product_prims = _typed(("RenderProduct",), "renderproduct")
+camera = _typed("camera")
+light = _typed("light")
+material = _typed("material")
+mesh = _typed("mesh")
+xform = _typed("xform")
+shader = _typed("shader")
+curve = _typed("curve")
+geomsubset = _typed("geomsubset")
+skeleton = _typed("skeleton")
+shape = _typed("shape")
+scope = _typed("scope")
+physics = _typed("physics")
+rendervar = _typed("rendervar")
+skelanimation = _typed("skelanimation")
+_render_product_prims = _typed("renderproduct")
 
 
 def renderproduct(path_pattern: str | Sequence[str] | None = None,
