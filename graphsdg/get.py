@@ -16,7 +16,7 @@ from __future__ import annotations
 import sys
 from typing import Any, Callable
 
-from graphsdg.functional.get import LIGHT_TYPES, TYPED_GETTERS  # noqa: F401 - LIGHT_TYPES re-exported
+from graphsdg.functional.get import TYPED_GETTERS
 from graphsdg.graph.calls import family_calls
 from graphsdg.graph.node import ReplicatorItem
 from graphsdg.graph.registration import register_function

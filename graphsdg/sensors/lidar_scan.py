@@ -42,7 +42,7 @@ from graphsdg import rng
 from graphsdg.sensors.lidar_profile import LidarProfile, LidarProfileError, output_settings, read_lidar_profile
 from graphsdg.sensors.mesh_bounds import sync_mesh_trees
 from graphsdg.sensors.ray_backend import ray_caster
-from graphsdg.sensors.scan_pattern import Firings, ScanPattern
+from graphsdg.sensors.scan_pattern import Firings, ScanPattern, spherical_points, unit_directions
 from graphsdg.sensors.scene_motion import GeomMotion, point_velocities, refresh_velocities
 from graphsdg.sensors.sensor_pose import SensorPose, sensor_pose
 from graphsdg.sensors.surface_materials import surface_table
@@ -93,9 +93,7 @@ class LidarReturns:
 
     def point_sensor(self) -> np.ndarray:
         """(N, 3) reported points in the sensor frame at firing (metres)."""
-        az, el = np.radians(self.azimuth_deg), np.radians(self.elevation_deg)
-        r = self.range_m
-        return np.stack([r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az), r * np.sin(el)], axis=1)
+        return spherical_points(self.azimuth_deg, self.elevation_deg, self.range_m)
 
 
 @dataclass
@@ -171,8 +169,7 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
         elevation = elevation + profile.elevation_error_mean_deg + \
             noise.normal(0.0, profile.elevation_error_std_deg, count)
     reported = np.where(valid, np.maximum(reported, 0.0), 0.0)
-    az, el = np.radians(azimuth), np.radians(elevation)
-    reported_dirs = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=1)
+    reported_dirs = unit_directions(azimuth, elevation)
     hit_units = origins + dirs_world * np.where(hits.geom >= 0, hits.distance, 0.0)[:, None]
     velocity = point_velocities(m, d, hits.geom, hit_units) * mpu
     returns = LidarReturns(

@@ -39,6 +39,7 @@ from graphsdg.sensors.lidar_profile import LidarProfileError, aux_level
 from graphsdg.sensors.lidar_scan import sensor_prim
 from graphsdg.sensors.mesh_bounds import sync_mesh_trees
 from graphsdg.sensors.ray_backend import ray_caster
+from graphsdg.sensors.scan_pattern import spherical_points
 from graphsdg.sensors.scene_motion import GeomMotion, point_velocities, refresh_velocities
 from graphsdg.sensors.sensor_pose import SensorPose, sensor_pose
 from graphsdg.sensors.surface_materials import surface_table
@@ -134,9 +135,7 @@ class RadarDetections:
 
     def point_sensor(self) -> np.ndarray:
         """(N, 3) detection positions in the radar's frame (metres)."""
-        az, el = np.radians(self.azimuth_deg), np.radians(self.elevation_deg)
-        r = self.range_m
-        return np.stack([r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az), r * np.sin(el)], axis=1)
+        return spherical_points(self.azimuth_deg, self.elevation_deg, self.range_m)
 
 
 @dataclass

@@ -49,9 +49,21 @@ class Firings:
 
     def directions(self) -> np.ndarray:
         """(N, 3) unit directions in the sensor frame."""
-        az, el = np.radians(self.azimuth_deg), np.radians(self.elevation_deg)
-        cos_el = np.cos(el)
-        return np.stack([cos_el * np.cos(az), cos_el * np.sin(az), np.sin(el)], axis=1)
+        return unit_directions(self.azimuth_deg, self.elevation_deg)
+
+
+def unit_directions(azimuth_deg: np.ndarray, elevation_deg: np.ndarray) -> np.ndarray:
+    """(N, 3) unit vectors of azimuth / elevation angles (degrees) in a sensor's frame (x forward, z up)."""
+    az, el = np.radians(azimuth_deg), np.radians(elevation_deg)
+    cos_el = np.cos(el)
+    return np.stack([cos_el * np.cos(az), cos_el * np.sin(az), np.sin(el)], axis=1)
+
+
+def spherical_points(azimuth_deg: np.ndarray, elevation_deg: np.ndarray, range_m: np.ndarray) -> np.ndarray:
+    """(N, 3) points at ``range_m`` along azimuth / elevation angles (degrees) in a sensor's frame."""
+    az, el = np.radians(azimuth_deg), np.radians(elevation_deg)
+    r = range_m
+    return np.stack([r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az), r * np.sin(el)], axis=1)
 
 
 def wrap_degrees(angle: np.ndarray) -> np.ndarray:
