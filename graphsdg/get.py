@@ -41,6 +41,7 @@ def _typed(what: str) -> Callable[..., ReplicatorItem]:
     return getter
 
 
+LIGHT_TYPES = TYPED_GETTERS["light"]
 camera = _typed("camera")
 light = _typed("light")
 material = _typed("material")
