@@ -211,7 +211,7 @@ def _camera_view(rt, rp) -> CameraView:
     read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
     sim = rt.sim
-    if not prim.IsA(UsdGeom.Camera):   # a lidar / radar product: its annotators read scans (graphsdg.sensors)
+    if prim.IsValid() and not prim_facts.is_a(prim, UsdGeom.Camera):   # a lidar / radar product (graphsdg.sensors)
         return sensor_camera_view(prim, rp.width, rp.height, sim.world_transforms.meters_per_unit())
     lens = sim.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
     return camera_view(prim, rp.width, rp.height, world=sim.camera_poses.world(prim), lens=lens,
