@@ -39,10 +39,11 @@ from graphsdg.compat.core_types import XFormPrimViewState
 from graphsdg.compat.core_utils_prims import is_prim_non_root_articulation_link
 from graphsdg.compat.modules import CompatError, CompatModule, CompatObject
 from graphsdg.compat.simulation_manager import SimulationManager
-from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
+from graphsdg.maths.rotations import decompose
 from graphsdg.physics.world_pose import set_world_pose
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.path_patterns import match_prim_paths
+from graphsdg.sim import transforms
 from graphsdg.stage.xform import set_local_pose
 
 log = logging.getLogger("carb")
@@ -226,9 +227,7 @@ class XFormPrim(CompatObject):
         pos = np.zeros((len(idx), 3), dtype=np.float32)
         quat = np.zeros((len(idx), 4), dtype=np.float32)
         for k, i in enumerate(idx):
-            m = np.array(UsdGeom.Xformable(self._prims[i]).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
-            t, r, _ = decompose(m)
-            pos[k], quat[k] = t, matrix_to_quat_wxyz(r)
+            pos[k], quat[k] = transforms.get_world_pose(self._prims[i])
         return pos, quat
 
     def set_world_poses(self, positions: Any = None, orientations: Any = None, indices: Any = None,
@@ -248,9 +247,7 @@ class XFormPrim(CompatObject):
         pos = np.zeros((len(idx), 3), dtype=np.float32)
         quat = np.zeros((len(idx), 4), dtype=np.float32)
         for k, i in enumerate(idx):
-            m = np.array(UsdGeom.Xformable(self._prims[i]).GetLocalTransformation(Usd.TimeCode.Default()))
-            t, r, _ = decompose(m)
-            pos[k], quat[k] = t, matrix_to_quat_wxyz(r)
+            pos[k], quat[k] = transforms.get_local_pose(self._prims[i])
         return pos, quat
 
     def set_local_poses(self, translations: Any = None, orientations: Any = None, indices: Any = None) -> None:

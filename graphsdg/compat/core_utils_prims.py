@@ -30,6 +30,7 @@ from graphsdg.compat.core_types import SDF_type_to_Gf
 from graphsdg.compat.core_utils import add_reference_to_stage, get_current_stage, get_prim_path
 from graphsdg.compat.modules import CompatModule
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
+from graphsdg.sim import transforms
 
 
 def _prim(prim_path: str) -> Usd.Prim:
@@ -314,18 +315,12 @@ def reset_xform_ops(prim: Usd.Prim) -> None:
 
 def get_local_pose(prim_path: str) -> tuple[np.ndarray, np.ndarray]:
     """(translation (3,), orientation (w, x, y, z)) relative to the parent, scale removed."""
-    m = np.array(UsdGeom.Xformable(_prim(prim_path)).GetLocalTransformation(Usd.TimeCode.Default()),
-                 dtype=np.float64)
-    t, r, _ = decompose(m)
-    return t, matrix_to_quat_wxyz(r)
+    return transforms.get_local_pose(_prim(prim_path))
 
 
 def get_world_pose(prim_path: str, fabric: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """(position (3,), orientation (w, x, y, z)) in the world, scale removed (``fabric`` reads the same: USD)."""
-    m = np.array(UsdGeom.Xformable(_prim(prim_path)).ComputeLocalToWorldTransform(Usd.TimeCode.Default()),
-                 dtype=np.float64)
-    t, r, _ = decompose(m)
-    return t, matrix_to_quat_wxyz(r)
+    return transforms.get_world_pose(_prim(prim_path))
 
 
 def modules() -> list[types.ModuleType]:

@@ -25,7 +25,7 @@ from graphsdg.compat.warp_arrays import as_warp_like as _warp
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.physics.world_pose import set_world_pose
-from graphsdg.sim.transforms import get_world_pose
+from graphsdg.sim.transforms import get_local_pose, get_world_pose
 from graphsdg.compat.experimental_stage_scope import current_stage as get_stage
 from graphsdg.stage.xform import set_local_pose
 
@@ -112,11 +112,9 @@ class XformPrim(Prim):
         """(translations (k, 3), orientations (k, 4) w, x, y, z) relative to each prim's parent."""
         t_out, q_out = [], []
         for path in self._selected(indices):
-            m = np.array(UsdGeom.Xformable(get_stage().GetPrimAtPath(path)).GetLocalTransformation(
-                Usd.TimeCode.Default()), dtype=np.float64)
-            t, r, _ = decompose(m)
+            t, q = get_local_pose(path)
             t_out.append(t)
-            q_out.append(matrix_to_quat_wxyz(r))
+            q_out.append(q)
         return _warp(t_out), _warp(q_out)
 
     def set_local_poses(self, translations: Any = None, orientations: Any = None, indices: Any = None) -> None:

@@ -23,7 +23,6 @@ from pxr import Gf, Usd, UsdGeom
 
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.prims import PrimLike, resolve_prim
-from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.stage.xform import parent_world_matrix, world_matrix
 
 
@@ -43,6 +42,13 @@ def get_world_position(prim: PrimLike) -> np.ndarray:
 def get_world_pose(prim: PrimLike) -> tuple[np.ndarray, np.ndarray]:
     """World (position (3,), orientation quaternion (w, x, y, z)) of the prim, scale removed."""
     t, r, _ = decompose(world_matrix(resolve_prim(prim)))
+    return t, matrix_to_quat_wxyz(r)
+
+
+def get_local_pose(prim: PrimLike) -> tuple[np.ndarray, np.ndarray]:
+    """(translation (3,), orientation quaternion (w, x, y, z)) of the prim relative to its parent, scale removed."""
+    local = UsdGeom.Xformable(resolve_prim(prim)).GetLocalTransformation(Usd.TimeCode.Default())
+    t, r, _ = decompose(np.array(local, dtype=np.float64))
     return t, matrix_to_quat_wxyz(r)
 
 
