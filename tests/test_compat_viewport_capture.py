@@ -61,3 +61,15 @@ def test_physx_interface_steps_a_falling_body_and_reads_its_pose(compat):
     assert not physx.get_rigidbody_transformation("/Nothing")["ret_val"]
     with pytest.warns(UserWarning, match="no effect"):
         physx.overwrite_gpu_setting(1)
+
+
+def test_old_create_hydra_texture_makes_a_render_product_of_the_camera(compat):
+    import omni.replicator.core as rep
+    import omni.usd
+    from omni.isaac.core.utils.render_product import create_hydra_texture, get_camera_prim_path, get_resolution
+    omni.usd.get_context().new_stage()
+    cam = rep.functional.create.camera(position=(3, 0, 0), look_at=(0, 0, 0), name="Cam")
+    texture, path = create_hydra_texture((64, 32), str(cam.GetPath()))
+    assert get_camera_prim_path(path) == str(cam.GetPath())
+    assert tuple(get_resolution(path)) == (64, 32)
+    assert texture.get_updates_enabled()

@@ -37,7 +37,7 @@ from graphsdg.compat.kit import CarbSettings, Float3
 from graphsdg.compat.modules import CompatError, CompatModule
 from graphsdg.compat.rendering_manager import aim_camera, camera_edit_context
 from graphsdg.physics.world_pose import set_world_pose
-from graphsdg.render.render_product import RenderProduct, registry
+from graphsdg.render.render_product import RenderProduct, create_render_product, registry
 from graphsdg.stage.context import get_stage
 
 _VIEWPORT_NAME = "Viewport"
@@ -190,6 +190,13 @@ def add_aov(render_product_path: str, aov_name: str) -> None:
         names.append(aov_name)
 
 
+def create_hydra_texture(resolution: tuple[int, int], camera_prim_path: str) -> tuple[Any, str]:
+    """Isaac's older ``create_hydra_texture``: a new render product of the camera at ``resolution``;
+    returns (its hydra texture, its path)."""
+    product = create_render_product(camera_prim_path, resolution, force_new=True)
+    return product.hydra_texture, product.path
+
+
 def get_camera_prim_path(render_product_path: str) -> str:
     """The product's camera path."""
     return _product(render_product_path).camera
@@ -241,6 +248,7 @@ def modules() -> list[types.ModuleType]:
                          create_viewport_for_camera=create_viewport_for_camera,
                          set_active_viewport_camera=set_active_viewport_camera),
             CompatModule("isaacsim.core.utils.render_product", add_aov=add_aov,
+                         create_hydra_texture=create_hydra_texture,
                          get_camera_prim_path=get_camera_prim_path, set_camera_prim_path=set_camera_prim_path,
                          get_resolution=get_resolution, set_resolution=set_resolution),
             CompatModule("isaacsim.core.utils.carb", set_carb_setting=set_carb_setting,
