@@ -123,6 +123,30 @@ def test_xform_prim_local_poses_scales_visibility_and_op_reset(compat):
         view.get_world_poses(indices=[3])
 
 
+def test_op_reset_keeps_a_referenced_float_orient_and_moves_the_prim(compat, tmp_path):
+    from pxr import Gf, Usd
+
+    from isaacsim.core.experimental.prims import XformPrim
+    asset = Usd.Stage.CreateNew(str(tmp_path / "asset.usda"))
+    root = UsdGeom.Xform.Define(asset, "/Asset")
+    root.AddTranslateOp().Set(Gf.Vec3d(0, 0, 0))
+    root.AddOrientOp(UsdGeom.XformOp.PrecisionFloat).Set(Gf.Quatf(1, 0, 0, 0))
+    UsdGeom.Cube.Define(asset, "/Asset/Box")
+    asset.SetDefaultPrim(root.GetPrim())
+    asset.Save()
+    stage = rep.stage.get_stage()
+    prim = stage.DefinePrim("/World/Ref", "Xform")
+    prim.GetReferences().AddReference(str(tmp_path / "asset.usda"))
+    half = np.sqrt(0.5)
+    view = XformPrim("/World/Ref", positions=(1, 2, 3), orientations=(half, 0, 0, half),
+                     reset_xform_op_properties=True)
+    ops = UsdGeom.Xformable(prim).GetOrderedXformOps()
+    assert [op.GetOpName() for op in ops] == ["xformOp:translate", "xformOp:orient", "xformOp:scale"]
+    assert ops[1].GetPrecision() == UsdGeom.XformOp.PrecisionFloat   # the asset's attribute, kept
+    np.testing.assert_allclose(view.get_world_poses()[0].numpy(), [[1, 2, 3]], atol=1e-6)
+    np.testing.assert_allclose(np.abs(view.get_world_poses()[1].numpy()), [[half, 0, 0, half]], atol=1e-6)
+
+
 def test_ground_plane_layout_and_it_stops_a_falling_cube(compat):
     from isaacsim.core.experimental.objects import Cube, GroundPlane
     from isaacsim.core.simulation_manager import SimulationManager

@@ -72,7 +72,11 @@ class XformPrim(Prim):
             raise ValueError(f"{what}: prims {not_xformable} are not Xformable (they have no transform)")
 
     def reset_xform_op_properties(self) -> None:
-        """Rewrite each prim's ops as ``translate``, ``orient``, ``scale`` (double), keeping its local transform."""
+        """Rewrite each prim's ops as ``translate``, ``orient``, ``scale``, keeping its local transform.
+
+        New ops are double precision; an op attribute the prim already has (perhaps from a referenced asset, where
+        it cannot be removed) is kept at its own precision, as Isaac keeps it.
+        """
         self._check_xformable("reset_xform_op_properties")
         for prim in self._prims:
             xf = UsdGeom.Xformable(prim)
@@ -82,17 +86,12 @@ class XformPrim(Prim):
             names = [op.GetOpName() for op in xf.GetOrderedXformOps()]
             xf.ClearXformOpOrder()
             for name in names:   # old op attributes would otherwise linger, unused
-                if name not in ("xformOp:translate", "xformOp:orient", "xformOp:scale"):
+                if name not in _STANDARD_OPS:
                     prim.RemoveProperty(name)
-            for name, type_name in (("xformOp:translate", Sdf.ValueTypeNames.Double3),
-                                    ("xformOp:orient", Sdf.ValueTypeNames.Quatd),
-                                    ("xformOp:scale", Sdf.ValueTypeNames.Double3)):
-                attr = prim.GetAttribute(name)
-                if attr and attr.GetTypeName() != type_name:
-                    prim.RemoveProperty(name)   # a float-precision op becomes a double one
-            xf.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(*t))
-            xf.AddOrientOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Quatd(*q))
-            xf.AddScaleOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(*s))
+            ops = [_standard_op(prim, xf, name) for name in _STANDARD_OPS]
+            for op, value in zip(ops, (t, q, s)):
+                _set_op_value(op, value)
+            xf.SetXformOpOrder(ops)
 
     # ---- poses ----------------------------------------------------------------------
     def get_world_poses(self, indices: Any = None) -> tuple[WarpLikeArray, WarpLikeArray]:
@@ -431,3 +430,27 @@ class RigidPrim(XformPrim):
     def get_masses(self, indices: Any = None) -> WarpLikeArray:
         """Simulated masses (kg)."""
         return _warp(self._view.get_masses(indices))
+
+
+_STANDARD_OPS = ("xformOp:translate", "xformOp:orient", "xformOp:scale")
+_OP_TYPES = {"xformOp:translate": UsdGeom.XformOp.TypeTranslate, "xformOp:orient": UsdGeom.XformOp.TypeOrient,
+             "xformOp:scale": UsdGeom.XformOp.TypeScale}
+
+
+def _standard_op(prim: Usd.Prim, xf: UsdGeom.Xformable, name: str) -> UsdGeom.XformOp:
+    """The prim's op ``name``: its existing attribute at its own precision, else a new double-precision op."""
+    attr = prim.GetAttribute(name)
+    if attr and attr.IsValid():
+        return UsdGeom.XformOp(attr)
+    return xf.AddXformOp(_OP_TYPES[name], UsdGeom.XformOp.PrecisionDouble, "")
+
+
+def _set_op_value(op: UsdGeom.XformOp, value: np.ndarray) -> None:
+    """Set a translate/scale vector or a (w, x, y, z) quaternion on ``op`` at the op's precision."""
+    values = [float(v) for v in value]
+    if op.GetOpType() == UsdGeom.XformOp.TypeOrient:
+        quat = {UsdGeom.XformOp.PrecisionFloat: Gf.Quatf, UsdGeom.XformOp.PrecisionHalf: Gf.Quath}
+        op.Set(quat.get(op.GetPrecision(), Gf.Quatd)(*values))
+        return
+    vec = {UsdGeom.XformOp.PrecisionFloat: Gf.Vec3f, UsdGeom.XformOp.PrecisionHalf: Gf.Vec3h}
+    op.Set(vec.get(op.GetPrecision(), Gf.Vec3d)(*values))
