@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 SETS = {
     "rgb": ["rgb"],

@@ -19,7 +19,7 @@ import time
 
 import graphsdg as rep
 from graphsdg.assets import catalog, get_assets_root_path
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import texture_images
 from graphsdg.sim.compiler import compile_stage
 

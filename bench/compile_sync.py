@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiler import compile_stage
 
 

@@ -52,7 +52,7 @@ rep.orchestrator.run()
 def _shard_main(script: str, out: str, frames: int, index: int, count: int, resume: bool) -> None:
     """Inside a shard process: run the job's frames of shard ``index``; print its summary as JSON."""
     from graphsdg import orchestrator
-    from graphsdg.jobs.frame_plan import FramePlan
+    from graphsdg.io.frame_plan import FramePlan
     from graphsdg.jobs.job import JobSpec, run_job
     job = JobSpec(script, seed=7, out=out, frames=frames, resume=resume)
     summary = run_job(job, FramePlan(index, count, resume) if count > 1 else None)

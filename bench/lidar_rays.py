@@ -38,7 +38,7 @@ LIDAR_AT = {"warehouse": (-8.0, 13.0, 2.0), "bench5000": (-5.0, 0.0, 0.5)}
 
 def build(scene: str):
     """Open ``scene`` and return the compiled simulation."""
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
 
     if scene == "warehouse":
         from graphsdg.assets import get_assets_root_path

@@ -23,7 +23,7 @@ import time
 
 import graphsdg as rep
 from graphsdg import settings
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.timeline import TimelineEventType
 
 SEED = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests", "seed_scripts",

@@ -28,7 +28,7 @@ import graphsdg as rep
 from graphsdg.benchmark import throughput
 from graphsdg.maths.rotations import look_at_matrix
 from graphsdg.render.pbr import ENABLED_GROUPS
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.visual import PBR_CAMERA
 
 

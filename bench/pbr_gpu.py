@@ -25,9 +25,9 @@ import numpy as np
 
 import graphsdg as rep
 from graphsdg import settings
-from graphsdg.benchmark import profiling
+from graphsdg.base import profiling
 from graphsdg.render.camera import camera_view
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 PASSES = {"color", "depth", "segmentation"}
 SKY = os.path.join(os.path.dirname(rep.__file__), "assets", "pack", "NVIDIA", "Assets", "Skies", "Indoor",

@@ -28,7 +28,7 @@ def measure(assets: int, frames: int) -> dict[str, float]:
     import graphsdg as rep
     from graphsdg.benchmark import throughput
     from graphsdg.render import rasterizer
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
 
     config = throughput.BenchConfig(resolution=(64, 64), asset_count=assets // len(throughput.SHAPES))
     objects, cams, rps = throughput.build_scene(config)

@@ -28,7 +28,7 @@ import time
 import graphsdg as rep  # first: it picks the headless GL platform before mujoco loads
 import mujoco
 import numpy as np
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 EXAMPLES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples")
 sys.path.insert(0, EXAMPLES)

@@ -42,7 +42,7 @@ import graphsdg as rep
 from graphsdg.jobs.cli import run_demo
 from graphsdg.io import run_state
 from graphsdg.render.render_product import registry as rp_registry
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 TRIM = False   # --trim: hand freed heap back to the OS before each sample (glibc malloc_trim)

@@ -27,6 +27,7 @@ register_sensor_schemas()   # before anything makes a stage: USD builds its sche
 
 from graphsdg import (annotators, backends, functional, orchestrator, rng, settings,  # noqa: E402
                       stage, writers)
+from graphsdg import runtime, settings_store  # noqa: E402,F401  (their old paths: engine.runtime, base.settings_store)
 from graphsdg import augmentations_default  # noqa: E402  (rep.augmentations_default; registers RgbToHsv, ...)
 from graphsdg.annotate.annotator import Annotator, AnnotatorRegistry  # noqa: E402
 from graphsdg.io import writers as _builtin_writers  # noqa: E402,F401  (registers BasicWriter)

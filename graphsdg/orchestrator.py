@@ -16,10 +16,10 @@ from typing import Any, Callable
 
 from pxr import UsdGeom
 
-from graphsdg import settings_store as settings
-from graphsdg.jobs import interrupts
-from graphsdg.benchmark import profiling
-from graphsdg import runtime as runtime_module
+from graphsdg.base import settings_store as settings
+from graphsdg.base import interrupts
+from graphsdg.base import profiling
+from graphsdg.engine import runtime as runtime_module
 from graphsdg.annotate.annotator import Annotator
 from graphsdg.annotate.frame import FrameView
 from graphsdg.annotate.semantic_filter import SemanticFilter
@@ -27,14 +27,14 @@ from graphsdg.graph import scheduler
 from graphsdg.io import run_state
 from graphsdg.io.location import open_location
 from graphsdg.io.write_queue import current_write_queue, get_write_queue
-from graphsdg.jobs import frame_plan
-from graphsdg.jobs.progress import Progress
+from graphsdg.io import frame_plan
+from graphsdg.engine.progress import Progress
 from graphsdg.maths.reference_time import reference_time
 from graphsdg.render import motion_blur
 from graphsdg.render.attachments import attachments
 from graphsdg.render.backend import RenderRequest
 from graphsdg.render.camera import CameraView, camera_view, read_lens
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sensors.sensor_view import sensor_camera_view
 from graphsdg.stage.context import stage_context
 from graphsdg.stage.prims import prim_facts
@@ -112,7 +112,7 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     wants it running again calls ``timeline.play()``).
     ``rt_subframes`` > 1 accumulates that many jittered renders (anti-aliasing).
     Ctrl-C (or SIGTERM) during a step takes effect when the frame has been handed
-    to the writers (:mod:`graphsdg.jobs.interrupts`).
+    to the writers (:mod:`graphsdg.base.interrupts`).
 
     ``wait_for_render=False`` pipelines: the step returns once the frame is drawn
     and its pixels are copying off the GPU; its annotators and writers run at the
@@ -562,7 +562,7 @@ def _planned_length(num_frames: int | None) -> int:
 
 
 def _planned_frames(progress: Progress) -> None:
-    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.jobs.frame_plan`)."""
+    """Capture the frames of ``_state.plan`` (see :mod:`graphsdg.io.frame_plan`)."""
     plan, total = _state.plan, _state.remaining or 0
     writers = list(runtime().writers)
     for writer in writers:

@@ -21,7 +21,7 @@ from typing import Hashable
 
 import numpy as np
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 
 _DEFAULT_SEED = 0
 _live_rngs: "weakref.WeakSet[ReplicatorRNG]" = weakref.WeakSet()

@@ -3,7 +3,7 @@
 Isaac Sim scripts configure Replicator through carb settings such as
 ``/omni/replicator/captureOnPlay`` or ``rtx/post/dlss/execMode``; :func:`set`,
 :func:`get` and :func:`reset` are those of the store in
-:mod:`graphsdg.settings_store` (keys graphsdg honours are listed in
+:mod:`graphsdg.base.settings_store` (keys graphsdg honours are listed in
 :data:`KNOWN_KEYS`; any other key is stored and warns once that it has no effect).
 The functions below are Replicator's ``omni.replicator.core.settings``.
 
@@ -21,7 +21,7 @@ from typing import Any
 from pxr import UsdPhysics
 
 from graphsdg.functional import physics
-from graphsdg.settings_store import (KNOWN_KEYS, VALIDATORS, get, get_as_bool, get_as_float, get_as_int,
+from graphsdg.base.settings_store import (KNOWN_KEYS, VALIDATORS, get, get_as_bool, get_as_float, get_as_int,
                                      get_as_string, normalize_key, reset, set, set_bool, set_float, set_int,
                                      set_string)
 from graphsdg.stage import metadata

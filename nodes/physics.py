@@ -20,7 +20,7 @@ from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.graph.value_shapes import SCALAR, VEC3
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.colliders import check_approximation
 
 from .modify import TARGET

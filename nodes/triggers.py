@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.graph.calls import Call
 from graphsdg.graph.node import Port, TriggerNode
 from graphsdg.graph.registry import register_node

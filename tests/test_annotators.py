@@ -9,7 +9,7 @@ import graphsdg as rep
 from graphsdg.errors import RenderProductDestroyedError, UnknownNameError
 from graphsdg.nodes.annotators import BBOX_2D_DTYPE, BBOX_3D_DTYPE, OCCLUSION_DTYPE
 from graphsdg.render.camera import camera_view
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.maths.rotations import euler_to_matrix
 
 from conftest import cube_corners

@@ -89,7 +89,7 @@ def test_box_dropped_on_the_pallet_rests_on_its_deck():
     box = rep.functional.create.reference(usd_path=root + catalog.USD_ASSETS["sm_cardboxd_01"].path,
                                           parent="/World", name="Box", position=(0.1, 0.05, 0.45))
     rep.functional.physics.apply_rigid_body(box, with_collider=True)
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     sim = runtime().sim
     sim.sync_dirty_prims()
     sim.advance(1.5)
@@ -112,7 +112,7 @@ def test_environment_renders_textured(key, view):
     rgb.attach(rp)
     depth.attach(rp)
     rep.orchestrator.step()
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     compiled = runtime().sim.ensure_compiled()
     gprims = [p for p in Usd.PrimRange(env, Usd.TraverseInstanceProxies()) if p.IsA(UsdGeom.Mesh)]
     # every mesh, nested references included (collider proxies and query probes draw no prim)

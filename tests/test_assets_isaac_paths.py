@@ -18,7 +18,7 @@ from pxr import Usd, UsdGeom, UsdPhysics, UsdShade
 import graphsdg as rep
 from graphsdg.assets import builtin_pack_root, catalog, get_assets_root_path
 from graphsdg.physics.articulations import ArticulationView
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage import materials as matlib
 from graphsdg.stage.mdl_modules import MdlModuleError, parse_module, read_module
 

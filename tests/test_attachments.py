@@ -8,7 +8,7 @@ import pytest
 
 import graphsdg as rep
 from graphsdg.render.attachments import attachments
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 class _Counting(rep.Writer):

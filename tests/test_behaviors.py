@@ -18,7 +18,7 @@ from graphsdg.behaviors import (LightRandomizer, LocationRandomizer, LookAtBehav
                                 attach_script, publish_event_and_wait_for_completion_async, script_manager)
 from graphsdg.behaviors import (light_randomizer, location_randomizer, look_at_behavior, rotation_randomizer,
                                 texture_randomizer, volume_stack_randomizer)
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 NS = "exposedVar"
 

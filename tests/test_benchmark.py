@@ -6,7 +6,7 @@ import math
 import pytest
 
 from graphsdg.benchmark.throughput import BenchConfig, _steady_rate, summarize_processes
-from graphsdg.jobs.cpu_share import cores_per_process, limit_image_threads
+from graphsdg.base.cpu_share import cores_per_process, limit_image_threads
 from graphsdg.io.write_queue import threads_per_process
 
 

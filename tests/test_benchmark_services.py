@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg import settings_store
+from graphsdg.base import settings_store
 from graphsdg.benchmark import process_stats
 from graphsdg.benchmark.benchmark_session import OUTPUT_FOLDER_SETTING, BenchmarkSession
 from graphsdg.benchmark.measurements import BooleanMeasurement, ListMeasurement, SingleMeasurement, TestPhase

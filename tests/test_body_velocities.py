@@ -5,7 +5,7 @@ import numpy as np
 from pxr import UsdPhysics
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.transforms import get_world_pose
 
 

@@ -5,7 +5,7 @@ import numpy as np
 
 import graphsdg as rep
 from graphsdg.orchestrator import _camera_view
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 def _scene():

@@ -18,7 +18,7 @@ from graphsdg.jobs.cli import main
 from graphsdg.dataset.formats import read_dataset
 from graphsdg.dataset.merge import merge_coco_documents, merge_shards
 from graphsdg.dataset.view import class_colour, write_view
-from graphsdg.jobs.frame_plan import FramePlan
+from graphsdg.io.frame_plan import FramePlan
 from graphsdg.jobs.job import JobSpec, run_job
 
 # A graph script with two writers (BasicWriter and COCO), two triggers (one every 3 frames) and

@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from graphsdg.benchmark import profiling
+from graphsdg.base import profiling
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError
 

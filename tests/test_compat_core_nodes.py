@@ -8,7 +8,7 @@ import pytest
 import graphsdg as rep
 from graphsdg.compat import isaac
 from graphsdg.io.writer import WriterRegistry
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ from pxr import UsdGeom, UsdPhysics
 import graphsdg as rep
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError, CompatImportError
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ from pxr import Gf, UsdGeom, UsdPhysics, UsdUtils
 
 import graphsdg as rep
 from graphsdg.compat import isaac
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 SIZE, MASS, DT = 0.2, 8.0, 1.0 / 120     # a 0.2 m cube at density 1000; graphsdg's physics step
 

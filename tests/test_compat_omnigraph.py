@@ -14,7 +14,7 @@ from pxr import Gf, UsdGeom
 import graphsdg as rep
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 # A Python OmniGraph node as a Kit extension ships it: it puts each target prim at (radius * k, 0, 0), k = 1, 2, ...
 _OGN = {"OgnLineUp": {"version": 1, "language": "Python", "description": "Lines prims up along X.",

@@ -12,7 +12,7 @@ from pxr import Gf, Sdf, UsdGeom, UsdPhysics
 import graphsdg as rep
 from graphsdg.compat import isaac
 from graphsdg.compat.modules import CompatError
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.sim.compile_error import CompileError
 

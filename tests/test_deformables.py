@@ -7,7 +7,7 @@ from pxr import Gf, UsdGeom, UsdPhysics
 
 import graphsdg as rep
 from graphsdg.compat import isaac
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 @pytest.fixture

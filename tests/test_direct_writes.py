@@ -6,7 +6,7 @@ import pytest
 
 import graphsdg as rep
 from graphsdg.maths import rotations
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import direct_writes, mesh_scaling
 
 

@@ -17,7 +17,7 @@ from graphsdg.physics.domain_randomization import EnvironmentFrames, interval_ro
 from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
 from graphsdg.physics.shape_properties import (ShapeTable, damping_ratio_to_restitution,
                                                 restitution_to_damping_ratio)
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 def _ball(name: str, x: float, z: float = 0.5, parent: str | None = None, radius: float = 0.1):

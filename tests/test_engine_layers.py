@@ -22,14 +22,14 @@ ENGINE_ROOMS = ("sim", "stage", "render", "annotate", "imaging", "sensors")
 
 #: What is built on the engine: the runtime and orchestrator, the immediate-mode and graph APIs, Isaac's
 #: physics API, compat mode, and the top-level faces of Replicator's API.
-ABOVE_ENGINE = ("graphsdg.runtime", "graphsdg.orchestrator", "graphsdg.functional", "graphsdg.physics",
+ABOVE_ENGINE = ("graphsdg.engine", "graphsdg.runtime", "graphsdg.orchestrator", "graphsdg.functional", "graphsdg.physics",
                 "graphsdg.graph", "graphsdg.nodes", "graphsdg.compat", "graphsdg.scenarios",
                 "graphsdg.create", "graphsdg.get", "graphsdg.modify", "graphsdg.randomizer",
                 "graphsdg.distribution", "graphsdg.trigger", "graphsdg.events", "graphsdg.annotators",
                 "graphsdg.writers", "graphsdg.backends")
 
 #: What attaches to render products reads and writes the attachment registry, never the runtime.
-ABOVE_WRITERS = ("graphsdg.runtime", "graphsdg.orchestrator", "graphsdg.functional", "graphsdg.physics")
+ABOVE_WRITERS = ("graphsdg.engine", "graphsdg.runtime", "graphsdg.orchestrator", "graphsdg.functional", "graphsdg.physics")
 
 
 def module_name(path: Path) -> str:

@@ -26,7 +26,7 @@ from graphsdg.episodes import (ArticulationRecordable, AttributeRecordable, Came
                                SamplingConfig, SessionReader, XformRecordable, target_discovery)
 from graphsdg.physics.articulation_dofs import ArticulationDofs
 from graphsdg.physics.joint_fit import fit_joint_positions
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
 
 FRANKA = "/Isaac/Robots/FrankaRobotics/FrankaPanda/franka.usd"

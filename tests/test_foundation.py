@@ -304,7 +304,7 @@ def test_hydra_texture_updates_disabled_skips_render():
 
 
 def test_attribute_edits_sync_without_recompiling():
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(W, H))
     ann, _ = _step_boxes(rp)
     sim = runtime().sim
@@ -327,7 +327,7 @@ def test_attribute_edits_sync_without_recompiling():
 @pytest.mark.parametrize("shape", ["cone", "torus"])
 def test_mesh_rescale_is_live_and_exact(shape):
     """Rescaling a mesh prim twice neither recompiles nor re-uploads, and renders what a fresh compile renders."""
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     rep.functional.create.xform(name="World")
     rep.functional.create.distant_light(intensity=1500, parent="/World", rotation=(315, 0, 0))
     rep.functional.create.dome_light(intensity=600, parent="/World")
@@ -429,7 +429,7 @@ def test_pose_value_shapes():
 
 
 def test_colour_and_depth_share_one_render_without_msaa():
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     rep.settings.set("/graphsdg/render/msaaSamples", 0)
     cube, cam, rp = unit_cube_scene(camera_position=(0, -4, 0), resolution=(W, H))
     rgb, depth = rep.annotators.get("rgb"), rep.annotators.get("distance_to_image_plane")

@@ -18,7 +18,7 @@ def test_physx_scene_keywords_author_the_api_attributes():
     assert prim.GetAttribute("physxScene:enableGPUDynamics").Get() is False
     assert UsdPhysics.Scene(prim).GetGravityMagnitudeAttr().Get() == pytest.approx(4.0)
     rep.orchestrator.step()
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     assert runtime().sim.model.opt.timestep == pytest.approx(1 / 90)   # the rate reaches the simulation
 
 

@@ -48,7 +48,7 @@ def test_wider_codes_give_the_same_ids_boxes_and_depth(monkeypatch, bits):
 
 
 def rasterizer_scene():
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     return runtime().rasterizer._scene
 
 
@@ -108,7 +108,7 @@ def test_id_pass_after_the_colour_pass_matches_an_id_pass_alone():
     """The id pass draws the scene the colour pass just updated (no second mjv_updateScene): the ids and
     depth are byte-identical to an id pass that updates the scene itself, rescaled meshes included."""
     from graphsdg.render.camera import camera_view
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
 
     rep.settings.set("/exts/omni.replicator.core/enableWriteToFabric", True)
     rp = _two_balls_and_a_box()
@@ -135,7 +135,7 @@ def test_id_framebuffer_depth_is_read_unpacked_and_matches_mujocos_buffer():
     """Id passes draw into graphsdg's own framebuffer (float depth, no stencil: read back as stored, 4
     bytes a pixel); its depth is byte-identical to the depth of MuJoCo's own single-sample buffer."""
     from graphsdg.render.camera import camera_view
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
 
     rep.settings.set("/graphsdg/render/msaaSamples", 0)   # colour + depth from MuJoCo's buffer, in one pass
     rp = _two_balls_and_a_box()
@@ -163,7 +163,7 @@ def test_id_framebuffer_stores_only_the_code_bytes(bits, size):
     from OpenGL import GL
 
     from graphsdg.render.id_framebuffer import IdFramebuffer
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     rep.functional.create.cube()
     rep.orchestrator.step()          # a GL context, current
     runtime().rasterizer._ensure_gl()

@@ -119,7 +119,7 @@ def test_annotators_label_every_code_of_the_read_width(monkeypatch, count, size)
     lut, image = seen["lut"], seen["image"]
     assert readback.code_bits(len(lut)) == (8 if count < 255 else 16)
     geom_of_pixel = lut[image]
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     geom_ids = {runtime().sim.compiled.geoms[str(c.GetPath())].geom_id: str(c.GetPath()) for c in cubes}
     is_cube = np.isin(geom_of_pixel, list(geom_ids))
     semantic = anns["semantic_segmentation"].get_data()
@@ -149,7 +149,7 @@ def test_a_crowded_scene_reads_two_byte_codes_and_labels_only_its_objects():
     for a in anns.values():
         a.attach(rps)
     rep.orchestrator.step()
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     scene = runtime().rasterizer._scene
     assert scene.ngeom >= 1000 and readback.code_bits(len(rasterizer._segid_lut(scene))) == 16
     instance = anns["instance_segmentation"].get_data()

@@ -14,7 +14,7 @@ import pytest
 from pxr import Gf, Sdf, UsdGeom, UsdPhysics
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.physics import queries
 from graphsdg.physics.articulations import ArticulationView, fixed_joint_enabled, set_fixed_joint_enabled
 from graphsdg.physics.bodies import RigidBodyView

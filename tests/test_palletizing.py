@@ -24,7 +24,7 @@ from pxr import UsdGeom, UsdPhysics, UsdShade
 
 import graphsdg as rep
 from graphsdg import settings
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
 from graphsdg.scenarios.palletizing import BinStacking

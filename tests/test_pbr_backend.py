@@ -16,7 +16,7 @@ import graphsdg as rep  # noqa: E402
 from graphsdg.render.camera import camera_view  # noqa: E402
 from graphsdg.render.pbr import PbrRenderer  # noqa: E402
 from graphsdg.render.pbr_outputs import code_format, code_table  # noqa: E402
-from graphsdg.runtime import runtime  # noqa: E402
+from graphsdg.engine.runtime import runtime  # noqa: E402
 
 W, H = 32, 24
 DEVICE = os.environ.get("GRAPHSDG_PBR_TEST_DEVICE", "cpu")

@@ -10,7 +10,7 @@ from pxr import Gf, Sdf, UsdShade
 import graphsdg as rep
 from graphsdg.render import pbr_scene as ps
 from graphsdg.render.camera import CameraView
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.imaging import environment_map
 from graphsdg.sim.lights import REFERENCE_IRRADIANCE
 from graphsdg.maths.rotations import quat_wxyz_to_matrix
@@ -261,7 +261,7 @@ def test_maps_compile_as_mujoco_texture_roles_only_where_pbr_draws(tmp_path, mon
     import mujoco
 
     from graphsdg.render import backend
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     rng = np.random.default_rng(3)
     files = {}
     for name in ("albedo", "normal", "orm"):

@@ -10,7 +10,7 @@ import pytest
 from pxr import Gf, UsdGeom, UsdPhysics
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.physics import queries
 from graphsdg.sim import bounds, transforms
 from graphsdg.physics.bodies import RigidBodyView

@@ -13,7 +13,7 @@ import pytest
 from PIL import Image
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.physics import queries
 from graphsdg.sim import bounds
 from graphsdg.physics.bodies import RigidBodyView

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 FLAGS = dict(rgb=True, distance_to_image_plane=True, semantic_segmentation=True, bounding_box_2d_tight=True)
 

@@ -16,7 +16,7 @@ from pxr import Usd, UsdGeom
 import graphsdg as rep
 from graphsdg.maths import rotations
 from graphsdg.render.camera import camera_view
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import direct_writes
 from graphsdg.stage import xform
 

@@ -12,7 +12,7 @@ from graphsdg import settings
 from graphsdg.render import backend
 from graphsdg.render.backend import BackendRequest, PbrUnavailableError, pbr_missing, requested_backend, \
     resolve_backend
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 HAVE_ALL = dict(has_module=lambda name: True, cuda_devices=lambda: 1, python=(3, 12))
 

@@ -8,7 +8,7 @@ import numpy as np
 import graphsdg as rep
 from graphsdg.render import rasterizer, scene_geoms
 from graphsdg.render.camera import camera_view
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 W, H = 64, 48
 

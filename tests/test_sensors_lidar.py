@@ -7,7 +7,7 @@ import pytest
 from pxr import Gf, UsdGeom
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sensors.generic_model_output import decode
 from graphsdg.sensors.lidar_profile import EmitterState, LidarProfile, LidarProfileError, author_lidar_profile
 from graphsdg.sensors.profile_catalog import lidar_profile

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sensors.lidar_profile import EmitterState, LidarProfile, author_lidar_profile
 from graphsdg.sensors.lidar_scan import LidarScanner
 

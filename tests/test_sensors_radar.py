@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sensors.generic_model_output import Modality, decode
 from graphsdg.sensors.lidar_profile import LidarProfileError
 

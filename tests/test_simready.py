@@ -111,7 +111,7 @@ def test_crate_is_centimetres_without_units_metadata():
 def test_ycb_physics_drop_rests_on_the_ground():
     """The physics file is a real rigid body: dropped on the grid, the cracker box settles at half its height."""
     import graphsdg as rep
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     rep.stage.new_stage()
     rep.functional.create.reference(usd_path=ROOT + "/Isaac/Environments/Grid/default_environment.usd", name="Grid")
     box = rep.functional.create.reference(usd_path=ROOT + "/Isaac/Props/YCB/Axis_Aligned_Physics/003_cracker_box.usd",

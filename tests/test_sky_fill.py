@@ -7,7 +7,7 @@ import pytest
 
 import graphsdg as rep
 from graphsdg.render import rasterizer, sky
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 W = H = 96
 

@@ -48,7 +48,7 @@ def test_long_demo_run_memory_is_flat(soak, tmp_path):
 
 
 def test_pipelined_soak_builds_the_asked_asset_count(soak, tmp_path):
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     samples = soak.soak_pipelined(str(tmp_path / "pipelined"), frames=6, every=3, resolution=(32, 24), seed=0,
                                   assets=15)
     assert [n for n, *_ in samples] == [0, 3, 6]

@@ -6,7 +6,7 @@ import pytest
 from pxr import Gf, Usd, UsdGeom, UsdShade
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 from conftest import unit_cube_scene
 

@@ -75,7 +75,7 @@ def test_draw_renders_what_a_capture_renders():
     cam = rep.functional.create.camera(position=(0, -4, 0), look_at=(0, 0, 0))
     rp = rep.create.render_product(cam, (32, 24))
     heard = []
-    from graphsdg.runtime import runtime
+    from graphsdg.engine.runtime import runtime
     runtime().render_observers.append(heard.append)
     try:
         captured = rep.orchestrator.frames_captured()

@@ -14,7 +14,7 @@ from graphsdg import orchestrator
 from graphsdg.jobs import synthetic_recorder
 from graphsdg.jobs.synthetic_recorder import RecorderState, SyntheticRecorder
 from graphsdg.render.attachments import attachments
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 def stage(labelled=True):

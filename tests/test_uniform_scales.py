@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import graphsdg as rep
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.direct_writes import DirectTargets, targets_for
 
 SHAPES = ("cube", "cone", "cylinder", "sphere", "torus")

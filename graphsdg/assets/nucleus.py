@@ -36,7 +36,7 @@ import posixpath
 import re
 from urllib.parse import unquote, urlsplit
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.assets.root import builtin_pack_root, get_assets_root_path
 
 SCHEME = "omniverse"

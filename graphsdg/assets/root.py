@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 import warnings
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 
 ASSETS_ROOT_SETTING = "/persistent/isaac/asset_root/default"
 ASSETS_ROOT_ENV = "GRAPHSDG_ASSETS_ROOT"

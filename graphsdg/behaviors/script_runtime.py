@@ -14,7 +14,7 @@ instantiated (and their exposed variables created) even while the timeline is st
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> _ = rep.stage.new_stage()
     >>> cube = rep.functional.create.cube(name="Cube")
     >>> from graphsdg.behaviors import location_randomizer
@@ -34,7 +34,7 @@ from typing import Any
 
 from pxr import Sdf, Tf, Usd
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.timeline import TimelineEventType
 from graphsdg.stage.context import get_stage, stage_context
 

@@ -22,7 +22,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 from graphsdg.behaviors import host
 from graphsdg.behaviors.xform_edits import set_transform_attributes
 from graphsdg.physics.forces import apply_force_at_pos
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 def create_asset(stage: Usd.Stage, asset_url: str, prim_path: str) -> Usd.Prim:

@@ -20,7 +20,7 @@ This is what Isaac Sim's ``BaseIsaacBenchmark`` does, measured on graphsdg:
 
 Example:
     >>> import tempfile, graphsdg as rep
-    >>> from graphsdg import settings_store
+    >>> from graphsdg.base import settings_store
     >>> settings_store.set(OUTPUT_FOLDER_SETTING, tempfile.mkdtemp())
     >>> _ = rep.stage.new_stage()
     >>> session = BenchmarkSession("doc_bench", backend_type="JSONFileMetrics", report_generation=False,
@@ -43,7 +43,8 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from graphsdg import orchestrator, settings_store
+from graphsdg import orchestrator
+from graphsdg.base import settings_store
 from graphsdg.benchmark import frametime_recorders, system_recorders  # noqa: F401 - they register the recorders
 from graphsdg.benchmark.measurements import Measurement, MetadataBase, StringMetadata, TestPhase
 from graphsdg.benchmark.metrics_files import MetricsBackendInterface, metrics_backend, version_branch

@@ -41,13 +41,14 @@ from __future__ import annotations
 import time
 from typing import Callable
 
-from graphsdg import settings_store
-from graphsdg.benchmark import frame_ticks, profiling
+from graphsdg.base import settings_store
+from graphsdg.base import profiling
+from graphsdg.benchmark import frame_ticks
 from graphsdg.benchmark.measurements import ListMeasurement, SingleMeasurement
 from graphsdg.benchmark.recorder_interface import (InputContext, MeasurementData, MeasurementDataRecorder,
                                                    MeasurementDataRecorderRegistry)
 from graphsdg.benchmark.sample_stats import SampleStats
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
 
 #: Profile accumulators that make up a frame's render time (``render`` holds the drawing and the queued copies,

@@ -253,7 +253,7 @@ def _apply(draw: dict[str, np.ndarray], assets, cams) -> None:
 def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     """Time graphsdg on the benchmark scene; ``before_timing()`` runs after the warm-up (a barrier, say)."""
     import graphsdg as rep
-    from graphsdg.benchmark import profiling
+    from graphsdg.base import profiling
     from graphsdg.io.write_queue import reset_write_queue
 
     rep.settings.set("/omni/replicator/backend/writeThreads", _write_threads(config))
@@ -261,7 +261,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
         rep.settings.set("/graphsdg/io/writeProcesses", config.write_processes)
     reset_write_queue()
     if config.image_threads is not None:
-        from graphsdg.jobs.cpu_share import limit_image_threads
+        from graphsdg.base.cpu_share import limit_image_threads
         limit_image_threads(config.image_threads)
     assets, cams, rps = build_scene(config)
     flags = {ANNOTATOR_FLAGS[a]: True for a in config.annotators}
@@ -324,8 +324,8 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     import mujoco
 
     import graphsdg as rep  # noqa: F401  (EGL selection)
-    from graphsdg.benchmark import profiling
-    from graphsdg.runtime import runtime
+    from graphsdg.base import profiling
+    from graphsdg.engine.runtime import runtime
 
     assets, cams, rps = build_scene(config)
     sim = runtime().sim
@@ -571,7 +571,7 @@ def launch_processes(config: BenchConfig, processes: int,
     environment: its GPU, say); return their :func:`_worker` results, the seconds it all took, and the
     config they ran (the writer and OpenCV threads set to each one's share of the cores)."""
     from graphsdg.benchmark.process_launch import run_in_processes
-    from graphsdg.jobs.cpu_share import cores_per_process
+    from graphsdg.base.cpu_share import cores_per_process
     from graphsdg.io.write_queue import threads_per_process
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(processes))

@@ -10,7 +10,7 @@
   ``omni_global_config``, ``omni_documents``, ``python`` (the interpreter);
   ``set_value`` adds more. A token nobody set logs a warning once.
 * ``carb.profiler``: ``begin``/``end`` zones and the ``profile`` decorator time
-  for real into graphsdg's profiling tables (:mod:`graphsdg.benchmark.profiling`,
+  for real into graphsdg's profiling tables (:mod:`graphsdg.base.profiling`,
   accumulator ``carb:<zone>``; ``rep.orchestrator.get_profile()`` and
   ``graphsdg bench --profile`` show them), filtered by the capture mask;
   ``value_*`` samples and instant events are kept (:func:`profiler_samples`).
@@ -36,7 +36,7 @@ import time
 import types
 from typing import Any, Callable
 
-from graphsdg.benchmark import profiling
+from graphsdg.base import profiling
 from graphsdg.compat.modules import PORTING, CompatError, CompatModule, CompatObject
 
 log = logging.getLogger("carb")

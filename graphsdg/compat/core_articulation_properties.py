@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage import physx_schemas
 
 _ARTICULATION_API = "PhysxArticulationAPI"

@@ -48,7 +48,7 @@ from graphsdg.compat.modules import CompatError, CompatModule
 from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.physics.articulation_tensor_view import ArticulationTensorView
 from graphsdg.physics.articulations import ArticulationView
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage.context import get_stage
 
 log = logging.getLogger("carb")

@@ -23,10 +23,10 @@ from typing import Any
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.compat.modules import CompatError, CompatObject
 from graphsdg.compat.simulation_manager import SimulationManager
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage import physx_schemas
 from graphsdg.stage.context import get_stage
 

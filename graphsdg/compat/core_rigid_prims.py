@@ -36,7 +36,7 @@ from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.maths.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.physics.forces import apply_force_at_pos
 from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 log = logging.getLogger("carb")
 

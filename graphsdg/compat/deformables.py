@@ -21,7 +21,7 @@ from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from graphsdg.compat.isaac_core import WarpLikeArray, XformPrim, _warp
 from graphsdg.compat.modules import CompatModule, CompatObject
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import deformables as dfm
 from graphsdg.stage.context import get_stage
 

@@ -57,7 +57,7 @@ from graphsdg.compat.event_names import (APP_POST_UPDATE, APP_PRE_UPDATE, APP_UP
                                          StageRenderingEventType, stage_event_name, stage_rendering_event_name)
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.render.render_product import registry as product_registry
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.timeline import TimelineEvent, TimelineEventType
 from graphsdg.stage.context import get_stage
 

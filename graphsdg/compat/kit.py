@@ -2,7 +2,7 @@
 
 Each class is a thin adapter: an app update is :func:`graphsdg.orchestrator.update`,
 the timeline is the runtime's :class:`~graphsdg.sim.timeline.Timeline`, the USD
-context is :mod:`graphsdg.stage`, carb settings are :mod:`graphsdg.settings_store`.
+context is :mod:`graphsdg.stage`, carb settings are :mod:`graphsdg.base.settings_store`.
 
 App updates and asyncio follow Kit: every coroutine awaiting
 ``next_update_async()`` resumes after the same next update (two coroutines
@@ -26,14 +26,14 @@ from typing import Any, Callable
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from graphsdg import orchestrator, stage
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.compat import event_names, extensions, viewport
 from graphsdg.compat.event_names import StageEventType
 from graphsdg.compat.kit_commands import COMMANDS
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
 from graphsdg.graph import clear as clear_graph
 from graphsdg.graph.graph import REPLICATOR_ROOT
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import transforms
 
 log = logging.getLogger("carb")
@@ -567,7 +567,7 @@ _asyncify_fixtures(AsyncTestCase)
 
 # ---- carb ------------------------------------------------------------------------
 class CarbSettings(CompatObject):
-    """carb.settings.ISettings over :mod:`graphsdg.settings_store`."""
+    """carb.settings.ISettings over :mod:`graphsdg.base.settings_store`."""
 
     _compat_name = "carb.settings.ISettings"
 

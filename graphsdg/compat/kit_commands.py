@@ -46,7 +46,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
-from graphsdg import settings_store
+from graphsdg.base import settings_store
 from graphsdg.functional.create import add_reference, clone
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 from graphsdg.stage import get_stage

@@ -43,7 +43,7 @@ from pxr import Usd, UsdUtils
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.compat.physx_schema import sdfPathToInt
 from graphsdg.physics import queries
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
 from graphsdg.stage.context import get_stage, stage_context
 

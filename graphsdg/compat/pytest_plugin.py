@@ -42,7 +42,7 @@ def pytest_configure(config) -> None:
     isaac.install()
     scale = config.getoption("--resolution-scale", None)
     if scale is not None:
-        from graphsdg import settings_store
+        from graphsdg.base import settings_store
         settings_store.set("/graphsdg/render/resolutionScale", scale)
 
 
@@ -186,7 +186,7 @@ def prepare_extension_test(test_file: Path) -> list[str]:
             enabled.append(name)
         except extensions.UnknownExtensionError:
             continue   # a name the test uses from it fails where it is used, naming the module
-    from graphsdg import settings_store
+    from graphsdg.base import settings_store
     for entry in entries:
         for path, value in setting_arguments(entry.get("args", [])).items():
             if path in settings_store.KNOWN_KEYS:

@@ -34,7 +34,7 @@ from typing import Any, Callable
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.compat import viewport
 from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.event_names import StageRenderingEventType, stage_rendering_event_name

@@ -29,7 +29,7 @@ from typing import Any, Callable
 import graphsdg
 from graphsdg import tools
 from graphsdg.compat.modules import CompatError, CompatModule, ForwardingModule
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 # documented names graphsdg cannot honour: module -> name -> why (the error says it)
 REFUSED: dict[str, dict[str, str]] = {

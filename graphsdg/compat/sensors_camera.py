@@ -49,7 +49,7 @@ from graphsdg.compat.event_names import StageEventType, StageRenderingEventType,
 from graphsdg.compat.modules import CompatModule
 from graphsdg.compat.sensors_camera_lenses import CameraLenses, carb_warn
 from graphsdg.maths.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage.context import get_stage
 
 log = logging.getLogger("carb")
@@ -123,7 +123,7 @@ def distort_point_kannala_brandt(camera_matrix: Any, distortion_model: Any, x: A
 
 def rendering_frequency() -> float | None:
     """``/app/runLoops/main/rateLimitFrequency``, None where unset."""
-    value = graphsdg.settings_store.get(RATE_LIMIT, None)
+    value = graphsdg.base.settings_store.get(RATE_LIMIT, None)
     return None if value is None else float(value)
 
 

@@ -28,7 +28,7 @@ from typing import Any
 from pxr import Sdf, Usd
 
 from graphsdg import functional
-from graphsdg import settings_store
+from graphsdg.base import settings_store
 from graphsdg.compat.experimental_prims import XformPrim
 from graphsdg.functional.sensors import set_sensor_attributes
 from graphsdg.compat.sensors_rtx_configs import (SUPPORTED_LIDAR_CONFIGS, SUPPORTED_RADAR_CONFIGS, check_variant,

@@ -45,7 +45,7 @@ from graphsdg.compat.sensors_rtx_runtime import parse_generic_model_output_data,
     parse_stable_id_map_data
 from graphsdg.functional.sensors import set_sensor_attributes
 from graphsdg.render.product_prims import sync_product_prims
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.timeline import TimelineEventType
 from graphsdg.sensors.lidar_profile import author_lidar_profile
 from graphsdg.sensors import surface_materials

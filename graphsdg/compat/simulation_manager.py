@@ -50,7 +50,7 @@ from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.compat.physics_views import PhysicsScene, SimulationView
 from graphsdg.functional.physics import create_physics_scene
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
 from graphsdg.physics.timeline import get_timeline_interface
 from graphsdg.sim.timeline import TimelineEventType

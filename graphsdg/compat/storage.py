@@ -40,7 +40,7 @@ from urllib.parse import urlparse, urlunparse
 
 from pxr import Sdf, Usd, UsdUtils
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.assets import root as asset_root
 from graphsdg.compat import omni_client as client
 from graphsdg.compat.modules import CompatModule

@@ -38,7 +38,7 @@ import numpy as np
 from PIL import Image
 
 from graphsdg.annotate.ids import color_of
-from graphsdg.jobs.frame_plan import SHARD_FOLDER
+from graphsdg.io.frame_plan import SHARD_FOLDER
 from graphsdg.io import encode
 from graphsdg.io.location import Location, open_location
 from graphsdg.io.writers.coco import renumber_annotations

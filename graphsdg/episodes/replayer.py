@@ -39,7 +39,7 @@ from graphsdg.episodes.registry import rehydrate
 from graphsdg.episodes.scalar_recordables import SimTimeRecordable
 from graphsdg.episodes.session_reader import SessionReader
 from graphsdg.physics.simulated_poses import restore_joint_state, save_joint_state, write_world_poses
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage.context import get_stage
 
 log = logging.getLogger("graphsdg.episodes")

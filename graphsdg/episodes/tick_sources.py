@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
 
 Unsubscribe = Callable[[], None]

@@ -10,7 +10,7 @@ import logging
 from typing import Any
 
 from graphsdg.episodes.recorder import EPISODE_ACTIVE, EpisodeRecorder
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.timeline import TimelineEventType
 
 log = logging.getLogger("graphsdg.episodes")

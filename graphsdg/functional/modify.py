@@ -18,11 +18,11 @@ from typing import Any
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.errors import closest
 from graphsdg.functional.per_prim import per_prim, per_prim_array
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import direct_writes
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib

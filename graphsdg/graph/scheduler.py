@@ -22,11 +22,11 @@ from typing import Any, Iterable
 import numpy as np
 from pxr import Sdf, Usd
 
-from graphsdg.benchmark import profiling
+from graphsdg.base import profiling
 from graphsdg.graph.current import current_graph, edit_context, release_graph
 from graphsdg.graph.graph import Graph, effective_triggers
 from graphsdg.graph.node import ExecContext, Node, ReplicatorItem, TriggerNode
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 
 
 def active_graph() -> Graph | None:

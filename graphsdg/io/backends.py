@@ -15,8 +15,8 @@ import uuid
 from typing import Any, Callable
 
 
-from graphsdg import settings_store as settings
-from graphsdg.jobs import frame_plan
+from graphsdg.base import settings_store as settings
+from graphsdg.io import frame_plan
 from graphsdg.errors import unknown_name
 from graphsdg.io import atomic_files, encode, object_store
 from graphsdg.io.atomic_files import remove_temporaries  # noqa: F401  (part of this module's face)

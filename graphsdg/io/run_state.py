@@ -49,7 +49,7 @@ import time
 import weakref
 from typing import Any
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.io.location import open_location
 from graphsdg.render.attachments import attachments
 from graphsdg.rng import get_global_seed

@@ -42,9 +42,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from graphsdg import settings_store as settings
-from graphsdg.benchmark import profiling
-from graphsdg.jobs.cpu_share import cores_per_process
+from graphsdg.base import settings_store as settings
+from graphsdg.base import profiling
+from graphsdg.base.cpu_share import cores_per_process
 from graphsdg.errors import WriterError
 from graphsdg.io.write_processes import FileWrite, WriteProcesses
 from graphsdg.io.written_totals import count_written

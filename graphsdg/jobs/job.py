@@ -15,8 +15,8 @@ import time
 from dataclasses import asdict, dataclass, field
 
 from graphsdg import orchestrator
-from graphsdg.jobs import frame_plan
-from graphsdg.jobs.frame_plan import FramePlan
+from graphsdg.io import frame_plan
+from graphsdg.io.frame_plan import FramePlan
 from graphsdg.io import backends
 from graphsdg.io.location import open_location
 from graphsdg.jobs.script_runner import run_script

@@ -31,7 +31,7 @@ import tempfile
 import time
 from dataclasses import replace
 
-from graphsdg.jobs.cpu_share import cores_per_process
+from graphsdg.base.cpu_share import cores_per_process
 from graphsdg.jobs.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
 from graphsdg.io import object_store
 from graphsdg.io.location import normalize
@@ -82,9 +82,9 @@ class ShardWorker:
         """Run shard ``index`` of ``count``; ``write_threads`` is the default writer pool size here
         (the script may still set ``/omni/replicator/backend/writeThreads`` itself), ``image_threads``
         OpenCV's pool size (None: its default)."""
-        from graphsdg import settings_store as settings
-        from graphsdg.jobs.cpu_share import limit_image_threads
-        from graphsdg.jobs.frame_plan import FramePlan
+        from graphsdg.base import settings_store as settings
+        from graphsdg.base.cpu_share import limit_image_threads
+        from graphsdg.io.frame_plan import FramePlan
         from graphsdg.io.write_queue import THREADS_KEY, get_write_queue
         if write_threads is not None:
             settings.set(THREADS_KEY, write_threads)

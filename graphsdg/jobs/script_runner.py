@@ -17,7 +17,7 @@ import sys
 from typing import Iterator, Sequence
 
 from graphsdg import orchestrator, rng
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.io.location import normalize
 from graphsdg.io.write_queue import get_write_queue
 from graphsdg.render.attachments import attachments

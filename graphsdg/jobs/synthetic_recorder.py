@@ -40,7 +40,7 @@ from pxr import UsdGeom, UsdSkel
 
 from graphsdg import backends, create, orchestrator
 from graphsdg.io.writer import WriterRegistry
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.stage.context import get_stage
 
 log = logging.getLogger("graphsdg.recorder")

@@ -41,7 +41,7 @@ import mujoco
 import numpy as np
 from pxr import Sdf, UsdPhysics
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene, JointBinding
 
 SCALAR_KINDS = ("revolute", "prismatic")

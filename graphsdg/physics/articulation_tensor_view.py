@@ -43,7 +43,7 @@ from graphsdg.physics import body_properties
 from graphsdg.physics.model_overrides import overrides_for
 from graphsdg.physics.rigid_body_tensor_view import row_indices, selected_rows
 from graphsdg.physics.shape_properties import ShapeTable
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene, JointBinding
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage.context import get_stage

@@ -38,7 +38,7 @@ import mujoco
 import numpy as np
 from pxr import Gf, Sdf, UsdPhysics
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim.compiled_scene import JointBinding
 from graphsdg.sim.rigid_bodies import rigid_root

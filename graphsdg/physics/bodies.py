@@ -24,7 +24,7 @@ from typing import Iterable, Sequence
 import numpy as np
 from pxr import Sdf, Usd, UsdPhysics
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import PrimLike

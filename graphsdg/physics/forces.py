@@ -17,7 +17,7 @@ Pushes still waiting when the stage is replaced are dropped with it.
 Example:
     >>> import numpy as np
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> _ = rep.stage.new_stage()
     >>> box = rep.functional.create.cube(position=(0, 0, 5), name="Box")
     >>> rep.functional.physics.apply_rigid_body(box)
@@ -35,7 +35,7 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
 from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.context import get_stage, stage_context

@@ -20,7 +20,7 @@ from typing import Sequence
 import numpy as np
 
 from graphsdg.physics.model_overrides import overrides_for
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene
 
 

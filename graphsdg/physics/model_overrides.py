@@ -15,7 +15,7 @@ them and keeps the simulation state exactly.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> _ = rep.stage.new_stage()
     >>> sim = runtime().sim
     >>> def gravity_off(compiled):
@@ -32,7 +32,7 @@ from typing import Callable, Hashable
 import mujoco
 import numpy as np
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene
 from graphsdg.sim.scene import SimScene
 from graphsdg.sim.timeline import TimelineEventType

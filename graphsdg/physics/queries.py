@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 
 from graphsdg.maths.rotations import quat_wxyz_to_matrix
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene
 from graphsdg.sim.rigid_bodies import rigid_root
 from graphsdg.stage.prims import PrimLike, resolve_prim

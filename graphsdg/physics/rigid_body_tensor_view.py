@@ -12,7 +12,7 @@ of only the selected rows is accepted too). What they write reaches MuJoCo's
 Example:
     >>> import numpy as np
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> _ = rep.stage.new_stage()
     >>> box = rep.functional.create.cube(position=(0, 0, 1), name="Box")
     >>> rep.functional.physics.apply_collider(box); rep.functional.physics.apply_rigid_body(box)
@@ -32,7 +32,7 @@ from graphsdg.physics import body_properties
 from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.physics.forces import apply_force_at_pos
 from graphsdg.physics.shape_properties import ShapeTable
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.scene import SimScene
 from graphsdg.stage.prims import PrimLike
 

@@ -36,7 +36,7 @@ from pxr import Sdf, UsdGeom
 from graphsdg.maths.rotations import compose, decompose, matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graphsdg.physics.joint_fit import fit_joint_positions
 from graphsdg.physics.world_pose import set_world_pose
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.compiled_scene import CompiledScene
 from graphsdg.stage.prims import resolve_prim
 from graphsdg.stage.xform import world_matrix

@@ -14,7 +14,7 @@ Example:
 """
 from __future__ import annotations
 
-from graphsdg.runtime import runtime
+from graphsdg.engine.runtime import runtime
 from graphsdg.sim.timeline import Subscription, Timeline, TimelineEvent, TimelineEventType
 
 

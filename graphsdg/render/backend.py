@@ -36,7 +36,7 @@ import sys
 from dataclasses import dataclass
 from typing import Any, Callable, Protocol, runtime_checkable
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 
 log = logging.getLogger("graphsdg.render")
 

@@ -37,7 +37,7 @@ from typing import Iterator
 import mujoco
 import numpy as np
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.maths.rotations import quat_slerp
 from graphsdg.render.camera import CameraView
 from graphsdg.sim import physics_steps

@@ -48,8 +48,8 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom, UsdShade
 
-from graphsdg import settings_store as settings
-from graphsdg.benchmark import profiling
+from graphsdg.base import settings_store as settings
+from graphsdg.base import profiling
 from graphsdg.imaging import environment_map
 from graphsdg.render import mesh_folds, pbr_scene
 from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderRequest, launch_groups, pbr_missing,

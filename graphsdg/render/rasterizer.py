@@ -39,7 +39,7 @@ import cv2
 import mujoco
 import numpy as np
 
-from graphsdg.benchmark import profiling
+from graphsdg.base import profiling
 from graphsdg.render import gl_direct, sky
 from graphsdg.render.backend import RenderRequest
 from graphsdg.render.camera import CameraView

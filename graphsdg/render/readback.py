@@ -35,7 +35,7 @@ from OpenGL import GL
 from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels   # no client-array wrapping: a PBO offset
 from OpenGL.raw.GL.VERSION.GL_3_0 import glBlitFramebuffer as raw_blit_framebuffer   # no error check of its own
 
-from graphsdg.benchmark import profiling
+from graphsdg.base import profiling
 from graphsdg.render import gl_direct as gld
 from graphsdg.render.polling import wait_until
 

@@ -11,7 +11,7 @@ from typing import Iterable, Sequence
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.errors import InvalidPrimError, RenderProductDestroyedError
 from graphsdg.sensors.usd_schemas import SENSOR_PRIM_TYPES
 from graphsdg.stage.context import get_stage

@@ -41,7 +41,7 @@ from typing import Callable
 
 import numpy as np
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
 from graphsdg.scenarios.palletizing_controller import Event, PalletizingController
@@ -83,7 +83,7 @@ class BinStacking:
     def load_world(self) -> None:
         """A new stage holding the cell, the arm at home, bin 0 on the belt and the rest stacked waiting."""
         from graphsdg import stage as stage_ctx
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
 
         self.flipped = [random.random() < FLIP_PROBABILITY for _ in range(self.num_bins)]
         stage = stage_ctx.new_stage()
@@ -95,7 +95,7 @@ class BinStacking:
 
     def start(self) -> None:
         """Hook the controller into physics and play the timeline."""
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
         if self.kinematics is None:
             raise RuntimeError("BinStacking.start(): load the world first (load_world / load_world_async)")
         sim = runtime().sim
@@ -109,7 +109,7 @@ class BinStacking:
 
     def stop(self) -> None:
         """Unhook the controller and pause the timeline."""
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
         runtime().sim.remove_physics_callback(CALLBACK)
         runtime().timeline.pause()
 
@@ -129,7 +129,7 @@ class BinStacking:
     def run_until(self, condition: Callable[[], bool], max_seconds: float = 600.0) -> bool:
         """App updates (one timeline frame each) until ``condition()`` or ``max_seconds`` of simulated time."""
         from graphsdg import orchestrator
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
         timeline = runtime().timeline
         start = timeline.get_current_time()
         while not condition():

@@ -115,7 +115,7 @@ class PalletizingController:
     # ---- the physics callback ------------------------------------------------
     def physics_step(self, step_size: float) -> None:
         """Advance everything by one physics step (registered with ``add_physics_callback``)."""
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
         sim = runtime().sim
         c = sim.compiled
         self.dt = float(step_size)
@@ -153,7 +153,7 @@ class PalletizingController:
 
     # ---- state of the bins -----------------------------------------------------
     def _data(self):
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
         return runtime().sim.compiled.data
 
     def bin_pose(self, i: int) -> Frame:
@@ -306,7 +306,7 @@ class PalletizingController:
         """Travel over bin ``i``'s upward face, come down until the cup touches, switch the grip on."""
         face, rot = self._up_face(i)
         yield from self._travel(Frame(face + Z * 0.03, rot))
-        from graphsdg.runtime import runtime
+        from graphsdg.engine.runtime import runtime
         c = runtime().sim.compiled
         start = self.tcp_cmd
         depth = 0.045

@@ -20,7 +20,7 @@ now.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> from graphsdg.sensors.lidar_profile import EmitterState, LidarProfile, author_lidar_profile
     >>> stage = rep.stage.new_stage()
     >>> wall = rep.functional.create.cube(position=(5.5, 0, 0), scale=(1, 20, 20))

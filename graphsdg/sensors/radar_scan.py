@@ -18,7 +18,7 @@ then range order. Optional Gaussian noise (``rangeNoiseStdM``, ``velocityNoiseSt
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> stage = rep.stage.new_stage()
     >>> _ = rep.functional.create.cube(position=(10.5, 0, 0), scale=(1, 4, 4))
     >>> radar = stage.DefinePrim("/Radar", "OmniRadar")

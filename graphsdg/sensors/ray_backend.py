@@ -11,7 +11,7 @@ Chosen like the render backend, from the setting ``/graphsdg/sensors/rayBackend`
 Both return the same :class:`~graphsdg.sensors.ray_caster.RayHits` for the same rays.
 
 Example:
-    >>> from graphsdg import settings_store
+    >>> from graphsdg.base import settings_store
     >>> settings_store.set("/graphsdg/sensors/rayBackend", "cpu")
     >>> ray_caster().name
     'cpu'
@@ -23,7 +23,7 @@ import importlib.util
 import sys
 from typing import Any
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.sensors.ray_caster import CpuRayCaster
 
 BACKEND_KEY = "/graphsdg/sensors/rayBackend"

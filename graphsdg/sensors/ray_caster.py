@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.sensors.scene_motion import GeomMotion
 from graphsdg.sim.visual import UNDRAWN_GROUPS
 

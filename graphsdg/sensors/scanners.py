@@ -8,7 +8,7 @@ stopped and played again) restarts a scanner.
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> stage = rep.stage.new_stage()
     >>> lidar = stage.DefinePrim("/Lidar", "OmniLidar")
     >>> _ = lidar.ApplyAPI("OmniSensorGenericLidarCoreAPI")

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Usd
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.sim.scene import SimScene
 
 PREFIX_SETTING = "/rtx/materialDb/nonVisualMaterialSemantics/prefix"

@@ -43,7 +43,7 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.sim import colliders, deformables, geom_subsets, physx_attributes
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import lights as lightmap

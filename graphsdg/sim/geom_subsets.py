@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 from pxr import Sdf, Usd, UsdGeom
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.sim.mesh_normals import MeshNormals
 from graphsdg.sim.texcoords import fan_triangles
 from graphsdg.stage import materials as matlib

@@ -24,7 +24,7 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom, UsdLux
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.imaging import environment_map
 from graphsdg.sim.compile_error import CompileError

@@ -49,7 +49,7 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 
 if TYPE_CHECKING:
     from graphsdg.sim.scene import SimScene

@@ -11,7 +11,7 @@ uniform rescale is ~25 operations. Every value written is the one the general pa
 
 Example:
     >>> import graphsdg as rep
-    >>> from graphsdg.runtime import runtime
+    >>> from graphsdg.engine.runtime import runtime
     >>> from graphsdg.sim.direct_writes import targets_for
     >>> _ = rep.stage.new_stage()
     >>> cubes = rep.functional.create_batch.cube(count=3)

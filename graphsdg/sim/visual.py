@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.sim.compiled_scene import GeomBinding
 
 HIDDEN_GROUP = 5            # geoms in this group are not drawn (invisible prims)

@@ -42,7 +42,7 @@ import cv2
 import numpy as np
 
 from graphsdg import rng
-from graphsdg.jobs import frame_plan
+from graphsdg.io import frame_plan
 from graphsdg.annotate.ids import color_of
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof

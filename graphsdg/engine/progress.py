@@ -16,7 +16,7 @@ import time
 from graphsdg.io import backends
 from graphsdg.io.write_queue import get_write_queue
 
-log = logging.getLogger("graphsdg.jobs.progress")
+log = logging.getLogger("graphsdg.engine.progress")
 LOG_EVERY_S = 10.0
 
 

@@ -6,7 +6,7 @@ the writer pool its encode+write work (on worker threads, so it overlaps the
 frame). ``graphsdg bench --profile`` and ``rep.orchestrator.get_profile()`` report them.
 
 Example:
-    >>> from graphsdg.benchmark import profiling
+    >>> from graphsdg.base import profiling
     >>> with profiling.timed("example"):
     ...     pass
     >>> "example" in profiling.snapshot()

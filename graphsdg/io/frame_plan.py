@@ -16,7 +16,7 @@ The plan lives in settings, so ``graphsdg run`` sets it before the script runs:
 
 Example:
     >>> from graphsdg import settings
-    >>> from graphsdg.jobs import frame_plan
+    >>> from graphsdg.io import frame_plan
     >>> settings.set("/graphsdg/run/shardIndex", 1); settings.set("/graphsdg/run/shardCount", 3)
     >>> [f for f in range(8) if frame_plan.current().owns(f)]
     [1, 4, 7]
@@ -29,7 +29,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 
-from graphsdg import settings_store as settings
+from graphsdg.base import settings_store as settings
 from graphsdg.io.object_store import is_s3_url
 
 SHARD_FOLDER = ".graphsdg-shards"   # per-shard aggregate files, inside a writer's output folder

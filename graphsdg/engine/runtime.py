@@ -1,0 +1,115 @@
+"""The process-wide capture runtime: stage, simulation, renderer, timeline.
+
+One :class:`Runtime` ties together what a capture needs: the current stage and
+its :class:`~graphsdg.sim.scene.SimScene`, the :class:`Rasterizer` (which owns
+the GL context and so lives on the thread that captures), the timeline, and the
+label tables. The annotators and writers attached to render products are held
+in :data:`graphsdg.render.attachments.attachments`, which the runtime reads. The
+orchestrator drives it.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+from pxr import Usd
+
+from graphsdg.annotate.frame import SceneLabels
+from graphsdg.annotate.ids import IdTables
+from graphsdg.render import render_product
+from graphsdg.render.attachments import OrderedSet, attachments
+from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
+from graphsdg.render.rasterizer import Rasterizer
+from graphsdg.sim.scene import SimScene
+from graphsdg.sim.timeline import Timeline
+from graphsdg.stage.context import stage_context
+
+
+class Runtime:
+    """Everything a capture step touches (see the module docstring)."""
+
+    def __init__(self) -> None:
+        self._sim: SimScene | None = None
+        self._sim_stage: Usd.Stage | None = None
+        self.rasterizer = Rasterizer()    # the classic backend (always there: tests and tools read its stats)
+        self._pbr = None                   # graphsdg.render.pbr.PbrRenderer, made on first use
+        self.timeline = Timeline(simulation=lambda: self.sim)
+        self.ids = IdTables()
+        self.labels = SceneLabels(self.ids)
+        self.graph_hooks: list[Callable[..., object]] = []
+        # called with the render product paths of every capture that rendered (Kit's new-frame events)
+        self.render_observers: list[Callable[[list[str]], None]] = []
+        stage_context.subscribe_replaced(self._on_stage_replaced)
+
+    @property
+    def annotators(self) -> OrderedSet:
+        """The attached annotators (:data:`graphsdg.render.attachments.attachments`)."""
+        return attachments.annotators
+
+    @property
+    def writers(self) -> OrderedSet:
+        """The attached writers (:data:`graphsdg.render.attachments.attachments`)."""
+        return attachments.writers
+
+    @property
+    def pending_capture(self) -> Callable[[], None] | None:
+        """The annotate-and-write work a ``step(wait_for_render=False)`` left pending, if any."""
+        return attachments.pending_capture
+
+    @pending_capture.setter
+    def pending_capture(self, finish: Callable[[], None] | None) -> None:
+        attachments.pending_capture = finish
+
+    def complete_capture(self) -> None:
+        """Annotate and write the capture a ``step(wait_for_render=False)`` left pending, if any."""
+        attachments.complete_capture()
+
+    @property
+    def renderer(self) -> RenderBackend:
+        """The render backend the settings choose now (:mod:`graphsdg.render.backend`): the classic
+        rasteriser or the PBR renderer (made on first use)."""
+        if resolve_backend() == "classic":
+            return self.rasterizer
+        if self._pbr is None:
+            from graphsdg.render.backend import pbr_device
+            from graphsdg.render.pbr import PbrRenderer   # imports Warp: only where pbr was chosen
+            self._pbr = PbrRenderer(pbr_device())
+        return self._pbr
+
+    @property
+    def stage(self) -> Usd.Stage:
+        return stage_context.get_stage()
+
+    @property
+    def sim(self) -> SimScene:
+        stage = self.stage
+        if self._sim is None or self._sim_stage is not stage:
+            assert stage_context.tracker is not None
+            self._sim = SimScene(stage, stage_context.tracker, pbr_draws=pbr_draws,
+                                 render_products=lambda: len(render_product.registry))
+            self._sim_stage = stage
+            self.timeline.set_time_codes_per_second(stage.GetTimeCodesPerSecond() or 60.0)
+        return self._sim
+
+    def _on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        # The attachments released themselves first (graphsdg.render.attachments); the simulation and the
+        # label tables belonged to the old stage too.
+        self._sim = None
+        self._sim_stage = None
+        self.ids.clear()
+        self.labels = SceneLabels(self.ids)
+        self.timeline.forget_simulation_state()
+
+    def check_attachments(self) -> None:
+        """Raise if an attached annotator or writer still points at a destroyed render product."""
+        attachments.check_live()
+
+
+_runtime: Runtime | None = None
+
+
+def runtime() -> Runtime:
+    """The process's :class:`Runtime` (created on first use)."""
+    global _runtime
+    if _runtime is None:
+        _runtime = Runtime()
+    return _runtime
