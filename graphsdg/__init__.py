@@ -25,6 +25,8 @@ from graphsdg.sensors.usd_schemas import register_sensor_schemas  # noqa: E402
 
 register_sensor_schemas()   # before anything makes a stage: USD builds its schema registry once
 
+from graphsdg.engine import session as _session  # noqa: E402,F401  (owns the process state before a stage is made)
+
 from graphsdg import (annotators, backends, functional, orchestrator, rng, settings,  # noqa: E402
                       stage, writers)
 from graphsdg import runtime, settings_store  # noqa: E402,F401  (their old paths: engine.runtime, base.settings_store)

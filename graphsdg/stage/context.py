@@ -23,14 +23,23 @@ from graphsdg.stage.changes import ChangeTracker
 
 class StageContext:
     """Holds the current ``Usd.Stage`` (kept in USD's stage cache while current) and notifies listeners when it is
-    replaced."""
+    replaced: first its owner (the session, :mod:`graphsdg.engine.session`), then the subscribers."""
 
     def __init__(self) -> None:
         self.stage: Usd.Stage | None = None
         self.tracker: ChangeTracker | None = None
         self.generation = 0
+        self._owner: Callable[[Usd.Stage | None], None] | None = None
         self._on_replaced: list[Callable[[Usd.Stage | None], None]] = []
         self._on_replacing: list[Callable[[Usd.Stage], None]] = []
+
+    def own(self, reset: Callable[[Usd.Stage | None], None]) -> None:
+        """Make ``reset(new_stage)`` the owner's reset: called on every replacement before any subscriber, so
+        the process state is reset in the owner's order whatever was imported first (one owner only)."""
+        if self._owner is not None and self._owner != reset:
+            raise RuntimeError(f"the stage context already has an owner ({self._owner!r}); "
+                               f"a process has one session")
+        self._owner = reset
 
     def subscribe_replaced(self, callback: Callable[[Usd.Stage | None], None]) -> None:
         """Call ``callback(new_stage)`` whenever the stage is replaced or closed."""
@@ -60,6 +69,8 @@ class StageContext:
         self.stage = stage
         self.tracker = ChangeTracker(stage) if stage is not None else None
         self.generation += 1
+        if self._owner is not None:
+            self._owner(stage)
         for cb in list(self._on_replaced):
             cb(stage)
         return stage

@@ -1,0 +1,81 @@
+"""The session: the one owner of the state a graphsdg process keeps between calls.
+
+Each piece of process state is one object made by the room that uses it, so
+that the low floors bind it at import without reaching up; the session holds
+every one of them and is the only thing that resets them. Pieces of the rooms
+below the engine are taken at import here; pieces of the rooms above it (the
+graph, the runtime, physics, Replicator's face) hand themselves over with
+:meth:`Session.adopt` into a slot named here, so the order below never depends
+on which module was imported first.
+
+When the stage is replaced or closed, the stage context calls its owner,
+:meth:`Session.stage_replaced`, before any subscriber (compat's contexts, a
+World, behaviour scripts), and the session resets its stage pieces in the order
+of :data:`Session.STAGE_RESETS`. The other pieces (:data:`Session.PROCESS_PARTS`)
+live as long as the process: a new stage keeps them.
+
+Replicator's module-level API is unchanged: ``rep.stage.new_stage()``,
+``rep.settings``, ``rep.orchestrator`` and the rest are faces over these pieces.
+
+Example:
+    >>> from graphsdg.engine.session import session
+    >>> from graphsdg.stage.context import stage_context
+    >>> session.stage_context is stage_context
+    True
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from pxr import Usd
+
+from graphsdg.stage.context import stage_context
+
+
+class Session:
+    """The process's state, each piece held once, and the order its stage pieces are reset in."""
+
+    #: The pieces reset when the stage is replaced, in this order; each has ``on_stage_replaced(stage)``.
+    STAGE_RESETS: tuple[str, ...] = ()
+
+    #: The pieces that outlive a stage (held, never reset by a replacement).
+    PROCESS_PARTS: tuple[str, ...] = (
+        "stage_context",     # the current stage and its change tracker; it calls stage_replaced
+    )
+
+    #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
+    ADOPTED: frozenset[str] = frozenset()
+
+    def __init__(self) -> None:
+        self.stage_context = stage_context
+        for name in self.ADOPTED:
+            setattr(self, name, None)
+        stage_context.own(self.stage_replaced)
+
+    def adopt(self, name: str, part: Any) -> Any:
+        """Hold ``part`` (made by a room above the engine) in the slot ``name``; returns ``part``."""
+        if name not in self.ADOPTED:
+            raise ValueError(f"the session has no slot {name!r} for a room to fill; slots: {sorted(self.ADOPTED)}")
+        held = getattr(self, name)
+        if held is not None and held is not part:
+            raise RuntimeError(f"the session's {name!r} is already {held!r}; a process holds one")
+        if name in self.STAGE_RESETS and not callable(getattr(part, "on_stage_replaced", None)):
+            raise TypeError(f"{name!r} is reset with the stage: {part!r} needs on_stage_replaced(stage)")
+        setattr(self, name, part)
+        return part
+
+    def parts(self) -> dict[str, Any]:
+        """Every piece held now, by slot name (stage pieces first, in reset order)."""
+        names = self.STAGE_RESETS + self.PROCESS_PARTS
+        return {name: getattr(self, name) for name in names if getattr(self, name) is not None}
+
+    def stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Reset the stage pieces for ``stage`` (None: closed), in the order of :data:`STAGE_RESETS`."""
+        for name in self.STAGE_RESETS:
+            part = getattr(self, name)
+            if part is not None:
+                part.on_stage_replaced(stage)
+
+
+#: The process's session.
+session = Session()
