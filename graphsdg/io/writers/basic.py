@@ -24,8 +24,7 @@ from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.io import io_functions as iof
 from graphsdg.io.backends import BaseBackend
 from graphsdg.io.basic_writer_layout import FLAGS, IMAGE, LayoutFile, files_of
-from graphsdg.io.writer import Writer
-from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 
 _SEMANTIC = {"bounding_box_2d_tight", "bounding_box_2d_loose", "semantic_segmentation", "instance_segmentation",
              "bounding_box_3d", "occlusion", "pointcloud"}
@@ -33,7 +32,7 @@ IMAGE_FORMATS = ("png", "jpg", "jpeg")
 _WRITE_BY_EXT = {"png": iof.write_image, "jpg": iof.write_image, "npy": iof.write_np, "json": iof.write_json}
 
 
-class BasicWriter(Writer):
+class BasicWriter(FormatWriter):
     """Replicator's BasicWriter (see the module docstring for the files it writes)."""
 
     frame_indexed = True
@@ -65,11 +64,8 @@ class BasicWriter(Writer):
         else:
             semantic_filter = SemanticFilter.parse("class:*")
         self.semantic_filter_predicate = semantic_filter.text
-        self.version = "0.0.2"
-        self.data_structure = "annotator"
-        self.backend = arguments.output_backend("BasicWriter", output_dir, backend, s3_bucket=s3_bucket,
-                                                s3_region=s3_region, s3_endpoint=s3_endpoint)
-        self.output_dir = getattr(self.backend, "output_dir", None)
+        super().__init__(output_dir, backend, version="0.0.2", data_structure="annotator", s3_bucket=s3_bucket,
+                         s3_region=s3_region, s3_endpoint=s3_endpoint)
         self._frame_id = 0
         self._sequence = ""
         self._padding = frame_padding

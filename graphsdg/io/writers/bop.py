@@ -49,8 +49,8 @@ from graphsdg.io import io_functions as iof
 from graphsdg.io.aggregate import AggregateFile
 from graphsdg.io.camera_geometry import USD_TO_OPENCV, PinholeCamera
 from graphsdg.io.labels import ClassTable, class_name
-from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 
 SCENE_FILES = ("scene_camera", "scene_gt", "scene_gt_info")
 
@@ -59,20 +59,16 @@ def _xywh(x0: int, y0: int, x1: int, y1: int) -> list[int]:
     return [int(x0), int(y0), int(x1 - x0 + 1), int(y1 - y0 + 1)]
 
 
-class BopWriter(Writer):
+class BopWriter(FormatWriter):
     """BOP scenes: rgb, depth, visible masks and pose json (see the module docstring)."""
 
     def __init__(self, output_dir: str | None = None, split: str = "train_pbr", scene_id: int = 0,
                  obj_ids: dict[str, int] | None = None, semantic_types: Sequence[str] | None = None,
                  semantic_filter_predicate: str | None = None, depth_scale: float = 1.0,
                  image_output_format: str = "png", write_masks: bool = True, backend=None) -> None:
+        super().__init__(output_dir, backend, version="0.1.0")
         name = type(self).__name__
-        self.version = "0.1.0"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend)
-        self.output_dir = getattr(self.backend, "output_dir", None)
-        filter_text = arguments.semantic_filter_text(name, semantic_types, semantic_filter_predicate)
-        self.semantic_types = list(semantic_types) if semantic_types else None
+        filter_text = self.semantic_filter(semantic_types, semantic_filter_predicate)
         if not isinstance(split, str) or not split or "/" in split:
             raise ValueError(f"{name}: split must be a folder name such as 'train_pbr', got {split!r}")
         if isinstance(scene_id, bool) or not isinstance(scene_id, int) or scene_id < 0:

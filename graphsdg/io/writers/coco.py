@@ -48,9 +48,9 @@ from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof
 from graphsdg.io.aggregate import AggregateFile
 from graphsdg.io.labels import ClassTable, class_name
-from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
 from graphsdg.io.writers.basic import sequence_prefix
+from graphsdg.io.writers.format_writer import FormatWriter
 
 DEFAULT_SEMANTIC_TYPES = ["class", "coco", "stuff", "thing"]
 FLUSH_EVERY = 25
@@ -66,7 +66,7 @@ def _mask_api():
     return mask_api
 
 
-class CocoWriter(Writer):
+class CocoWriter(FormatWriter):
     """COCO detection + instance segmentation (see the module docstring for the layout)."""
 
     frame_indexed = True
@@ -77,20 +77,16 @@ class CocoWriter(Writer):
                  image_output_format: str = "png", coco_license_info: list[dict] | None = None,
                  segmentation: str = "rle", write_panoptic: bool = True, date_created: Any = None,
                  backend=None) -> None:
-        name = type(self).__name__
         self.mask_api = _mask_api()
-        self.version = "0.0.1"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend, overwrite=False, s3_bucket=s3_bucket,
-                                                s3_region=s3_region, s3_endpoint=s3_endpoint)
-        self.output_dir = getattr(self.backend, "output_dir", None)
+        super().__init__(output_dir, backend, version="0.0.1", overwrite=False, s3_bucket=s3_bucket,
+                         s3_region=s3_region, s3_endpoint=s3_endpoint)
+        name = type(self).__name__
         if segmentation not in SEGMENTATION_FORMATS:
             raise ValueError(f"{name}: segmentation must be one of {SEGMENTATION_FORMATS}, got {segmentation!r}")
         self._segmentation = segmentation
         self._padding = arguments.frame_padding(name, frame_padding)
         self._ext = arguments.image_extension(name, image_output_format)
-        self.semantic_types = list(semantic_types) if semantic_types is not None else list(DEFAULT_SEMANTIC_TYPES)
-        filter_text = arguments.semantic_filter_text(name, self.semantic_types, None)
+        filter_text = self.semantic_filter(semantic_types, default_types=DEFAULT_SEMANTIC_TYPES)
         if dataset_id is None:
             # Replicator draws the id from Python's random seeded with the global seed: same seed, same names.
             dataset_id = "".join(random.Random(rng.get_global_seed()).choices(string.ascii_lowercase, k=8))

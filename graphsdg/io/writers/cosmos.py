@@ -40,8 +40,8 @@ from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import cosmos_controls, io_functions as iof, video
 from graphsdg.io.backends import BaseBackend, writes_discarded
 from graphsdg.io.write_queue import get_write_queue
-from graphsdg.io.writer import ON_FRAME, Writer
-from graphsdg.io.writers import arguments
+from graphsdg.io.writer import ON_FRAME
+from graphsdg.io.writers.format_writer import FormatWriter
 from graphsdg.stage import get_stage
 
 MODALITIES = ("rgb", "shaded_seg", "segmentation", "depth", "edges")
@@ -85,7 +85,7 @@ def encode_clip_video(backend: BaseBackend, clip: int, modality: str, frames: in
     backend.write_blob(video_path(clip, modality), video.encode_mp4(images(), fps))
 
 
-class CosmosWriter(Writer):
+class CosmosWriter(FormatWriter):
     """Replicator's CosmosWriter: rgb, shaded_seg, segmentation, depth and edges clips (see the module docstring).
 
     Args:
@@ -101,11 +101,8 @@ class CosmosWriter(Writer):
     def __init__(self, output_dir: str | None = None, backend: BaseBackend | None = None,
                  segmentation_mapping: Mapping[str, Any] | None = None, use_instance_id: bool = True,
                  canny_threshold_low: float = 10, canny_threshold_high: float = 100) -> None:
+        super().__init__(output_dir, backend, version="0.1.0")
         name = type(self).__name__
-        self.version = "0.1.0"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend)
-        self.output_dir = getattr(self.backend, "output_dir", None)
         if segmentation_mapping is not None and not isinstance(segmentation_mapping, Mapping):
             raise ValueError(f"{name}: segmentation_mapping must be a dict of semantic label -> RGBA colour, got "
                              f"{segmentation_mapping!r}")

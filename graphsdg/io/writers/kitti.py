@@ -53,8 +53,7 @@ from graphsdg.annotate.ids import color_of
 from graphsdg.io import io_functions as iof
 from graphsdg.io.camera_geometry import USD_TO_OPENCV, PinholeCamera, box_corners, truncation_ratio
 from graphsdg.io.labels import class_name
-from graphsdg.io.writer import Writer
-from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 
 # KITTI's semantic label colours (the Cityscapes table): label -> RGBA.
 KITTI_LABELS = {
@@ -72,7 +71,7 @@ KITTI_LABELS = {
 }
 
 
-class KittiWriter(Writer):
+class KittiWriter(FormatWriter):
     """KITTI labels, images, segmentation and depth (see the module docstring)."""
 
     def __init__(self, output_dir: str | None = None, s3_bucket: str | None = None, s3_region: str | None = None,
@@ -83,14 +82,10 @@ class KittiWriter(Writer):
                  mapping_dict: dict | None = None, colorize_instance_segmentation: bool = False,
                  semantic_filter_predicate: str | None = None, use_kitti_dir_names: bool = False,
                  backend=None) -> None:
+        super().__init__(output_dir, backend, version="0.0.1", s3_bucket=s3_bucket, s3_region=s3_region,
+                         s3_endpoint=s3_endpoint)
         name = type(self).__name__
-        self.version = "0.0.1"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend, s3_bucket=s3_bucket, s3_region=s3_region,
-                                                s3_endpoint=s3_endpoint)
-        self.output_dir = getattr(self.backend, "output_dir", None)
-        filter_text = arguments.semantic_filter_text(name, semantic_types, semantic_filter_predicate)
-        self.semantic_types = list(semantic_types) if semantic_types else None
+        filter_text = self.semantic_filter(semantic_types, semantic_filter_predicate)
         if isinstance(bbox_height_threshold, bool) or not isinstance(bbox_height_threshold, int) \
                 or bbox_height_threshold < 0:
             raise ValueError(f"{name}: bbox_height_threshold must be a non-negative integer of pixels, got "

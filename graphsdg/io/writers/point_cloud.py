@@ -32,8 +32,8 @@ import numpy as np
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof
 from graphsdg.io.point_cloud_files import encode_pcd, encode_ply
-from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 
 FORMATS = ("npy", "ply", "pcd")
 LIDAR_FIELDS = [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("intensity", "<f4"), ("range", "<f4"),
@@ -63,18 +63,15 @@ def structured_cloud(points: np.ndarray, info: dict, color: Sequence[float] | No
     return cloud
 
 
-class PointCloudWriter(Writer):
+class PointCloudWriter(FormatWriter):
     """Lidar / radar point clouds to ``.npy``, PLY and PCD files (see the module docstring)."""
 
     def __init__(self, output_dir: str | None = None, frame: str = "world", formats: Sequence[str] = ("npy", "ply"),
                  skip_empty_frames: bool = True, frame_padding: int = 4, backend=None,
                  s3_bucket: str | None = None, s3_region: str | None = None, s3_endpoint: str | None = None) -> None:
+        super().__init__(output_dir, backend, version="0.0.1", s3_bucket=s3_bucket, s3_region=s3_region,
+                         s3_endpoint=s3_endpoint)
         name = type(self).__name__
-        self.version = "0.0.1"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend, s3_bucket=s3_bucket, s3_region=s3_region,
-                                                s3_endpoint=s3_endpoint)
-        self.output_dir = getattr(self.backend, "output_dir", None)
         if str(frame).lower() not in ("world", "sensor"):
             raise ValueError(f"{name}: frame must be 'world' or 'sensor', got {frame!r}")
         chosen = [formats] if isinstance(formats, str) else list(formats)

@@ -47,8 +47,8 @@ from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof
 from graphsdg.io.camera_geometry import CUBOID_KEYPOINTS, PinholeCamera, box_corners, truncation_ratio
 from graphsdg.io.labels import class_name
-from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 
 FORMATS = ("dope", "centerpose")
@@ -60,7 +60,7 @@ KEYPOINT_COLORS = [(255, 255, 255), (255, 0, 0), (0, 200, 0), (0, 0, 255), (255,
                    (255, 0, 255), (255, 165, 0), (128, 0, 128)]
 
 
-class PoseWriter(Writer):
+class PoseWriter(FormatWriter):
     """Object poses and projected cuboids per frame (see the module docstring)."""
 
     def __init__(self, output_dir: str | None = None, use_subfolders: bool = False,
@@ -68,12 +68,9 @@ class PoseWriter(Writer):
                  write_debug_images: bool = False, frame_padding: int = 6, format: str | None = None,
                  semantic_types: Sequence[str] | None = None, use_s3: bool = False, s3_bucket: str | None = None,
                  s3_endpoint_url: str | None = None, s3_region: str | None = None, backend=None) -> None:
+        super().__init__(output_dir, backend, version="0.0.1", use_s3=bool(use_s3), s3_bucket=s3_bucket,
+                         s3_endpoint=s3_endpoint_url, s3_region=s3_region)
         name = type(self).__name__
-        self.version = "0.0.1"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend, use_s3=bool(use_s3), s3_bucket=s3_bucket,
-                                                s3_endpoint=s3_endpoint_url, s3_region=s3_region)
-        self.output_dir = getattr(self.backend, "output_dir", None)
         if format is not None and str(format).lower() not in FORMATS:
             raise ValueError(f"{name}: unsupported format {format!r}; supported: {FORMATS} or None")
         if isinstance(visibility_threshold, bool) or not isinstance(visibility_threshold, (int, float)) \
@@ -85,8 +82,7 @@ class PoseWriter(Writer):
         self._skip_empty = bool(skip_empty_frames)
         self._debug = bool(write_debug_images)
         self._padding = arguments.frame_padding(name, frame_padding)
-        self.semantic_types = list(semantic_types) if semantic_types is not None else ["class"]
-        filter_text = arguments.semantic_filter_text(name, self.semantic_types, None)
+        filter_text = self.semantic_filter(semantic_types, default_types=["class"])
         self._frame_id = 0
         self.annotators = [
             AnnotatorRegistry.get_annotator("rgb"),

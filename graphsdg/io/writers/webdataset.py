@@ -45,8 +45,8 @@ import numpy as np
 from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import encode
 from graphsdg.io.labels import class_name
-from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 
 
 class _OrderedShards:
@@ -119,7 +119,7 @@ class _OrderedShards:
         self._index += 1
 
 
-class WebDatasetWriter(Writer):
+class WebDatasetWriter(FormatWriter):
     """Tar shards of per-frame samples (see the module docstring)."""
 
     def __init__(self, output_dir: str | None = None, shard_pattern: str = "shard-%06d.tar", maxcount: int = 1000,
@@ -128,11 +128,8 @@ class WebDatasetWriter(Writer):
                  distance_to_image_plane: bool = False, camera_params: bool = True,
                  semantic_types: Sequence[str] | None = None, semantic_filter_predicate: str | None = None,
                  image_output_format: str = "png", frame_padding: int = 6, backend=None) -> None:
+        super().__init__(output_dir, backend, version="0.1.0")
         name = type(self).__name__
-        self.version = "0.1.0"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend)
-        self.output_dir = getattr(self.backend, "output_dir", None)
         try:
             shard_pattern % 0
         except (TypeError, ValueError):
@@ -141,8 +138,7 @@ class WebDatasetWriter(Writer):
         for arg, value in (("maxcount", maxcount), ("maxsize", maxsize)):
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"{name}: {arg} must be a positive integer, got {value!r}")
-        filter_text = arguments.semantic_filter_text(name, semantic_types, semantic_filter_predicate)
-        self.semantic_types = list(semantic_types) if semantic_types else None
+        filter_text = self.semantic_filter(semantic_types, semantic_filter_predicate)
         self._ext = arguments.image_extension(name, image_output_format)
         self._padding = arguments.frame_padding(name, frame_padding)
         self._shards = _OrderedShards(shard_pattern, maxcount, maxsize)

@@ -26,7 +26,6 @@ Example:
 """
 from __future__ import annotations
 
-import io
 import logging
 import os
 from typing import Any

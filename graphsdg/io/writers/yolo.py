@@ -36,8 +36,8 @@ from graphsdg.annotate.annotator import AnnotatorRegistry
 from graphsdg.io import io_functions as iof
 from graphsdg.io.aggregate import AggregateFile
 from graphsdg.io.labels import ClassTable, class_name
-from graphsdg.io.writer import Writer
 from graphsdg.io.writers import arguments
+from graphsdg.io.writers.format_writer import FormatWriter
 
 BOX_TYPES = {"tight": "bounding_box_2d_tight_fast", "loose": "bounding_box_2d_loose_fast"}
 
@@ -50,7 +50,7 @@ def data_yaml(snapshot: dict) -> bytes:
     return ("\n".join(lines) + "\n").encode()
 
 
-class YoloWriter(Writer):
+class YoloWriter(FormatWriter):
     """YOLO (Ultralytics) detection labels (see the module docstring)."""
 
     def __init__(self, output_dir: str | None = None, classes: Sequence[str] | None = None,
@@ -58,13 +58,9 @@ class YoloWriter(Writer):
                  split: str = "train", val_every: int = 0, bbox_type: str = "tight",
                  image_output_format: str = "png", frame_padding: int = 6, min_visibility: float = 0.0,
                  backend=None) -> None:
+        super().__init__(output_dir, backend, version="0.1.0")
         name = type(self).__name__
-        self.version = "0.1.0"
-        self.data_structure = "renderProduct"
-        self.backend = arguments.output_backend(name, output_dir, backend)
-        self.output_dir = getattr(self.backend, "output_dir", None)
-        filter_text = arguments.semantic_filter_text(name, semantic_types, semantic_filter_predicate)
-        self.semantic_types = list(semantic_types) if semantic_types else None
+        filter_text = self.semantic_filter(semantic_types, semantic_filter_predicate)
         if bbox_type not in BOX_TYPES:
             raise ValueError(f"{name}: bbox_type must be one of {sorted(BOX_TYPES)}, got {bbox_type!r}")
         if not isinstance(split, str) or not split or "/" in split:
