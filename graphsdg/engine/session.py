@@ -19,7 +19,9 @@ Replicator's module-level API is unchanged: ``rep.stage.new_stage()``,
 
 Example:
     >>> from graphsdg.engine.session import session
-    >>> from graphsdg.stage.context import stage_context
+    >>> from graphsdg.render.attachments import attachments
+from graphsdg.render.render_product import registry as render_products
+from graphsdg.stage.context import stage_context
     >>> session.stage_context is stage_context
     True
 """
@@ -29,6 +31,8 @@ from typing import Any
 
 from pxr import Usd
 
+from graphsdg.render.attachments import attachments
+from graphsdg.render.render_product import registry as render_products
 from graphsdg.stage.context import stage_context
 
 
@@ -36,7 +40,11 @@ class Session:
     """The process's state, each piece held once, and the order its stage pieces are reset in."""
 
     #: The pieces reset when the stage is replaced, in this order; each has ``on_stage_replaced(stage)``.
-    STAGE_RESETS: tuple[str, ...] = ()
+    STAGE_RESETS: tuple[str, ...] = (
+        "render_products",   # destroyed: they showed the old stage
+        "attachments",       # writers detach (writing what they hold, while the runtime still has the old
+                             # stage's simulation and labels), then annotators
+    )
 
     #: The pieces that outlive a stage (held, never reset by a replacement).
     PROCESS_PARTS: tuple[str, ...] = (
@@ -48,6 +56,8 @@ class Session:
 
     def __init__(self) -> None:
         self.stage_context = stage_context
+        self.render_products = render_products
+        self.attachments = attachments
         for name in self.ADOPTED:
             setattr(self, name, None)
         stage_context.own(self.stage_replaced)

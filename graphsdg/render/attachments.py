@@ -32,8 +32,6 @@ from typing import Any, Callable, Generic, Iterator, TypeVar
 from pxr import Usd
 
 from graphsdg.errors import RenderProductDestroyedError
-from graphsdg.render.render_product import registry as rp_registry
-from graphsdg.stage.context import stage_context
 
 T = TypeVar("T")
 
@@ -89,18 +87,15 @@ class Attachments:
                         f"render product {rp.name!r} ({rp.path}) was destroyed but {kind} {name!r} is still "
                         f"attached to it; call detach() before destroy(), or attach to a live render product")
 
-    def release_session(self, stage: Usd.Stage | None = None) -> None:
-        """Destroy the render products and detach every writer, then every annotator (the stage was replaced)."""
-        rp_registry.clear()
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Detach every writer, then every annotator (the stage was replaced; the session destroyed the render
+        products first and resets the runtime after, so the writers write what they still hold for the old
+        stage)."""
         for w in list(self.writers):
             w.detach()
         for a in list(self.annotators):
             a.detach()
 
 
-#: The process's attachments.
+#: The process's attachments (held by the session, :mod:`graphsdg.engine.session`).
 attachments = Attachments()
-
-# Subscribed on import, before any runtime exists, so that the runtime's own reset (simulation, label tables)
-# always comes after the writers have written what they still hold for the old stage.
-stage_context.subscribe_replaced(attachments.release_session)

@@ -146,10 +146,16 @@ class RenderProductRegistry:
                          f"{[p.path for p in self._products]}")
 
     def clear(self) -> None:
+        """Destroy every live render product."""
         for rp in list(self._products):
             rp.destroy()
 
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Destroy every render product: they showed the old stage."""
+        self.clear()
 
+
+#: The process's render products (held by the session, :mod:`graphsdg.engine.session`).
 registry = RenderProductRegistry()
 
 
