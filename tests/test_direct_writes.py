@@ -7,7 +7,8 @@ import pytest
 import graphsdg as rep
 from graphsdg.maths import rotations
 from graphsdg.engine.runtime import runtime
-from graphsdg.sim import direct_writes, mesh_scaling
+from graphsdg.sim import mesh_scaling
+from graphsdg.sim.pose_writes import mujoco_poses, targets
 
 
 def test_euler_quaternions_match_the_matrix_route():
@@ -95,8 +96,8 @@ def test_batched_mesh_rescale_matches_rescaling_one_by_one():
 def test_unevenly_scaled_sphere_falls_back_to_the_stage():
     prims = _batch_scene()
     sphere = prims[-1]
-    assert direct_writes.write_poses(runtime().sim, [sphere], None, None, np.array([[1.0, 1.0, 1.0]]))
-    assert not direct_writes.write_poses(runtime().sim, [sphere], None, None, np.array([[1.0, 2.0, 1.0]]))
+    assert mujoco_poses.write_poses(runtime().sim, [sphere], None, None, np.array([[1.0, 1.0, 1.0]]))
+    assert not mujoco_poses.write_poses(runtime().sim, [sphere], None, None, np.array([[1.0, 2.0, 1.0]]))
     rep.functional.modify.pose([sphere], scale_value=[(1.0, 2.0, 1.0)])   # authored on the stage instead
     assert tuple(sphere.GetAttribute("xformOp:scale").Get()) == (1.0, 2.0, 1.0)
 
@@ -104,9 +105,9 @@ def test_unevenly_scaled_sphere_falls_back_to_the_stage():
 def test_cached_targets_follow_the_prims_passed():
     prims = _batch_scene()
     sim = runtime().sim
-    a = direct_writes.targets_for(sim, prims)
-    assert direct_writes.targets_for(sim, list(prims)) is a          # an equal list: the cached indices
-    b = direct_writes.targets_for(sim, prims[::-1])
+    a = targets.targets_for(sim, prims)
+    assert targets.targets_for(sim, list(prims)) is a          # an equal list: the cached indices
+    b = targets.targets_for(sim, prims[::-1])
     assert b is not a and list(b.geom_ids) == list(a.geom_ids)[::-1]
     rep.functional.modify.pose(prims[::-1], position_value=np.arange(21.0).reshape(7, 3))
     for i, p in enumerate(prims[::-1]):
@@ -117,7 +118,7 @@ def test_cached_targets_follow_the_prims_passed():
 def test_zero_quaternion_is_refused():
     prims = _batch_scene()
     with pytest.raises(ValueError, match="must not be zero"):
-        direct_writes.write_poses(runtime().sim, prims[:1], None, np.zeros((1, 4)), None)
+        mujoco_poses.write_poses(runtime().sim, prims[:1], None, np.zeros((1, 4)), None)
 
 
 def test_poses_under_a_transformed_parent_match_authored_ones():
@@ -303,7 +304,7 @@ def test_camera_poses_keep_the_parts_they_were_composed_from_until_the_stage_edi
     from pxr import Sdf
 
     from graphsdg.maths.rotations import compose, decompose, euler_to_matrix
-    from graphsdg.sim.camera_poses import CameraPoses
+    from graphsdg.sim.pose_writes.camera_poses import CameraPoses
     from graphsdg.stage.changes import ChangeSet
     poses = CameraPoses()
     m = compose(np.array([1.0, 2.0, 3.0]), euler_to_matrix(np.array([10.0, 20.0, 30.0]), "XYZ"),

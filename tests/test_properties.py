@@ -17,7 +17,7 @@ import graphsdg as rep
 from graphsdg.maths import rotations
 from graphsdg.render.camera import camera_view
 from graphsdg.engine.runtime import runtime
-from graphsdg.sim import direct_writes
+from graphsdg.sim.pose_writes import mujoco_poses
 from graphsdg.stage import xform
 
 from test_graph_distributions import draw
@@ -320,8 +320,8 @@ def test_random_scenes_compile_render_and_round_trip_their_transforms(scene):
     assert sim.model_version == version
     _assert_poses_match_usd(sim, prims)
     via_usd = {str(p.GetPath()): _body_pose(sim, str(p.GetPath())) for p in prims}
-    assert direct_writes.write_poses(sim, prims, new_pos[::-1].copy(), new_rot[::-1].copy(), None)
-    assert direct_writes.write_poses(sim, prims, new_pos, new_rot, None)
+    assert mujoco_poses.write_poses(sim, prims, new_pos[::-1].copy(), new_rot[::-1].copy(), None)
+    assert mujoco_poses.write_poses(sim, prims, new_pos, new_rot, None)
     for p in prims:
         pos, mat = _body_pose(sim, str(p.GetPath()))
         assert np.allclose(pos, via_usd[str(p.GetPath())][0], atol=1e-9)

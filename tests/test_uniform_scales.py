@@ -1,12 +1,12 @@
-"""Uniform rescales of a batch through a precomputed plan (graphsdg/sim/uniform_scales.py): the same model,
-bit for bit, as the general path of direct writes."""
+"""Uniform rescales of a batch through a precomputed plan (graphsdg/sim/pose_writes/uniform_scales.py): the
+same model, bit for bit, as the general path of direct writes."""
 from __future__ import annotations
 
 import numpy as np
 
 import graphsdg as rep
 from graphsdg.engine.runtime import runtime
-from graphsdg.sim.direct_writes import DirectTargets, targets_for
+from graphsdg.sim.pose_writes.targets import DirectTargets, targets_for
 
 SHAPES = ("cube", "cone", "cylinder", "sphere", "torus")
 

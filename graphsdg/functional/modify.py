@@ -23,7 +23,8 @@ from graphsdg.assets.nucleus import resolve_asset_path
 from graphsdg.errors import closest
 from graphsdg.functional.per_prim import per_prim, per_prim_array
 from graphsdg.engine.runtime import runtime
-from graphsdg.sim import direct_writes
+from graphsdg.sim.pose_writes import camera_poses, colors, mujoco_poses
+from graphsdg.sim.pose_writes.plan import PosePath, pose_paths
 from graphsdg.stage import materials as matlib
 from graphsdg.stage import semantics as semlib
 from graphsdg.stage.prims import prim_facts, resolve_prim, resolve_prims
@@ -54,23 +55,25 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
         raise ValueError("size and scale are exclusive; pass one of them")
     targets = resolve_prims(prims)
     look_at_value = _look_at_point(look_at_value)
-    n = len(targets)
     if rotation_value is not None and look_at_value is not None:
         raise ValueError("rotation and look_at are exclusive; pass one of them")
-    if scale_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
-            and _write_to_fabric() and _pose_cameras(targets, position_value, rotation_value, look_at_value,
-                                                     look_at_up_axis):
-        return
-    if look_at_value is None and size_value is None and pivot_value is None and rotation_order.upper() == "XYZ" \
-            and _write_to_fabric():
-        arrays = [None if v is None else per_prim_array(v, n, name, width=width, uniform=uniform,
-                                                         uniform_per_prim=uniform)
-                  for v, name, width, uniform in ((position_value, "position_value", 3, False),
-                                                  (rotation_value, "rotation_value", _pose_width(rotation_value),
-                                                   False),
-                                                  (scale_value, "scale_value", 3, True))]
-        if direct_writes.write_poses(runtime().sim, targets, *arrays):
-            return
+    for path in pose_paths(_write_to_fabric(), scale=scale_value, look_at=look_at_value, size=size_value,
+                           pivot=pivot_value, rotation_order=rotation_order):
+        if path is PosePath.CAMERA:
+            if _pose_cameras(targets, position_value, rotation_value, look_at_value, look_at_up_axis):
+                return
+        elif path is PosePath.MUJOCO:
+            if _pose_geoms(targets, position_value, rotation_value, scale_value):
+                return
+        else:
+            _author_poses(targets, position_value, rotation_value, scale_value, look_at_value, look_at_up_axis,
+                          rotation_order, size_value, pivot_value)
+
+
+def _author_poses(targets: list, position_value: Any, rotation_value: Any, scale_value: Any, look_at_value: Any,
+                  look_at_up_axis: Any, rotation_order: str, size_value: Any, pivot_value: Any) -> None:
+    """The stage path: each prim's ``xformOp`` s authored (:func:`graphsdg.stage.xform.set_local_pose`)."""
+    n = len(targets)
     positions = per_prim(position_value, n, "position_value")
     rotations = per_prim(rotation_value, n, "rotation_value", width=_pose_width(rotation_value))
     scales = per_prim(scale_value, n, "scale_value", uniform=True, uniform_per_prim=True)
@@ -85,9 +88,21 @@ def pose(prims: Any, position_value: Any = None, rotation_value: Any = None, sca
             _apply_pivot(prim, np.asarray(pivots[i], dtype=np.float64), positions[i])
 
 
+def _pose_geoms(targets: list, position_value: Any, rotation_value: Any, scale_value: Any) -> bool:
+    """The MuJoCo path (:mod:`graphsdg.sim.pose_writes.mujoco_poses`); False when the prims are not all plain
+    compiled gprims."""
+    n = len(targets)
+    arrays = [None if v is None else per_prim_array(v, n, name, width=width, uniform=uniform,
+                                                     uniform_per_prim=uniform)
+              for v, name, width, uniform in ((position_value, "position_value", 3, False),
+                                              (rotation_value, "rotation_value", _pose_width(rotation_value), False),
+                                              (scale_value, "scale_value", 3, True))]
+    return mujoco_poses.write_poses(runtime().sim, targets, *arrays)
+
+
 def _pose_cameras(targets: list, position_value: Any, rotation_value: Any, look_at_value: Any,
                   look_at_up_axis: Any) -> bool:
-    """Write-to-fabric for cameras (:mod:`graphsdg.sim.camera_poses`); False when the prims are not all
+    """The camera path (:mod:`graphsdg.sim.pose_writes.camera_poses`); False when the prims are not all
     cameras with graphsdg's op stack."""
     if not targets or not all(prim_facts.is_a(p, UsdGeom.Camera) for p in targets):
         return False
@@ -102,7 +117,8 @@ def _pose_cameras(targets: list, position_value: Any, rotation_value: Any, look_
         [as_vec3(v, "look_at") for v in per_prim(look_at_value, n, "look_at_value")]
     up = as_vec3(look_at_up_axis, "look_at_up_axis") if look_at_up_axis is not None else \
         up_axis_vector(targets[0].GetStage())
-    return direct_writes.write_camera_poses(runtime().sim, targets, positions, rotations, looks, up)
+    sim = runtime().sim
+    return camera_poses.write_camera_poses(sim, sim.camera_poses, targets, positions, rotations, looks, up)
 
 
 def _pose_width(value: Any) -> int:
@@ -236,11 +252,11 @@ def visibility(prims: Any, value: bool | list[bool]) -> None:
 def display_color(prims: Any, value: Any) -> None:
     """Set ``primvars:displayColor`` (one colour for all, or (N, 3))."""
     targets = resolve_prims(prims)
-    colors = per_prim_array(value, len(targets), "display color")
+    rgb = per_prim_array(value, len(targets), "display color")
     if _write_to_fabric():
-        if direct_writes.write_colors(runtime().sim, targets, colors[:, :3]):
+        if colors.write_colors(runtime().sim, targets, rgb[:, :3]):
             return
-    for prim, c in zip(targets, colors):
+    for prim, c in zip(targets, rgb):
         gprim = UsdGeom.Gprim(prim)
         if not gprim:
             raise TypeError(f"prim {prim.GetPath()} ({prim.GetTypeName()}) has no displayColor (not a gprim)")

@@ -37,7 +37,7 @@ from pxr import Sdf, Usd, UsdGeom
 from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
-from graphsdg.sim.camera_poses import CameraPoses
+from graphsdg.sim.pose_writes.camera_poses import CameraPoses
 from graphsdg.stage.world_transforms import WorldTransforms
 from graphsdg.sim.compiled_scene import BodyBinding, CompiledScene
 from graphsdg.sim.compiler import compile_stage

@@ -1,13 +1,9 @@
-"""Write randomized poses and colours straight into MuJoCo (Replicator's write-to-fabric).
+"""Compiled-model indices of a list of prims, the eligibility test of write-to-fabric's MuJoCo path.
 
-With the setting ``/exts/omni.replicator.core/enableWriteToFabric`` on, the
-functional ``modify.pose`` / ``display_color`` calls land here: values go into
-``mocap_pos``, ``mocap_quat``, ``geom_size`` and ``geom_rgba`` as whole arrays, with
-no USD authoring and no change-notice round trip. As in Replicator, the stage is
-not updated (saving it keeps the authored values), so readers of USD transforms
-see the last authored pose. Prims that are not plain compiled gprims (rigid
-bodies, xforms with children, mesh prims whose colliders would need rebuilding)
-are not eligible; callers then author USD as usual.
+:func:`targets_for` gives a prim list's :class:`DirectTargets` (geom, mocap and size-convention arrays),
+cached per compile and prim list: a script passes the same prims every frame. A list is eligible when every
+prim is a plain compiled gprim (no rigid body, no xform with children, no mesh whose colliders would need
+rebuilding); otherwise its poses and colours are authored on the stage.
 """
 from __future__ import annotations
 
@@ -16,15 +12,12 @@ from typing import Sequence
 
 import mujoco
 import numpy as np
-from pxr import Usd, UsdGeom
+from pxr import Usd
 
-from graphsdg.sim.camera_poses import posed_parts
+from graphsdg.maths.rotations import decompose, matrix_to_quat_wxyz
 from graphsdg.sim.gprims import primitive_size
+from graphsdg.sim.pose_writes.uniform_scales import UniformScalePlan
 from graphsdg.sim.scene import SimScene
-from graphsdg.sim.uniform_scales import UniformScalePlan
-from graphsdg.maths.rotations import canonical_quat, compose, decompose, euler_xyz_to_quat, matrix_to_quat_wxyz, \
-    quat_multiply, unit_quat
-from graphsdg.stage.prims import prim_facts
 from graphsdg.stage.xform import parent_world_matrix
 
 
@@ -78,14 +71,14 @@ class DirectTargets:
             b.scale = row
 
     def uniform_plan(self, model: mujoco.MjModel) -> UniformScalePlan | None:
-        """How this batch's uniform rescales are written (:mod:`graphsdg.sim.uniform_scales`), or None where
-        they take the general path; worked out on first use (the targets are cached per compile)."""
+        """How this batch's uniform rescales are written (:mod:`~graphsdg.sim.pose_writes.uniform_scales`), or
+        None where they take the general path; worked out on first use (the targets are cached per compile)."""
         if self._uniform_plan is _NOT_WORKED_OUT:
             plan = None
             if UniformScalePlan.fits(self, model):
                 prims = np.flatnonzero(~self.is_mesh)
-                unit = _simple_sizes(self, np.ones((len(self.prims), 3)))[1][prims]
-                plan = UniformScalePlan(self, model, unit, _half_extents(self, prims, unit))
+                unit = simple_sizes(self, np.ones((len(self.prims), 3)))[1][prims]
+                plan = UniformScalePlan(self, model, unit, half_extents(self, prims, unit))
             self._uniform_plan = plan
         return self._uniform_plan
 
@@ -143,111 +136,7 @@ def targets_for(sim: SimScene, prims: Sequence[Usd.Prim]) -> DirectTargets:
     return _cache.get(sim, prims)
 
 
-def write_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray | None,
-                rotations: np.ndarray | None, scales: np.ndarray | None) -> bool:
-    """Write per-prim local poses into MuJoCo; ``False`` (nothing written) if not eligible.
-
-    ``rotations`` are Euler XYZ degrees (N, 3) or quaternions (N, 4).
-    """
-    t = targets_for(sim, prims)
-    if not t.eligible:
-        return False
-    m, d = sim.model, sim.data
-    n = len(prims)
-    uniform = None
-    if scales is not None:
-        world_scale = np.asarray(scales, dtype=np.float64).reshape(n, 3)
-        if not t.parent_is_identity:
-            world_scale = world_scale * t.parent_s
-        current = t.current_scales()
-        plan = t.uniform_plan(m)
-        if plan is not None:
-            uniform = plan.prepare(world_scale, current)
-    if scales is not None and uniform is None:
-        sized, sizes = _simple_sizes(t, world_scale)
-        for i in np.flatnonzero(~sized & ~t.is_mesh):   # unevenly scaled spheres, x/y-axis tubes
-            kind, size, _ = primitive_size(t.prims[i], world_scale[i])
-            if int(kind) != int(m.geom_type[t.geom_ids[i]]):
-                return False   # e.g. a sphere scaled unevenly becomes an ellipsoid: recompile via USD
-            sizes[i] = size
-            sized[i] = True
-    if positions is not None:
-        local = np.asarray(positions, dtype=np.float64).reshape(n, 3)
-        d.mocap_pos[t.mocap_ids] = local if t.parent_is_identity else \
-            t.parent_t + np.einsum("nij,nj->ni", t.parent_r, local * t.parent_s)
-    if rotations is not None:
-        rot = np.asarray(rotations, dtype=np.float64)
-        local_q = unit_quat(rot.reshape(n, 4)) if rot.shape[-1] == 4 else euler_xyz_to_quat(rot.reshape(n, 3))
-        d.mocap_quat[t.mocap_ids] = local_q if t.parent_is_identity else \
-            canonical_quat(quat_multiply(t.parent_q, local_q))
-    if uniform is not None:
-        plan.write(sim, uniform, world_scale, current)
-    elif scales is not None:
-        _write_mesh_scales(sim, t, world_scale, current)
-        rows = np.flatnonzero(sized)
-        if rows.size:
-            gids = t.geom_ids[rows]
-            m.geom_size[gids] = sizes[rows]
-            m.geom_rbound[gids] = np.linalg.norm(_half_extents(t, rows, sizes[rows]), axis=1)
-            current[rows] = world_scale[rows]   # every binding's scale (its row of this array)
-    mujoco.mj_kinematics(m, d)
-    return True
-
-
-def write_camera_poses(sim: SimScene, prims: Sequence[Usd.Prim], positions: np.ndarray | None,
-                       rotations: np.ndarray | None, looks: Sequence | None, up: Sequence[float]) -> bool:
-    """Pose cameras without authoring the stage (:mod:`graphsdg.sim.camera_poses`); ``False`` (nothing
-    written) unless every prim is a camera with the canonical op stack.
-
-    ``positions`` / ``rotations``: (N, 3) or (N, 4) local values or None; ``looks``: a world point per
-    camera or None; ``up``: the up axis of the aim.
-    """
-    if not prims:
-        return False
-    sim.sync_dirty_prims()   # edits authored before this write must not undo it at the next sync
-    poses = sim.camera_poses
-    paths = [prim_facts.path(p) for p in prims]
-    if not all(poses.is_canonical(p, path) for p, path in zip(prims, paths)):
-        return False
-    for i, (prim, path) in enumerate(zip(prims, paths)):
-        current = poses.local_parts(path)
-        if current is None:
-            current = decompose(np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
-                                         dtype=np.float64))
-        parts = posed_parts(current, poses.parent_world(prim, path), None if positions is None else positions[i],
-                            None if rotations is None else rotations[i], None if looks is None else looks[i], up)
-        poses.set_local(path, compose(*parts), parts)
-    return True
-
-
-def write_colors(sim: SimScene, prims: Sequence[Usd.Prim], rgb: np.ndarray) -> bool:
-    """Write per-prim display colours into ``geom_rgba``; ``False`` if not eligible."""
-    t = targets_for(sim, prims)
-    if not t.eligible or t.has_material:
-        return False
-    rgba = np.ones((len(prims), 4))
-    rgba[:, :3] = np.asarray(rgb, dtype=np.float64).reshape(len(prims), 3)
-    sim.model.geom_rgba[t.geom_ids] = rgba
-    return True
-
-
-def _write_mesh_scales(sim: SimScene, t: DirectTargets, world_scale: np.ndarray, current: np.ndarray) -> None:
-    """Rescale the mesh geoms whose scale changed (compared as one array, not per prim); ``current`` is
-    :meth:`DirectTargets.current_scales`."""
-    rows = t.mesh_rows
-    if not rows.size:
-        return
-    old = current[rows]
-    new = world_scale[rows]
-    changed = np.any(np.abs(new - old) > 1e-12 * np.maximum(1.0, np.abs(old)), axis=1)
-    if not changed.any():
-        return
-    rows, old, new = rows[changed], old[changed], new[changed]
-    sim.rescale_meshes(t.geom_ids[rows], old, new)
-    current[rows] = new
-
-
-def _half_extents(t: DirectTargets, rows: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+def half_extents(t: DirectTargets, rows: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """(len(rows), 3) half extents of the primitive geoms of ``t``'s ``rows`` with ``sizes`` (MuJoCo's size
     convention)."""
     out = np.array(sizes, dtype=np.float64, copy=True)
@@ -259,7 +148,7 @@ def _half_extents(t: DirectTargets, rows: np.ndarray, sizes: np.ndarray) -> np.n
     return out
 
 
-def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(which rows, (N, 3) sizes) of boxes, uniformly scaled spheres and z-axis cylinders/capsules, as array
     products; other rows are zero."""
     s = np.abs(world_scale)
@@ -273,4 +162,4 @@ def _simple_sizes(t: DirectTargets, world_scale: np.ndarray) -> tuple[np.ndarray
     return box | sphere | tube, sizes
 
 
-__all__ = ["write_poses", "write_colors"]
+__all__ = ["DirectTargets", "targets_for", "simple_sizes", "half_extents"]

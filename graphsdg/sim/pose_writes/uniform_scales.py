@@ -2,7 +2,7 @@
 
 A randomizer that scales a batch (``rep.functional.modify.pose(prims, scale_value=...)`` with
 write-to-fabric) most often gives each prim one factor for all three axes. The general path of
-:mod:`graphsdg.sim.direct_writes` then still works out, every frame, which rows are boxes, spheres or
+:mod:`graphsdg.sim.pose_writes.mujoco_poses` then still works out, every frame, which rows are boxes, spheres or
 tubes, whether the meshes are distinct and their vertices one run, and checks each step: ~75 small NumPy
 operations for 50 assets, ~0.2 ms a frame inside a capture loop, where each costs 2-4 times what it does in
 a tight loop. :class:`UniformScalePlan` works those out once per target list and compile, so a frame's
@@ -12,7 +12,7 @@ uniform rescale is ~25 operations. Every value written is the one the general pa
 Example:
     >>> import graphsdg as rep
     >>> from graphsdg.engine.runtime import runtime
-    >>> from graphsdg.sim.direct_writes import targets_for
+    >>> from graphsdg.sim.pose_writes.targets import targets_for
     >>> _ = rep.stage.new_stage()
     >>> cubes = rep.functional.create_batch.cube(count=3)
     >>> sim = runtime().sim
@@ -31,7 +31,7 @@ import mujoco
 import numpy as np
 
 if TYPE_CHECKING:
-    from graphsdg.sim.direct_writes import DirectTargets
+    from graphsdg.sim.pose_writes.targets import DirectTargets
     from graphsdg.sim.scene import SimScene
 
 _EYE = np.eye(3)

@@ -4,7 +4,7 @@ With ``/exts/omni.replicator.core/enableWriteToFabric`` on, ``rep.functional.mod
 here instead of authoring ``xformOp``s: the camera's new local transform is stored by path, and renders
 (:func:`graphsdg.render.camera.camera_view`) compose it with the parent's current world transform (a parent
 that moves, on the stage or with physics, carries the camera along). As for the geoms of
-:mod:`graphsdg.sim.direct_writes` (and Replicator's Fabric), the stage keeps its authored pose, so readers of
+:mod:`graphsdg.sim.pose_writes.mujoco_poses` (and Replicator's Fabric), the stage keeps its authored pose, so readers of
 USD transforms see that one. Authoring the camera's own transform on the stage afterwards makes the stage's
 pose count again, as a USD edit reaches Fabric.
 
@@ -20,7 +20,7 @@ Example:
 """
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 from pxr import Usd, UsdGeom
@@ -29,6 +29,9 @@ from graphsdg.maths.rotations import compose, decompose, euler_to_matrix, quat_w
 from graphsdg.stage.changes import ChangeSet
 from graphsdg.stage.prims import prim_facts
 from graphsdg.stage.xform import aimed_rotation, parent_world_matrix
+
+if TYPE_CHECKING:
+    from graphsdg.sim.scene import SimScene
 
 _ROTATIONS = (UsdGeom.XformOp.TypeRotateXYZ, UsdGeom.XformOp.TypeOrient)
 
@@ -148,4 +151,30 @@ def posed_parts(current: tuple[np.ndarray, np.ndarray, np.ndarray], parent: np.n
     return t, r, s
 
 
-__all__ = ["CameraPoses", "posed_local", "posed_parts"]
+def write_camera_poses(sim: SimScene, poses: CameraPoses, prims: Sequence[Usd.Prim],
+                       positions: np.ndarray | None, rotations: np.ndarray | None, looks: Sequence | None,
+                       up: Sequence[float]) -> bool:
+    """Pose cameras into ``poses`` without authoring ``sim``'s stage; ``False`` (nothing written) unless every
+    prim is a camera with the canonical op stack.
+
+    ``positions`` / ``rotations``: (N, 3) or (N, 4) local values or None; ``looks``: a world point per
+    camera or None; ``up``: the up axis of the aim.
+    """
+    if not prims:
+        return False
+    sim.sync_dirty_prims()   # edits authored before this write must not undo it at the next sync
+    paths = [prim_facts.path(p) for p in prims]
+    if not all(poses.is_canonical(p, path) for p, path in zip(prims, paths)):
+        return False
+    for i, (prim, path) in enumerate(zip(prims, paths)):
+        current = poses.local_parts(path)
+        if current is None:
+            current = decompose(np.array(UsdGeom.Xformable(prim).GetLocalTransformation(Usd.TimeCode.Default()),
+                                         dtype=np.float64))
+        parts = posed_parts(current, poses.parent_world(prim, path), None if positions is None else positions[i],
+                            None if rotations is None else rotations[i], None if looks is None else looks[i], up)
+        poses.set_local(path, compose(*parts), parts)
+    return True
+
+
+__all__ = ["CameraPoses", "posed_local", "posed_parts", "write_camera_poses"]
