@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import graphsdg as rep
+from graphsdg.engine import capture
 from graphsdg.graph import GraphBuildError
 
 from conftest import unit_cube_scene
@@ -159,7 +160,7 @@ def test_step_uses_the_fired_triggers_rt_subframes(monkeypatch):
     with rep.trigger.on_frame(interval=2, rt_subframes=7):
         rep.create.light(light_type="Sphere", intensity=rep.distribution.uniform(1.0, 2.0))
     seen = []
-    monkeypatch.setattr(rep.orchestrator, "_capture", lambda subframes, *a, **k: seen.append(subframes))
+    monkeypatch.setattr(capture, "_capture", lambda subframes, *a, **k: seen.append(subframes))
     for _ in range(3):
         rep.orchestrator.step()
     assert seen == [7, 1, 7]

@@ -116,10 +116,10 @@ def test_module_paths_of_the_api_import(compat_rep):
 
 
 def test_next_capture_subframes_reach_the_orchestrator(compat_rep):
-    from graphsdg import orchestrator
+    from graphsdg.engine import capture
     seen = []
-    original = orchestrator._capture
-    orchestrator._capture = lambda subframes, *args, **kwargs: seen.append(subframes)
+    original = capture._capture
+    capture._capture = lambda subframes, *args, **kwargs: seen.append(subframes)
     try:
         compat_rep.orchestrator.set_next_rt_subframes(3)
         compat_rep.orchestrator.step()
@@ -128,7 +128,7 @@ def test_next_capture_subframes_reach_the_orchestrator(compat_rep):
         compat_rep.orchestrator.step()
         compat_rep.orchestrator.step()
     finally:
-        orchestrator._capture = original
+        capture._capture = original
     assert seen == [3, 5, 1]                                       # once each, then the setting's default again
     assert compat_rep.orchestrator.get_sim_times_to_write() == []
     with pytest.raises(ValueError, match="positive integer"):
