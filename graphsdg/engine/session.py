@@ -44,6 +44,8 @@ class Session:
         "render_products",   # destroyed: they showed the old stage
         "attachments",       # writers detach (writing what they hold, while the runtime still has the old
                              # stage's simulation and labels), then annotators
+        "graph",             # the current graph is released (its prims went with the old stage) and the
+                             # builder's open blocks close
     )
 
     #: The pieces that outlive a stage (held, never reset by a replacement).
@@ -52,7 +54,7 @@ class Session:
     )
 
     #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
-    ADOPTED: frozenset[str] = frozenset()
+    ADOPTED: frozenset[str] = frozenset({"graph"})
 
     def __init__(self) -> None:
         self.stage_context = stage_context

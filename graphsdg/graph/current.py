@@ -13,43 +13,56 @@ from typing import Iterator
 
 from pxr import Sdf, Usd
 
+from graphsdg.engine.session import session
 from graphsdg.graph.graph import REPLICATOR_ROOT, Graph
 from graphsdg.graph.node import Node
-from graphsdg.graph.scopes import scopes
+from graphsdg.graph.scopes import BuildScopes, scopes
 from graphsdg.stage.context import get_stage, stage_context
 
-_graph: Graph | None = None
-_graph_stage: Usd.Stage | None = None
+class CurrentGraph:
+    """The graph new nodes join, the stage it was made on, and the builder's open ``with`` blocks."""
+
+    def __init__(self, build_scopes: BuildScopes) -> None:
+        self.graph: Graph | None = None
+        self.stage: Usd.Stage | None = None
+        self.scopes = build_scopes
+
+    def get(self, create: bool = True) -> Graph | None:
+        """The graph new nodes join (a new one after a clear, a new stage, or ``/Replicator`` removal)."""
+        # make the stage first: making one releases the graph, which must not be the graph made here
+        stage = get_stage() if create else stage_context.stage
+        if self.graph is not None and (self.stage is not stage or self.graph.is_released(stage)):
+            self.release(remove_prims=False)
+        if self.graph is None and create:
+            self.graph = Graph()
+            self.stage = stage
+        return self.graph
+
+    def release(self, remove_prims: bool = True) -> None:
+        """Drop the current graph; with ``remove_prims`` also remove ``/Replicator`` and the graph's layers."""
+        graph = self.graph
+        self.graph, self.stage = None, None
+        self.scopes.clear()
+        if graph is None:
+            return
+        stage = stage_context.stage
+        if stage is not None and remove_prims:
+            remove_prim_specs(stage, REPLICATOR_ROOT)
+            for layer in graph.layers:
+                _remove_sublayer(stage, layer)
+        for node in graph:
+            node.graph = None
+
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """The graph lived on the old stage: release it (its prims went with that stage)."""
+        self.release(remove_prims=False)
 
 
-def current_graph(create: bool = True) -> Graph | None:
-    """The graph new nodes join (a new one after a clear, a new stage, or ``/Replicator`` removal)."""
-    global _graph, _graph_stage
-    # make the stage first: making one releases the graph, which must not be the graph made here
-    stage = get_stage() if create else stage_context.stage
-    if _graph is not None and (_graph_stage is not stage or _graph.is_released(stage)):
-        release_graph(remove_prims=False)
-    if _graph is None and create:
-        _graph = Graph()
-        _graph_stage = stage
-    return _graph
+#: The process's current graph (held by the session, :mod:`graphsdg.engine.session`).
+current = session.adopt("graph", CurrentGraph(scopes))
 
-
-def release_graph(remove_prims: bool = True) -> None:
-    """Drop the current graph; with ``remove_prims`` also remove ``/Replicator`` and the graph's layers."""
-    global _graph, _graph_stage
-    graph = _graph
-    _graph, _graph_stage = None, None
-    scopes.__init__()
-    if graph is None:
-        return
-    stage = stage_context.stage
-    if stage is not None and remove_prims:
-        remove_prim_specs(stage, REPLICATOR_ROOT)
-        for layer in graph.layers:
-            _remove_sublayer(stage, layer)
-    for node in graph:
-        node.graph = None
+current_graph = current.get
+release_graph = current.release
 
 
 def remove_prim_specs(stage: Usd.Stage, path: str) -> None:
@@ -108,9 +121,3 @@ def edit_context(node: Node) -> Iterator[None]:
     with Usd.EditContext(get_stage(), node.layer):
         yield
 
-
-def _on_stage_replaced(stage: Usd.Stage | None) -> None:
-    release_graph(remove_prims=False)
-
-
-stage_context.subscribe_replaced(_on_stage_replaced)

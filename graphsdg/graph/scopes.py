@@ -34,7 +34,14 @@ class BuildScopes:
     def exit_trigger(self, trigger: Node) -> None:
         self.trigger = None
 
+    def clear(self) -> None:
+        """Close every block (the graph they built into was released)."""
+        self.trigger = None
+        self.targets.clear()
+        self.layers.clear()
 
+
+#: The process's open blocks (held by the current graph, :mod:`graphsdg.graph.current`).
 scopes = BuildScopes()
 
 
