@@ -25,6 +25,7 @@ from graphsdg.graph.value_shapes import SCALAR, VEC3, attribute_shapes
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.materials import surface_shader
 
+from .mirrored_ports import mirrored_port, mirrored_ports
 from .modify import POSE_PORTS, apply_pose
 
 # ports in the order of the calls' parameters (a node lists its values in this order)
@@ -111,8 +112,8 @@ def _shape_node(shape: str) -> type[CreateNode]:
                    f"makes each a ``UsdGeom.Mesh`` (Replicator's default; graphsdg's is an implicit prim).")
         type_name = f"create.{shape}"
         default_name = shape.capitalize()
-        inputs = {**SHAPE_POSE, "semantics": Port(list), "material": Port("material"), "visible": Port(bool, True),
-                  "as_mesh": Port(bool, False), **COMMON}
+        inputs = {**SHAPE_POSE, "semantics": Port(list), "material": Port("material"),
+                  **mirrored_ports(make_fn, visible=bool, as_mesh=bool), **COMMON}
 
         def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
             prim = make_fn(name=name, parent=parent, semantics=self.value_of("semantics"),
@@ -137,7 +138,7 @@ class CreateXform(CreateNode):
 
     type_name = "create.xform"
     default_name = "Xform"
-    inputs = {**POSE, "semantics": Port(list), "visible": Port(bool, True), **COMMON}
+    inputs = {**POSE, "semantics": Port(list), **mirrored_ports(FC.xform, visible=bool), **COMMON}
 
     def make(self, ctx: ExecContext, name: str, parent: Sdf.Path) -> Usd.Prim:
         return FC.xform(name=name, parent=parent, semantics=self.value_of("semantics"),
@@ -157,11 +158,12 @@ class CreateLight(CreateNode):
     """
 
     # the renderer turns Kelvin into RGB with graphsdg.sim.lights.kelvin_to_rgb and multiplies it with color;
-    # temperature's default is the int 6500, as Replicator's (plain values are part of the node's identity)
+    # temperature's default is the int 6500, as Replicator's (plain values are part of the node's identity);
+    # every light function of graphsdg.functional.create has the same default intensity
     type_name = "create.light"
     inputs = {**POSE, "light_type": Port(str, "Distant"), "color": Port("rgb", (1.0, 1.0, 1.0)),
-              "intensity": Port(float, 1000.0), "exposure": Port(float), "temperature": Port(float, 6500),
-              "texture": Port(str), **COMMON}
+              "intensity": mirrored_port(FC.distant_light, "intensity", float), "exposure": Port(float),
+              "temperature": Port(float, 6500), "texture": Port(str), **COMMON}
     attribute_ports = {"color": "inputs:color", "intensity": "inputs:intensity", "exposure": "inputs:exposure",
                        "temperature": "inputs:colorTemperature", "texture": "inputs:texture:file"}
 
@@ -188,7 +190,8 @@ class CreateLight(CreateNode):
             plain = _plain(self, port)
             if plain is not None:
                 kwargs[port] = plain
-        kwargs.setdefault("temperature", 6500.0)
+        # a drawn temperature starts at the port's default; each execution then sets its draw
+        kwargs.setdefault("temperature", float(self.inputs["temperature"].default))
         if kind == "dome" and _plain(self, "texture") is not None:
             kwargs["texture"] = _plain(self, "texture")
         return LIGHT_TYPES[kind](**kwargs)
@@ -210,11 +213,11 @@ class CreateCamera(CreateNode):
     type_name = "create.camera"
     default_name = "Camera"
     call = Call(ignored_keywords="fisheye")
-    inputs = {**{k: p for k, p in POSE.items() if k != "scale"}, "focal_length": Port(float, 24.0),
-              "focus_distance": Port(float, 400.0), "f_stop": Port(float, 0.0),
-              "horizontal_aperture": Port(float, 20.955), "horizontal_aperture_offset": Port(float, 0.0),
-              "vertical_aperture_offset": Port(float, 0.0), "clipping_range": Port("vec2", (0.01, 1000000.0)),
-              "projection_type": Port(str, "pinhole"), **COMMON}
+    inputs = {**{k: p for k, p in POSE.items() if k != "scale"},
+              **mirrored_ports(FC.camera, focal_length=float, focus_distance=float, f_stop=float,
+                               horizontal_aperture=float, horizontal_aperture_offset=float,
+                               vertical_aperture_offset=float, clipping_range="vec2", projection_type=str),
+              **COMMON}
     attribute_ports = {"focal_length": "focalLength", "focus_distance": "focusDistance", "f_stop": "fStop",
                        "horizontal_aperture": "horizontalAperture"}
 

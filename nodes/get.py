@@ -3,11 +3,14 @@ from __future__ import annotations
 
 import logging
 
+from graphsdg.functional import get as FG
 from graphsdg.graph.calls import Call
 from graphsdg.graph.node import ExecContext, Node, Port
 from graphsdg.graph.registry import register_node
 from graphsdg.stage.prims import resolve_prims
 from graphsdg.stage.query import find_prims
+
+from .mirrored_ports import mirrored_ports
 
 log = logging.getLogger("graphsdg.graph")
 
@@ -25,7 +28,8 @@ class GetPrims(Node):
     call = Call()
     inputs = {"path_pattern": Port(str), "path_match": Port(str), "path_pattern_exclusion": Port(str),
               "prim_types": Port(list), "prim_types_exclusion": Port(list), "semantics": Port(list),
-              "semantics_exclusion": Port(list), "cache_result": Port(bool, True), "ignore_case": Port(bool, True)}
+              "semantics_exclusion": Port(list), "cache_result": Port(bool, True),
+              **mirrored_ports(FG.prims, ignore_case=bool)}
     outputs = {"prims": Port("prims")}
 
     def _query(self) -> dict:

@@ -18,8 +18,11 @@ from graphsdg.render.render_product import registry as render_products
 from graphsdg.stage.prims import resolve_prim
 from graphsdg.stage.xform import up_axis_vector, world_matrix
 
+from .mirrored_ports import default_of, mirrored_port, mirrored_ports
+
 TARGET = {"input_prims": Port("prims", required=True)}
 POSE_PORTS = ("position", "rotation", "scale", "size", "pivot", "look_at")
+ROTATION_ORDER = default_of(F.pose, "rotation_order")   # the Euler order of nodes without a rotation_order port
 
 
 def pose_rows(ctx: ExecContext, port: str, n: int) -> np.ndarray | None:
@@ -86,9 +89,9 @@ def apply_pose(ctx: ExecContext, prims: list[Usd.Prim]) -> None:
     pivot = pose_rows(ctx, "pivot", n) if "pivot" in ctx.node.inputs else None
     look_at = look_at_points(ctx.value("look_at"), n) if ctx.given("look_at") else None
     up = ctx.value("look_at_up_axis") if ctx.given("look_at_up_axis") else None
-    order = ctx.value("rotation_order") if "rotation_order" in ctx.node.inputs else "XYZ"
+    order = ctx.value("rotation_order") if "rotation_order" in ctx.node.inputs else ROTATION_ORDER
     F.pose(prims, position_value=position, rotation_value=rotation, scale_value=scale, look_at_value=look_at,
-           look_at_up_axis=up, rotation_order=order or "XYZ", size_value=size, pivot_value=pivot)
+           look_at_up_axis=up, rotation_order=order or ROTATION_ORDER, size_value=size, pivot_value=pivot)
 
 
 def _with_components(ctx: ExecContext, prims: list[Usd.Prim], full: Any, base: str, n: int) -> Any:
@@ -122,7 +125,7 @@ class Pose(Node):
     call = Call()
     inputs = {**TARGET, "position": Port("vec3"), "position_x": Port(float), "position_y": Port(float),
               "position_z": Port(float), "rotation": Port("vec3"), "rotation_x": Port(float),
-              "rotation_y": Port(float), "rotation_z": Port(float), "rotation_order": Port(str, "XYZ"),
+              "rotation_y": Port(float), "rotation_z": Port(float), "rotation_order": mirrored_port(F.pose, "rotation_order", str),
               "scale": Port("vec3|float"), "size": Port("vec3|float"), "pivot": Port("vec3"),
               "look_at": Port("vec3|prim"), "look_at_up_axis": Port("vec3")}
     outputs = {"prims": Port("prims")}
@@ -134,7 +137,7 @@ class Pose(Node):
             raise ValueError("modify.pose: rotation and look_at are exclusive; pass one of them")
         if values.get("size") is not None and values.get("scale") is not None:
             raise ValueError("modify.pose: size and scale are exclusive; pass one of them")
-        order = values.get("rotation_order") or "XYZ"
+        order = values.get("rotation_order") or ROTATION_ORDER
         if str(order).upper() not in ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"):
             raise ValueError(f"modify.pose: rotation_order must be one of XYZ, XZY, YXZ, YZX, ZXY, ZYX, "
                              f"got {order!r}")
@@ -182,7 +185,7 @@ class Semantics(Node):
     type_name = "modify.semantics"
     family = "modify"
     call = Call(params=("semantics", "input_prims", "mode"), named=False)
-    inputs = {**TARGET, "semantics": Port(list), "mode": Port(str, "add")}
+    inputs = {**TARGET, "semantics": Port(list), **mirrored_ports(F.semantics, mode=str)}
     outputs = {"prims": Port("prims")}
 
     def __init__(self, name: str | None = None, **values: Any) -> None:

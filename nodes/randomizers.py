@@ -18,6 +18,7 @@ from graphsdg.graph.registry import register_node
 from graphsdg.graph.samples import Samples
 from graphsdg.graph.value_shapes import SCALAR, value_shape
 
+from .mirrored_ports import mirrored_port, mirrored_ports
 from .modify import TARGET
 
 
@@ -119,8 +120,7 @@ class Rotation(Randomizer):
 
     type_name = "randomizer.rotation"
     call = Call(named=False)
-    inputs = {**TARGET, "min_angle": Port("vec3", (-180.0, -180.0, -180.0)),
-              "max_angle": Port("vec3", (180.0, 180.0, 180.0)), "seed": Port(int)}
+    inputs = {**TARGET, **mirrored_ports(FR.rotation, min_angle="vec3", max_angle="vec3"), "seed": Port(int)}
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
@@ -130,14 +130,6 @@ class Rotation(Randomizer):
 
 
 UNBOUNDED = (None, None, None)   # a sampling corner that limits no axis (Replicator's min_samp / max_samp)
-
-
-def _functional_scatter(name: str):
-    fn = getattr(FR, name, None)
-    if fn is None:
-        raise NotImplementedError(f"graphsdg.functional.randomizer.{name} is not available in this build; "
-                                  f"the scatter placement logic ships with the physics module")
-    return fn
 
 
 def _opt_prims(ctx: ExecContext, port: str) -> list[Usd.Prim] | None:
@@ -151,7 +143,9 @@ class Scatter2D(Randomizer):
     type_name = "randomizer.scatter_2d"
     inputs = {**TARGET, "surface_prims": Port("prims", required=True), "no_coll_prims": Port("prims"),
               "min_samp": Port("vec3", UNBOUNDED), "max_samp": Port("vec3", UNBOUNDED), "seed": Port(int),
-              "offset": Port(float, 0), "check_for_collisions": Port(bool, False)}
+              # Replicator's graph call takes the int 0, its functional call 0.0 (plain values are part of the
+              # node's identity)
+              "offset": Port(float, 0), **mirrored_ports(FR.scatter_2d, check_for_collisions=bool)}
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
@@ -161,7 +155,7 @@ class Scatter2D(Randomizer):
         extents = _extents(ctx)
         if extents is not None:
             kwargs["extents"] = extents
-        _functional_scatter("scatter_2d")(prims, ctx.prims("surface_prims"), **kwargs)
+        FR.scatter_2d(prims, ctx.prims("surface_prims"), **kwargs)
         ctx.record("positions", [_translation(p) for p in prims])
         return {"prims": prims}
 
@@ -174,9 +168,10 @@ class Scatter3D(Randomizer):
     inputs = {**TARGET, "volume_prims": Port("prims"), "no_coll_prims": Port("prims"),
               "volume_excl_prims": Port("prims"), "min_samp": Port("vec3", UNBOUNDED),
               "max_samp": Port("vec3", UNBOUNDED),
-              "resolution_scaling": Port(float, 1.0), "voxel_size": Port(float, 0.0),
-              "check_for_collisions": Port(bool, False), "prevent_vol_overlap": Port(bool, True),
-              "viz_sampled_voxels": Port(bool, False), "seed": Port(int)}
+              "resolution_scaling": mirrored_port(FR.scatter_3d, "resolution_scaling", float),
+              "voxel_size": mirrored_port(FR.scatter_3d, "input_voxel_size", float),
+              **mirrored_ports(FR.scatter_3d, check_for_collisions=bool, prevent_vol_overlap=bool,
+                               viz_sampled_voxels=bool), "seed": Port(int)}
 
     def compute(self, ctx: ExecContext) -> dict:
         prims = ctx.prims()
@@ -190,7 +185,7 @@ class Scatter3D(Randomizer):
         extents = _extents(ctx)
         if extents is not None:
             kwargs["extents"] = extents
-        _functional_scatter("scatter_3d")(prims, _opt_prims(ctx, "volume_prims"), **kwargs)
+        FR.scatter_3d(prims, _opt_prims(ctx, "volume_prims"), **kwargs)
         ctx.record("positions", [_translation(p) for p in prims])
         return {"prims": prims}
 

@@ -12,7 +12,8 @@ Example:
 """
 from __future__ import annotations
 
-from typing import Any
+import inspect
+from typing import Any, Callable
 
 import numpy as np
 
@@ -20,23 +21,51 @@ from graphsdg.functional import create
 from graphsdg.functional.per_prim import per_prim
 
 
-def _batch(shape: str):
-    def create_many(count: int = 1, position: Any = None, rotation: Any = None, scale: Any = None,
-                    look_at: Any = None, look_at_up_axis: Any = None, semantics: Any = None, visible: bool = True,
-                    name: str | None = None, parent: Any = None) -> list:
-        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
-            raise ValueError(f"count must be a positive integer, got {count!r}")
-        positions = per_prim(position, count, "position")
-        rotations = per_prim(rotation, count, "rotation")
-        scales = per_prim(scale, count, "scale", uniform=True, uniform_per_prim=True)
-        targets = per_prim(look_at, count, "look_at")
-        fn = getattr(create, shape)
-        return [fn(position=positions[i], rotation=rotations[i], scale=scales[i], look_at=targets[i],
-                   look_at_up_axis=look_at_up_axis, semantics=semantics, visible=visible, name=name,
-                   parent=parent) for i in range(count)]
+PER_PRIM = ("position", "rotation", "scale", "look_at")   # one value for all, or one row per prim
 
-    create_many.__name__ = shape
+
+def _batch_signature(single: Callable[..., Any], leave_out: tuple[str, ...] = ()) -> inspect.Signature:
+    """``count=1`` and then ``single``'s parameters (less ``leave_out``), defaults and all: a batch call's
+    signature, so each default is written once, in :mod:`graphsdg.functional.create`."""
+    count = inspect.Parameter("count", inspect.Parameter.POSITIONAL_OR_KEYWORD, default=1, annotation="int")
+    kept = [p.replace(annotation="Any") if p.name in PER_PRIM else p
+            for p in inspect.signature(single).parameters.values() if p.name not in leave_out]
+    return inspect.Signature([count, *kept], return_annotation="list")
+
+
+def _bound(signature: inspect.Signature, name: str, args: tuple, kwargs: dict) -> dict[str, Any]:
+    """The call's arguments by name, defaults filled in; a bad call raises Python's TypeError naming ``name``."""
+    try:
+        bound = signature.bind(*args, **kwargs)
+    except TypeError as exc:
+        raise TypeError(f"{name}() {exc}") from None
+    bound.apply_defaults()
+    return dict(bound.arguments)
+
+
+def _count(value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"count must be a positive integer, got {value!r}")
+    return value
+
+
+def _batch(shape: str):
+    signature = _batch_signature(getattr(create, shape), leave_out=("as_mesh",))
+
+    def create_many(*args: Any, **kwargs: Any) -> list:
+        shared = _bound(signature, shape, args, kwargs)
+        count = _count(shared.pop("count"))
+        positions = per_prim(shared.pop("position"), count, "position")
+        rotations = per_prim(shared.pop("rotation"), count, "rotation")
+        scales = per_prim(shared.pop("scale"), count, "scale", uniform=True, uniform_per_prim=True)
+        targets = per_prim(shared.pop("look_at"), count, "look_at")
+        fn = getattr(create, shape)
+        return [fn(position=positions[i], rotation=rotations[i], scale=scales[i], look_at=targets[i], **shared)
+                for i in range(count)]
+
+    create_many.__name__ = create_many.__qualname__ = shape
     create_many.__doc__ = f"Create ``count`` {shape} prims; returns the list of prims."
+    create_many.__signature__ = signature  # type: ignore[attr-defined]
     return create_many
 
 
@@ -49,13 +78,10 @@ plane = _batch("plane")
 disk = _batch("disk")
 torus = _batch("torus")
 
+_CAMERA = _batch_signature(create.camera)
 
-def camera(count: int = 1, position: Any = None, rotation: Any = None, look_at: Any = None,
-           look_at_up_axis: Any = None, focal_length: float = 24.0, focus_distance: float = 400.0, f_stop: float = 0.0,
-           horizontal_aperture: float = 20.955, vertical_aperture: float | None = None,
-           horizontal_aperture_offset: float = 0.0, vertical_aperture_offset: float = 0.0,
-           clipping_range: tuple[float, float] = (0.01, 1000000.0), projection_type: str = "pinhole",
-           name: str | None = None, parent: Any = None, semantics: Any = None) -> list:
+
+def camera(*args: Any, **kwargs: Any) -> list:
     """Create ``count`` cameras (``rep.functional.create.camera`` each); poses per prim (an ``(N, 3)`` array) or
     shared, the lens shared by all; returns the list of camera prims.
 
@@ -66,15 +92,13 @@ def camera(count: int = 1, position: Any = None, rotation: Any = None, look_at: 
         >>> [(str(c.GetPath()), c.GetTypeName()) for c in cams]
         [('/Camera', 'Camera'), ('/Camera_01', 'Camera')]
     """
-    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
-        raise ValueError(f"count must be a positive integer, got {count!r}")
-    positions = per_prim(position, count, "position")
-    rotations = per_prim(rotation, count, "rotation")
-    targets = per_prim(look_at, count, "look_at")
-    return [create.camera(position=positions[i], rotation=rotations[i], look_at=targets[i],
-                          look_at_up_axis=look_at_up_axis, focal_length=focal_length, focus_distance=focus_distance,
-                          f_stop=f_stop, horizontal_aperture=horizontal_aperture, vertical_aperture=vertical_aperture,
-                          horizontal_aperture_offset=horizontal_aperture_offset,
-                          vertical_aperture_offset=vertical_aperture_offset, clipping_range=clipping_range,
-                          projection_type=projection_type, name=name, parent=parent, semantics=semantics)
+    shared = _bound(_CAMERA, "camera", args, kwargs)
+    count = _count(shared.pop("count"))
+    positions = per_prim(shared.pop("position"), count, "position")
+    rotations = per_prim(shared.pop("rotation"), count, "rotation")
+    targets = per_prim(shared.pop("look_at"), count, "look_at")
+    return [create.camera(position=positions[i], rotation=rotations[i], look_at=targets[i], **shared)
             for i in range(count)]
+
+
+camera.__signature__ = _CAMERA  # type: ignore[attr-defined]
