@@ -21,6 +21,7 @@ Example:
     >>> from graphsdg.engine.session import session
     >>> from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import registry as render_products
+from graphsdg.sensors.scanners import scanners
 from graphsdg.stage.context import stage_context
     >>> session.stage_context is stage_context
     True
@@ -33,6 +34,7 @@ from pxr import Usd
 
 from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import registry as render_products
+from graphsdg.sensors.scanners import scanners
 from graphsdg.stage.context import stage_context
 
 
@@ -46,6 +48,7 @@ class Session:
                              # stage's simulation and labels), then annotators
         "graph",             # the current graph is released (its prims went with the old stage) and the
                              # builder's open blocks close
+        "scanners",          # lidar and radar scanners of the old stage's sensors are forgotten
     )
 
     #: The pieces that outlive a stage (held, never reset by a replacement).
@@ -60,6 +63,7 @@ class Session:
         self.stage_context = stage_context
         self.render_products = render_products
         self.attachments = attachments
+        self.scanners = scanners
         for name in self.ADOPTED:
             setattr(self, name, None)
         stage_context.own(self.stage_replaced)

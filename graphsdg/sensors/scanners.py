@@ -26,7 +26,6 @@ from graphsdg.sensors.lidar_profile import LidarProfileError
 from graphsdg.sensors.lidar_scan import LidarScanner
 from graphsdg.sensors.radar_scan import RadarScanner
 from graphsdg.sim.scene import SimScene
-from graphsdg.stage.context import stage_context
 
 SCANNER_TYPES = {"OmniLidar": LidarScanner, "OmniRadar": RadarScanner}
 
@@ -66,13 +65,15 @@ class Scanners:
         self._latest[key] = (frame_index, now, out)
         return out
 
-    def clear(self, stage: Usd.Stage | None = None) -> None:
-        """Forget every scanner (the stage was replaced)."""
+    def clear(self) -> None:
+        """Forget every scanner and its latest output."""
         self._scanners.clear()
         self._latest.clear()
 
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Forget every scanner: they scanned the old stage's sensors."""
+        self.clear()
 
-#: The process's scanners.
+
+#: The process's scanners (held by the session, :mod:`graphsdg.engine.session`).
 scanners = Scanners()
-
-stage_context.subscribe_replaced(scanners.clear)
