@@ -49,6 +49,8 @@ class Session:
         "graph",             # the current graph is released (its prims went with the old stage) and the
                              # builder's open blocks close
         "scanners",          # lidar and radar scanners of the old stage's sensors are forgotten
+        "forces",            # pushes not yet applied are dropped (they named the old stage's bodies)
+        "randomization_targets",   # physics views registered for randomization are forgotten
     )
 
     #: The pieces that outlive a stage (held, never reset by a replacement).
@@ -57,7 +59,7 @@ class Session:
     )
 
     #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
-    ADOPTED: frozenset[str] = frozenset({"graph"})
+    ADOPTED: frozenset[str] = frozenset({"graph", "forces", "randomization_targets"})
 
     def __init__(self) -> None:
         self.stage_context = stage_context

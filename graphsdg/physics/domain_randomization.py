@@ -50,13 +50,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from pxr import Usd
 
+from graphsdg.engine.session import session
 from graphsdg.errors import unknown_name
 from graphsdg.maths.rotations import euler_xyz_to_quat, quat_wxyz_to_euler_xyz
 from graphsdg.physics import gravity as gravity_access
 from graphsdg.physics.articulation_tensor_view import ArticulationTensorView
 from graphsdg.physics.rigid_body_tensor_view import RigidBodyTensorView
-from graphsdg.stage.context import stage_context
 
 SIMULATION_ATTRIBUTES = ("gravity",)
 RIGID_BODY_ATTRIBUTES = ("angular_velocity", "linear_velocity", "velocity", "position", "orientation", "force",
@@ -177,8 +178,13 @@ class RandomizationTargets:
         return target
 
     def clear(self) -> None:
+        """Forget every registered view and the simulation."""
         self.targets.clear()
         self.simulation = None
+
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """The views showed the old stage: forget them (as Isaac cleans up when the stage closes)."""
+        self.clear()
 
 
 def _name(name: Any) -> str:
@@ -375,16 +381,10 @@ def interval_rows(frames: np.ndarray, interval: int) -> np.ndarray:
     return np.nonzero((frames % int(interval) == 0) & (frames > 0))[0]
 
 
-_targets = RandomizationTargets()
+#: The process's registered views (held by the session, :mod:`graphsdg.engine.session`).
+_targets = session.adopt("randomization_targets", RandomizationTargets())
 
 
 def randomization_targets() -> RandomizationTargets:
     """The process's registered views (emptied when the stage is replaced, as Isaac cleans up on close)."""
     return _targets
-
-
-def _on_stage_replaced(stage: object) -> None:
-    _targets.clear()
-
-
-stage_context.subscribe_replaced(_on_stage_replaced)

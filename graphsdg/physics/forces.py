@@ -35,10 +35,13 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
+from pxr import Usd
+
 from graphsdg.engine.runtime import runtime
+from graphsdg.engine.session import session
 from graphsdg.sim import physics_steps
 from graphsdg.sim.rigid_bodies import rigid_root
-from graphsdg.stage.context import get_stage, stage_context
+from graphsdg.stage.context import get_stage
 
 MODES = ("Force", "Impulse", "Velocity", "Acceleration")
 
@@ -51,11 +54,6 @@ class Push:
     value: np.ndarray
     point: np.ndarray
     mode: str
-
-
-_queue: list[Push] = []
-_applied: list[np.ndarray] = []      # generalised forces added for the step under way
-_handles: tuple[int, int] | None = None
 
 
 def _vector(values: Sequence[float], what: str) -> np.ndarray:
@@ -75,20 +73,12 @@ def apply_force_at_pos(body_path: str, value: Sequence[float], position: Sequenc
     if root is None:
         raise ValueError(f"apply_force_at_pos: {body_path} is not a rigid body (no prim with RigidBodyAPI at or "
                          f"above it)")
-    _queue.append(Push(str(root.GetPath()), _vector(value, "the force"), _vector(position, "the position"), mode))
-    _listen()
+    pushes.add(Push(str(root.GetPath()), _vector(value, "the force"), _vector(position, "the position"), mode))
 
 
 def pending() -> list[Push]:
     """The pushes waiting for the next physics step."""
-    return list(_queue)
-
-
-def _listen() -> None:
-    global _handles
-    if _handles is None:
-        _handles = (physics_steps.subscribe(True, -(2 ** 31), _before_step),
-                    physics_steps.subscribe(False, 2 ** 31, _after_step))
+    return list(pushes.queue)
 
 
 def _wrench(push: Push, m: mujoco.MjModel, d: mujoco.MjData, body: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -107,39 +97,53 @@ def _wrench(push: Push, m: mujoco.MjModel, d: mujoco.MjData, body: int, dt: floa
     return m.body_mass[body] * linear, inertia @ angular
 
 
-def _before_step(dt: float) -> None:
-    if not _queue:
-        return
-    sim = runtime().sim
-    c = sim.compiled
-    m, d = c.model, c.data
-    pushes, _queue[:] = list(_queue), []
-    for push in pushes:
-        binding = c.bodies.get(push.path)
-        if binding is None or (binding.qvel_adr < 0 and not binding.articulated):
-            raise ValueError(f"apply_force_at_pos: {push.path} is not a dynamic rigid body of the simulation "
-                             f"(kinematic bodies and static colliders cannot be pushed)")
-        force, torque = _wrench(push, m, d, binding.body_id, dt)
-        generalised = np.zeros(m.nv)
-        mujoco.mj_applyFT(m, d, force, torque, d.xipos[binding.body_id], binding.body_id, generalised)
-        d.qfrc_applied += generalised
-        _applied.append(generalised)
+class Pushes:
+    """The pushes waiting for the next physics step and the generalised forces of the step under way."""
+
+    def __init__(self) -> None:
+        self.queue: list[Push] = []
+        self.applied: list[np.ndarray] = []      # generalised forces added for the step under way
+        self._handles: tuple[int, int] | None = None
+
+    def add(self, push: Push) -> None:
+        """Queue ``push`` for the next physics step (listening to the steps from the first push on)."""
+        self.queue.append(push)
+        if self._handles is None:
+            self._handles = (physics_steps.subscribe(True, -(2 ** 31), self._before_step),
+                             physics_steps.subscribe(False, 2 ** 31, self._after_step))
+
+    def _before_step(self, dt: float) -> None:
+        if not self.queue:
+            return
+        sim = runtime().sim
+        c = sim.compiled
+        m, d = c.model, c.data
+        due, self.queue[:] = list(self.queue), []
+        for push in due:
+            binding = c.bodies.get(push.path)
+            if binding is None or (binding.qvel_adr < 0 and not binding.articulated):
+                raise ValueError(f"apply_force_at_pos: {push.path} is not a dynamic rigid body of the simulation "
+                                 f"(kinematic bodies and static colliders cannot be pushed)")
+            force, torque = _wrench(push, m, d, binding.body_id, dt)
+            generalised = np.zeros(m.nv)
+            mujoco.mj_applyFT(m, d, force, torque, d.xipos[binding.body_id], binding.body_id, generalised)
+            d.qfrc_applied += generalised
+            self.applied.append(generalised)
+
+    def _after_step(self, dt: float) -> None:
+        if not self.applied:
+            return
+        d = runtime().sim.compiled.data
+        for generalised in self.applied:
+            if generalised.shape == d.qfrc_applied.shape:
+                d.qfrc_applied -= generalised
+        self.applied.clear()
+
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Pushes belong to the stage they were given on: drop them."""
+        self.queue.clear()
+        self.applied.clear()
 
 
-def _after_step(dt: float) -> None:
-    if not _applied:
-        return
-    d = runtime().sim.compiled.data
-    for generalised in _applied:
-        if generalised.shape == d.qfrc_applied.shape:
-            d.qfrc_applied -= generalised
-    _applied.clear()
-
-
-def _on_stage_replaced(stage) -> None:
-    """Pushes belong to the stage they were given on."""
-    _queue.clear()
-    _applied.clear()
-
-
-stage_context.subscribe_replaced(_on_stage_replaced)
+#: The process's pushes (held by the session, :mod:`graphsdg.engine.session`).
+pushes = session.adopt("forces", Pushes())
