@@ -27,7 +27,7 @@ from graphsdg import settings
 from graphsdg.engine.runtime import runtime
 from graphsdg.scenarios import palletizing_cell as cell
 from graphsdg.scenarios import ur10
-from graphsdg.scenarios.palletizing import BinStacking
+from graphsdg.scenarios.palletizing import BinStacking, upside_down_bins
 from graphsdg.physics.articulations import ArticulationView
 from graphsdg.physics.bodies import RigidBodyView
 from graphsdg.sim.bounds import create_bbox_cache
@@ -164,8 +164,8 @@ def test_seed_script_captures_on_robot_events_and_leaves_the_simulation_unchange
     assert "[PalletizingSDGDemo] Palletizing SDG demo finished.." in out
     root = tmp_path / "_out_palletizing_sdg_demo"
     random.seed(42)
-    flipped = [random.random() < 0.5 for _ in range(NUM_BINS)]
-    assert flipped == [False, True, True]
+    flipped = upside_down_bins(NUM_BINS)
+    assert flipped == [True, True, False]
     # bin flip captures (annotators + the seed's Pillow helper) only for the bins that came upside down
     for i in range(NUM_BINS):
         annot = root / f"annot_bin_{i}"

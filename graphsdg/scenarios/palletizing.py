@@ -28,7 +28,7 @@ Example:
     >>> sample = BinStacking(num_bins=2)
     >>> sample.load_world()
     >>> sample.flipped
-    [False, True]
+    [True, True]
     >>> sample.start()
     >>> sample.run_until(lambda: len(sample.placed) == 1, max_seconds=30.0) and sample.placed
     [0]
@@ -51,6 +51,26 @@ CALLBACK = "graphsdg.scenarios.palletizing"
 NUM_BINS_SETTING = "/graphsdg/scenarios/palletizing/numBins"
 DEFAULT_NUM_BINS = 36
 FLIP_PROBABILITY = 0.5
+
+
+def upside_down_bins(count: int) -> list[bool]:
+    """Which of ``count`` bins arrive upside down, drawn from Python's ``random`` as Isaac's sample spawns bins.
+
+    Isaac's sample draws four numbers a bin (its offset across the belt, two for its yaw, then whether it is
+    turned over); a bin whose last draw is at most 0.5 arrives upside down. The stand-in's belt centres its bins,
+    so the first three draws are taken only to keep the sequence, and a seeded run turns over the bins Isaac's
+    does (``random.seed(42)``: bins 0 and 1 of two, as Isaac's palletizing test expects).
+
+    Example:
+        >>> random.seed(42); upside_down_bins(4)
+        [True, True, False, False]
+    """
+    flags = []
+    for _ in range(count):
+        random.uniform(-0.15, 0.15)
+        random.random(), random.random()
+        flags.append(random.random() <= FLIP_PROBABILITY)
+    return flags
 
 
 class BinStacking:
@@ -85,7 +105,7 @@ class BinStacking:
         from graphsdg import stage as stage_ctx
         from graphsdg.engine.runtime import runtime
 
-        self.flipped = [random.random() < FLIP_PROBABILITY for _ in range(self.num_bins)]
+        self.flipped = upside_down_bins(self.num_bins)
         stage = stage_ctx.new_stage()
         cell.build_cell(stage, self.layout, self.num_bins, self.flipped)
         self.kinematics = ur10.author_arm(stage, cell.ROBOT, Frame(np.zeros(3), np.eye(3)))
