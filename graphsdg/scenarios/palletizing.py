@@ -54,12 +54,12 @@ FLIP_PROBABILITY = 0.5
 
 
 def upside_down_bins(count: int) -> list[bool]:
-    """Which of ``count`` bins arrive upside down, drawn from Python's ``random`` as Isaac's sample spawns bins.
+    """Which of ``count`` bins arrive upside down, drawn from Python's ``random`` four numbers a bin.
 
-    Isaac's sample draws four numbers a bin (its offset across the belt, two for its yaw, then whether it is
-    turned over); a bin whose last draw is at most 0.5 arrives upside down. The stand-in's belt centres its bins,
-    so the first three draws are taken only to keep the sequence, and a seeded run turns over the bins Isaac's
-    does (``random.seed(42)``: bins 0 and 1 of two, as Isaac's palletizing test expects).
+    The draws follow Isaac's sample as it spawns a bin (its offset across the belt, two for its yaw, then the
+    turn-over draw); the stand-in's belt centres its bins, so the first three are taken only to keep the
+    sequence. A bin whose last draw is at most 0.5 arrives upside down: with ``random.seed(42)`` that turns over
+    the first two bins, the outcome Isaac's palletizing test records for that seed.
 
     Example:
         >>> random.seed(42); upside_down_bins(4)
