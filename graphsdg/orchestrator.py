@@ -19,7 +19,6 @@ from graphsdg.engine.capture import advance_time, capture_subframes, draw, drain
 from graphsdg.engine.run_loop import pause, resume, run, stop  # noqa: F401
 from graphsdg.engine.runtime import runtime
 from graphsdg.engine.state import OrchestratorError, Status, engine_state as _state
-from graphsdg.graph import scheduler
 
 
 async def step_async(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float | None = None,
@@ -141,15 +140,9 @@ def preview() -> None:
     The stage shows what the next captured frame will randomize to (the
     scheduler's counters are not advanced) and MuJoCo is synced to it.
     """
-    graph = scheduler.active_graph()
-    if graph is not None:
-        snap = scheduler.snapshot(graph)
-        try:
-            scheduler.run_subgraphs(graph, [t for t in graph.triggers if not getattr(t, "exhausted", lambda: 0)()],
-                                    graph.frame)
-        finally:
-            scheduler.restore(graph, snap)
-    runtime().sim.sync_dirty_prims()
+    rt = runtime()
+    rt.frame_provider.preview()
+    rt.sim.sync_dirty_prims()
 
 
 async def preview_async() -> None:

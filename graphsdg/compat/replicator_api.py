@@ -7,8 +7,8 @@ forwarding modules of its submodules, what Replicator documents and graphsdg has
   (RTX projection materials and decals, MDL shader graphs, keyboard triggers, skeletal animation,
   RTX-sensor tiling); a name stays importable, so only a script that calls it stops;
 * ``rep.orchestrator.set_next_rt_subframes`` / ``set_minimum_next_rt_subframes`` (the next capture's
-  subframes, through the runtime's graph hooks) and ``get_sim_times_to_write`` (always empty: graphsdg
-  writes each capture in its own step, nothing waits);
+  subframes: :func:`graphsdg.engine.capture.request_next_subframes`) and ``get_sim_times_to_write`` (always
+  empty: graphsdg writes each capture in its own step, nothing waits);
 * ``rep.orchestrator.run`` / ``run_async`` and ``get_is_started`` as Kit scripts poll them: in Kit ``run()``
   returns at once and the script updates the app ``while not get_is_started()`` and then ``while
   get_is_started()``; graphsdg's ``run()`` has made every frame when it returns, so the first
@@ -29,7 +29,7 @@ from typing import Any, Callable
 import graphsdg
 from graphsdg import tools
 from graphsdg.compat.modules import CompatError, CompatModule, ForwardingModule
-from graphsdg.engine.runtime import runtime
+from graphsdg.engine.capture import request_next_subframes, withdraw_subframe_request
 
 # documented names graphsdg cannot honour: module -> name -> why (the error says it)
 REFUSED: dict[str, dict[str, str]] = {
@@ -68,36 +68,14 @@ def refusal(qualified: str, why: str) -> Callable[..., Any]:
     return refuse
 
 
-class _SubframeRequests:
-    """The subframes asked for the next capture (``set_next_rt_subframes``), handed to the orchestrator through
-    the runtime's graph hooks (the largest request wins; the capture never takes fewer than its setting)."""
-
-    def __init__(self) -> None:
-        self.pending = 0
-
-    def __call__(self) -> dict[str, int] | None:
-        if not self.pending:
-            return None
-        requested, self.pending = self.pending, 0
-        return {"rt_subframes": requested}
-
-    def request(self, value: int, minimum: bool) -> None:
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ValueError(f"rt_subframes must be a positive integer, got {value!r}")
-        self.pending = max(self.pending, value) if minimum else value
-
-
-_requests = _SubframeRequests()
-
-
 def set_next_rt_subframes(value: int) -> None:
     """Render the next capture with ``value`` subframes (at least ``/omni/replicator/RTSubframes``)."""
-    _requests.request(value, minimum=False)
+    request_next_subframes(value, minimum=False)
 
 
 def set_minimum_next_rt_subframes(value: int) -> None:
     """Render the next capture with at least ``value`` subframes."""
-    _requests.request(value, minimum=True)
+    request_next_subframes(value, minimum=True)
 
 
 def get_sim_times_to_write() -> list:
@@ -159,17 +137,7 @@ def modules() -> list[types.ModuleType]:
     return out
 
 
-def install() -> None:
-    """Let the next capture's subframe requests reach the orchestrator."""
-    hooks = runtime().graph_hooks
-    if _requests not in hooks:
-        hooks.append(_requests)
-
-
 def uninstall() -> None:
-    """Stop answering subframe requests (compat mode removed)."""
-    _requests.pending = 0
+    """Forget a pending subframe request and an unseen run start (compat mode removed)."""
+    withdraw_subframe_request()
     _RunStarts.unseen = False
-    hooks = runtime().graph_hooks
-    if _requests in hooks:
-        hooks.remove(_requests)

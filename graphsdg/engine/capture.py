@@ -18,6 +18,7 @@ from graphsdg.annotate.frame import FrameView
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.base import interrupts, profiling
 from graphsdg.base import settings_store as settings
+from graphsdg.engine.frame_provider import GraphStep
 from graphsdg.engine.runtime import runtime
 from graphsdg.engine.state import Status, engine_state as _state
 from graphsdg.io import run_state
@@ -88,17 +89,8 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None, def
     rt.check_attachments()
     _state.set(Status.STEPPING)
     t = time.perf_counter()
-    fired: set = set()
-    trigger_outputs: dict[str, int] = {}
-    provenance: dict[str, Any] = {}
-    subframes_override = 0
-    for hook in list(rt.graph_hooks):
-        result = hook()
-        if result:
-            fired |= set(result.get("fired", ()))
-            trigger_outputs.update(result.get("trigger_outputs", {}))
-            subframes_override = max(subframes_override, int(result.get("rt_subframes", 0)))
-            provenance.update(result.get("provenance", {}))
+    graph = rt.frame_provider.step(float(rt.timeline.get_current_time()))
+    requested, _state.next_subframes = _state.next_subframes, 0   # set_next_rt_subframes: this capture only
     t = _timed("graph", t)
     sim = rt.sim
     sim.sync_dirty_prims()
@@ -108,12 +100,28 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None, def
     if pause_timeline and rt.timeline.is_playing():
         rt.timeline.pause()
     t = _timed("physics", t)
-    subframes = capture_subframes(rt_subframes, subframes_override)
-    _capture(subframes, fired, trigger_outputs, provenance, defer)   # times its render, annotate, write phases
+    subframes = capture_subframes(rt_subframes, max(graph.rt_subframes, requested))
+    _capture(subframes, graph, defer)   # times its render, annotate, write phases
     _state.frame_index += 1
     _state.stage_step += 1
     run_state.checkpoint()
     _state.set(Status.STEPPED)
+
+
+def request_next_subframes(value: int, minimum: bool = False) -> None:
+    """Render the next capture with ``value`` subframes (Replicator's ``set_next_rt_subframes``).
+
+    ``minimum``: at least ``value`` (the larger of two requests wins). The capture never takes fewer than
+    ``/omni/replicator/RTSubframes`` or the fired triggers ask for (:func:`capture_subframes`).
+    """
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"rt_subframes must be a positive integer, got {value!r}")
+    _state.next_subframes = max(_state.next_subframes, value) if minimum else value
+
+
+def withdraw_subframe_request() -> None:
+    """Forget a :func:`request_next_subframes` the next capture has not taken yet."""
+    _state.next_subframes = 0
 
 
 def capture_subframes(rt_subframes: int, graph_request: int = 0) -> int:
@@ -155,12 +163,13 @@ def _camera_view(rt, rp) -> CameraView:
     """A render product's camera now (its pose written with write-to-fabric, when it was; its lens as last
     read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
-    sim = rt.sim
+    scene = rt.render_scene
+    units = scene.sim.world_transforms
     if prim.IsValid() and not prim_facts.is_a(prim, UsdGeom.Camera):   # a lidar / radar product (graphsdg.sensors)
-        return sensor_camera_view(prim, rp.width, rp.height, sim.world_transforms.meters_per_unit())
-    lens = sim.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
-    return camera_view(prim, rp.width, rp.height, world=sim.camera_poses.world(prim), lens=lens,
-                       meters_per_unit=sim.world_transforms.meters_per_unit())
+        return sensor_camera_view(prim, rp.width, rp.height, units.meters_per_unit())
+    lens = scene.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
+    return camera_view(prim, rp.width, rp.height, world=scene.camera_poses.world(prim), lens=lens,
+                       meters_per_unit=units.meters_per_unit())
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
@@ -173,14 +182,12 @@ def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
     return products
 
 
-def _capture(subframes: int, fired: set, trigger_outputs: dict[str, int], provenance: dict | None = None,
-             defer: bool = False) -> None:
+def _capture(subframes: int, graph: GraphStep, defer: bool = False) -> None:
     """Render every active product, then annotate and write, now or (``defer``) when next asked."""
     rt = runtime()
     products = _active_products(rt)
     defer = defer and _state.plan is None and all(a.spec.pixels_only for _, anns in products.values() for a in anns)
-    capture = _Capture(fired, trigger_outputs, provenance, _state.stage_step, _state.planned_frame, rt.sim.data.time,
-                       list(rt.writers))
+    capture = _Capture(graph, _state.stage_step, _state.planned_frame, rt.sim.data.time, list(rt.writers))
     for (path, (_, annotators)), frame in zip(products.items(), _render(rt, products, subframes, defer)):
         capture.frames.append((path, frame, annotators))
     if products:
@@ -204,13 +211,11 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
         passes: set[str] = set()
         for a in annotators:
             passes |= a.spec.passes
-        if passes:   # products whose annotators read no pixels (a lidar's) need no framebuffer
-            sim.require_offscreen(rp.width, rp.height)
         motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
         views.append(view)
         requests.append(RenderRequest(view, passes, subframes, defer, motion) if passes else None)
     drawn = [r for r in requests if r is not None]
-    outputs = iter(rt.renderer.render_batch(sim, drawn) if drawn else [])
+    outputs = iter(rt.renderer.render_batch(rt.render_scene, drawn) if drawn else [])   # sizes its buffers
     t = _timed("render", t)
     frames = []
     for (rp, annotators), view, request in zip(products.values(), views, requests):
@@ -238,9 +243,8 @@ def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -
     requests = []
     for rp in render_products:
         rp.check_alive()
-        sim.require_offscreen(rp.width, rp.height)
         requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None))
-    outputs = list(rt.renderer.render_batch(sim, requests)) if requests else []
+    outputs = list(rt.renderer.render_batch(rt.render_scene, requests)) if requests else []
     for out in outputs:
         out.finish()   # hand the pixel buffers back once the colour is read
     if render_products:
@@ -252,11 +256,11 @@ def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -
 class _Capture:
     """One step's rendered products, and what :meth:`finish` needs to annotate and write them."""
 
-    def __init__(self, fired: set, trigger_outputs: dict[str, int], provenance: dict | None, stage_step: int,
-                 planned_frame: int | None, sim_time: float, writers: list) -> None:
+    def __init__(self, graph: GraphStep, stage_step: int, planned_frame: int | None, sim_time: float,
+                 writers: list) -> None:
         self.frames: list[tuple[str, FrameView, list[Annotator]]] = []
         self.writers = writers   # those attached when the frame was rendered (a writer attached later skips it)
-        self.fired, self.trigger_outputs, self.provenance = fired, trigger_outputs, provenance
+        self.fired, self.trigger_outputs, self.provenance = graph.fired, graph.trigger_outputs, graph.provenance
         self.stage_step, self.planned_frame, self.sim_time = stage_step, planned_frame, sim_time
 
     def finish(self) -> None:

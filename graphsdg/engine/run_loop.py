@@ -13,7 +13,6 @@ from graphsdg.engine.capture import drain, step
 from graphsdg.engine.progress import Progress
 from graphsdg.engine.runtime import runtime
 from graphsdg.engine.state import OrchestratorError, Status, engine_state as _state
-from graphsdg.graph import scheduler
 from graphsdg.io import frame_plan
 from graphsdg.io.location import open_location
 from graphsdg.io.write_queue import get_write_queue
@@ -52,9 +51,9 @@ def run(num_frames: int | None = None, start_timeline: bool = False) -> None:
     if num_frames is None and settings.get("/graphsdg/run/numFrames") is not None:
         num_frames = int(settings.get("/graphsdg/run/numFrames"))   # graphsdg run --frames N
     if num_frames is None:
-        unlimited = scheduler.unlimited_triggers()
-        graph = scheduler.active_graph()
-        if graph is None or not any(t.counts_toward_completion for t in graph.triggers):
+        graph = runtime().frame_provider
+        unlimited = graph.unlimited_triggers()
+        if not graph.counts_frames():
             raise OrchestratorError("run() without num_frames needs a graph whose on_frame/on_time triggers set "
                                     "max_execs; pass num_frames=N")
         if unlimited:
@@ -106,7 +105,7 @@ def _frames(progress: Progress) -> bool:
             return True
         if _state.remaining is not None and _state.remaining <= 0:
             break
-        if _state.remaining is None and scheduler.all_exhausted():
+        if _state.remaining is None and runtime().frame_provider.exhausted():
             break
         step(pause_timeline=False)
         progress.advance()
@@ -120,12 +119,11 @@ def _planned_length(num_frames: int | None) -> int:
     """The frame count of a sharded/resumed run: ``num_frames``, or what on_frame ``max_execs`` imply."""
     if num_frames is not None:
         return num_frames
-    graph = scheduler.active_graph()
-    counted = [t for t in graph.triggers if t.counts_toward_completion] if graph is not None else []
-    if not counted or any(not hasattr(t, "interval") or not t.max_execs for t in counted):
+    length = runtime().frame_provider.planned_length()
+    if length is None:
         raise OrchestratorError("a sharded or resumed run() needs num_frames (or graphsdg run --frames N) "
                                 "unless every trigger is an on_frame trigger with max_execs")
-    return max((t.max_execs - 1) * t.interval + 1 for t in counted)
+    return length
 
 
 def _planned_frames(progress: Progress) -> None:
@@ -139,8 +137,8 @@ def _planned_frames(progress: Progress) -> None:
                 f"frame_index it receives (set frame_indexed = True on a writer that does; see docs/cli.md)")
         frame_plan.record_writer(writer)
     _state.frame_bases = {id(w): w.num_written or 0 for w in writers}
-    graph = scheduler.active_graph()
-    start = graph.frame if graph is not None else 0
+    graph = runtime().frame_provider
+    start = graph.frame()   # None without a graph: nothing to seek
     frames = [f for f in range(total) if plan.owns(f)]
     if plan.resume:
         if not plan.sharded:   # shards share folders: the merge step removes their leftovers
@@ -157,8 +155,8 @@ def _planned_frames(progress: Progress) -> None:
         for f in frames:
             if _state.stop_requested:
                 break
-            if f != following and graph is not None:
-                scheduler.seek(start + f)     # the frame's random values, as in one uninterrupted run
+            if f != following and start is not None:
+                graph.seek(start + f)     # the frame's random values, as in one uninterrupted run
             _state.planned_frame = f
             step(pause_timeline=False)
             following = f + 1
@@ -167,8 +165,8 @@ def _planned_frames(progress: Progress) -> None:
             _state.set(Status.STARTED)
     finally:
         _state.planned_frame = None
-    if graph is not None and following != total:
-        scheduler.seek(start + total, restore_state=False)   # where an uninterrupted run would have left it
+    if start is not None and following != total:
+        graph.seek(start + total, restore_state=False)   # where an uninterrupted run would have left it
 
 
 def pause() -> None:

@@ -15,6 +15,7 @@ from pxr import Usd
 
 from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
+from graphsdg.engine.frame_provider import NO_GRAPH, FrameProvider
 from graphsdg.render import render_product
 from graphsdg.render.attachments import OrderedSet, attachments
 from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
@@ -35,7 +36,7 @@ class Runtime:
         self.timeline = Timeline(simulation=lambda: self.sim)
         self.ids = IdTables()
         self.labels = SceneLabels(self.ids)
-        self.graph_hooks: list[Callable[..., object]] = []
+        self.frame_provider: FrameProvider = NO_GRAPH   # the graph installs its scheduler here
         # called with the render product paths of every capture that rendered (Kit's new-frame events)
         self.render_observers: list[Callable[[list[str]], None]] = []
         stage_context.subscribe_replaced(self._on_stage_replaced)

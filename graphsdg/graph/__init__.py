@@ -7,6 +7,7 @@
 * :mod:`~graphsdg.graph.builder`: adding nodes; :mod:`~graphsdg.graph.scopes`: the open ``with`` blocks;
 * :mod:`~graphsdg.graph.current`: the current graph, its lifetime and ``new_layer``;
 * :mod:`~graphsdg.graph.scheduler`: per-step trigger firing, execution, provenance, seek;
+* :mod:`~graphsdg.graph.frame_provider`: the scheduler as the engine's frame provider;
 * :mod:`~graphsdg.graph.export`, :mod:`~graphsdg.graph.drawing` and :mod:`~graphsdg.graph.dry_run`: seeing the graph.
 
 Example:
@@ -19,7 +20,7 @@ Example:
     >>> rep.graph.clear()
 """
 from graphsdg.errors import GraphBuildError
-from graphsdg.graph import scheduler
+from graphsdg.graph import frame_provider, scheduler
 from graphsdg.graph.current import current_graph, new_layer, remove_prim_specs
 from graphsdg.graph.drawing import draw, layout
 from graphsdg.graph.dry_run import DryRunReport, dry_run
@@ -29,7 +30,7 @@ from graphsdg.graph.node import ExecContext, Node, Port, ReplicatorItem, Trigger
 from graphsdg.graph.registry import NodeRegistry, register_node
 from graphsdg.graph.scheduler import clear, seek
 
-scheduler.install()
+frame_provider.install()   # the engine asks the current graph through it
 
 __all__ = ["Node", "Port", "TriggerNode", "ExecContext", "NodeRegistry", "register_node", "Graph", "ReplicatorItem",
            "GraphBuildError", "current_graph", "new_layer", "describe", "to_dict", "to_dot", "to_json",

@@ -1,6 +1,6 @@
 """The scheduler: once per ``orchestrator.step()``, fire triggers and run their subgraphs in order.
 
-It plugs into the orchestrator through ``runtime().graph_hooks``. Each step:
+The engine reaches it through the runtime's frame provider (:mod:`graphsdg.graph.frame_provider`). Each step:
 every trigger polls once (frame count, simulated time, pending custom events);
 the nodes gated by a fired trigger run in the graph's cached topological order,
 each with its own execution index; what they sampled is kept as provenance.
@@ -10,7 +10,7 @@ Example:
     >>> _ = rep.stage.new_stage()
     >>> with rep.trigger.on_frame(interval=2):
     ...     light = rep.create.light(light_type="Sphere", intensity=rep.distribution.uniform(100, 200))
-    >>> [sorted(rep.graph.scheduler.graph_step()["trigger_outputs"].items()) for _ in range(3)]
+    >>> [sorted(rep.graph.scheduler.graph_step().trigger_outputs.items()) for _ in range(3)]
     [[('on_frame', 1)], [('on_frame', 1)], [('on_frame', 2)]]
 """
 from __future__ import annotations
@@ -23,6 +23,7 @@ import numpy as np
 from pxr import Sdf, Usd
 
 from graphsdg.base import profiling
+from graphsdg.engine.frame_provider import GraphStep
 from graphsdg.graph.current import current_graph, edit_context, release_graph
 from graphsdg.graph.graph import Graph, effective_triggers
 from graphsdg.graph.node import ExecContext, Node, ReplicatorItem, TriggerNode
@@ -126,22 +127,23 @@ def evaluate_all(graph: Graph) -> list[Node]:
     return ran
 
 
-def graph_step() -> dict[str, Any] | None:
-    """The orchestrator hook: one step of the current graph."""
+def graph_step(sim_time: float | None = None) -> GraphStep | None:
+    """One step of the current graph at ``sim_time`` (default: the timeline's time); None without a graph."""
     graph = active_graph()
     if graph is None:
         return None
-    rt = runtime()
-    sim_time = float(rt.timeline.get_current_time())
+    if sim_time is None:
+        sim_time = runtime().timeline.get_current_time()
+    sim_time = float(sim_time)
     frame = graph.frame
     fired = fire_triggers(graph, sim_time)
     ran = run_subgraphs(graph, fired, frame)
     _keep_provenance(graph, ran, frame)
     graph.frame += 1
-    return {"fired": {ReplicatorItem(t) for t in fired},
-            "trigger_outputs": {t.name: t.exec_count for t in graph.triggers},
-            "rt_subframes": max((t.rt_subframes for t in fired if isinstance(t, TriggerNode)), default=0),
-            "provenance": provenance(graph, frame, fired)}
+    return GraphStep(fired=frozenset(ReplicatorItem(t) for t in fired),
+                     trigger_outputs={t.name: t.exec_count for t in graph.triggers},
+                     rt_subframes=max((t.rt_subframes for t in fired if isinstance(t, TriggerNode)), default=0),
+                     provenance=provenance(graph, frame, fired))
 
 
 def all_exhausted() -> bool:
@@ -264,11 +266,4 @@ def restore(graph: Graph, snap: dict) -> None:
 def clear() -> None:
     """Remove the current graph, ``/Replicator`` (everything the graph created) and its layers."""
     release_graph(remove_prims=True)
-
-
-def install() -> None:
-    """Register :func:`graph_step` as an orchestrator graph hook (once)."""
-    hooks = runtime().graph_hooks
-    if graph_step not in hooks:
-        hooks.append(graph_step)
 
