@@ -19,9 +19,10 @@ Replicator's module-level API is unchanged: ``rep.stage.new_stage()``,
 
 Example:
     >>> from graphsdg.engine.session import session
-    >>> from graphsdg.render.attachments import attachments
+from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import registry as render_products
 from graphsdg.sensors.scanners import scanners
+from graphsdg.sim.physics_steps import steps as physics_steps
 from graphsdg.stage.context import stage_context
     >>> session.stage_context is stage_context
     True
@@ -35,6 +36,7 @@ from pxr import Usd
 from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import registry as render_products
 from graphsdg.sensors.scanners import scanners
+from graphsdg.sim.physics_steps import steps as physics_steps
 from graphsdg.stage.context import stage_context
 
 
@@ -56,6 +58,7 @@ class Session:
     #: The pieces that outlive a stage (held, never reset by a replacement).
     PROCESS_PARTS: tuple[str, ...] = (
         "stage_context",     # the current stage and its change tracker; it calls stage_replaced
+        "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
     )
 
     #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
@@ -66,6 +69,7 @@ class Session:
         self.render_products = render_products
         self.attachments = attachments
         self.scanners = scanners
+        self.physics_steps = physics_steps
         for name in self.ADOPTED:
             setattr(self, name, None)
         stage_context.own(self.stage_replaced)

@@ -25,38 +25,48 @@ from __future__ import annotations
 import itertools
 from typing import Callable
 
-# handle -> (pre_step, order, callback); handles grow, so sorting by (order, handle) keeps subscription order
-_observers: dict[int, tuple[bool, int, Callable[[float], None]]] = {}
-_handles = itertools.count(1)
+class PhysicsSteps:
+    """The observers of every physics step, by handle."""
+
+    def __init__(self) -> None:
+        # handle -> (pre_step, order, callback); handles grow, so sorting by (order, handle) keeps subscription order
+        self._observers: dict[int, tuple[bool, int, Callable[[float], None]]] = {}
+        self._handles = itertools.count(1)
+
+    def subscribe(self, pre_step: bool, order: int, callback: Callable[[float], None]) -> int:
+        """Call ``callback(step_size)`` before (``pre_step``) or after every physics step; returns a handle."""
+        if not callable(callback):
+            raise TypeError(f"physics step observer must be callable, got {callback!r}")
+        if isinstance(order, bool) or not isinstance(order, int):
+            raise TypeError(f"physics step observer order must be an int, got {order!r}")
+        handle = next(self._handles)
+        self._observers[handle] = (bool(pre_step), order, callback)
+        return handle
+
+    def unsubscribe(self, handle: int) -> None:
+        """End the observation ``handle`` (a handle already ended is ignored)."""
+        self._observers.pop(handle, None)
+
+    def is_subscribed(self, handle: int) -> bool:
+        """Whether ``handle`` still observes physics steps."""
+        return handle in self._observers
+
+    def notify(self, pre_step: bool, step_size: float) -> None:
+        """Report one physics step of ``step_size`` seconds to its pre- or post-step observers."""
+        observers = self._observers
+        if not observers:
+            return
+        due = sorted((order, handle) for handle, (pre, order, _) in observers.items() if pre == pre_step)
+        for _, handle in due:
+            entry = observers.get(handle)   # an observer may end another one during the step
+            if entry is not None:
+                entry[2](step_size)
 
 
-def subscribe(pre_step: bool, order: int, callback: Callable[[float], None]) -> int:
-    """Call ``callback(step_size)`` before (``pre_step``) or after every physics step; returns a handle."""
-    if not callable(callback):
-        raise TypeError(f"physics step observer must be callable, got {callback!r}")
-    if isinstance(order, bool) or not isinstance(order, int):
-        raise TypeError(f"physics step observer order must be an int, got {order!r}")
-    handle = next(_handles)
-    _observers[handle] = (bool(pre_step), order, callback)
-    return handle
+#: The process's physics step observers (held by the session, :mod:`graphsdg.engine.session`).
+steps = PhysicsSteps()
 
-
-def unsubscribe(handle: int) -> None:
-    """End the observation ``handle`` (a handle already ended is ignored)."""
-    _observers.pop(handle, None)
-
-
-def is_subscribed(handle: int) -> bool:
-    """Whether ``handle`` still observes physics steps."""
-    return handle in _observers
-
-
-def notify(pre_step: bool, step_size: float) -> None:
-    """Report one physics step of ``step_size`` seconds to its pre- or post-step observers."""
-    if not _observers:
-        return
-    due = sorted((order, handle) for handle, (pre, order, _) in _observers.items() if pre == pre_step)
-    for _, handle in due:
-        entry = _observers.get(handle)   # an observer may end another one during the step
-        if entry is not None:
-            entry[2](step_size)
+subscribe = steps.subscribe
+unsubscribe = steps.unsubscribe
+is_subscribed = steps.is_subscribed
+notify = steps.notify
