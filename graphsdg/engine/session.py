@@ -19,11 +19,7 @@ Replicator's module-level API is unchanged: ``rep.stage.new_stage()``,
 
 Example:
     >>> from graphsdg.engine.session import session
-from graphsdg.render.attachments import attachments
-from graphsdg.render.render_product import registry as render_products
-from graphsdg.sensors.scanners import scanners
-from graphsdg.sim.physics_steps import steps as physics_steps
-from graphsdg.stage.context import stage_context
+    >>> from graphsdg.stage.context import stage_context
     >>> session.stage_context is stage_context
     True
 """
