@@ -30,6 +30,7 @@ from typing import Any
 from pxr import Usd
 
 from graphsdg.render.attachments import attachments
+from graphsdg.render.motion_blur import recorder as motion_blur
 from graphsdg.render.render_product import registry as render_products
 from graphsdg.sensors.scanners import scanners
 from graphsdg.sim.physics_steps import steps as physics_steps
@@ -55,6 +56,7 @@ class Session:
     PROCESS_PARTS: tuple[str, ...] = (
         "stage_context",     # the current stage and its change tracker; it calls stage_replaced
         "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
+        "motion_blur",       # the motion of the last step, recorded for a blurred capture
     )
 
     #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
@@ -66,6 +68,7 @@ class Session:
         self.attachments = attachments
         self.scanners = scanners
         self.physics_steps = physics_steps
+        self.motion_blur = motion_blur
         for name in self.ADOPTED:
             setattr(self, name, None)
         stage_context.own(self.stage_replaced)

@@ -256,9 +256,10 @@ class MotionBlur:
         return self._scratch[1]
 
 
-_motion_blur = MotionBlur()
+#: The process's motion blur recorder (held by the session, :mod:`graphsdg.engine.session`).
+recorder = MotionBlur()
 
 
 def motion_blur() -> MotionBlur:
     """The process's motion blur recorder."""
-    return _motion_blur
+    return recorder
