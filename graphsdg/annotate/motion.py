@@ -69,6 +69,7 @@ class CaptureHistory:
         return previous
 
 
+#: The process's latest capture of each render product (held by the session, :mod:`graphsdg.engine.session`).
 history = CaptureHistory()
 
 

@@ -29,6 +29,7 @@ from typing import Any
 
 from pxr import Usd
 
+from graphsdg.annotate.motion import history as motion_history
 from graphsdg.render.attachments import attachments
 from graphsdg.render.motion_blur import recorder as motion_blur
 from graphsdg.render.render_product import registry as render_products
@@ -57,6 +58,7 @@ class Session:
         "stage_context",     # the current stage and its change tracker; it calls stage_replaced
         "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
         "motion_blur",       # the motion of the last step, recorded for a blurred capture
+        "motion_history",    # each live render product's last capture, for motion vectors (held weakly)
     )
 
     #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
@@ -69,6 +71,7 @@ class Session:
         self.scanners = scanners
         self.physics_steps = physics_steps
         self.motion_blur = motion_blur
+        self.motion_history = motion_history
         for name in self.ADOPTED:
             setattr(self, name, None)
         stage_context.own(self.stage_replaced)
