@@ -134,33 +134,33 @@ def main() -> None:
     rt = runtime()
     pbr = PbrRenderer(args.device)   # before the compile: the model gets the PBR camera
     sim = rt.sim
-    sim.require_offscreen(size, size)
+    scene = rt.render_scene
     view = camera_view(cam, size, size)
     rows, images, hashes, phases = [], {}, {}, {}
 
     vary = randomizer(boxes, rest, sim) if args.randomize else None
-    s, out = timed(lambda: rt.rasterizer.render(sim, view, PASSES), args.frames, vary)
+    s, out = timed(lambda: rt.rasterizer.render(scene, view, PASSES), args.frames, vary)
     rows.append(("classic (OpenGL rasteriser)", s, None))
     if vary is not None:
         vary.put_back()
-    images["classic"] = rt.rasterizer.render(sim, view, PASSES).color
+    images["classic"] = rt.rasterizer.render(scene, view, PASSES).color
 
     def pbr_tier(name: str, frames: int) -> None:
         t = time.perf_counter()
-        first = pbr.render(sim, view, PASSES)
+        first = pbr.render(scene, view, PASSES)
         first_s = time.perf_counter() - t
         profiling.reset()
-        s, out = timed(lambda: pbr.render(sim, view, PASSES), frames, vary)
+        s, out = timed(lambda: pbr.render(scene, view, PASSES), frames, vary)
         phases[name] = {k: v / frames * 1000 for k, v in profiling.snapshot().items() if "pbr" in k}
         rows.append((f"pbr {name}", s, first_s))
         if vary is not None:
             vary.put_back()
-        images[name] = pbr.render(sim, view, PASSES).color
+        images[name] = pbr.render(scene, view, PASSES).color
         # same seeds, new renderer: same bytes?
         pbr._renders.clear()
-        a = digest(pbr.render(sim, view, PASSES))
+        a = digest(pbr.render(scene, view, PASSES))
         other = PbrRenderer(args.device)
-        b = digest(other.render(sim, view, PASSES))
+        b = digest(other.render(scene, view, PASSES))
         other.close()
         hashes[name] = (a, b)
 
@@ -170,7 +170,7 @@ def main() -> None:
         import cProfile
         import pstats
         profiler = cProfile.Profile()
-        profiler.runcall(timed, lambda: pbr.render(sim, view, PASSES), args.cprofile, vary)
+        profiler.runcall(timed, lambda: pbr.render(scene, view, PASSES), args.cprofile, vary)
         if vary is not None:
             vary.put_back()
         pstats.Stats(profiler).sort_stats("tottime").print_stats(25)

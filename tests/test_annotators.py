@@ -332,7 +332,7 @@ def test_isolated_render_crop_matches_the_full_render():
     rep.orchestrator.step()
     rt = runtime()
     view = camera_view(cam, W, H)
-    out = rt.rasterizer.render(rt.sim, view, {"segmentation"})
+    out = rt.rasterizer.render(rt.render_scene, view, {"segmentation"})
     every = np.arange(rt.sim.model.ngeom)
     assert np.array_equal(out.render_isolated(every, (0, 0, W, H)), out.geom_ids)
     assert np.array_equal(out.render_isolated(every, (30, 20, 90, 70)), out.geom_ids[20:70, 30:90])
@@ -771,8 +771,8 @@ def test_tight_boxes_and_label_tables_read_a_backends_code_bounds_when_it_makes_
     shift = {"x": 0}
 
     class WithCodeBounds:
-        def render_batch(self, sim, requests):
-            outs = rasterizer.render_batch(sim, requests)
+        def render_batch(self, scene, requests):
+            outs = rasterizer.render_batch(scene, requests)
             for out in outs:
                 if out.id_lut is not None:
                     out.put("code_boxes", _code_bounds(out.id_codes, len(out.id_lut), shift["x"]))

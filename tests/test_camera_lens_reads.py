@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 import graphsdg as rep
-from graphsdg.orchestrator import _camera_view
+from graphsdg.engine.capture import _camera_view
 from graphsdg.engine.runtime import runtime
 
 
@@ -23,7 +23,7 @@ def test_a_lens_edit_reaches_the_next_capture():
     rep.orchestrator.step()
     wide = int(np.isfinite(depth.get_data()).sum())
     assert _camera_view(runtime(), rp).focal_length == 24.0
-    assert runtime().sim.prim_reads.get(str(cam.GetPath()), "lens", lambda: None) is not None   # kept
+    assert runtime().render_scene.prim_reads.get(str(cam.GetPath()), "lens", lambda: None) is not None   # kept
     cam.GetAttribute("focalLength").Set(48.0)                      # twice the focal length: the box doubles
     rep.orchestrator.step()
     assert _camera_view(runtime(), rp).focal_length == 48.0

@@ -229,7 +229,7 @@ CAMERA_POSES = [
 def test_cameras_posed_with_write_to_fabric_match_authored_poses():
     """Camera poses written beside the stage give the view and the depth image the stage's authoring gives;
     the stage keeps its authored pose."""
-    from graphsdg.orchestrator import _camera_view
+    from graphsdg.engine.capture import _camera_view
 
     def run(fabric: bool):
         cam, cube, rp, depth = _camera_rig(fabric)
@@ -242,7 +242,7 @@ def test_cameras_posed_with_write_to_fabric_match_authored_poses():
             views.append((view.position, view.rotation))
             images.append(depth.get_data())
         assert (tuple(cam.GetAttribute("xformOp:translate").Get()) == authored) == fabric
-        assert (runtime().sim.camera_poses.local(str(cam.GetPath())) is not None) == fabric
+        assert (runtime().render_scene.camera_poses.local(str(cam.GetPath())) is not None) == fabric
         return views, images
 
     stage_views, stage_images = run(False)
@@ -261,11 +261,11 @@ def test_a_later_stage_edit_of_a_fabric_posed_camera_wins():
     """Authoring the camera's transform after a fabric pose makes the stage's pose count again; a fabric pose
     after a stage edit is kept (the edit is synced first); a parent moved on the stage carries the fabric-posed
     camera along."""
-    from graphsdg.orchestrator import _camera_view
+    from graphsdg.engine.capture import _camera_view
     from graphsdg.stage.xform import set_local_pose, world_matrix
 
     cam, cube, rp, depth = _camera_rig(True)
-    poses, path = runtime().sim.camera_poses, str(cam.GetPath())
+    poses, path = runtime().render_scene.camera_poses, str(cam.GetPath())
     rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
     fabric_t = _camera_view(runtime(), rp).position
     set_local_pose(cam, position=(0.0, 0.0, 6.0), look_at=(0.0, 0.0, 0.0))    # authored on the stage
@@ -296,7 +296,7 @@ def test_cameras_with_other_op_stacks_are_authored():
     cam, cube, rp, depth = _camera_rig(True)
     UsdGeom.Xformable(cam).AddTranslateOp(UsdGeom.XformOp.PrecisionDouble, "pivot")
     rep.functional.modify.pose(cam, position_value=(4.0, 1.0, 2.0), look_at_value=(0.0, 0.0, 0.0))
-    assert runtime().sim.camera_poses.local(str(cam.GetPath())) is None
+    assert runtime().render_scene.camera_poses.local(str(cam.GetPath())) is None
     assert tuple(cam.GetAttribute("xformOp:translate").Get()) == (4.0, 1.0, 2.0)
 
 

@@ -344,14 +344,15 @@ def test_mesh_rescale_is_live_and_exact(shape):
     compiles = sim.stats["compiles"]
     rep.functional.modify.pose(prim, scale_value=(0.8, 0.8, 0.8))
     rep.orchestrator.step()
-    sim.require_offscreen(2 * W, 2 * H)   # a new GL context: it uploads the rescaled mesh, later maps are relative
+    runtime().render_scene.require_offscreen(2 * W, 2 * H)   # a new GL context: it uploads the rescaled mesh,
+    # later maps are relative
     rep.orchestrator.step()
     rep.functional.modify.pose(prim, scale_value=(1.6, 0.7, 1.2), rotation_value=(0, 40, 20))
     rep.orchestrator.step()
-    assert sim.stats["compiles"] == compiles and sim.mesh_maps   # drawn through the map, not re-uploaded
+    assert sim.stats["compiles"] == compiles and runtime().render_scene.mesh_maps   # drawn through the map
     live_boxes, live_rgb = ann.get_data()["data"], rgb.get_data()[..., :3].astype(int)
     sim.recompile()                        # the same scale compiled from scratch
-    assert not sim.mesh_maps
+    assert not runtime().render_scene.mesh_maps
     rep.orchestrator.step()
     fresh_boxes, fresh_rgb = ann.get_data()["data"], rgb.get_data()[..., :3].astype(int)
     assert len(live_boxes) == len(fresh_boxes) == 2          # the shape and the sphere

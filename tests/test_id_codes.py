@@ -120,11 +120,10 @@ def test_id_pass_after_the_colour_pass_matches_an_id_pass_alone():
         rep.functional.modify.pose(shapes, position_value=rng.uniform(-1.5, 1.5, (6, 3)),
                                    rotation_value=rng.uniform(0, 360, (6, 3)),
                                    scale_value=rng.uniform(0.3, 0.9, 6))
-        rt.sim.require_offscreen(W, H)
         rt.sim.sync_dirty_prims()
         view = camera_view(rp.camera_prim(), W, H)
-        both = rt.rasterizer.render(rt.sim, view, {"color", "segmentation", "depth"})
-        alone = rt.rasterizer.render(rt.sim, view, {"segmentation", "depth"})
+        both = rt.rasterizer.render(rt.render_scene, view, {"color", "segmentation", "depth"})
+        alone = rt.rasterizer.render(rt.render_scene, view, {"segmentation", "depth"})
         np.testing.assert_array_equal(both.geom_ids, alone.geom_ids)
         np.testing.assert_array_equal(both.depth, alone.depth)
         torus_geoms = {rt.sim.compiled.geoms[str(p.GetPath())].geom_id for p in shapes}
@@ -140,10 +139,9 @@ def test_id_framebuffer_depth_is_read_unpacked_and_matches_mujocos_buffer():
     rep.settings.set("/graphsdg/render/msaaSamples", 0)   # colour + depth from MuJoCo's buffer, in one pass
     rp = _two_balls_and_a_box()
     rt = runtime()
-    rt.sim.require_offscreen(W, H)
     view = camera_view(rp.camera_prim(), W, H)
-    from_ids = rt.rasterizer.render(rt.sim, view, {"segmentation", "depth"}).depth
-    from_mujoco = rt.rasterizer.render(rt.sim, view, {"color", "depth"}).depth
+    from_ids = rt.rasterizer.render(rt.render_scene, view, {"segmentation", "depth"}).depth
+    from_mujoco = rt.rasterizer.render(rt.render_scene, view, {"color", "depth"}).depth
     np.testing.assert_array_equal(from_ids, from_mujoco)
     assert np.isfinite(from_ids).sum() > 300 and np.isinf(from_ids).sum() > 3000   # objects and background
     packed = rt.rasterizer._reads._packed_depth

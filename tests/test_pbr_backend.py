@@ -41,11 +41,10 @@ def _scene():
 def test_pbr_labels_match_the_classic_path_and_colour_has_its_layout(renderer):
     cube, ball, cam = _scene()
     rt = runtime()
-    sim = rt.sim
+    scene = rt.render_scene
     view = camera_view(cam, W, H)
-    sim.require_offscreen(W, H)
-    out = renderer.render(sim, view, {"color", "hdr", "depth", "segmentation"})
-    classic = rt.rasterizer.render(sim, view, {"depth", "segmentation"})
+    out = renderer.render(scene, view, {"color", "hdr", "depth", "segmentation"})
+    classic = rt.rasterizer.render(scene, view, {"depth", "segmentation"})
     assert out.color.shape == (H, W, 4) and out.color.dtype == np.uint8 and (out.color[..., 3] == 255).all()
     assert out.hdr.shape == (H, W, 3) and out.hdr.dtype == np.float32
     assert out.geom_ids.dtype == np.int32 and np.array_equal(out.geom_ids, classic.geom_ids)
@@ -66,15 +65,15 @@ def test_pbr_follows_poses_and_is_deterministic(renderer):
     cube, ball, cam = _scene()
     sim = runtime().sim
     view = camera_view(cam, W, H)
-    sim.require_offscreen(W, H)
-    first = renderer.render(sim, view, {"color", "segmentation"})
-    again = renderer.render(sim, view, {"color", "segmentation"})
+    scene = runtime().render_scene
+    first = renderer.render(scene, view, {"color", "segmentation"})
+    again = renderer.render(scene, view, {"color", "segmentation"})
     assert np.array_equal(first.color, again.color)
     rep.functional.modify.pose(cube, position_value=(-1.5, 0, 0.5))
     sim.sync_dirty_prims()
     sim.forward()
-    moved = renderer.render(sim, view, {"segmentation"})
-    classic = runtime().rasterizer.render(sim, view, {"segmentation"})
+    moved = renderer.render(scene, view, {"segmentation"})
+    classic = runtime().rasterizer.render(scene, view, {"segmentation"})
     assert not np.array_equal(moved.geom_ids, first.geom_ids)
     assert np.array_equal(moved.geom_ids, classic.geom_ids)
 
@@ -97,10 +96,10 @@ def test_pbr_ids_of_a_scene_of_more_than_255_geoms_come_back_in_two_bytes(render
     cam = rep.functional.create.camera(position=(0, 0, 6), look_at=(0, 0, 0))
     sim = runtime().sim
     assert sim.ensure_compiled().model.ngeom >= 300
-    sim.require_offscreen(W, H)
+    scene = runtime().render_scene
     view = camera_view(cam, W, H)
-    out = renderer.render(sim, view, {"segmentation"})
-    classic = runtime().rasterizer.render(sim, view, {"segmentation"})
+    out = renderer.render(scene, view, {"segmentation"})
+    classic = runtime().rasterizer.render(scene, view, {"segmentation"})
     assert out.id_codes.dtype == np.uint16 and len(out.id_lut) == 1 << 16
     assert len(np.unique(out.geom_ids)) > 50, "many boxes in view"
     assert (out.id_lut[out.id_codes] != classic.geom_ids).sum() <= 2   # pixel centres on an edge may differ
@@ -129,14 +128,14 @@ def test_pbr_follows_rescaled_meshes_sizes_and_camera_intrinsics(renderer):
     cube, ball, cam = _scene()
     mesh = rep.functional.create.cube(position=(-1.0, 0.8, 0.4), scale=0.5, name="MeshCube", as_mesh=True)
     sim = runtime().sim
-    sim.require_offscreen(W, H)
+    scene = runtime().render_scene
 
     def compare():
         sim.sync_dirty_prims()
         sim.forward()
         view = camera_view(cam, W, H)
-        out = renderer.render(sim, view, {"depth", "segmentation"})
-        classic = runtime().rasterizer.render(sim, view, {"depth", "segmentation"})
+        out = renderer.render(scene, view, {"depth", "segmentation"})
+        classic = runtime().rasterizer.render(scene, view, {"depth", "segmentation"})
         # a pixel centre lying on a silhouette edge may fall either side in a rasteriser and a ray tracer
         diff = out.geom_ids != classic.geom_ids
         assert diff.sum() <= 2, (diff.sum(), np.argwhere(diff)[:5])
@@ -147,7 +146,7 @@ def test_pbr_follows_rescaled_meshes_sizes_and_camera_intrinsics(renderer):
     rep.functional.modify.pose(mesh, scale_value=(1.4, 1.4, 1.4))
     rep.functional.modify.pose(ball, scale_value=(0.3, 0.3, 0.3))
     rescaled = compare()
-    assert sim.mesh_maps, "the mesh was rescaled in place"
+    assert scene.mesh_maps, "the mesh was rescaled in place"
     assert not np.array_equal(before.geom_ids, rescaled.geom_ids)
     UsdGeom.Camera(cam).GetFocalLengthAttr().Set(35.0)
     zoomed = compare()
@@ -162,27 +161,26 @@ def test_pbr_draws_a_steps_products_in_one_launch_each_at_its_own_size(renderer)
     from graphsdg.render.backend import RenderRequest
     cube, ball, cam = _scene()
     side = rep.functional.create.camera(position=(0.5, 4.0, 1.5), look_at=(0.3, 0, 0.4))
-    sim = runtime().sim
+    scene = runtime().render_scene
     views = [camera_view(cam, W, H), camera_view(side, 20, 16)]
-    sim.require_offscreen(W, H)
     passes = {"color", "depth", "segmentation"}
     launches = renderer.stats["color"]
-    outs = renderer.render_batch(sim, [RenderRequest(v, passes) for v in views])
+    outs = renderer.render_batch(scene, [RenderRequest(v, passes) for v in views])
     assert renderer.stats["color"] == launches + 1, "both products in one launch"
-    assert sim.pbr_cameras >= 2
+    assert scene.pbr_cameras >= 2
     for view, out in zip(views, outs):
-        classic = runtime().rasterizer.render(sim, view, {"depth", "segmentation"})
+        classic = runtime().rasterizer.render(scene, view, {"depth", "segmentation"})
         assert out.color.shape == (view.height, view.width, 4)
         assert (out.geom_ids != classic.geom_ids).sum() <= 1
         hit = np.isfinite(out.depth) & np.isfinite(classic.depth)
         assert np.median(np.abs(out.depth[hit] - classic.depth[hit]) / classic.depth[hit]) < 1e-3
-        alone = renderer.render(sim, view, passes)
+        alone = renderer.render(scene, view, passes)
         assert np.array_equal(alone.geom_ids, out.geom_ids) and np.array_equal(alone.depth, out.depth)
         assert np.abs(alone.color.astype(int) - out.color.astype(int)).mean() < 2.0
     assert len({out.geom_ids.tobytes() for out in outs}) == 2, "each camera saw its own view"
     settings.set("/graphsdg/render/pbrBatchPixels", 0)     # one launch per product
     launches = renderer.stats["color"]
-    renderer.render_batch(sim, [RenderRequest(v, passes) for v in views])
+    renderer.render_batch(scene, [RenderRequest(v, passes) for v in views])
     assert renderer.stats["color"] == launches + 2
 
 
@@ -260,14 +258,14 @@ def test_a_deferred_pbr_render_gives_its_own_frames_pixels_when_read_after_the_n
     cube, ball, cam = _scene()
     sim = runtime().sim
     view = camera_view(cam, W, H)
-    sim.require_offscreen(W, H)
+    scene = runtime().render_scene
     passes = {"color", "depth", "segmentation"}
-    now = renderer.render(sim, view, passes)
-    deferred = renderer.render_batch(sim, [RenderRequest(view, passes, defer=True)])[0]
+    now = renderer.render(scene, view, passes)
+    deferred = renderer.render_batch(scene, [RenderRequest(view, passes, defer=True)])[0]
     rep.functional.modify.pose(cube, position_value=(-1.5, 0, 0.5))
     sim.sync_dirty_prims()
     sim.forward()
-    moved = renderer.render(sim, view, passes)          # reuses the deferred render's buffers
+    moved = renderer.render(scene, view, passes)          # reuses the deferred render's buffers
     assert not np.array_equal(moved.geom_ids, now.geom_ids)
     for name in ("color", "depth", "id_codes", "code_boxes"):
         assert np.array_equal(deferred.get(name), now.get(name)), name

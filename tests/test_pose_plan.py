@@ -41,7 +41,7 @@ def test_each_path_lands_where_the_plan_says():
     assert tuple(cube.GetAttribute("xformOp:translate").Get()) == authored
     np.testing.assert_array_equal(sim.data.xpos[sim.compiled.geoms[str(cube.GetPath())].body_id], (1, 2, 3))
     rep.functional.modify.pose(cam, position_value=(0.0, 1.0, 6.0))                # camera: kept beside the stage
-    assert sim.camera_poses.local(str(cam.GetPath()))[3, :3].tolist() == [0.0, 1.0, 6.0]
+    assert runtime().render_scene.camera_poses.local(str(cam.GetPath()))[3, :3].tolist() == [0.0, 1.0, 6.0]
     assert tuple(cam.GetAttribute("xformOp:translate").Get()) == (0.0, 0.0, 5.0)
     rep.functional.modify.pose([cube, cam], position_value=(4.0, 0.0, 0.0))       # mixed: neither path takes it
     assert tuple(cube.GetAttribute("xformOp:translate").Get()) == (4.0, 0.0, 0.0)

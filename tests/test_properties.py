@@ -300,7 +300,7 @@ def test_random_scenes_compile_render_and_round_trip_their_transforms(scene):
     _assert_poses_match_usd(sim, prims)
     # every pixel a prim covers lies inside the projection of its USD world bound (pose, scale, axis agree)
     view = camera_view(cam, W, H)
-    out = runtime().rasterizer.render(sim, view, {"segmentation"}, 1)
+    out = runtime().rasterizer.render(runtime().render_scene, view, {"segmentation"}, 1)
     for prim in prims:
         gid = sim.compiled.geoms[str(prim.GetPath())].geom_id
         ys, xs = np.nonzero(out.geom_ids == gid)

@@ -110,12 +110,12 @@ def test_captures_render_through_the_chosen_backend(monkeypatch):
     calls = []
 
     class Recording:
-        def render(self, sim, view, passes, subframes=1, defer=False, motion=None):
+        def render(self, scene, view, passes, subframes=1, defer=False, motion=None):
             raise AssertionError("a step renders its products through render_batch")
 
-        def render_batch(self, sim, requests):
+        def render_batch(self, scene, requests):
             calls.append([(r.view.width, r.view.height, set(r.passes), r.subframes) for r in requests])
-            return runtime().rasterizer.render_batch(sim, requests)
+            return runtime().rasterizer.render_batch(scene, requests)
 
         def close(self):
             pass
@@ -174,9 +174,9 @@ def test_models_compiled_for_pbr_carry_a_camera_per_render_product(monkeypatch):
 
     assert {pbr_camera_name(i) for i in range(3)} <= names(model) and pbr_camera_name(3) not in names(model)
     compiles = sim.stats["compiles"]
-    sim.require_pbr_cameras(2)
+    runtime().render_scene.require_pbr_cameras(2)
     assert sim.stats["compiles"] == compiles and sim.model is model
     sim.data.time = 1.25
-    sim.require_pbr_cameras(5)
+    runtime().render_scene.require_pbr_cameras(5)
     assert sim.stats["compiles"] == compiles + 1 and pbr_camera_name(4) in names(sim.model)
     assert sim.data.time == 1.25

@@ -40,8 +40,8 @@ def _scene_after_update(rt, view, monkeypatch, array: bool) -> mujoco.MjvScene:
     if not array:
         monkeypatch.setattr(rasterizer, "geom_array", lambda scene: None)
     ras = rt.rasterizer
-    ras.bind(rt.sim)
-    ras._update_scene(rt.sim, view, rasterizer.geometry_bounds(rt.sim.model, rt.sim.data), (0.0, 0.0))
+    ras.bind(rt.render_scene)
+    ras._update_scene(rt.render_scene, view, rasterizer.geometry_bounds(rt.sim.model, rt.sim.data), (0.0, 0.0))
     monkeypatch.undo()
     return ras._scene
 
@@ -64,12 +64,12 @@ def test_rescaled_mesh_matrices_are_those_of_the_per_geom_loop(monkeypatch):
     rt, view, meshes = _mixed_scene()
     by_loop = np.array([g.mat.copy() for g in _scene_after_update(rt, view, monkeypatch, array=False).geoms[:50]])
     by_array = np.array([g.mat.copy() for g in _scene_after_update(rt, view, monkeypatch, array=True).geoms[:50]])
-    assert rt.sim.mesh_maps and rt.rasterizer._uploaded_inverse == {}
+    assert rt.render_scene.mesh_maps and rt.rasterizer._uploaded_inverse == {}
     np.testing.assert_array_equal(by_array, by_loop)
     # meshes rescaled before the context was made are drawn through the inverse of that upload's map
     rt.rasterizer._version = -1
-    rt.rasterizer.bind(rt.sim)
-    assert set(rt.rasterizer._uploaded_inverse) == set(rt.sim.mesh_maps)
+    rt.rasterizer.bind(rt.render_scene)
+    assert set(rt.rasterizer._uploaded_inverse) == set(rt.render_scene.mesh_maps)
     rep.functional.modify.pose(meshes[4:], scale_value=0.7)             # the tori again, after the upload
     rt.sim.sync_dirty_prims()
     by_loop = np.array([g.mat.copy() for g in _scene_after_update(rt, view, monkeypatch, array=False).geoms[:50]])
@@ -103,7 +103,7 @@ def test_too_few_geoms_to_check_the_layout_fall_back_to_the_attributes():
 
 
 def test_mesh_maps_compose_as_the_per_mesh_loop_did():
-    """SimScene.mesh_maps as arrays: the composed maps are the dict loop's, bit for bit, repeats in order."""
+    """RenderScene.mesh_maps as arrays: the composed maps are the dict loop's, bit for bit, repeats in order."""
     from graphsdg.sim.mesh_scaling import MeshMaps
     rng = np.random.default_rng(5)
     maps, reference = MeshMaps(), {}

@@ -24,14 +24,15 @@ def _run(scales: list[np.ndarray], general: bool, monkeypatch) -> dict[str, np.n
     for s in scales:
         rep.functional.modify.pose(prims, position_value=rng.uniform(-1, 1, (len(prims), 3)),
                                    rotation_value=rng.uniform(0, 360, (len(prims), 3)), scale_value=s)
-    sim = runtime().sim
+    sim, scene = runtime().sim, runtime().render_scene
     m = sim.model
-    ids, maps = sim.mesh_maps.stacked()
+    ids, maps = scene.mesh_maps.stacked()
     t = targets_for(sim, prims)
     assert (t.uniform_plan(m) is None) == general    # the bench's shapes fit a plan
     return {"size": m.geom_size.copy(), "rbound": m.geom_rbound.copy(), "pos": m.geom_pos.copy(),
             "aabb": m.geom_aabb.copy(), "vert": m.mesh_vert.copy(), "map_ids": ids, "maps": maps,
-            "stamps": sim.mesh_stamps.copy(), "current": t.current_scales().copy(), "mocap": sim.data.mocap_quat.copy()}
+            "stamps": scene.mesh_stamps.copy(), "current": t.current_scales().copy(),
+            "mocap": sim.data.mocap_quat.copy()}
 
 
 def test_the_plan_writes_what_the_general_path_writes_bit_for_bit(monkeypatch):

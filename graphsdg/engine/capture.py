@@ -163,12 +163,13 @@ def _camera_view(rt, rp) -> CameraView:
     """A render product's camera now (its pose written with write-to-fabric, when it was; its lens as last
     read, until the stage edits the camera)."""
     prim = rp.camera_prim(rt.stage)
-    sim = rt.sim
+    scene = rt.render_scene
+    units = scene.sim.world_transforms
     if prim.IsValid() and not prim_facts.is_a(prim, UsdGeom.Camera):   # a lidar / radar product (graphsdg.sensors)
-        return sensor_camera_view(prim, rp.width, rp.height, sim.world_transforms.meters_per_unit())
-    lens = sim.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
-    return camera_view(prim, rp.width, rp.height, world=sim.camera_poses.world(prim), lens=lens,
-                       meters_per_unit=sim.world_transforms.meters_per_unit())
+        return sensor_camera_view(prim, rp.width, rp.height, units.meters_per_unit())
+    lens = scene.prim_reads.get(prim_facts.path(prim), "lens", lambda: read_lens(prim))
+    return camera_view(prim, rp.width, rp.height, world=scene.camera_poses.world(prim), lens=lens,
+                       meters_per_unit=units.meters_per_unit())
 
 
 def _active_products(rt) -> dict[str, tuple[Any, list[Annotator]]]:
@@ -210,13 +211,11 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
         passes: set[str] = set()
         for a in annotators:
             passes |= a.spec.passes
-        if passes:   # products whose annotators read no pixels (a lidar's) need no framebuffer
-            sim.require_offscreen(rp.width, rp.height)
         motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
         views.append(view)
         requests.append(RenderRequest(view, passes, subframes, defer, motion) if passes else None)
     drawn = [r for r in requests if r is not None]
-    outputs = iter(rt.renderer.render_batch(sim, drawn) if drawn else [])
+    outputs = iter(rt.renderer.render_batch(rt.render_scene, drawn) if drawn else [])   # sizes its buffers
     t = _timed("render", t)
     frames = []
     for (rp, annotators), view, request in zip(products.values(), views, requests):
@@ -244,9 +243,8 @@ def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -
     requests = []
     for rp in render_products:
         rp.check_alive()
-        sim.require_offscreen(rp.width, rp.height)
         requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None))
-    outputs = list(rt.renderer.render_batch(sim, requests)) if requests else []
+    outputs = list(rt.renderer.render_batch(rt.render_scene, requests)) if requests else []
     for out in outputs:
         out.finish()   # hand the pixel buffers back once the colour is read
     if render_products:

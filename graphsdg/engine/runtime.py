@@ -1,7 +1,8 @@
 """The process-wide capture runtime: stage, simulation, renderer, timeline.
 
 One :class:`Runtime` ties together what a capture needs: the current stage and
-its :class:`~graphsdg.sim.scene.SimScene`, the :class:`Rasterizer` (which owns
+its :class:`~graphsdg.sim.scene.SimScene`, the
+:class:`~graphsdg.render.render_scene.RenderScene` the renderers draw of it, the :class:`Rasterizer` (which owns
 the GL context and so lives on the thread that captures), the timeline, and the
 label tables. The annotators and writers attached to render products are held
 in :data:`graphsdg.render.attachments.attachments`, which the runtime reads. The
@@ -20,6 +21,7 @@ from graphsdg.render import render_product
 from graphsdg.render.attachments import OrderedSet, attachments
 from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
 from graphsdg.render.rasterizer import Rasterizer
+from graphsdg.render.render_scene import RenderScene
 from graphsdg.sim.scene import SimScene
 from graphsdg.sim.timeline import Timeline
 from graphsdg.stage.context import stage_context
@@ -30,6 +32,7 @@ class Runtime:
 
     def __init__(self) -> None:
         self._sim: SimScene | None = None
+        self._render_scene: RenderScene | None = None
         self._sim_stage: Usd.Stage | None = None
         self.rasterizer = Rasterizer()    # the classic backend (always there: tests and tools read its stats)
         self._pbr = None                   # graphsdg.render.pbr.PbrRenderer, made on first use
@@ -85,16 +88,25 @@ class Runtime:
         stage = self.stage
         if self._sim is None or self._sim_stage is not stage:
             assert stage_context.tracker is not None
-            self._sim = SimScene(stage, stage_context.tracker, pbr_draws=pbr_draws,
-                                 render_products=lambda: len(render_product.registry))
+            self._sim = SimScene(stage, stage_context.tracker)
+            self._render_scene = RenderScene(self._sim, pbr_draws=pbr_draws,
+                                             render_products=lambda: len(render_product.registry))
             self._sim_stage = stage
             self.timeline.set_time_codes_per_second(stage.GetTimeCodesPerSecond() or 60.0)
         return self._sim
+
+    @property
+    def render_scene(self) -> RenderScene:
+        """What the renderers draw of :attr:`sim` (:mod:`graphsdg.render.render_scene`)."""
+        self.sim   # made with the simulation of the current stage
+        assert self._render_scene is not None
+        return self._render_scene
 
     def _on_stage_replaced(self, stage: Usd.Stage | None) -> None:
         # The attachments released themselves first (graphsdg.render.attachments); the simulation and the
         # label tables belonged to the old stage too.
         self._sim = None
+        self._render_scene = None
         self._sim_stage = None
         self.ids.clear()
         self.labels = SceneLabels(self.ids)

@@ -117,8 +117,8 @@ def _pose_cameras(targets: list, position_value: Any, rotation_value: Any, look_
         [as_vec3(v, "look_at") for v in per_prim(look_at_value, n, "look_at_value")]
     up = as_vec3(look_at_up_axis, "look_at_up_axis") if look_at_up_axis is not None else \
         up_axis_vector(targets[0].GetStage())
-    sim = runtime().sim
-    return camera_poses.write_camera_poses(sim, sim.camera_poses, targets, positions, rotations, looks, up)
+    scene = runtime().render_scene
+    return camera_poses.write_camera_poses(scene.sim, scene.camera_poses, targets, positions, rotations, looks, up)
 
 
 def _pose_width(value: Any) -> int:

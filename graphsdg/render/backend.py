@@ -1,8 +1,8 @@
 """The render backend seam: which renderer draws a render product's passes.
 
 Render products, annotators and writers only see :class:`RenderBackend`: a
-``render(sim, view, passes, subframes, defer, motion)`` that returns
-:class:`~graphsdg.render.rasterizer.RenderOutputs`, and ``render_batch(sim, requests)``
+``render(scene, view, passes, subframes, defer, motion)`` that returns
+:class:`~graphsdg.render.rasterizer.RenderOutputs`, and ``render_batch(scene, requests)``
 for a step's render products at once (:class:`RenderRequest`; the pbr backend draws
 several in one launch, the classic one draw by draw), in one layout (uint8 RGBA
 colour, linear float ``hdr``, planar-z depth with ``inf`` background, int32 geom
@@ -80,12 +80,13 @@ class RenderRequest:
 class RenderBackend(Protocol):
     """What render products' captures call; both backends return the same :class:`RenderOutputs` layout."""
 
-    def render(self, sim, view, passes: set[str], subframes: int = 1, defer: bool = False,
+    def render(self, scene, view, passes: set[str], subframes: int = 1, defer: bool = False,
                motion=None):   # -> graphsdg.render.rasterizer.RenderOutputs
-        """Render ``passes`` (``color``, ``hdr``, ``depth``, ``segmentation``) of ``view`` of ``sim`` now."""
+        """Render ``passes`` (``color``, ``hdr``, ``depth``, ``segmentation``) of ``view`` of ``scene`` (a
+        :class:`~graphsdg.render.render_scene.RenderScene`, the scene description both backends share) now."""
         ...
 
-    def render_batch(self, sim, requests: list[RenderRequest]) -> list:
+    def render_batch(self, scene, requests: list[RenderRequest]) -> list:
         """Render every request of one step (one :class:`RenderOutputs` each, in order)."""
         ...
 

@@ -233,7 +233,7 @@ def camera_view(prim: Usd.Prim, width: int, height: int, cache: UsdGeom.XformCac
                 world: np.ndarray | None = None, lens: CameraLens | None = None,
                 meters_per_unit: float | None = None) -> CameraView:
     """Read a ``UsdGeom.Camera`` prim at a resolution. ``world``: its world transform when it is not the
-    stage's (a camera posed with write-to-fabric, :mod:`graphsdg.sim.camera_poses`); ``lens``: its
+    stage's (a camera posed with write-to-fabric, :mod:`graphsdg.sim.pose_writes.camera_poses`); ``lens``: its
     :func:`read_lens`, and ``meters_per_unit``: the stage's, when the caller keeps them."""
     if lens is None:
         lens = read_lens(prim)

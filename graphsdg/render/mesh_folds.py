@@ -1,6 +1,6 @@
 """Rescaled meshes traced without rebuilding their BVHs: the rescale folded into the geom frame.
 
-The classic rasteriser draws a rescaled mesh through a matrix (:attr:`SimScene.mesh_maps`); so does this
+The classic rasteriser draws a rescaled mesh through a matrix (:attr:`RenderScene.mesh_maps`); so does this
 backend. A ray tracer maps each ray into a mesh geom's frame by the transpose of the geom's matrix and maps
 the hit normal back by the matrix itself. A mesh whose vertices are ``G v`` (``v`` as its BVH was built,
 ``G`` the rescale since then) is traced exactly by handing the tracer ``X = xmat G^-T`` instead of the
@@ -11,7 +11,7 @@ mesh's half extents; those are replaced by ``|G^T| |G| e``, which ``|X|`` maps o
 ``|xmat G| e`` (for a diagonal ``G``, exactly it). A rescale then costs a 3x3 product per geom and no
 BVH refit (measured on an H100: 20 rescaled meshes' refits were 2.3 ms of a frame).
 
-Vertex changes that no map describes (deformables: :attr:`SimScene.mesh_reshapes`) are refit instead
+Vertex changes that no map describes (deformables: :attr:`RenderScene.mesh_reshapes`) are refit instead
 (:mod:`graphsdg.render.pbr_meshes`). Pure numpy: tested without a GPU.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ from graphsdg.sim.mesh_scaling import MeshMaps
 
 def current_maps(maps: MeshMaps, nmesh: int) -> np.ndarray:
     """(nmesh, 3, 3) maps from the compiled vertices to the current ones (identity where none):
-    :attr:`SimScene.mesh_maps` as one array."""
+    :attr:`RenderScene.mesh_maps` as one array."""
     out = np.tile(np.eye(3), (nmesh, 1, 1))
     present = np.flatnonzero(maps.present[:nmesh]) if len(maps.present) else np.zeros(0, dtype=np.int64)
     out[present] = maps.matrices[present]

@@ -58,8 +58,8 @@ from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
 from graphsdg.maths.rotations import decompose
 from graphsdg.render.rasterizer import PASSES, Rasterizer, RenderOutputs
+from graphsdg.render.render_scene import RenderScene
 from graphsdg.sim import lights as lightmap
-from graphsdg.sim.scene import SimScene
 from graphsdg.sim.visual import UNDRAWN_GROUPS, drawn_geom_mask, pbr_camera_name
 from graphsdg.stage.xform import world_matrix
 
@@ -90,10 +90,10 @@ class _MeshState:
     """The context's mesh BVHs against the simulation's meshes (:mod:`graphsdg.render.pbr_meshes`)."""
 
     geom_mesh: np.ndarray      # (ngeom,) each geom's mesh id, -1 for other geom types
-    built_maps: np.ndarray     # (nmesh, 3, 3) SimScene.mesh_maps (identity where none) the BVHs' vertices had
+    built_maps: np.ndarray     # (nmesh, 3, 3) RenderScene.mesh_maps (identity where none) the BVHs' vertices had
     half_extents: np.ndarray   # (nmesh, 3) the scene BVH's mesh bounds for those vertices
-    reshapes: np.ndarray       # SimScene.mesh_reshapes when the BVHs last took new vertices
-    stamps: np.ndarray         # SimScene.mesh_stamps when the traced frames below were computed
+    reshapes: np.ndarray       # RenderScene.mesh_reshapes when the BVHs last took new vertices
+    stamps: np.ndarray         # RenderScene.mesh_stamps when the traced frames below were computed
     mirror_vert: np.ndarray    # host copies of the device's mesh vertices and normals
     mirror_normal: np.ndarray
     relative: np.ndarray       # (nmesh, 3, 3) built vertices -> current ones
@@ -102,7 +102,8 @@ class _MeshState:
 
 
 class PbrRenderer:
-    """Renders :class:`SimScene` views with mujoco-warp-pbr (see the module docstring)."""
+    """Renders :class:`~graphsdg.render.render_scene.RenderScene` views with mujoco-warp-pbr (see the module
+    docstring)."""
 
     MAX_CONTEXTS = 4    # live render contexts (device memory): a step's batch, plus products drawn alone
 
@@ -128,20 +129,21 @@ class PbrRenderer:
         self._queued: list = []                  # pbr_outputs.QueuedReads of deferred renders not yet taken
 
     # ---- contexts ------------------------------------------------------
-    def _key(self, sim: SimScene, views: list[CameraView], subframes: int) -> tuple:
+    def _key(self, scene: RenderScene, views: list[CameraView], subframes: int) -> tuple:
         request = requested_backend()
-        model = sim.model
+        model = scene.sim.model
         drawn = drawn_geom_mask(model)
         per_axis = math.ceil(math.sqrt(subframes)) if request.tier == "realtime" else 1
         sizes = tuple((v.width, v.height) for v in views)
-        return (id(model), sim.model_version, sizes, request.tier, request.path_samples, request.denoise, per_axis,
+        return (id(model), scene.version, sizes, request.tier, request.path_samples, request.denoise, per_axis,
                 drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)))
 
-    def _context(self, sim: SimScene, views: list[CameraView], subframes: int) -> _Context:
-        sim.require_pbr_cameras(len(views))
+    def _context(self, scene: RenderScene, views: list[CameraView], subframes: int) -> _Context:
+        sim = scene.sim
+        scene.require_pbr_cameras(len(views))
         if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, pbr_camera_name(len(views) - 1)) < 0:
             sim.recompile(keep_state=True)   # compiled while the classic backend drew: add the PBR cameras
-        key = self._key(sim, views, subframes)
+        key = self._key(scene, views, subframes)
         ctx = self._contexts.pop(key, None)
         if ctx is None:
             for stale in [k for k in self._contexts if k[:2] != key[:2]]:   # built for another model
@@ -149,18 +151,19 @@ class PbrRenderer:
             while len(self._contexts) >= self.MAX_CONTEXTS:   # the least recently used goes
                 del self._contexts[next(iter(self._contexts))]
             with profiling.timed("render:pbr_context"):
-                ctx = self._build(sim, views, key)
+                ctx = self._build(scene, views, key)
             self.stats["contexts"] += 1
         self._contexts[key] = ctx    # (re)inserted last: the most recently used
         return ctx
 
-    def _build(self, sim: SimScene, views: list[CameraView], key: tuple) -> _Context:
+    def _build(self, scene: RenderScene, views: list[CameraView], key: tuple) -> _Context:
         wp, mjw, mjpbr = self._wp, self._mjw, self._mjpbr
+        sim = scene.sim
         model = sim.model
         cameras = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, pbr_camera_name(i)) for i in range(len(views))]
         request = requested_backend()
         exposure_setting = float(settings.get("/graphsdg/render/exposure", 1.0))
-        env, yaw = self._environment(sim)
+        env, yaw = self._environment(sim.stage)
         path = request.tier == "path"
         cam_active = [i in cameras for i in range(model.ncam)]
         with wp.ScopedDevice(self._device):
@@ -177,28 +180,27 @@ class PbrRenderer:
                 denoise=path and request.denoise, camera_rays=[pbr_scene.camera_rays(v) for v in views])
         layouts = [self._layout(v, model.ngeom) for v in views]
         return _Context(key=key, model=m, data=d, rc=rc, cameras=cameras, env_yaw=yaw, layouts=layouts,
-                        rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(sim, rc),
+                        rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(scene, rc),
                         uploads=self._uploads.PinnedUploads(self._device))
 
     def _layout(self, view: CameraView, ngeom: int):
         return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
                                            view.far, self._device, ngeom)
 
-    def _mesh_state(self, sim: SimScene, rc) -> _MeshState:
+    def _mesh_state(self, scene: RenderScene, rc) -> _MeshState:
         """The context was built from the model's current vertices: every mesh's BVH is up to date."""
-        model, nmesh = sim.model, sim.model.nmesh
+        model, nmesh = scene.sim.model, scene.sim.model.nmesh
         geom_mesh = np.where(model.geom_type == mujoco.mjtGeom.mjGEOM_MESH, model.geom_dataid, -1).astype(np.int64)
         half = rc.base.mesh_bounds_size.numpy().astype(np.float64) if nmesh else np.zeros((0, 3))
-        return _MeshState(geom_mesh=geom_mesh, built_maps=mesh_folds.current_maps(sim.mesh_maps, nmesh),
-                          half_extents=half, reshapes=_counts(sim.mesh_reshapes, nmesh),
-                          stamps=_counts(sim.mesh_stamps, nmesh),
+        return _MeshState(geom_mesh=geom_mesh, built_maps=mesh_folds.current_maps(scene.mesh_maps, nmesh),
+                          half_extents=half, reshapes=_counts(scene.mesh_reshapes, nmesh),
+                          stamps=_counts(scene.mesh_stamps, nmesh),
                           mirror_vert=np.array(model.mesh_vert, dtype=np.float32),
                           mirror_normal=np.array(model.mesh_normal, dtype=np.float32),
                           relative=np.tile(np.eye(3), (nmesh, 1, 1)), moved=np.zeros(nmesh, dtype=bool))
 
-    def _environment(self, sim: SimScene) -> tuple[np.ndarray | None, float]:
+    def _environment(self, stage: Usd.Stage) -> tuple[np.ndarray | None, float]:
         """The stage's dome lights as one environment map in nits, and its yaw (0 when resampled)."""
-        stage = sim.stage
         domes = [p for p in stage.Traverse() if p.GetTypeName() == "DomeLight"
                  and UsdGeom.Imageable(p).ComputeVisibility(Usd.TimeCode.Default()) != UsdGeom.Tokens.invisible]
         if not domes:
@@ -219,27 +221,30 @@ class PbrRenderer:
         return total, yaw
 
     # ---- renders -------------------------------------------------------
-    def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
+    def render(self, scene: RenderScene, view: CameraView, passes: set[str], subframes: int = 1,
                defer: bool = False, motion=None) -> RenderOutputs:
         """Render ``passes`` of ``view``: colour, depth and ids from the same rays (see the module docstring)."""
-        return self._render_launch(sim, [RenderRequest(view, passes, subframes, defer, motion)])[0]
+        scene.require_offscreen(view.width, view.height)   # the classic footprints of render_isolated draw there
+        return self._render_launch(scene, [RenderRequest(view, passes, subframes, defer, motion)])[0]
 
-    def render_batch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
+    def render_batch(self, scene: RenderScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
         """Render a step's products: those one launch can draw together (no motion blur, one launch of samples,
         :func:`~graphsdg.render.backend.launch_groups`'s pixel limit) as cameras of one launch, the rest alone.
         A product's pixels do not depend on which products share its launch, except the soft-shadow and path
         samples' seed (each launch's own, deterministic)."""
+        for r in requests:   # the classic footprints of render_isolated draw in the offscreen buffer
+            scene.require_offscreen(r.view.width, r.view.height)
         outputs: list[RenderOutputs | None] = [None] * len(requests)
         tier = requested_backend()
         together = [i for i, r in enumerate(requests)
                     if self._one_launch(r, tier) and r.subframes == requests[0].subframes]
         for group in launch_groups([requests[i].view.width * requests[i].view.height for i in together]):
             chosen = [together[j] for j in group]
-            for i, out in zip(chosen, self._render_launch(sim, [requests[i] for i in chosen])):
+            for i, out in zip(chosen, self._render_launch(scene, [requests[i] for i in chosen])):
                 outputs[i] = out
         for i, r in enumerate(requests):
             if outputs[i] is None:
-                outputs[i] = self._render_launch(sim, [r])[0]
+                outputs[i] = self._render_launch(scene, [r])[0]
         return outputs
 
     @staticmethod
@@ -248,7 +253,7 @@ class PbrRenderer:
         no path samples beyond one launch's."""
         return request.motion is None and (tier.tier == "realtime" or request.subframes <= max(1, tier.path_samples))
 
-    def _render_launch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
+    def _render_launch(self, scene: RenderScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
         """Render ``requests`` (several only when each takes one launch: :meth:`_one_launch`) as the cameras of
         one render context."""
         for r in requests:
@@ -260,16 +265,16 @@ class PbrRenderer:
         self._take_queued()
         views = [r.view for r in requests]
         wp, first = self._wp, requests[0]
-        ctx = self._context(sim, views, first.subframes)
+        ctx = self._context(scene, views, first.subframes)
         seeds = tuple(v.path for v in views)
         with wp.ScopedDevice(self._device):
             with profiling.timed("render:pbr_upload"):
-                self._upload_state(sim, views, ctx)
+                self._upload_state(scene, views, ctx)
             path = requested_backend().tier == "path"
             launches = max(1, math.ceil(first.subframes / max(1, ctx.rc.path_samples))) if path else 1
-            acc = self._motion_blur(sim, ctx, first.motion, launches) if first.motion is not None else None
+            acc = self._motion_blur(scene, ctx, first.motion, launches) if first.motion is not None else None
             if acc is not None:
-                self._upload_state(sim, views, ctx)     # labels from the capture's own instant
+                self._upload_state(scene, views, ctx)     # labels from the capture's own instant
                 launches = 1
             with profiling.timed("render:pbr"):
                 for _ in range(launches):
@@ -289,7 +294,7 @@ class PbrRenderer:
                 else:
                     queued.hosts()
         self.stats["products"] += len(requests)
-        return [self._outputs_of(sim, r, _host_of(queued, i), layout.table, acc)
+        return [self._outputs_of(scene, r, _host_of(queued, i), layout.table, acc)
                 for i, (r, layout) in enumerate(zip(requests, ctx.layouts))]
 
     def _take_queued(self) -> None:
@@ -305,7 +310,7 @@ class PbrRenderer:
         self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
         self.stats["color"] += 1
 
-    def _outputs_of(self, sim: SimScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,
+    def _outputs_of(self, scene: RenderScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,
                     acc: np.ndarray | None) -> RenderOutputs:
         """One product's :class:`RenderOutputs`, its passes taken from ``host()`` (its
         :class:`~graphsdg.render.pbr_outputs.HostFrame`, waited for on first use when the render was deferred);
@@ -332,7 +337,7 @@ class PbrRenderer:
             out.put("code_boxes", lambda: host().code_boxes)
             out.id_lut = table
             out.put("geom_ids", lambda: lookup(table, out.id_codes))
-        out.render_isolated = lambda geoms, crop: self._classic().render_isolated(sim, view, geoms, crop)
+        out.render_isolated = lambda geoms, crop: self._classic().render_isolated(scene, view, geoms, crop)
         return out
 
     def _colour(self, ctx: _Context, index: int = 0) -> np.ndarray:
@@ -344,31 +349,32 @@ class PbrRenderer:
         self._mjpbr.get_rgb(ctx.rc, index, rgb)
         return rgb.numpy()[0]
 
-    def _motion_blur(self, sim: SimScene, ctx: _Context, motion, launches: int) -> np.ndarray:
+    def _motion_blur(self, scene: RenderScene, ctx: _Context, motion, launches: int) -> np.ndarray:
         """Mean display colour of renders at the motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`):
         each sub-frame's geometry, lights and camera, and the next seed (its own soft-shadow and path samples)."""
         acc = None
         with profiling.timed("render:pbr_motion"):
             for i in range(motion.count):
                 posed, seen = motion.pose(i)
-                self._upload_state(sim, [seen], ctx, data=posed)
+                self._upload_state(scene, [seen], ctx, data=posed)
                 for _ in range(launches):
                     self._launch(ctx, (seen.path,))
                     acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
         return acc / (motion.count * launches)
 
-    def _upload_state(self, sim: SimScene, views: list[CameraView], ctx: _Context, data=None) -> None:
+    def _upload_state(self, scene: RenderScene, views: list[CameraView], ctx: _Context, data=None) -> None:
         """The simulation's poses and randomized model fields into the renderer (no recompile).
 
         Poses change every frame and always go up; model fields that randomizers may write (colours,
         material bindings, sizes, light colours) go up only when they differ from the last upload. Every copy
         goes through :class:`~graphsdg.render.pbr_uploads.PinnedUploads`."""
+        sim = scene.sim
         model, m, d, rc, uploads = sim.model, ctx.model, ctx.data, ctx.rc, ctx.uploads
         data = sim.data if data is None else data
         uploads.begin()
         uploads.put("geom_xpos", d.geom_xpos, data.geom_xpos)
         uploads.put("geom_xmat", d.geom_xmat,
-                    self._traced_frames(sim, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3)))
+                    self._traced_frames(scene, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3)))
         if model.nlight:
             uploads.put("light_xpos", d.light_xpos, data.light_xpos)
             uploads.put("light_xdir", d.light_xdir, data.light_xdir)
@@ -384,7 +390,7 @@ class PbrRenderer:
         uploads.end()
         if changed & {"geom_matid", "light_diffuse"} or "surfaces" not in ctx.uploaded:
             exposure = float(settings.get("/graphsdg/render/exposure", 1.0))
-            world = pbr_scene.world_arrays(model, self._surfaces(sim), exposure)
+            world = pbr_scene.world_arrays(model, self._surfaces(scene), exposure)
             rc.geom_metallic.assign(world.geom_metallic[None])
             rc.geom_roughness.assign(world.geom_roughness[None])
             rc.geom_reflectance.assign(world.geom_reflectance[None])
@@ -393,16 +399,16 @@ class PbrRenderer:
             ctx.uploaded["surfaces"] = True
         self._mjw.refit_bvh(m, d, rc.base)
 
-    def _traced_frames(self, sim: SimScene, ctx: _Context, xmat: np.ndarray) -> np.ndarray:
+    def _traced_frames(self, scene: RenderScene, ctx: _Context, xmat: np.ndarray) -> np.ndarray:
         """Geom frames for the tracer: rescaled meshes folded in, other vertex changes refit into their BVHs
         (:mod:`graphsdg.render.pbr_meshes`); the scene BVH's mesh bounds follow."""
-        model, state, meshes, folds = sim.model, ctx.meshes, self._meshes, mesh_folds
+        model, state, meshes, folds = scene.sim.model, ctx.meshes, self._meshes, mesh_folds
         if not model.nmesh:
             return xmat
-        stamps = _counts(sim.mesh_stamps, model.nmesh)
+        stamps = _counts(scene.mesh_stamps, model.nmesh)
         if not np.array_equal(stamps, state.stamps):
-            now = folds.current_maps(sim.mesh_maps, model.nmesh)
-            reshapes = _counts(sim.mesh_reshapes, model.nmesh)
+            now = folds.current_maps(scene.mesh_maps, model.nmesh)
+            reshapes = _counts(scene.mesh_reshapes, model.nmesh)
             reshaped = meshes.changed(state.reshapes, reshapes)
             if reshaped.size:      # vertices no map describes (deformables): new vertices into the BVHs
                 with profiling.timed("render:pbr_mesh_refit"):
@@ -455,17 +461,18 @@ class PbrRenderer:
                            for layout, key, old, view in zip(ctx.layouts, keys, ctx.rays_keys, views)]
             ctx.rays_keys = keys
 
-    def _surfaces(self, sim: SimScene) -> dict[int, pbr_scene.SurfaceFields]:
+    def _surfaces(self, scene: RenderScene) -> dict[int, pbr_scene.SurfaceFields]:
+        sim = scene.sim
         compiled = sim.ensure_compiled()
         cache = getattr(self, "_surface_cache", None)
-        if cache is None or cache[0] != (id(compiled), sim.model_version):
+        if cache is None or cache[0] != (id(compiled), scene.version):
             stage = sim.stage
             fields = {}
             for path, mid in compiled.materials.items():
                 prim = stage.GetPrimAtPath(path)
                 if prim and mid >= 0:
                     fields[mid] = pbr_scene.surface_fields(UsdShade.Material(prim))
-            cache = ((id(compiled), sim.model_version), fields)
+            cache = ((id(compiled), scene.version), fields)
             self._surface_cache = cache
         return cache[1]
 

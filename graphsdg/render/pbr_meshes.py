@@ -15,7 +15,7 @@ import warp as wp
 
 
 def changed(seen: np.ndarray, now: np.ndarray) -> np.ndarray:
-    """Ids of the meshes whose stamp moved (:attr:`graphsdg.sim.scene.SimScene.mesh_stamps`)."""
+    """Ids of the meshes whose stamp moved (:attr:`graphsdg.render.render_scene.RenderScene.mesh_stamps`)."""
     if seen.shape != now.shape:
         return np.arange(now.shape[0])
     return np.flatnonzero(seen != now)

@@ -48,8 +48,8 @@ from graphsdg.render.lookup import lookup
 from graphsdg.render.motion_blur import MotionSamples
 from graphsdg.render.readback import PixelReads, code_bits
 from graphsdg.render.scene_geoms import geom_array
+from graphsdg.render.render_scene import RenderScene
 from graphsdg.sim.mesh_scaling import MeshMaps
-from graphsdg.sim.scene import SimScene
 from graphsdg.sim.visual import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 
 PASSES = ("color", "hdr", "depth", "segmentation")
@@ -154,7 +154,7 @@ def jitter_offsets(n: int) -> list[tuple[float, float]]:
 
 
 class Rasterizer:
-    """Renders a :class:`SimScene` from :class:`CameraView` s."""
+    """Renders a :class:`~graphsdg.render.render_scene.RenderScene` from :class:`CameraView` s."""
 
     def __init__(self) -> None:
         self._gl = None
@@ -168,7 +168,7 @@ class Rasterizer:
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FREE
         self._version = -1
         self._model: mujoco.MjModel | None = None
-        # inverse of SimScene.mesh_maps when the meshes were uploaded (a mesh absent: identity)
+        # inverse of RenderScene.mesh_maps when the meshes were uploaded (a mesh absent: identity)
         self._uploaded_inverse: dict[int, np.ndarray] = {}
         self._undo = _undo_table({})   # the same by mesh id, as arrays
         self._reads: PixelReads | None = None
@@ -187,20 +187,20 @@ class Rasterizer:
         if self._gl_address is None or gl_direct.egl_current_context() != self._gl_address:
             self._gl.make_current()
 
-    def bind(self, sim: SimScene) -> None:
+    def bind(self, scene: RenderScene) -> None:
         """Make the GL contexts match the scene's current model."""
         with profiling.timed("render:bind+uploads"):
-            self._bind(sim)
+            self._bind(scene)
 
-    def _bind(self, sim: SimScene) -> None:
+    def _bind(self, scene: RenderScene) -> None:
         self._ensure_gl()
-        model = sim.model
+        model = scene.sim.model
         quality = render_quality(max(int(model.vis.global_.offwidth), int(model.vis.global_.offheight)))
         if (int(model.vis.quality.shadowsize), int(model.vis.quality.offsamples)) != quality:
             # the render mode changed since the compile: takes effect now, no recompile needed
             model.vis.quality.shadowsize, model.vis.quality.offsamples = quality
             self._version = -1
-        if self._version != sim.model_version or self._model is not model:
+        if self._version != scene.version or self._model is not model:
             if self._mjr is not None:
                 self._mjr.free()
             self._mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
@@ -210,19 +210,19 @@ class Rasterizer:
             mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
             self._mjr.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
             self._scene = mujoco.MjvScene(model, maxgeom=max(1000, 2 * model.ngeom + 100))
-            self._version = sim.model_version
+            self._version = scene.version
             self._model = model
-            self._uploaded_inverse = {mid: np.linalg.inv(m) for mid, m in sim.mesh_maps.items()}
+            self._uploaded_inverse = {mid: np.linalg.inv(m) for mid, m in scene.mesh_maps.items()}
             self._undo = _undo_table(self._uploaded_inverse)
             self._flat_sky = sky.uniform_sky(model)
-        if sim.meshes_to_upload:   # deformables' meshes moved by physics
-            for mid in sorted(sim.meshes_to_upload):
+        if scene.meshes_to_upload:   # deformables' meshes moved by physics
+            for mid in sorted(scene.meshes_to_upload):
                 mujoco.mjr_uploadMesh(model, self._mjr, mid)
-            sim.meshes_to_upload.clear()
-        if sim.textures_to_upload:
-            for tid in sorted(sim.textures_to_upload):
+            scene.meshes_to_upload.clear()
+        if scene.textures_to_upload:
+            for tid in sorted(scene.textures_to_upload):
                 mujoco.mjr_uploadTexture(model, self._mjr, tid)
-            sim.textures_to_upload.clear()
+            scene.textures_to_upload.clear()
             self._flat_sky = sky.uniform_sky(model)
 
     def _id_framebuffer(self, bits: int) -> IdFramebuffer:
@@ -255,27 +255,28 @@ class Rasterizer:
             self._gl = None
 
     # ---- one render ----------------------------------------------------
-    def _update_scene(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float],
+    def _update_scene(self, scene: RenderScene, view: CameraView, bounds: tuple[np.ndarray, float],
                       jitter: tuple[float, float], crop: Crop | None = None,
                       data: mujoco.MjData | None = None) -> float:
-        """Fill the scene for one render of ``view`` with the geometry inside ``bounds`` (from
+        """Fill the MuJoCo scene for one render of ``view`` with the geometry inside ``bounds`` (from
         :func:`geometry_bounds`), posed as in ``data`` (default: the simulation's); returns the far plane
         used (see :func:`effective_far`)."""
-        scene = self._scene
-        assert scene is not None and self._mjr is not None
+        mjv = self._scene
+        assert mjv is not None and self._mjr is not None
+        sim = scene.sim
         center, radius = bounds
         far = effective_far(center, radius, view)
         mujoco.mjv_updateScene(sim.model, sim.data if data is None else data, self._option, None, self._camera,
-                               mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, scene)
-        if sim.mesh_maps:
-            self._draw_rescaled_meshes(sim, scene)
-        if scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW]:
-            self._fit_directional_shadows(scene, center, radius)
+                               mujoco.mjtCatBit.mjCAT_STATIC | mujoco.mjtCatBit.mjCAT_DYNAMIC, mjv)
+        if scene.mesh_maps:
+            self._draw_rescaled_meshes(scene, mjv)
+        if mjv.flags[mujoco.mjtRndFlag.mjRND_SHADOW]:
+            self._fit_directional_shadows(mjv, center, radius)
         left, right, bottom, top = view.frustum_window(crop, jitter)
         forward = -view.rotation[:, 2]
         up = view.rotation[:, 1]
         for i in range(2):
-            cam = scene.camera[i]
+            cam = mjv.camera[i]
             cam.pos[:] = view.position
             cam.forward[:] = forward
             cam.up[:] = up
@@ -286,7 +287,7 @@ class Rasterizer:
             cam.frustum_near = view.near
             cam.frustum_far = SKY_FAR_FACTOR * far
             cam.orthographic = 1 if view.projection == "orthographic" else 0
-        scene.enabletransform = 0
+        mjv.enabletransform = 0
         return far
 
     def _fit_directional_shadows(self, scene: mujoco.MjvScene, center: np.ndarray, radius: float) -> None:
@@ -310,7 +311,7 @@ class Rasterizer:
         if fitted:
             self._mjr.shadowClip = radius
 
-    def _draw_rescaled_meshes(self, sim: SimScene, scene: mujoco.MjvScene) -> None:
+    def _draw_rescaled_meshes(self, scene: RenderScene, mjv: mujoco.MjvScene) -> None:
         """Fold meshes rescaled since their upload into their scene geoms' matrices.
 
         The GPU holds each mesh as it was at upload; the model's vertices are that
@@ -318,14 +319,15 @@ class Rasterizer:
         geom's rotation matrix times that map draws the current mesh (the fixed
         function pipeline transforms normals by the inverse transpose).
         """
-        maps, uploaded_inverse = sim.mesh_maps, self._uploaded_inverse
+        maps, uploaded_inverse = scene.mesh_maps, self._uploaded_inverse
         # ints, not the enums: comparing with a pybind11 enum costs microseconds per geom
-        dataid, geom_obj, mesh = sim.model.geom_dataid, int(mujoco.mjtObj.mjOBJ_GEOM), int(mujoco.mjtGeom.mjGEOM_MESH)
-        geoms = geom_array(scene)
+        dataid = scene.sim.model.geom_dataid
+        geom_obj, mesh = int(mujoco.mjtObj.mjOBJ_GEOM), int(mujoco.mjtGeom.mjGEOM_MESH)
+        geoms = geom_array(mjv)
         if geoms is not None:
             _fold_mesh_maps(geoms, dataid, maps, self._undo, mesh, geom_obj)
             return
-        for g in scene.geoms[:scene.ngeom]:
+        for g in mjv.geoms[:mjv.ngeom]:
             if g.type != mesh or g.objtype != geom_obj:
                 continue
             mid = int(dataid[g.objid])
@@ -334,11 +336,14 @@ class Rasterizer:
                 undo = uploaded_inverse.get(mid)
                 g.mat[:] = g.mat @ (current if undo is None else current @ undo)
 
-    def render_batch(self, sim: SimScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
-        """:meth:`render` of each request in turn (the rasteriser draws one camera per pass)."""
-        return [self.render(sim, r.view, r.passes, r.subframes, defer=r.defer, motion=r.motion) for r in requests]
+    def render_batch(self, scene: RenderScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
+        """:meth:`render` of each request in turn (the rasteriser draws one camera per pass), the offscreen
+        buffer first made to hold them all."""
+        for r in requests:
+            scene.require_offscreen(r.view.width, r.view.height)
+        return [self.render(scene, r.view, r.passes, r.subframes, defer=r.defer, motion=r.motion) for r in requests]
 
-    def render(self, sim: SimScene, view: CameraView, passes: set[str], subframes: int = 1,
+    def render(self, scene: RenderScene, view: CameraView, passes: set[str], subframes: int = 1,
                defer: bool = False, motion: MotionSamples | None = None) -> RenderOutputs:
         """Render the requested ``passes`` of ``view`` (only those: each pass costs a render).
 
@@ -347,18 +352,18 @@ class Rasterizer:
         caller can do other work meanwhile. Jittered subframes are always read
         at once (they are summed on the CPU). ``motion``: the colour is the mean of
         renders at these motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`);
-        depth and ids stay those of the simulation's current state.
+        depth and ids stay those of the simulation's current state. The scene's offscreen buffer grows to hold
+        ``view`` if it must (the renderer owns its sizes, as MuJoCo's ``Renderer`` does).
         """
         unknown = set(passes) - set(PASSES)
         if unknown:
             raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
         if subframes < 1:
             raise ValueError(f"subframes must be >= 1, got {subframes}")
-        self.bind(sim)
+        scene.require_offscreen(view.width, view.height)
+        self.bind(scene)
+        sim = scene.sim
         model = sim.model
-        if view.width > model.vis.global_.offwidth or view.height > model.vis.global_.offheight:
-            raise ValueError(f"resolution {view.width}x{view.height} exceeds the offscreen buffer "
-                             f"{model.vis.global_.offwidth}x{model.vis.global_.offheight}")
         out = RenderOutputs()
         drawn = drawn_geom_mask(model)
         bounds = geometry_bounds(model, sim.data, drawn)   # one state for all of this render's passes
@@ -370,11 +375,11 @@ class Rasterizer:
             int(model.vis.quality.offsamples) == 0 and motion is None
         scene_far = None   # set while the scene holds this frame's unjittered geometry (reused by the id pass)
         if colour:
-            scene_far = self._render_color(sim, view, bounds, subframes, out, want_color="color" in passes,
+            scene_far = self._render_color(scene, view, bounds, subframes, out, want_color="color" in passes,
                                            want_linear="hdr" in passes, want_depth=depth_with_colour,
                                            motion=motion, drawn=drawn)
         if "segmentation" in passes or ("depth" in passes and not depth_with_colour):
-            codes, lut, depth = self._render_ids(sim, view, bounds, None, with_depth="depth" in passes,
+            codes, lut, depth = self._render_ids(scene, view, bounds, None, with_depth="depth" in passes,
                                                  scene_far=scene_far)
             if "segmentation" in passes:
                 out.put("id_codes", codes)
@@ -383,26 +388,26 @@ class Rasterizer:
             out.put("depth", depth)
         if not defer:
             out.finish()
-        out.render_isolated = lambda geoms, crop: self.render_isolated(sim, view, geoms, crop)
+        out.render_isolated = lambda geoms, crop: self.render_isolated(scene, view, geoms, crop)
         return out
 
-    def _render_color(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], subframes: int,
+    def _render_color(self, scene: RenderScene, view: CameraView, bounds: tuple[np.ndarray, float], subframes: int,
                       out: RenderOutputs, want_color: bool, want_linear: bool, want_depth: bool,
                       motion: MotionSamples | None = None, drawn: np.ndarray | None = None) -> float | None:
         """Draw and queue the colour pass; returns the far plane when the scene is left as updated for
         the unjittered view (one subframe), else None. ``drawn``: :func:`drawn_geom_mask` of the model, when
         the caller has it."""
         assert self._scene is not None and self._mjr is not None and self._reads is not None
-        scene, ctx = self._scene, self._mjr
+        ctx, model = self._mjr, scene.sim.model
         w, h = view.width, view.height
         rect = mujoco.MjrRect(0, 0, w, h)
-        flags = scene.flags
+        flags = self._scene.flags
         flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 0
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 0
         # a one-colour sky is one flat rectangle behind the geometry, cheaper than MuJoCo's skybox draw
         background = self._flat_sky
         if background is not None:
-            if not sky.fill_is_exact(sim.model, drawn_geom_mask(sim.model) if drawn is None else drawn):
+            if not sky.fill_is_exact(model, drawn_geom_mask(model) if drawn is None else drawn):
                 background = None
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = background is None
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 1
@@ -414,14 +419,14 @@ class Rasterizer:
             acc = np.zeros((h, w, 3), dtype=np.float32)
             for i in range(n):
                 posed, seen = motion.pose(i * motion.count // n)
-                self._update_scene(sim, seen, bounds, jitters[i], data=posed)
+                self._update_scene(scene, seen, bounds, jitters[i], data=posed)
                 with profiling.timed("render:color"):
                     self._draw_color(rect, background)
                 acc += self._reads.read_color(ctx, w, h).result()[..., :3]
                 self.stats["color"] += 1
             _put_average(out, acc / n, want_color, want_linear)
             return None
-        far = self._update_scene(sim, view, bounds, (0.0, 0.0))
+        far = self._update_scene(scene, view, bounds, (0.0, 0.0))
         with profiling.timed("render:color"):
             self._draw_color(rect, background)
         with profiling.timed("readback:color"):
@@ -438,7 +443,7 @@ class Rasterizer:
             return far
         acc = pixels.result()[..., :3].astype(np.float32)
         for jit in jitter_offsets(subframes)[1:]:
-            self._update_scene(sim, view, bounds, jit)
+            self._update_scene(scene, view, bounds, jit)
             self._draw_color(rect, background)
             acc += self._reads.read_color(ctx, w, h).result()[..., :3]
             self.stats["color"] += 1
@@ -451,7 +456,7 @@ class Rasterizer:
         if background is not None:
             sky.fill_background(rect.width, rect.height, background)
 
-    def _render_ids(self, sim: SimScene, view: CameraView, bounds: tuple[np.ndarray, float], crop: Crop | None,
+    def _render_ids(self, scene: RenderScene, view: CameraView, bounds: tuple[np.ndarray, float], crop: Crop | None,
                     with_depth: bool, scene_far: float | None = None
                     ) -> tuple[Callable[[], np.ndarray], np.ndarray, Callable[[], np.ndarray] | None]:
         """Id codes (a finisher), their code -> geom id table, and a depth finisher, of the view or a
@@ -463,11 +468,11 @@ class Rasterizer:
         id colours ignore.
         """
         assert self._scene is not None and self._mjr is not None and self._reads is not None
-        scene, ctx = self._scene, self._mjr
+        mjv, ctx = self._scene, self._mjr
         x0, y0, x1, y1 = crop if crop is not None else (0, 0, view.width, view.height)
         w, h = x1 - x0, y1 - y0
         rect = mujoco.MjrRect(0, 0, w, h)
-        flags = scene.flags
+        flags = mjv.flags
         flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = 1
         flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = 1
         flags[mujoco.mjtRndFlag.mjRND_SKYBOX] = 0
@@ -476,12 +481,12 @@ class Rasterizer:
             if scene_far is not None and crop is None:
                 far = scene_far
             else:
-                far = self._update_scene(sim, view, bounds, (0.0, 0.0), crop)
+                far = self._update_scene(scene, view, bounds, (0.0, 0.0), crop)
             kind = "ids" if crop is None else "isolated"
-            lut = _segid_lut(scene)   # the scene's segid -> geom id table of this render, taken now
+            lut = _segid_lut(mjv)   # the MuJoCo scene's segid -> geom id table of this render, taken now
             with self._id_framebuffer(code_bits(len(lut))).bound(ctx):
                 with profiling.timed(f"render:{kind}"):
-                    mujoco.mjr_render(rect, scene, ctx)
+                    mujoco.mjr_render(rect, mjv, ctx)
                 with profiling.timed(f"readback:{kind}"):
                     codes = self._reads.read_codes(ctx, w, h, len(lut))
                     raw = self._reads.read_depth(ctx, w, h, _depth_decoder(far, view)) if with_depth \
@@ -492,7 +497,7 @@ class Rasterizer:
         self.stats[kind] += 1
         return codes.result, lut, (raw.result if raw is not None else None)
 
-    def render_isolated(self, sim: SimScene, view: CameraView, geoms: Sequence[int], crop: Crop) -> np.ndarray:
+    def render_isolated(self, scene: RenderScene, view: CameraView, geoms: Sequence[int], crop: Crop) -> np.ndarray:
         """Geom ids (H', W') of the ``crop`` of ``view`` with only ``geoms`` drawn (-1 elsewhere).
 
         Every other geom is moved to the hidden group for this one render and put
@@ -501,8 +506,9 @@ class Rasterizer:
         x0, y0, x1, y1 = (int(c) for c in crop)
         if not (0 <= x0 < x1 <= view.width and 0 <= y0 < y1 <= view.height):
             raise ValueError(f"crop {crop} is not a non-empty rectangle inside {view.width}x{view.height}")
-        if self._model is not sim.model or self._version != sim.model_version:
-            self.bind(sim)   # normally bound (and current) already: this follows render() of the same view
+        sim = scene.sim
+        if self._model is not sim.model or self._version != scene.version:
+            self.bind(scene)   # normally bound (and current) already: this follows render() of the same view
         model = sim.model
         group = model.geom_group
         saved = group.copy()
@@ -510,7 +516,7 @@ class Rasterizer:
         keep[np.asarray(list(geoms), dtype=np.int64)] = True
         try:
             group[~keep] = HIDDEN_GROUP
-            codes, lut, _ = self._render_ids(sim, view, geometry_bounds(model, sim.data), (x0, y0, x1, y1),
+            codes, lut, _ = self._render_ids(scene, view, geometry_bounds(model, sim.data), (x0, y0, x1, y1),
                                              with_depth=False)
             return lookup(lut, codes())
         finally:
@@ -602,7 +608,7 @@ def _undo_table(uploaded_inverse: dict[int, np.ndarray]) -> tuple[np.ndarray, np
 
 def _fold_mesh_maps(geoms: np.ndarray, dataid: np.ndarray, maps: MeshMaps | dict[int, np.ndarray],
                     uploaded_inverse: tuple[np.ndarray, np.ndarray], mesh: int, geom_obj: int) -> None:
-    """:meth:`Rasterizer._draw_rescaled_meshes` over the scene's geoms as one array (``scene_geoms``);
+    """:meth:`Rasterizer._draw_rescaled_meshes` over the MuJoCo scene's geoms as one array (``scene_geoms``);
     ``uploaded_inverse`` as :func:`_undo_table` gives it.
 
     The products are those of the per-geom loop, batched: for each drawn mesh geom

@@ -40,6 +40,7 @@ from pxr import Usd
 
 from graphsdg import rng
 from graphsdg.sensors.lidar_profile import LidarProfile, LidarProfileError, output_settings, read_lidar_profile
+from graphsdg.render.render_scene import render_scene_of
 from graphsdg.sensors.mesh_bounds import sync_mesh_trees
 from graphsdg.sensors.ray_backend import ray_caster
 from graphsdg.sensors.scan_pattern import Firings, ScanPattern, spherical_points, unit_directions
@@ -147,7 +148,7 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
     motion = GeomMotion.still() if frozen else GeomMotion.of(m, d)
     sync_mesh_trees(sim)
     hits = ray_caster().cast(m, d, origins, dirs_world, dt, motion, cutoff=profile.far_range_m / mpu,
-                             mesh_stamps=sim.mesh_stamps)
+                             mesh_stamps=render_scene_of(sim).mesh_stamps)
     true_range = np.where(hits.geom >= 0, hits.distance * mpu, 0.0)
     surface = surface_table(sim)
     cos_incidence = np.abs(np.einsum("ij,ij->i", hits.normal, dirs_world))

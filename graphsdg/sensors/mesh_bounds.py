@@ -6,7 +6,7 @@ vertices and its geom's bounds, and renderers draw their uploaded copy through t
 ``mesh_bvhadr .. + mesh_bvhnum``: centre and half size per node, in the mesh's frame), which the compile built
 around the compiled vertices; a shrunk triangle leaves its box and rays pass through it. Before sensors cast,
 :func:`sync_mesh_trees` brings the trees of the meshes changed since the last cast (their
-:attr:`~graphsdg.sim.scene.SimScene.mesh_stamps` moved) up to date from the compiled trees:
+:attr:`~graphsdg.render.render_scene.RenderScene.mesh_stamps` moved) up to date from the compiled trees:
 
 * a mesh changed by linear maps only (``mesh_maps``): each box through the map ``L``: centre ``L c``, half
   size ``|L| h`` (a box that holds the mapped box; exact for the uniform and axis scales of rescales);
@@ -38,6 +38,9 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from graphsdg.render.render_scene import render_scene_of
+from graphsdg.sim.scene import SimScene
+
 
 def _tree_rows(model: mujoco.MjModel, mesh_id: int) -> slice:
     start = int(model.mesh_bvhadr[mesh_id])
@@ -52,15 +55,17 @@ class MeshTrees:
         self.compiled = np.array(model.bvh_aabb, copy=True)
         self.stamps = np.zeros(model.nmesh, dtype=np.int64)
 
-    def sync(self, sim: Any) -> np.ndarray:
-        """Bring the trees of the meshes whose stamps moved up to ``sim``'s vertices; returns their ids."""
+    def sync(self, scene: Any) -> np.ndarray:
+        """Bring the trees of the meshes whose stamps moved up to the model's vertices, as ``scene`` (a
+        :class:`~graphsdg.render.render_scene.RenderScene`: its mesh maps, stamps and reshapes) records them;
+        returns their ids."""
         m = self.model
-        stamps = _counts(sim.mesh_stamps, m.nmesh)
+        stamps = _counts(scene.mesh_stamps, m.nmesh)
         changed = np.flatnonzero(stamps != self.stamps)
         if not changed.size:
             return changed
-        reshaped = _counts(sim.mesh_reshapes, m.nmesh)
-        maps = sim.mesh_maps
+        reshaped = _counts(scene.mesh_reshapes, m.nmesh)
+        maps = scene.mesh_maps
         for mesh_id in changed.tolist():
             rows = _tree_rows(m, mesh_id)
             if reshaped[mesh_id] or mesh_id not in maps:
@@ -98,7 +103,7 @@ def _whole_box(model: mujoco.MjModel, mesh_id: int) -> np.ndarray:
 _trees: dict[int, MeshTrees] = {}
 
 
-def sync_mesh_trees(sim: Any) -> np.ndarray:
+def sync_mesh_trees(sim: SimScene) -> np.ndarray:
     """Bring the mesh trees of ``sim``'s compiled model up to its rescaled meshes (module docstring); returns the
     ids of the meshes changed since the last call."""
     m = sim.model
@@ -106,7 +111,7 @@ def sync_mesh_trees(sim: Any) -> np.ndarray:
     if trees is None or trees.model is not m:
         _trees.clear()             # one compiled model at a time: a recompile drops the last one's copies
         trees = _trees[id(m)] = MeshTrees(m)
-    return trees.sync(sim)
+    return trees.sync(render_scene_of(sim))
 
 
 __all__ = ["MeshTrees", "sync_mesh_trees"]

@@ -37,6 +37,7 @@ from pxr import Usd
 from graphsdg import rng
 from graphsdg.sensors.lidar_profile import LidarProfileError, aux_level
 from graphsdg.sensors.lidar_scan import sensor_prim
+from graphsdg.render.render_scene import render_scene_of
 from graphsdg.sensors.mesh_bounds import sync_mesh_trees
 from graphsdg.sensors.ray_backend import ray_caster
 from graphsdg.sensors.scan_pattern import spherical_points
@@ -182,7 +183,7 @@ def detect(sim: SimScene, pose: SensorPose, profile: RadarProfile, noise: np.ran
     origins = np.broadcast_to(pose.position, dirs.shape)
     sync_mesh_trees(sim)
     hits = ray_caster().cast(m, d, origins, dirs, np.zeros(len(dirs)), GeomMotion.still(),
-                             cutoff=profile.max_range_m / mpu, mesh_stamps=sim.mesh_stamps)
+                             cutoff=profile.max_range_m / mpu, mesh_stamps=render_scene_of(sim).mesh_stamps)
     rng_m = hits.distance * mpu
     keep = (hits.geom >= 0) & (rng_m >= profile.min_range_m) & (rng_m <= profile.max_range_m)
     if not keep.any():

@@ -489,16 +489,16 @@ def set_node_velocities(b: FlexBinding, data: mujoco.MjData, velocities: np.ndar
 
 
 def follow(bindings: list[FlexBinding], model: mujoco.MjModel, data: mujoco.MjData, stage: Usd.Stage,
-           meshes_to_upload: set[int]) -> None:
-    """Move every embedded render mesh with its flex: MuJoCo's vertices (queued for upload to the
-    renderers in ``meshes_to_upload``) and the USD points (authored; the caller mutes change tracking)."""
+           moved: set[int]) -> None:
+    """Move every embedded render mesh with its flex: MuJoCo's vertices (the meshes' ids added to ``moved``,
+    for the renderers' copies) and the USD points (authored; the caller mutes change tracking)."""
     with Sdf.ChangeBlock():
         for b in bindings:
             nodes = node_positions(b, data)
             for e in b.meshes:
                 world = np.einsum("pm,pmk->pk", e.point_weights, nodes[e.point_nodes])
                 _write_vertices(model, data, e, world[e.vert_points])
-                meshes_to_upload.add(e.mesh_id)
+                moved.add(e.mesh_id)
                 prim = stage.GetPrimAtPath(e.path)
                 if prim:
                     local = _to(e.world_to_local, world).astype(np.float32)

@@ -251,9 +251,9 @@ def light_dir_and_pos(prim: Usd.Prim, cache: UsdGeom.XformCache | None = None) -
 
 
 def sync_light(c: CompiledScene, stage: Usd.Stage, path: str, cache: UsdGeom.XformCache,
-               textures_to_upload: set[int]) -> None:
+               changed_textures: set[int]) -> None:
     """An edit of light ``path`` (or above it) written into the model; a changed skybox texture's id is
-    added to ``textures_to_upload``."""
+    added to ``changed_textures``."""
     prim = stage.GetPrimAtPath(path)
     binding = c.lights[path]
     if not prim or not binding.light_ids:
@@ -274,7 +274,7 @@ def sync_light(c: CompiledScene, stage: Usd.Stage, path: str, cache: UsdGeom.Xfo
         lid = binding.light_ids[0]
         m.light_diffuse[lid] = np.maximum(0.5 * params.color, 0)
         m.light_specular[lid] = np.minimum(0.5 * params.color * 0.3, 0.3)
-        _set_sky(c, np.clip(params.color, 0, 1), textures_to_upload)
+        _set_sky(c, np.clip(params.color, 0, 1), changed_textures)
         return
     pos, direction = light_dir_and_pos(prim, cache)
     lid = binding.light_ids[0]
@@ -287,7 +287,7 @@ def sync_light(c: CompiledScene, stage: Usd.Stage, path: str, cache: UsdGeom.Xfo
     m.light_castshadow[lid] = params.cast_shadow
 
 
-def _set_sky(c: CompiledScene, rgb: np.ndarray, textures_to_upload: set[int]) -> None:
+def _set_sky(c: CompiledScene, rgb: np.ndarray, changed_textures: set[int]) -> None:
     tid = c.sky_texture_id
     if tid < 0:
         raise NeedsRecompile
@@ -296,4 +296,4 @@ def _set_sky(c: CompiledScene, rgb: np.ndarray, textures_to_upload: set[int]) ->
     n = m.tex_width[tid] * m.tex_height[tid] * m.tex_nchannel[tid]
     pixel = np.round(rgb * 255).astype(np.uint8)
     m.tex_data[adr:adr + n] = np.tile(pixel, n // 3)
-    textures_to_upload.add(int(tid))
+    changed_textures.add(int(tid))

@@ -5,7 +5,7 @@ them in the mesh's own frame (``geom_pos``/``geom_quat`` place that frame in the
 body). Going from scale ``s0`` to ``s`` is the linear map
 ``v_mesh' = Rg^T diag(s / s0) Rg v_mesh`` with ``geom_pos' = (s / s0) * geom_pos``;
 normals take the inverse transpose. Renderers do not re-upload the mesh: they draw
-their uploaded copy through the same linear map (:attr:`SimScene.mesh_maps`), which
+their uploaded copy through the same linear map (:attr:`RenderScene.mesh_maps`), which
 costs a 3x3 product per geom instead of a vertex upload per frame.
 Only visual geoms are rescaled this way: colliding meshes (convex hulls, BVHs,
 inertia) recompile.
@@ -51,7 +51,7 @@ def _distinct(ids: np.ndarray) -> bool:
 
 
 class MeshMaps(MutableMapping):
-    """Mesh id -> the 3x3 map from its compiled vertices to its current ones (:attr:`SimScene.mesh_maps`),
+    """Mesh id -> the 3x3 map from its compiled vertices to its current ones (:attr:`RenderScene.mesh_maps`),
     held as one (n, 3, 3) array and a mask of the ids that have a map.
 
     A dict of small arrays cost ~2 us a mesh per frame to compose and another ~1

@@ -23,6 +23,11 @@ tracker's :class:`~graphsdg.stage.changes.ChangeSet`:
 on the stage (:mod:`~graphsdg.sim.pose_write_back`); :meth:`SimScene.body_pose` and :meth:`SimScene.body_velocity`
 read a body's state; :meth:`SimScene.snapshot` / :meth:`SimScene.restore`
 implement the timeline's stop (bodies return to where they were at play).
+
+What renderers keep beside the model (offscreen sizes, uploads, mesh maps, camera poses) is the render
+scene's (:mod:`graphsdg.render.render_scene`): the scene asks it what a compile must carry and tells it of
+meshes and textures changed in place through its :attr:`SimScene.render_link`
+(:mod:`~graphsdg.sim.render_link`); it hears of recompiles through :meth:`SimScene.subscribe_recompile`.
 """
 from __future__ import annotations
 
@@ -37,7 +42,6 @@ from pxr import Sdf, Usd, UsdGeom
 from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import joints as jointmap
 from graphsdg.sim import physics_steps
-from graphsdg.sim.pose_writes.camera_poses import CameraPoses
 from graphsdg.stage.world_transforms import WorldTransforms
 from graphsdg.sim.compiled_scene import BodyBinding, CompiledScene
 from graphsdg.sim.compiler import compile_stage
@@ -45,13 +49,13 @@ from graphsdg.sim.edit_aspects import ALL_ASPECTS, INHERITED_ASPECTS, edit_aspec
 from graphsdg.sim.geom_poses import sync_geom_pose
 from graphsdg.sim.lights import sync_light
 from graphsdg.sim.materials import sync_geom_material, sync_material
-from graphsdg.sim.mesh_scaling import MeshMaps, rescale_mesh_geoms
+from graphsdg.sim.mesh_scaling import rescale_mesh_geoms
 from graphsdg.sim.needs_recompile import NeedsRecompile
 from graphsdg.sim.pose_write_back import PoseWriter, set_world_pose_sdf
+from graphsdg.sim.render_link import RenderLink
 from graphsdg.sim.rigid_bodies import VELOCITY_ATTRIBUTES, authored_velocity, rigid_root, sync_body_pose
 from graphsdg.sim.state_carry import carry_state
 from graphsdg.sim.visual import sync_visibility
-from graphsdg.stage.read_cache import PrimReadCache
 from graphsdg.stage.changes import ChangeSet, ChangeTracker
 from graphsdg.stage.xform import world_matrix
 from graphsdg.maths.rotations import decompose, quat_wxyz_to_matrix
@@ -62,38 +66,19 @@ _model_versions = itertools.count()
 class SimScene:
     """MuJoCo model and data of one stage, kept in step with it."""
 
-    def __init__(self, stage: Usd.Stage, tracker: ChangeTracker,
-                 pbr_draws: Callable[[], bool] = lambda: False,
-                 render_products: Callable[[], int] = lambda: 1) -> None:
+    def __init__(self, stage: Usd.Stage, tracker: ChangeTracker) -> None:
         self.stage = stage
         self.tracker = tracker
-        # asked at each compile: whether the pbr backend draws this process's models (render/ knows; sim/ is below)
-        self.pbr_draws = pbr_draws
-        # asked at each compile: how many render products there are, so that a model compiled for the pbr backend
-        # has a camera for each when it draws them in one launch (no recompile in the middle of a step)
-        self.render_products = render_products
         self.compiled: CompiledScene | None = None
-        self.offscreen = (64, 64)
-        self.pbr_cameras = 1                # cameras compiled for the pbr backend (render products per launch)
-        # changes on every recompile (renderers rebuild contexts); drawn from one process-wide counter so
-        # that (id(sim), model_version) keys stay unique when a freed scene's id is reused by a new one
+        # the scene renderers draw of this simulation (graphsdg.render.render_scene attaches itself), asked what
+        # a compile must carry and told of meshes and textures changed in place; this default: nothing draws it
+        self.render_link = RenderLink()
+        # changes on every recompile; drawn from one process-wide counter so that (id(sim), model_version)
+        # keys stay unique when a freed scene's id is reused by a new one
         self.model_version = next(_model_versions)
         self.labels_version = 0             # bumps when semantic labels may have changed
-        self.textures_to_upload: set[int] = set()
-        self.meshes_to_upload: set[int] = set()   # meshes whose vertices moved (deformables), for renderers
-        # mesh id -> 3x3 map from the compiled vertices to the current ones, for meshes rescaled in
-        # place since the compile; renderers draw the copy they uploaded through it (no re-upload)
-        self.mesh_maps = MeshMaps()
-        # per mesh: the count of vertex changes since the compile (rescales, deformables), so renderers that
-        # keep their own copy (the pbr backend's BVHs) find the changed meshes with one comparison
-        self.mesh_stamps = np.zeros(0, dtype=np.int64)
-        # per mesh: the count of those changes that mesh_maps does not describe (deformables): a renderer
-        # that draws its copy through the maps must take new vertices only for these
-        self.mesh_reshapes = np.zeros(0, dtype=np.int64)
         self.stats = {"compiles": 0, "compile_s": 0.0, "syncs": 0, "sync_s": 0.0, "edited_prims": 0}
         self.world_transforms = WorldTransforms(stage)   # read once until the stage changes
-        self.camera_poses = CameraPoses(self.world_transforms.parent_world)   # cameras posed with write-to-fabric
-        self.prim_reads = PrimReadCache()   # values read from prims until the stage edits them
         self._on_recompile: list[Callable[[CompiledScene], None]] = []
         self._pose_writers: dict[str, PoseWriter] = {}
         self._physics_callbacks: dict[str, Callable[[float], None]] = {}
@@ -114,78 +99,38 @@ class SimScene:
         assert self.compiled is not None
         return self.compiled
 
-    def require_offscreen(self, width: int, height: int) -> None:
-        """Make MuJoCo's offscreen buffer at least ``width`` x ``height`` (recompiles if it grows)."""
-        w, h = max(self.offscreen[0], width), max(self.offscreen[1], height)
-        if (w, h) != self.offscreen:
-            self.offscreen = (w, h)
-            if self.compiled is not None:
-                self.compiled.model.vis.global_.offwidth = w
-                self.compiled.model.vis.global_.offheight = h
-                self.model_version = next(_model_versions)
-
-    def require_pbr_cameras(self, count: int) -> None:
-        """Compile at least ``count`` cameras for the pbr backend, to draw that many render products in one
-        launch (recompiles, keeping the state, if they grow and the model has them too few: only when products
-        were created after the compile, since each compile gives every render product one)."""
-        if count > self.pbr_cameras:
-            self.pbr_cameras = count
-            if self.compiled is not None:
-                self.recompile(keep_state=True)
-
     def rescale_mesh(self, geom_id: int, old_scale: np.ndarray, new_scale: np.ndarray) -> None:
-        """Rescale visual mesh geom ``geom_id`` in place and record the map for renderers."""
+        """Rescale visual mesh geom ``geom_id`` in place and tell the renderers' scene the map."""
         self.rescale_meshes(np.array([geom_id]), np.array([old_scale]), np.array([new_scale]))
 
     def rescale_meshes(self, geom_ids: np.ndarray, old_scales: np.ndarray, new_scales: np.ndarray) -> None:
         """:meth:`rescale_mesh` for many visual mesh geoms at once (their scales as (N, 3) arrays)."""
         mesh_ids, linears = rescale_mesh_geoms(self.model, geom_ids, old_scales, new_scales)
-        self.mesh_maps.compose(mesh_ids, linears)
-        self.stamp_meshes(mesh_ids, mapped=True)
-
-    def stamp_meshes(self, mesh_ids, mapped: bool = False, distinct: bool = False) -> None:
-        """Record that meshes ``mesh_ids``' vertices changed (see :attr:`mesh_stamps`); ``mapped``: by a linear
-        map composed into :attr:`mesh_maps` (else :attr:`mesh_reshapes` counts the change too); ``distinct``:
-        no id repeats (one indexed addition instead of ``np.add.at``)."""
-        nmesh = self.model.nmesh
-        if self.mesh_stamps.shape[0] != nmesh:
-            self.mesh_stamps = np.zeros(nmesh, dtype=np.int64)
-        if self.mesh_reshapes.shape[0] != nmesh:
-            self.mesh_reshapes = np.zeros(nmesh, dtype=np.int64)
-        ids = np.asarray(list(mesh_ids) if isinstance(mesh_ids, set) else mesh_ids, dtype=np.int64)
-        for counts in (self.mesh_stamps,) if mapped else (self.mesh_stamps, self.mesh_reshapes):
-            if distinct:
-                counts[ids] += 1
-            else:
-                np.add.at(counts, ids, 1)
+        self.render_link.meshes_rescaled(mesh_ids, linears)
 
     def recompile(self, keep_state: bool = True) -> CompiledScene:
         """Compile the stage anew, keeping time and rigid-body state unless ``keep_state`` is False."""
         old = self.compiled
         start = time.perf_counter()
-        pbr = self.pbr_draws()
-        if pbr:
-            self.pbr_cameras = max(self.pbr_cameras, int(self.render_products()))
-        new = compile_stage(self.stage, self.offscreen, pbr=pbr, pbr_cameras=self.pbr_cameras)
+        needs = self.render_link.draw_needs()
+        new = compile_stage(self.stage, needs.offscreen, pbr=needs.pbr, pbr_cameras=needs.pbr_cameras)
         if old is not None and keep_state:
             carry_state(old, new)
             mujoco.mj_forward(new.model, new.data)
         self.compiled = new
         self.model_version = next(_model_versions)
         self.labels_version += 1
-        self.textures_to_upload.clear()
-        self.mesh_maps.clear()
-        self.mesh_stamps = np.zeros(new.model.nmesh, dtype=np.int64)
-        self.mesh_reshapes = np.zeros(new.model.nmesh, dtype=np.int64)
-        self.meshes_to_upload.clear()
-        self.follow_deformables()
+        moved = self._move_deformables()
         self.stats["compiles"] += 1
         self.stats["compile_s"] += time.perf_counter() - start
         for cb in list(self._on_recompile):
             cb(new)
+        if moved is not None:   # after the hooks: the render scene's records start afresh for the new model there
+            self.render_link.meshes_reshaped(moved)
         return new
 
     def subscribe_recompile(self, callback: Callable[[CompiledScene], None]) -> None:
+        """Call ``callback(compiled)`` after every compile (the render scene, physics views' model overrides)."""
         self._on_recompile.append(callback)
 
     # ---- sync ----------------------------------------------------------
@@ -193,8 +138,7 @@ class SimScene:
         """Bring MuJoCo up to date with every stage edit since the last sync."""
         changes = self.tracker.drain()
         if changes:
-            self.camera_poses.forget_edited(changes)
-            self.prim_reads.forget(changes)
+            self.render_link.stage_synced(changes)
         if self.compiled is None:
             self.recompile()
             return
@@ -326,7 +270,10 @@ class SimScene:
 
     def _refresh_light(self, path: str, cache: UsdGeom.XformCache) -> None:
         assert self.compiled is not None
-        sync_light(self.compiled, self.stage, path, cache, self.textures_to_upload)
+        textures: set[int] = set()
+        sync_light(self.compiled, self.stage, path, cache, textures)
+        if textures:
+            self.render_link.textures_changed(textures)
 
     def _refresh_material(self, path: str) -> None:
         assert self.compiled is not None
@@ -386,13 +333,20 @@ class SimScene:
 
     def follow_deformables(self) -> None:
         """Move deformables' render meshes with their flexes (MuJoCo vertices and USD points)."""
+        moved = self._move_deformables()
+        if moved is not None:
+            self.render_link.meshes_reshaped(moved)
+
+    def _move_deformables(self) -> set[int] | None:
+        """:meth:`follow_deformables` without telling the renderers' scene; the ids of the meshes moved, None
+        when the model has no deformables."""
         c = self.compiled
         if c is None or not c.deformables:
-            return
+            return None
+        moved: set[int] = set()
         with self.tracker.muted():
-            deformables.follow(c.deformables, c.model, c.data, self.stage, self.meshes_to_upload)
-        if self.meshes_to_upload:
-            self.stamp_meshes(self.meshes_to_upload)
+            deformables.follow(c.deformables, c.model, c.data, self.stage, moved)
+        return moved
 
     def write_back_rigid_bodies(self) -> None:
         """Author simulated rigid-body poses on the stage (as PhysX does for USD readers)."""

@@ -111,8 +111,7 @@ class UniformScalePlan:
             m.geom_pos[geoms] *= k[:, None]
             m.geom_aabb[geoms] *= size[:, None]
             m.geom_rbound[geoms] *= size
-            sim.mesh_maps.compose(self.mesh_ids, k[:, None, None] * _EYE, distinct=True)
-            sim.stamp_meshes(self.mesh_ids, mapped=True, distinct=True)
+            sim.render_link.meshes_rescaled(self.mesh_ids, k[:, None, None] * _EYE, distinct=True)
             current[self.mesh_rows] = world_scale[self.mesh_rows]
         if self.prim_rows.size:
             size = np.abs(prepared.factors[self.prim_rows])[:, None]
