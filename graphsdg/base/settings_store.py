@@ -206,11 +206,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/sensors/rayThreads": _integer(0),
 }
 
-_values: dict[str, Any] = {}
 _MISSING = object()
-_generation = 0   # bumped by every set and reset (readers cache what they derive from settings)
-_warned: set[str] = set()
-_lock = threading.Lock()
 
 
 def normalize_key(key: str) -> str:
@@ -220,70 +216,82 @@ def normalize_key(key: str) -> str:
     return "/" + key.strip().lstrip("/")
 
 
-def set(key: str, value: Any) -> None:  # noqa: A001 - mirrors carb's API name
-    """Store ``value`` under ``key``; warn once if graphsdg does not use the key.
+class SettingsStore:
+    """The values set, which unknown keys were warned about, and a generation bumped by every change."""
 
-    A key graphsdg uses refuses a value it cannot use (``ValueError`` naming the key).
-    """
-    k = normalize_key(key)
-    check = VALIDATORS.get(k)
-    if check is not None:
-        check(k, value)
-    global _generation
-    with _lock:
-        _values[k] = value
-        _generation += 1
-        unknown = k not in KNOWN_KEYS and k not in _warned
+    def __init__(self) -> None:
+        self._values: dict[str, Any] = {}
+        self._generation = 0   # bumped by every set and reset (readers cache what they derive from settings)
+        self._warned: set[str] = set()
+        self._lock = threading.Lock()
+
+    def set(self, key: str, value: Any) -> None:  # noqa: A003 - mirrors carb's API name
+        """Store ``value`` under ``key``; warn once if graphsdg does not use the key.
+
+        A key graphsdg uses refuses a value it cannot use (``ValueError`` naming the key).
+        """
+        k = normalize_key(key)
+        check = VALIDATORS.get(k)
+        if check is not None:
+            check(k, value)
+        with self._lock:
+            self._values[k] = value
+            self._generation += 1
+            unknown = k not in KNOWN_KEYS and k not in self._warned
+            if unknown:
+                self._warned.add(k)
         if unknown:
-            _warned.add(k)
-    if unknown:
-        warnings.warn(
-            f"setting {k!r} has no effect in graphsdg (stored, but nothing reads it){closest(k, KNOWN_KEYS)}; "
-            f"honoured keys: {', '.join(sorted(KNOWN_KEYS))}",
-            stacklevel=2,
-        )
+            warnings.warn(
+                f"setting {k!r} has no effect in graphsdg (stored, but nothing reads it){closest(k, KNOWN_KEYS)}; "
+                f"honoured keys: {', '.join(sorted(KNOWN_KEYS))}",
+                stacklevel=2,
+            )
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """Return the value of ``key``: what was set, else graphsdg's default, else ``default``."""
+        if type(key) is str:
+            # A frame reads settings ~50 times: a key spelt as stored (stored keys are normalized) needs neither
+            # normalizing nor the lock (one dict read is atomic)
+            value = self._values.get(key, _MISSING)
+            if value is not _MISSING:
+                return value
+            known = KNOWN_KEYS.get(key)   # a known key left at its default (most of a frame's reads)
+            if known is not None:
+                return known[0] if known[0] is not None else default
+        k = normalize_key(key)
+        with self._lock:
+            if k in self._values:
+                return self._values[k]
+        if k in KNOWN_KEYS and KNOWN_KEYS[k][0] is not None:
+            return KNOWN_KEYS[k][0]
+        return default
+
+    def reset(self) -> None:
+        """Forget every value that was set (defaults apply again) and which keys were already warned about."""
+        with self._lock:
+            self._values.clear()
+            self._warned.clear()
+            self._generation += 1
+
+    def generation(self) -> int:
+        """A number that changes whenever a setting is set or the settings are reset: what a hot path derived
+        from settings stays valid while it is the same.
+
+        Example:
+            >>> g = generation(); set("/omni/replicator/backend/writeThreads", 2); generation() != g
+            True
+            >>> reset()
+        """
+        return self._generation
 
 
-def get(key: str, default: Any = None) -> Any:
-    """Return the value of ``key``: what was set, else graphsdg's default, else ``default``."""
-    if type(key) is str:
-        # A frame reads settings ~50 times: a key spelt as stored (stored keys are normalized) needs neither
-        # normalizing nor the lock (one dict read is atomic)
-        value = _values.get(key, _MISSING)
-        if value is not _MISSING:
-            return value
-        known = KNOWN_KEYS.get(key)   # a known key left at its default (most of a frame's reads)
-        if known is not None:
-            return known[0] if known[0] is not None else default
-    k = normalize_key(key)
-    with _lock:
-        if k in _values:
-            return _values[k]
-    if k in KNOWN_KEYS and KNOWN_KEYS[k][0] is not None:
-        return KNOWN_KEYS[k][0]
-    return default
+#: The process's settings (held by the session, :mod:`graphsdg.engine.session`).
+store = SettingsStore()
 
-
-def reset() -> None:
-    """Forget every value that was set (defaults apply again) and which keys were already warned about."""
-    global _generation
-    with _lock:
-        _values.clear()
-        _warned.clear()
-        _generation += 1
-
-
-def generation() -> int:
-    """A number that changes whenever a setting is set or the settings are reset: what a hot path derived
-    from settings stays valid while it is the same.
-
-    Example:
-        >>> g = generation(); set("/omni/replicator/backend/writeThreads", 2); generation() != g
-        True
-        >>> reset()
-    """
-    return _generation
-
+set = store.set  # noqa: A001 - mirrors carb's API name
+get = store.get
+reset = store.reset
+generation = store.generation
 
 # carb-style aliases so `settings.get_settings().set(...)` reads naturally.
 set_bool = set_int = set_float = set_string = set

@@ -30,6 +30,7 @@ from typing import Any
 from pxr import Usd
 
 from graphsdg.annotate.motion import history as motion_history
+from graphsdg.base.settings_store import store as settings
 from graphsdg.render.attachments import attachments
 from graphsdg.render.motion_blur import recorder as motion_blur
 from graphsdg.render.render_product import registry as render_products
@@ -56,6 +57,7 @@ class Session:
     #: The pieces that outlive a stage (held, never reset by a replacement).
     PROCESS_PARTS: tuple[str, ...] = (
         "stage_context",     # the current stage and its change tracker; it calls stage_replaced
+        "settings",          # the settings store (rep.settings, carb's settings in compat mode)
         "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
         "motion_blur",       # the motion of the last step, recorded for a blurred capture
         "motion_history",    # each live render product's last capture, for motion vectors (held weakly)
@@ -66,6 +68,7 @@ class Session:
 
     def __init__(self) -> None:
         self.stage_context = stage_context
+        self.settings = settings
         self.render_products = render_products
         self.attachments = attachments
         self.scanners = scanners
