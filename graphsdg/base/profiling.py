@@ -17,23 +17,51 @@ from __future__ import annotations
 import threading
 import time
 
-# Each thread adds into a table of its own (no lock on the way: a frame adds ~30 times); snapshot() and
-# reset() go over every thread's table under the registry lock. Ended threads' totals fold into one table.
-_registry_lock = threading.Lock()
-_tables: list[tuple[threading.Thread, dict[str, float]]] = []
-_ended: dict[str, float] = {}
-_local = threading.local()
+class ProfilingTables:
+    """Seconds per accumulator name, one table per thread that adds, plus the totals of ended threads.
 
+    Each thread adds into a table of its own (no lock on the way: a frame adds ~30 times); snapshot() and
+    reset() go over every thread's table under the registry lock. Ended threads' totals fold into one table.
+    """
 
-def _new_table() -> dict[str, float]:
-    table: dict[str, float] = {}
-    with _registry_lock:
-        for thread, old in [entry for entry in _tables if not entry[0].is_alive()]:
-            _tables.remove((thread, old))
-            _fold(old, _ended)
-        _tables.append((threading.current_thread(), table))
-    _local.table = table
-    return table
+    def __init__(self) -> None:
+        self._registry_lock = threading.Lock()
+        self._tables: list[tuple[threading.Thread, dict[str, float]]] = []
+        self._ended: dict[str, float] = {}
+        self._local = threading.local()
+
+    def _new_table(self) -> dict[str, float]:
+        table: dict[str, float] = {}
+        with self._registry_lock:
+            for thread, old in [entry for entry in self._tables if not entry[0].is_alive()]:
+                self._tables.remove((thread, old))
+                _fold(old, self._ended)
+            self._tables.append((threading.current_thread(), table))
+        self._local.table = table
+        return table
+
+    def add(self, name: str, seconds: float) -> None:
+        """Add ``seconds`` to the accumulator ``name``."""
+        try:
+            table = self._local.table
+        except AttributeError:
+            table = self._new_table()
+        table[name] = table.get(name, 0.0) + seconds
+
+    def snapshot(self) -> dict[str, float]:
+        """Seconds per accumulator since the last :func:`reset`, every thread's added up."""
+        with self._registry_lock:
+            totals = dict(self._ended)
+            for _, table in self._tables:
+                _fold(table, totals)
+        return totals
+
+    def reset(self) -> None:
+        """Zero every accumulator."""
+        with self._registry_lock:
+            self._ended.clear()
+            for _, table in self._tables:
+                table.clear()
 
 
 def _fold(table: dict[str, float], into: dict[str, float]) -> None:
@@ -41,13 +69,12 @@ def _fold(table: dict[str, float], into: dict[str, float]) -> None:
         into[name] = into.get(name, 0.0) + seconds
 
 
-def add(name: str, seconds: float) -> None:
-    """Add ``seconds`` to the accumulator ``name``."""
-    try:
-        table = _local.table
-    except AttributeError:
-        table = _new_table()
-    table[name] = table.get(name, 0.0) + seconds
+#: The process's profiling tables (held by the session, :mod:`graphsdg.engine.session`).
+tables = ProfilingTables()
+
+add = tables.add
+snapshot = tables.snapshot
+reset = tables.reset
 
 
 class timed:
@@ -68,19 +95,3 @@ class timed:
     def __exit__(self, *exc: object) -> bool:
         add(self.name, time.perf_counter() - self.start)
         return False
-
-
-def snapshot() -> dict[str, float]:
-    """Seconds per accumulator since the last :func:`reset`, every thread's added up."""
-    with _registry_lock:
-        totals = dict(_ended)
-        for _, table in _tables:
-            _fold(table, totals)
-    return totals
-
-
-def reset() -> None:
-    with _registry_lock:
-        _ended.clear()
-        for _, table in _tables:
-            table.clear()

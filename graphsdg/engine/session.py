@@ -30,6 +30,7 @@ from typing import Any
 from pxr import Usd
 
 from graphsdg.annotate.motion import history as motion_history
+from graphsdg.base.profiling import tables as profiling
 from graphsdg.base.settings_store import store as settings
 from graphsdg.render.attachments import attachments
 from graphsdg.render.motion_blur import recorder as motion_blur
@@ -58,6 +59,7 @@ class Session:
     PROCESS_PARTS: tuple[str, ...] = (
         "stage_context",     # the current stage and its change tracker; it calls stage_replaced
         "settings",          # the settings store (rep.settings, carb's settings in compat mode)
+        "profiling",         # seconds per named phase (graphsdg bench --profile, orchestrator.get_profile)
         "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
         "motion_blur",       # the motion of the last step, recorded for a blurred capture
         "motion_history",    # each live render product's last capture, for motion vectors (held weakly)
@@ -69,6 +71,7 @@ class Session:
     def __init__(self) -> None:
         self.stage_context = stage_context
         self.settings = settings
+        self.profiling = profiling
         self.render_products = render_products
         self.attachments = attachments
         self.scanners = scanners
