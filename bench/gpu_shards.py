@@ -2,7 +2,7 @@
 process, and a shard killed half way resumes to the same bytes.
 
 Each shard is its own process started as ``graphsdg bench --gpus`` starts its processes
-(:func:`graphsdg.jobs.gpu_assignment.process_environment`: ``CUDA_VISIBLE_DEVICES`` naming one GPU, EGL bound
+(:func:`graphsdg.render.gpu_assignment.process_environment`: ``CUDA_VISIBLE_DEVICES`` naming one GPU, EGL bound
 to it at import) and runs :func:`graphsdg.jobs.job.run_job` for its frame plan, as a Ray shard does; the
 parent merges the shards (:func:`graphsdg.dataset.merge.merge_shards`) and compares every file with a
 one-process run of the same job on GPU 0. ``--kill-after S`` SIGKILLs shard 1 that many seconds into its
@@ -61,7 +61,7 @@ def _shard_main(script: str, out: str, frames: int, index: int, count: int, resu
 
 
 def _start(script, out, frames, index, count, resume, gpu):
-    from graphsdg.jobs.gpu_assignment import process_environment
+    from graphsdg.render.gpu_assignment import process_environment
     env = {**os.environ, **process_environment(gpu)}
     args = [sys.executable, __file__, "--shard", str(index), "--count", str(count), "--script", script, "--out", out,
             "--frames", str(frames)] + (["--resume"] if resume else [])
@@ -122,7 +122,7 @@ def main() -> int:
     if args.shard is not None:
         _shard_main(args.script, args.out, args.frames, args.shard, args.count, args.resume)
         return 0
-    from graphsdg.jobs.gpu_assignment import choose_gpus
+    from graphsdg.render.gpu_assignment import choose_gpus
     gpus = choose_gpus(args.gpus)
     work = tempfile.mkdtemp(prefix="graphsdg-gpu-shards-", dir="/dev/shm" if os.path.isdir("/dev/shm") else None)
     script = os.path.join(work, "job.py")

@@ -21,7 +21,7 @@ from graphsdg.render.gl_platform import select_gl_platform
 
 select_gl_platform()   # before anything imports mujoco
 
-from graphsdg.sensors.usd_schemas import register_sensor_schemas  # noqa: E402
+from graphsdg.stage.sensor_schemas import register_sensor_schemas  # noqa: E402
 
 register_sensor_schemas()   # before anything makes a stage: USD builds its schema registry once
 

@@ -14,7 +14,7 @@ import os
 import pytest
 
 from graphsdg.jobs.cli import main
-from graphsdg.jobs.gpu_assignment import (GpuCountError, GpuInfo, check_egl_sees, choose_gpus,
+from graphsdg.render.gpu_assignment import (GpuCountError, GpuInfo, check_egl_sees, choose_gpus,
                                           default_processes_per_gpu, gpu_of_process, gpu_share, parse_nvidia_smi,
                                           process_environment, visible_gpus)
 from graphsdg.render.egl_device import EglDeviceError, bind_visible_gpu, egl_index_of
@@ -149,8 +149,8 @@ def test_every_worker_fits_and_a_multiple_of_the_gpus_loads_them_alike(gpus):
 
 
 def test_the_gpu_flags_fail_before_anything_runs_on_a_machine_without_that_many(capsys, monkeypatch, job_script):
-    monkeypatch.setattr("graphsdg.jobs.gpu_assignment._query_nvidia_smi", lambda: "")
-    monkeypatch.setattr("graphsdg.jobs.gpu_assignment._proc_driver_gpus", lambda: [])
+    monkeypatch.setattr("graphsdg.render.gpu_assignment._query_nvidia_smi", lambda: "")
+    monkeypatch.setattr("graphsdg.render.gpu_assignment._proc_driver_gpus", lambda: [])
     monkeypatch.delenv("CUDA_VISIBLE_DEVICES", raising=False)
     assert main(["bench", "--gpus", "2", "--num-frames", "1", "--resolution", "16", "16"]) == 1
     err = capsys.readouterr().err
@@ -230,7 +230,7 @@ def test_bench_processes_each_start_on_their_own_gpu(monkeypatch):
         run_on_gpus(config, 1, gpus)
 
 
-@pytest.mark.parametrize("name", ["graphsdg.jobs.gpu_assignment", "graphsdg.render.egl_device",
+@pytest.mark.parametrize("name", ["graphsdg.render.gpu_assignment", "graphsdg.render.egl_device",
                                   "graphsdg.benchmark.multi_gpu", "graphsdg.benchmark.gpu_sampler",
                                   "graphsdg.jobs.scaleout"])
 def test_the_docstring_examples_run(name):

@@ -1,4 +1,4 @@
-"""The synthetic data recorder (graphsdg.jobs.synthetic_recorder): frames through a writer over the timeline."""
+"""The synthetic data recorder (graphsdg.synthetic_recorder): frames through a writer over the timeline."""
 from __future__ import annotations
 
 import asyncio
@@ -11,8 +11,8 @@ from PIL import Image
 
 import graphsdg as rep
 from graphsdg import orchestrator
-from graphsdg.jobs import synthetic_recorder
-from graphsdg.jobs.synthetic_recorder import RecorderState, SyntheticRecorder
+from graphsdg import synthetic_recorder
+from graphsdg.synthetic_recorder import RecorderState, SyntheticRecorder
 from graphsdg.render.attachments import attachments
 from graphsdg.engine.runtime import runtime
 

@@ -1,7 +1,7 @@
 """``graphsdg bench --gpus K``: the benchmark's processes spread over K GPUs, a row per GPU, and the scaling.
 
 The processes are dealt out to the first K GPUs this process sees
-(:mod:`graphsdg.jobs.gpu_assignment`): each starts with ``CUDA_VISIBLE_DEVICES`` naming its GPU, so its
+(:mod:`graphsdg.render.gpu_assignment`): each starts with ``CUDA_VISIBLE_DEVICES`` naming its GPU, so its
 CUDA device (Warp, the pbr backend) and, at import, its EGL device (the classic rasteriser) are that GPU.
 The table has the run's total row (:func:`graphsdg.benchmark.throughput.summarize_processes`) and a row per
 GPU: its processes, their frames/s over their common window and while all of them ran, the CPU time a
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 from graphsdg.benchmark.gpu_sampler import GpuSampler, summarize
 from graphsdg.benchmark.throughput import BenchConfig, _steady_rate, launch_processes, summarize_processes
-from graphsdg.jobs.gpu_assignment import GpuInfo, gpu_of_process, process_environment
+from graphsdg.render.gpu_assignment import GpuInfo, gpu_of_process, process_environment
 
 AGGREGATE = "aggregate frames/s (all frames / common window)"
 

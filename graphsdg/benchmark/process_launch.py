@@ -2,7 +2,7 @@
 
 ``graphsdg bench --processes P [--gpus K]`` runs P benchmark processes; with ``--gpus`` each must render on
 its own GPU, which only its environment can say before CUDA or EGL start in it (``CUDA_VISIBLE_DEVICES``,
-:mod:`graphsdg.jobs.gpu_assignment`). A pool's workers all inherit the parent's environment, so
+:mod:`graphsdg.render.gpu_assignment`). A pool's workers all inherit the parent's environment, so
 :func:`run_in_processes` starts one spawned process per task with the parent's environment patched for
 that task while it starts. Every task gets the same barrier (``before_timing``): they build and warm up
 apart, then time together. A task that fails aborts the barrier, so the others stop waiting, and the

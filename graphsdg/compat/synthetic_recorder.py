@@ -1,6 +1,6 @@
 """Isaac compat area: ``isaacsim.replicator.synthetic_recorder`` (the recorder, without its window).
 
-``SyntheticRecorder`` and ``RecorderState`` are :mod:`graphsdg.jobs.synthetic_recorder`. The extension's
+``SyntheticRecorder`` and ``RecorderState`` are :mod:`graphsdg.synthetic_recorder`. The extension's
 window (``SyntheticRecorderWindow``, the menu entry) is Kit UI and out of scope. Isaac leaves the extension
 off in a standalone app.
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 import types
 
 from graphsdg.compat.modules import CompatModule
-from graphsdg.jobs import synthetic_recorder as engine
+from graphsdg import synthetic_recorder as engine
 
 NAME = "isaacsim.replicator.synthetic_recorder"
 EXTENSIONS = {NAME: (NAME,)}

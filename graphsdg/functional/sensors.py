@@ -29,7 +29,7 @@ from graphsdg.errors import closest
 from graphsdg.sensors.lidar_profile import CORE_API, author_lidar_profile
 from graphsdg.sensors.profile_catalog import lidar_profile
 from graphsdg.sensors.radar_scan import RADAR_API
-from graphsdg.sensors.usd_schemas import require_sensor_schemas
+from graphsdg.stage.sensor_schemas import require_sensor_schemas
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import PrimLike, parent_path, unique_child_path
 from graphsdg.stage.xform import set_local_pose

@@ -116,7 +116,7 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
     scaling table. Every count is checked against the machine before anything runs."""
     from graphsdg.benchmark import multi_gpu
     from graphsdg.benchmark.throughput import format_table
-    from graphsdg.jobs.gpu_assignment import check_egl_sees, choose_gpus, default_processes_per_gpu
+    from graphsdg.render.gpu_assignment import check_egl_sees, choose_gpus, default_processes_per_gpu
     if args.processes and args.processes_per_gpu:
         raise ValueError(f"--processes {args.processes} and --processes-per-gpu {args.processes_per_gpu} both say "
                          f"how many processes run: give one of them")
@@ -244,7 +244,7 @@ def _hint(exc: BaseException) -> str:
     from graphsdg.jobs.job import JobMismatchError
     from graphsdg.io.object_store import ObjectStoreError, S3MissingError
     from graphsdg.jobs.scaleout import RayMissingError, ShardFailedError
-    from graphsdg.jobs.gpu_assignment import GpuCountError
+    from graphsdg.render.gpu_assignment import GpuCountError
     from graphsdg.render.egl_device import EglDeviceError
     if isinstance(exc, (GpuCountError, EglDeviceError)):
         return "nvidia-smi lists this machine's GPUs; CUDA_VISIBLE_DEVICES limits the ones graphsdg sees"

@@ -6,7 +6,7 @@ frames ``i, i + K, ...`` of its ``orchestrator.run(num_frames)`` (the scheduler
 seeks to each, so every frame holds the values of one uninterrupted run and the
 union of the shards is that run's dataset). Actors ask for one CPU and
 ``gpus_per_worker`` GPUs (by default an even share of every GPU of the cluster,
-:func:`~graphsdg.jobs.gpu_assignment.gpu_share`; ``--gpus K`` uses K of them); Ray
+:func:`~graphsdg.render.gpu_assignment.gpu_share`; ``--gpus K`` uses K of them); Ray
 shows each actor its GPU through ``CUDA_VISIBLE_DEVICES`` and the EGL device follows
 it, so CUDA (the pbr backend) and EGL render on the GPU Ray assigned. ``--workers auto``
 puts the cores' share of workers on each GPU (:func:`default_workers`). The driver then
@@ -32,7 +32,7 @@ import time
 from dataclasses import replace
 
 from graphsdg.base.cpu_share import cores_per_process
-from graphsdg.jobs.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
+from graphsdg.render.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
 from graphsdg.io import object_store
 from graphsdg.io.location import normalize
 from graphsdg.io.write_queue import threads_per_process
@@ -121,11 +121,11 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
     summary (with per-shard and per-GPU rows).
 
     ``gpus``: use that many GPUs (default: all the cluster's); more than the machine or cluster has is an
-    error naming both counts. Each worker asks for :func:`~graphsdg.jobs.gpu_assignment.gpu_share` of a GPU
+    error naming both counts. Each worker asks for :func:`~graphsdg.render.gpu_assignment.gpu_share` of a GPU
     unless ``gpus_per_worker`` says otherwise.
     """
     from graphsdg.dataset import merge
-    from graphsdg.jobs.gpu_assignment import choose_gpus, gpu_share
+    from graphsdg.render.gpu_assignment import choose_gpus, gpu_share
 
     if workers != "auto" and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"--workers must be a positive integer or 'auto', got {workers!r}")
@@ -216,7 +216,7 @@ def _visible_gpu_count() -> int:
 
 def default_workers(gpus: int, cores: int) -> int:
     """``--workers auto``: on GPUs, each GPU's default share of processes
-    (:func:`~graphsdg.jobs.gpu_assignment.default_processes_per_gpu`), a multiple of the GPU count so every
+    (:func:`~graphsdg.render.gpu_assignment.default_processes_per_gpu`), a multiple of the GPU count so every
     GPU gets as many; without GPUs, one a core.
 
     Example:

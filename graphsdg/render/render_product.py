@@ -13,7 +13,7 @@ from pxr import Usd, UsdGeom
 
 from graphsdg.base import settings_store as settings
 from graphsdg.errors import InvalidPrimError, RenderProductDestroyedError
-from graphsdg.sensors.usd_schemas import SENSOR_PRIM_TYPES
+from graphsdg.stage.sensor_schemas import SENSOR_PRIM_TYPES
 from graphsdg.stage.context import get_stage
 from graphsdg.stage.prims import resolve_prim, structure_version
 

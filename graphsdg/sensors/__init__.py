@@ -5,5 +5,5 @@ rays with MuJoCo (``mj_multiRay`` on the CPU, MuJoCo Warp on a GPU). ``docs/sens
 models; Isaac's sensor APIs over it are in ``graphsdg/compat/`` (``sensors_rtx*.py``).
 
 Importing the package itself does nothing: ``import graphsdg`` registers the sensor USD schemas
-(:mod:`graphsdg.sensors.usd_schemas`) before anything makes a stage.
+(:mod:`graphsdg.stage.sensor_schemas`) before anything makes a stage.
 """

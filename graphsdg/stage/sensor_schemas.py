@@ -4,7 +4,7 @@ Isaac Sim describes its RTX sensors with typed prims (``OmniLidar``, ``OmniRadar
 their settings (``OmniSensorGenericLidarCoreAPI``, the multiple-apply
 ``OmniSensorGenericLidarCoreEmitterStateAPI:s001``, ``OmniSensorGenericRadarWpmDmatAPI``, and the render
 products' ``OmniSensorDepthSensorSingleViewAPI``). usd-core knows none of them, so graphsdg ships its own
-definitions of those names (``usd_schema/generatedSchema.usda``, with a ``plugInfo.json`` that makes the typed
+definitions of those names (``sensor_schema/generatedSchema.usda``, with a ``plugInfo.json`` that makes the typed
 ones ``UsdGeomXformable``) and registers them as a codeless schema plugin. The attributes and fallbacks are
 graphsdg's (``docs/sensors.md`` lists them); the names are Isaac's, so scripts that author or read them work.
 
@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import os
 
-SCHEMA_FOLDER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "usd_schema")
+SCHEMA_FOLDER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "sensor_schema")
 
 #: The typed sensor prims graphsdg's schemas define.
 SENSOR_PRIM_TYPES = ("OmniLidar", "OmniRadar")
