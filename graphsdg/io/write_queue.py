@@ -573,10 +573,6 @@ class WriteQueue:
         return self._processes.pids() if self._processes is not None else []
 
 
-_queue: WriteQueue | None = None
-_queue_lock = threading.Lock()
-
-
 def threads_per_process(processes: int, cores: int | None = None) -> int:
     """Writer threads for each of ``processes`` processes sharing ``cores`` (default: this machine's).
 
@@ -629,48 +625,55 @@ def processes_wanted(value: Any, threads: int, cores: int | None = None) -> int:
     return int(value)
 
 
-_configured_at: tuple[int, tuple[int, int, int, int]] = (-1, (0, 0, 0, 0))
+class ProcessQueue:
+    """The process-wide write queue: made on first use, reconfigured when its settings change."""
+
+    def __init__(self) -> None:
+        self.queue: WriteQueue | None = None
+        self._lock = threading.Lock()
+        self._configured_at: tuple[int, tuple[int, int, int, int]] = (-1, (0, 0, 0, 0))
+
+    def _configured(self) -> tuple[int, int, int, int]:
+        """(threads, queue size, queue bytes, processes) from the settings; read again only when a setting
+        changed (a frame asks for the queue ~10 times)."""
+        generation = settings.generation()
+        if self._configured_at[0] != generation:
+            threads = _positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS))
+            self._configured_at = (generation, (threads, _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
+                                                _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30)),
+                                                processes_wanted(settings.get(PROCESSES_KEY, "auto"), threads)))
+        return self._configured_at[1]
+
+    def get(self) -> WriteQueue:
+        """The process-wide write queue, with the current settings applied."""
+        queue = self.queue
+        if queue is not None and self._configured_at[0] == settings.generation():   # no setting changed since
+            return queue
+        threads, size, max_bytes, processes = self._configured()
+        with self._lock:
+            if self.queue is None:
+                self.queue = WriteQueue(threads, size, max_bytes, processes)
+            elif (threads, size, max_bytes, processes) != (self.queue.num_threads, self.queue.max_size,
+                                                           self.queue.max_bytes, self.queue.num_processes):
+                self.queue.configure(threads, size, max_bytes, processes)
+            return self.queue
+
+    def current(self) -> WriteQueue | None:
+        """The process-wide queue if one was made (never creates one: used at interpreter exit)."""
+        return self.queue
+
+    def reset(self) -> None:
+        """Drain and drop the queue; the next use creates one with the current settings."""
+        with self._lock:
+            q, self.queue = self.queue, None
+        if q is not None:
+            q.shutdown()
+            q.raise_errors()
 
 
-def _configured() -> tuple[int, int, int, int]:
-    """(threads, queue size, queue bytes, processes) from the settings; read again only when a setting changed
-    (a frame asks for the queue ~10 times)."""
-    global _configured_at
-    generation = settings.generation()
-    if _configured_at[0] != generation:
-        threads = _positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS))
-        _configured_at = (generation, (threads, _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
-                                       _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30)),
-                                       processes_wanted(settings.get(PROCESSES_KEY, "auto"), threads)))
-    return _configured_at[1]
+#: The process's write queue (held by the session, :mod:`graphsdg.engine.session`).
+process_queue = ProcessQueue()
 
-
-def get_write_queue() -> WriteQueue:
-    """The process-wide write queue, with the current settings applied."""
-    global _queue
-    queue = _queue
-    if queue is not None and _configured_at[0] == settings.generation():   # no setting changed since applied
-        return queue
-    threads, size, max_bytes, processes = _configured()
-    with _queue_lock:
-        if _queue is None:
-            _queue = WriteQueue(threads, size, max_bytes, processes)
-        elif (threads, size, max_bytes, processes) != (_queue.num_threads, _queue.max_size, _queue.max_bytes,
-                                                       _queue.num_processes):
-            _queue.configure(threads, size, max_bytes, processes)
-        return _queue
-
-
-def current_write_queue() -> WriteQueue | None:
-    """The process-wide queue if one was made (never creates one: used at interpreter exit)."""
-    return _queue
-
-
-def reset_write_queue() -> None:
-    """Drain and drop the queue; the next use creates one with the current settings."""
-    global _queue
-    with _queue_lock:
-        q, _queue = _queue, None
-    if q is not None:
-        q.shutdown()
-        q.raise_errors()
+get_write_queue = process_queue.get
+current_write_queue = process_queue.current
+reset_write_queue = process_queue.reset
