@@ -1,12 +1,11 @@
 """Thread pools of a process that shares one host's cores with other graphsdg processes.
 
 OpenCV (id lookups, depth clipping) runs its operations on a pool of one thread
-per core, whose idle threads spin briefly before sleeping. Sixteen processes
-with sixteen such threads each on sixteen cores spent ~2 ms of CPU per frame
-(mostly in the kernel, measured on the H200 host) waking and parking them, for
-no speed: one 512x512 image operation is too small to split. Processes that
-share a host (``graphsdg bench --processes K``, local Ray shards) give OpenCV
-their share of the cores instead.
+per core, whose idle threads spin briefly before sleeping. Many processes with
+such pools on one host spend CPU waking and parking them, for no speed: one
+512x512 image operation is too small to split (docs/performance.md, "OpenCV's
+thread pools"). Processes that share a host (``graphsdg bench --processes K``,
+local Ray shards) give OpenCV their share of the cores instead.
 
 Example:
     >>> cores_per_process(16, cores=16), cores_per_process(3, cores=16), cores_per_process(4, cores=2)

@@ -2,8 +2,8 @@
 
 ``graphsdg bench --gpus K`` reports, per GPU, the share of time a kernel or a draw was running on it
 (``utilization.gpu``) and the memory in use, averaged over the window in which every process was timing.
-A GPU that the assignment missed shows 0 %; one held near 100 % is the limit, one well below it is fed
-too slowly by the CPU. Without ``nvidia-smi`` there are no samples and the columns read ``-``.
+A GPU that the assignment missed shows none; one held near full use is the limit, one well below it is
+fed too slowly by the CPU. Without ``nvidia-smi`` there are no samples and the columns read ``-``.
 
 Example:
     >>> samples = parse_samples(["0, 97, 5000", "1, 40, 3000", "0, 99, 5100"], stamp=10.0)

@@ -1,4 +1,4 @@
-"""What this process uses right now: memory, CPU time, and the GPU it runs on, read from the system.
+"""What this process uses right now: memory, CPU time and its GPU, read from the system.
 
 * memory (:func:`memory_usage`): resident set (RSS), virtual size (VMS) and unique
   set (USS: pages no other process shares) in bytes, from ``/proc/self``. Where
@@ -6,7 +6,7 @@
   ``getrusage`` and VMS and USS are 0.
 * CPU (:class:`ProcessCpuMeter`): the process's CPU time (user + system, every
   thread) over the wall time since the last reading, in percent of one core
-  (200 % is two cores busy).
+  (two busy cores read as two hundred).
 * GPUs (:func:`gpu_devices`): each NVIDIA GPU's name, the memory in use on it and
   the part of that this process holds, from NVML (``libnvidia-ml``, which comes
   with the driver; no package needed). Without a driver the list is empty. A

@@ -4,7 +4,7 @@ Every shape exists in three kinds, as in Isaac:
 
 * ``Visual<Shape>`` (:class:`SingleGeometryPrim`): a ``UsdGeom`` gprim without
   collision, bound to a new ``PreviewSurface`` at ``/World/Looks/visual_material``
-  (``_1``, ``_2``, ...) in ``color`` (50 % grey by default) unless a
+  (``_1``, ``_2``, ...) in ``color`` (mid grey, 0.5, by default) unless a
   ``visual_material`` is given;
 * ``Fixed<Shape>``: also a collider (``CollisionAPI``) bound to a new physics
   material at ``/World/Physics_Materials/physics_material`` (static friction 0.2,

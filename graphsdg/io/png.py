@@ -1,10 +1,10 @@
-"""PNG files compressed with Intel's ISA-L deflate (``isal``): the same images, ~6x less CPU.
+"""PNG files compressed with Intel's ISA-L deflate (``isal``): the same images for less CPU.
 
 A PNG is a signature, an ``IHDR`` chunk, the zlib stream of the filtered rows
 (``IDAT``) and ``IEND`` (PNG spec, ISO/IEC 15948). Encoding the frame's images
-was the largest CPU cost of a written frame: OpenCV's libpng + zlib spends
-~3.5 ms on a 512x512 RGBA render, ISA-L level 1 ~0.6 ms for a slightly smaller
-file, and it releases the GIL, so writer threads run in parallel. Every row
+was the largest CPU cost of a written frame; ISA-L level 1 takes a fraction of
+OpenCV's libpng + zlib time for a slightly smaller file (docs/performance.md,
+"PNG encoding with ISA-L"), and it releases the GIL, so writer threads run in parallel. Every row
 uses the ``Sub`` filter (each byte minus the byte one pixel to the left, mod 256),
 which is what OpenCV picks for rendered images too, computed in one numpy pass.
 

@@ -3,7 +3,7 @@
 Started by :mod:`graphsdg.io.write_processes`, never imported by the rest of graphsdg. It imports only
 :mod:`graphsdg.io.encode` and :mod:`graphsdg.io.atomic_files` (NumPy, OpenCV, ISA-L), not the package
 (USD, MuJoCo, GL): :data:`BOOT` stands a bare ``graphsdg`` package in for the real one, so a writer
-process starts in ~0.1 s.
+process starts quickly (docs/performance.md, "Writer processes and the interpreter lock").
 
 The protocol, over two pipes (``multiprocessing.connection`` framing, pickled tuples):
 

@@ -1,8 +1,8 @@
 """Writer processes: image, array and JSON files encoded and written outside the interpreter lock.
 
-A writer thread shares the interpreter lock with the thread that renders: measured on a GPU host, a
-128x128 frame's main thread took ~60 % more CPU with one writer thread running (15-20 hand-offs of the
-lock a frame; docs/performance.md). So the write queue hands the writes it can describe as data, the
+A writer thread shares the interpreter lock with the thread that renders, and each hand-off of the lock
+costs the render thread CPU (docs/performance.md, "Writer processes and the interpreter lock"). So the
+write queue hands the writes it can describe as data, the
 ``rep.functional.write_image`` / ``write_np`` / ``write_json`` / ``write_blob`` calls that BasicWriter
 and most writers schedule to a local file, to writer processes instead:
 
@@ -11,9 +11,8 @@ and most writers schedule to a local file, to writer processes instead:
 * a frame's writes go to one process as one message (:meth:`WriteProcesses.send`), and come back as one
   reply, taken by the threads that use the pool (:meth:`WriteProcesses.collect`: by a send that finds a
   process holding :data:`COLLECT_AFTER` batches or must choose whether to start another, and by whoever
-  waits for writes to finish). No thread of its own reads them: measured on a GPU host, a reader
-  thread woken by each reply took the interpreter lock from the thread that renders about once a frame,
-  costing it ~0.2 ms of a 3.5 ms 128x128 frame;
+  waits for writes to finish). No thread of its own reads them: a reader thread woken by each reply
+  would take the interpreter lock from the thread that renders about once a frame;
 * processes start as the backlog needs them (one while it keeps up), up to a limit; two writes to the
   same file go to the same process, so the last one scheduled is the one on disk;
 * the processes encode with the same functions as a writer thread (:mod:`graphsdg.io.write_process`),

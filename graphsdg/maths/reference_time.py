@@ -2,7 +2,8 @@
 
 The value is ``fractions.Fraction(seconds).limit_denominator(1_000_000)`` (the closest such fraction, the
 smaller denominator on a tie), worked out on plain integers: a frame asks for it once or twice, and the
-``Fraction`` objects the standard way builds cost ~40 Python calls a frame.
+``Fraction`` objects the standard way builds cost many Python calls a frame (docs/performance.md,
+"Reference time").
 
 Example:
     >>> reference_time(0.1)

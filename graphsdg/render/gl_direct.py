@@ -1,13 +1,12 @@
-"""GL and EGL entry points that keep the interpreter lock: for the many short calls of every frame.
+"""GL and EGL entry points for short calls, called without releasing the interpreter lock.
 
 PyOpenGL calls GL through ctypes, which releases the interpreter lock around every
-call, then checks ``glGetError`` (a second call). For a call that returns in a
-microsecond (a bind, a state change, a fence poll) the release is a hand-off, not
-a help: a writer thread running Python takes the lock, and the render thread waits
-until that thread gives it back, up to the interpreter's switch interval (5 ms).
-Measured on the CPU machine with one other thread running Python: ``glBindBuffer``
-through PyOpenGL took 1.9 ms a call (waiting for the lock), through these 1 us.
-A frame makes ~60 such calls (readback, id framebuffer, one-colour sky).
+call, then checks ``glGetError`` (a second call). For a call that returns at once
+(a bind, a state change, a fence poll) the release is a hand-off, not a help: a
+writer thread running Python takes the lock, and the render thread waits until
+that thread gives it back, up to the interpreter's switch interval. A frame makes
+dozens of such calls (readback, id framebuffer, one-colour sky); docs/performance.md
+("Short GL calls and the interpreter lock") has the measurements.
 
 The functions here are the same driver entry points (resolved from the library
 PyOpenGL loaded), called through ``ctypes.PYFUNCTYPE``, which keeps the lock, and

@@ -2,25 +2,20 @@
 
 Ids and depth must be exact at pixel centres, so they are drawn with one sample
 per pixel. MuJoCo turns multisampling off for its id colours, which Mesa
-honours; NVIDIA's driver (measured: H200, driver 580, 4x MSAA) still resolves
-the multisampled id colours, blending neighbouring ids into the colour of a
-third geom (labels far from their objects, boxes up to 160 pixels too big). So
-id passes draw into a framebuffer of their own.
+honours; NVIDIA's driver still resolves the multisampled id colours, blending
+neighbouring ids into the colour of a third geom. So id passes draw into a
+framebuffer of their own.
 
 It is graphsdg's, not MuJoCo's, because of its depth format. MuJoCo's buffers
-hold depth as DEPTH32F_STENCIL8 (8 bytes a pixel, stencil for mirror
-reflections, which graphsdg never compiles); reading depth alone out of them
-makes NVIDIA's driver unpack it on the GPU (0.30 ms of a 512x512 frame), and
-reading them as stored moves twice the bytes. Here depth is DEPTH_COMPONENT32F:
-read as stored, 4 bytes a pixel, in one copy. (Measured on the H200 host with
-16 processes sharing the GPU: every extra byte read back costs throughput,
-768 KB more a frame cut it by 12 %.)
+hold depth as DEPTH32F_STENCIL8 (stencil for mirror reflections, which graphsdg
+never compiles), which NVIDIA's driver unpacks on the GPU to read depth alone.
+Here depth is DEPTH_COMPONENT32F: read as stored, 4 bytes a pixel, in one copy.
 
 Its colour holds only the bytes of id colour the codes need (:func:`colour_format`):
 one (R8) for scenes of fewer than 255 geoms, so reading the codes back is a plain
-copy of one byte a pixel; reading the red byte out of RGBA8 made the GPU repack
-every pixel (0.078 ms of GPU time per 512x512 frame on the H200, more than the
-copy of the whole 4-byte colour image).
+copy of one byte a pixel, where the red byte of RGBA8 would make the GPU repack
+every pixel. docs/performance.md ("The id framebuffer's formats") has the
+measurements behind these choices.
 
 Example (inside a current GL context)::
 

@@ -1,8 +1,9 @@
-"""Warp's kernel cache for the pbr backend: one folder per node, each kernel compiled once, compiled ahead.
+"""Warp's kernel cache for the pbr backend: one folder a node, each kernel compiled once.
 
 Nearly all of a fresh GPU machine's first pbr frame is Warp compiling mujoco-warp-pbr's render megakernel
-(one module specialised on the scene: light count, geom types, baked settings; 47-85 s on H100 hosts,
-issue 37), and every process that starts meanwhile compiles it again. This module makes that once a node:
+(one module specialised on the scene: light count, geom types, baked settings; docs/performance.md, "The pbr
+kernels' first compile"), and every process that starts meanwhile compiles it again. This module makes that
+once a node:
 
 * **One cache folder.** ``GRAPHSDG_KERNEL_CACHE`` (else Warp's own: ``WARP_CACHE_PATH`` or
   ``~/.cache/warp``) for every graphsdg process of the node, Ray workers included (the variable is

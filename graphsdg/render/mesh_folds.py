@@ -9,7 +9,7 @@ parameter ``t`` (so distances and depth are the world's), and ``X n = xmat G^-T 
 transpose that normals take. The scene BVH bounds a mesh geom by the corners of ``X`` applied to the
 mesh's half extents; those are replaced by ``|G^T| |G| e``, which ``|X|`` maps onto a box containing
 ``|xmat G| e`` (for a diagonal ``G``, exactly it). A rescale then costs a 3x3 product per geom and no
-BVH refit (measured on an H100: 20 rescaled meshes' refits were 2.3 ms of a frame).
+BVH refit (docs/performance.md, "Rescaled meshes without BVH refits").
 
 Vertex changes that no map describes (deformables: :attr:`RenderScene.mesh_reshapes`) are refit instead
 (:mod:`graphsdg.render.pbr_meshes`). Pure numpy: tested without a GPU.

@@ -2,8 +2,9 @@
 
 A blocking wait in NVIDIA's drivers (``glClientWaitSync`` with a timeout, ``cudaDeviceSynchronize`` in its
 default schedule) spins a CPU core until the GPU is done. On a host running one capture process per core,
-those spins took the cores the other processes' writers needed (docs/performance.md). Polling with short
-sleeps, 20 us at first and doubling up to 200 us, ends a wait at most ~0.2 ms late for a few system calls.
+those spins took the cores the other processes' writers needed (docs/performance.md, "Waiting for the GPU
+without spinning"). Polling with short sleeps, :data:`FIRST_SLEEP` at first and doubling up to
+:data:`LONGEST_SLEEP`, ends a wait at most one longest sleep late, for a few system calls.
 
 Example:
     >>> import itertools

@@ -11,9 +11,8 @@ buffer stores it.
 
 Mapping a buffer the GPU is still copying into makes NVIDIA's driver spin on
 the CPU until it is done. With many processes sharing one GPU each such wait
-is long (other contexts' work runs first): measured on the H200 host with 16
-processes, 5.5 of a frame's 16 CPU milliseconds went to that spinning. So each
-read is followed by a fence, and a map first waits for the fence by polling it
+is long (other contexts' work runs first; docs/performance.md, "Waiting for the
+GPU without spinning"). So each read is followed by a fence, and a map first waits for the fence by polling it
 and sleeping in between (:func:`wait_for_fence`), which leaves the core to
 other processes and the interpreter lock to the writer threads.
 

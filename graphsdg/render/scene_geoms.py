@@ -3,10 +3,10 @@
 Two passes of every render read or write a few fields of every geom in the
 scene: the id colours' code -> geom table (``segid``, ``objtype``, ``objid``) and
 the rescaled meshes' matrices (``type``, ``objid``, ``mat``). Through the Python
-bindings each geom is an object and each field an attribute, ~1.9 us a geom per
-pass on the CPU machine: 9.4 ms a pass at 5,000 geoms, the largest per-object
-cost of a crowded frame. Over the same memory as a structured array each pass is
-a few array operations.
+bindings each geom is an object and each field an attribute, the largest
+per-object cost of a crowded frame (docs/performance.md, "Scene geoms as one
+array"). Over the same memory as a structured array each pass is a few array
+operations.
 
 The view is laid over the bindings' own memory: its address comes from a field
 the bindings already expose as an array (``size``), its stride from two

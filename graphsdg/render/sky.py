@@ -1,9 +1,8 @@
 """A one-colour sky drawn as one flat rectangle behind the geometry instead of MuJoCo's skybox.
 
 MuJoCo draws its skybox as a textured cylinder around the camera after the
-opaque geometry: on the H200 (whose GH100 die has few graphics units) that draw
-was 0.14 of the 0.58 GPU milliseconds of a 512x512 4x-MSAA colour pass of the
-benchmark scene. When the sky is one colour (an untextured dome light) the same
+opaque geometry, a costly draw on GPUs with few graphics units (docs/performance.md,
+"The one-colour sky"). When the sky is one colour (an untextured dome light) the same
 samples come from one untextured rectangle drawn where the depth buffer still
 holds its clear value, i.e. where no geometry was drawn, sample by sample, so
 anti-aliased edges resolve exactly as they do over the skybox.

@@ -1,9 +1,9 @@
 """World transforms read from a stage, kept until the stage changes.
 
 A capture reads a few world transforms every frame (a camera's parent, to place a camera posed with
-write-to-fabric; the stage's units), and in a capture loop each read pays for cold caches: ~40 us a
-``ComputeLocalToWorldTransform`` measured inside the bench loop, against ~3 us in a tight loop. A scene
-randomized with write-to-fabric leaves the stage untouched, so the values read once stay right.
+write-to-fabric; the stage's units), and in a capture loop each read pays for cold caches
+(docs/performance.md, "World transforms kept"). A scene randomized with write-to-fabric leaves the stage
+untouched, so the values read once stay right.
 
 :class:`WorldTransforms` listens to the stage's ``ObjectsChanged`` notices, all of them (graphsdg's own
 write-backs of simulated bodies included), and forgets everything it read at the first one: a transform

@@ -18,8 +18,8 @@ outer boundaries through pixel centres: approximate, holes filled). Extra key:
 Categories: with ``coco_categories`` (``{label: {"name", "id", ...}}``, as in
 Replicator) labels missing from it become ``"other"``; without it every label
 is its own category, numbered from 1 in first-seen order. The JSON is rewritten
-every 25 frames, on ``flush()`` (``wait_until_complete()``, ``detach()``) and in
-``on_final_frame``.
+every :data:`FLUSH_EVERY` frames, on ``flush()`` (``wait_until_complete()``,
+``detach()``) and in ``on_final_frame``.
 
 Needs ``pycocotools`` (``pip install graphsdg[datasets]``).
 

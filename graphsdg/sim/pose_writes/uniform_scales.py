@@ -3,10 +3,9 @@
 A randomizer that scales a batch (``rep.functional.modify.pose(prims, scale_value=...)`` with
 write-to-fabric) most often gives each prim one factor for all three axes. The general path of
 :mod:`graphsdg.sim.pose_writes.mujoco_poses` then still works out, every frame, which rows are boxes, spheres or
-tubes, whether the meshes are distinct and their vertices one run, and checks each step: ~75 small NumPy
-operations for 50 assets, ~0.2 ms a frame inside a capture loop, where each costs 2-4 times what it does in
-a tight loop. :class:`UniformScalePlan` works those out once per target list and compile, so a frame's
-uniform rescale is ~25 operations. Every value written is the one the general path writes, bit for bit
+tubes, whether the meshes are distinct and their vertices one run, and checks each step.
+:class:`UniformScalePlan` works those out once per target list and compile, so a frame's uniform rescale
+is a third of the operations (docs/performance.md, "Uniform rescales"). Every value written is the one the general path writes, bit for bit
 (the sizes are the unit sizes times the factor, products the general path computes the same way).
 
 Example:
