@@ -5,8 +5,9 @@ write-to-fabric) most often gives each prim one factor for all three axes. The g
 :mod:`graphsdg.sim.pose_writes.mujoco_poses` then still works out, every frame, which rows are boxes, spheres or
 tubes, whether the meshes are distinct and their vertices one run, and checks each step.
 :class:`UniformScalePlan` works those out once per target list and compile, so a frame's uniform rescale
-is a third of the operations (docs/performance.md, "Uniform rescales"). Every value written is the one the general path writes, bit for bit
-(the sizes are the unit sizes times the factor, products the general path computes the same way).
+is a third of the operations (docs/performance.md, "Uniform rescales"). Every value written is the one
+the general path writes, bit for bit (the sizes are the unit sizes times the factor, products the general
+path computes the same way).
 
 Example:
     >>> import graphsdg as rep
