@@ -1,4 +1,4 @@
-"""The synthetic data recorder: a writer attached to render products, capturing a set number of frames.
+"""The synthetic data recorder: a writer on render products capturing a set number of frames.
 
 A :class:`SyntheticRecorder` (Isaac Sim's ``isaacsim.replicator.synthetic_recorder`` without its window) is
 configured by attributes: ``writer_name`` and ``writer_params`` (given to ``writer.initialize``),

@@ -1,5 +1,5 @@
-"""Randomizer nodes: each execution calls the matching ``graphsdg.functional.randomizer`` function
-with the node's per-execution stream as ``rng``."""
+"""Randomizer nodes: each execution calls the matching ``graphsdg.functional.randomizer`` function. It passes the
+node's per-execution stream as ``rng``."""
 from __future__ import annotations
 
 import os

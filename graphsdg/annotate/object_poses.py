@@ -1,4 +1,5 @@
-"""The ``dope`` and ``pose`` annotators: labelled objects' poses in a chosen camera frame and their projections.
+"""The ``dope`` and ``pose`` annotators: labelled objects' poses and projections. Poses are in a chosen camera
+frame.
 
 Both start from the USD camera (its view and projection matrices, from ``camera_params``) and a *desired*
 camera turned from it by ``cameraRotation`` (Euler degrees, X then Y then Z about fixed axes; ``(180, 0, 0)``

@@ -1,4 +1,4 @@
-"""Stand-ins for Isaac's camera-calibration assets: a 6 x 10 checkerboard target and the Hawk stereo camera.
+"""Stand-ins for Isaac's camera-calibration assets. A 6 x 10 checkerboard target and the Hawk stereo camera.
 
 * ``/Isaac/Props/Camera/checkerboard_6x10.usd``: a calibration board with
   6 x 10 inner corners (7 x 11 squares of 0.1 m) on a white margin, 0.8 m wide

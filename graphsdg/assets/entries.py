@@ -1,4 +1,4 @@
-"""What one item of the asset pack is: its path, its size and the code that writes it.
+"""What one item of the asset pack is. Its path, its size and the code that writes it.
 
 :class:`UsdAsset` and :class:`ImageAsset` describe the pack's files;
 :mod:`graphsdg.assets.catalog` gathers them from the modules that build them.

@@ -1,4 +1,4 @@
-"""Stand-ins for Isaac Sim's material-handling props: a wooden pallet, a small KLT bin and a platform dolly.
+"""Stand-ins for Isaac Sim's material-handling props. A wooden pallet, a small KLT bin and a platform dolly.
 
 * ``/Isaac/Props/Pallet/pallet.usd``: a 1.22 x 1.02 m (48 x 40 in) stringer
   pallet: three stringers, seven top deck boards and three bottom boards, each a

@@ -1,4 +1,4 @@
-"""More of Isaac Sim's Simple_Warehouse props: a traffic cone, a wet-floor sign, a plastic drum, pallets and boxes.
+"""More of Isaac Sim's Simple_Warehouse props. A traffic cone, a wet-floor sign, a plastic drum, pallets and boxes.
 
 Stand-ins at ``/Isaac/Environments/Simple_Warehouse/Props/<name>.usd``, the
 distractors and stacking props of Isaac's SDG examples (object-based SDG's mesh

@@ -1,6 +1,6 @@
-"""Behavior scripts: per-prim Python behaviors attached through ``omni:scripting:scripts`` and driven by the
-timeline or by events, and graphsdg's randomizing behaviors (location, rotation, look-at, light, texture,
-volume stacking) with their settings exposed as USD attributes.
+"""Behavior scripts: per-prim Python behaviors and graphsdg's randomizing behaviors. Scripts attach through
+``omni:scripting:scripts`` and are driven by the timeline or by events; the randomizing behaviors (location,
+rotation, look-at, light, texture, volume stacking) expose their settings as USD attributes.
 """
 from graphsdg.behaviors.exposed_variables import (EXPOSED_ATTR_NS, EXPOSED_VARS_CHANGED_EVENT, EXTENSION_NAME,
                                                   SCOPE_NAME, add_behavior_script,

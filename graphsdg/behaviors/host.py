@@ -1,4 +1,5 @@
-"""What the host application gives behavior scripts: a bus of named events and a wait for the next app update.
+"""What the host application gives behavior scripts: an event bus and an update wait. The bus carries named events;
+the wait ends at the next app update.
 
 Behaviors talk to the outside through named events (a payload dict each): a script observes the events that
 control it and dispatches its state. Long-running behaviors (a physics settling run) wait for app updates

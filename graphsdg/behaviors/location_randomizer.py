@@ -1,4 +1,5 @@
-"""LocationRandomizer: moves prims by a random offset in a box, around where they were or around a target prim.
+"""LocationRandomizer: moves prims by a random offset in a box. The box lies around where they were or around a
+target prim.
 
 Exposed (``exposedVar:locationRandomizer:``): ``range:minPosition`` / ``range:maxPosition`` (the offset's box),
 ``frame:useRelativeFrame`` (add the offset to the prim's starting location, or to its starting offset from the

@@ -1,4 +1,5 @@
-"""RotationRandomizer: turns prims to random Euler angles (X, then Y, then Z about fixed axes) in a range.
+"""RotationRandomizer: turns prims to random Euler angles in a range. The angles turn X, then Y, then Z about fixed
+axes.
 
 Exposed (``exposedVar:rotationRandomizer:``): ``range:minRotation`` / ``range:maxRotation`` (degrees per
 axis), ``includeChildren``, ``interval``, ``seed``. The rotation goes into the prim's own rotation op

@@ -1,4 +1,4 @@
-"""The physics set-up a stacking behavior builds: assets, colliders, rigid bodies, walls, and stepping by hand.
+"""The physics set-up a stacking behavior builds. Assets, colliders, rigid bodies, walls, and stepping by hand.
 
 Stacking drops assets onto a surface and lets physics settle them while the timeline is stopped: each step
 is ``SimScene.advance`` (which authors the simulated poses on the stage, so the settled stack is what the

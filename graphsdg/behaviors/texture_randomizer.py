@@ -1,4 +1,5 @@
-"""TextureRandomizer: binds an OmniPBR material of its own to each gprim and draws its texture and UV settings.
+"""TextureRandomizer: gives each gprim its own OmniPBR material and draws its texture. It also draws the material's
+UV settings.
 
 Exposed (``exposedVar:textureRandomizer:``): ``textures:assets`` (asset paths) and ``textures:csv`` (comma-
 separated; a path without a URL scheme is under the asset root), ``projectUvwProbability``,

@@ -1,3 +1,3 @@
-"""The SDG throughput benchmark (``graphsdg bench``: :mod:`graphsdg.benchmark.throughput`) and the named
-per-phase time accumulators that it and ``rep.orchestrator.get_profile()`` report
-(:mod:`graphsdg.base.profiling`)."""
+"""The SDG throughput benchmark (``graphsdg bench``) and its per-phase time accumulators. The benchmark is
+:mod:`graphsdg.benchmark.throughput`; the named accumulators that it and ``rep.orchestrator.get_profile()`` report
+are :mod:`graphsdg.base.profiling`."""

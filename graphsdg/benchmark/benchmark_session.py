@@ -1,4 +1,4 @@
-"""A benchmark in phases: recorders started per phase, measurements stored per phase, metrics files at the end.
+"""A benchmark in phases. Recorders started per phase, measurements stored per phase, metrics files at the end.
 
 This is what Isaac Sim's ``BaseIsaacBenchmark`` does, measured on graphsdg:
 

@@ -1,4 +1,4 @@
-"""Where a benchmark's phases go when it stops: the metrics files Isaac Sim's benchmark services write.
+"""Where a benchmark's phases go when it stops. The metrics files Isaac Sim's benchmark services write.
 
 Backends, chosen by name (:func:`metrics_backend`):
 

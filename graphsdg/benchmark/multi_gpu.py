@@ -1,4 +1,4 @@
-"""``graphsdg bench --gpus K``: the benchmark's processes spread over K GPUs, a row per GPU, and the scaling.
+"""``graphsdg bench --gpus K``: the benchmark's processes spread over K GPUs. A row per GPU, and the scaling.
 
 The processes are dealt out to the first K GPUs this process sees
 (:mod:`graphsdg.render.gpu_assignment`): each starts with ``CUDA_VISIBLE_DEVICES`` naming its GPU, so its

@@ -1,4 +1,4 @@
-"""What this process uses right now: memory, CPU time and its GPU, read from the system.
+"""What this process uses right now: memory, CPU time and its GPU. Each figure is read from the system.
 
 * memory (:func:`memory_usage`): resident set (RSS), virtual size (VMS) and unique
   set (USS: pages no other process shares) in bytes, from ``/proc/self``. Where

@@ -1,4 +1,4 @@
-"""What a benchmark recorder is: its base class, what it returns, and the registry that names recorders.
+"""What a benchmark recorder is. Its base class, what it returns, and the registry that names recorders.
 
 A recorder measures one thing over a benchmark phase. Stateful ones
 (frame times, CPU use) have ``start_collecting()`` / ``stop_collecting()`` and

@@ -1,5 +1,6 @@
-"""Isaac compat area: ``isaacsim.core.prims.SingleArticulation``, ``isaacsim.core.api.robots.Robot`` and
-``isaacsim.core.api.controllers.ArticulationController``: one articulation through a one-row
+"""Isaac compat area: ``SingleArticulation``, ``Robot`` and ``ArticulationController`` over one articulation.
+Isaac's ``isaacsim.core.prims.SingleArticulation``, ``isaacsim.core.api.robots.Robot`` and
+``isaacsim.core.api.controllers.ArticulationController``, through a one-row
 :class:`~graphsdg.compat.core_articulations.Articulation` (see that module for how joints map onto MuJoCo).
 
 ``SingleArticulation`` answers for the first row (``get_joint_positions()`` is a (K,) array); its

@@ -1,4 +1,4 @@
-"""The stage Isaac Sim 6's experimental API acts on: the one ``use_stage`` set on this thread, else the current one.
+"""The stage Isaac Sim 6's experimental API acts on. The one ``use_stage`` set on this thread, else the current one.
 
 ``isaacsim.core.experimental.utils.stage.use_stage(stage)`` makes every experimental
 function and wrapper of the calling thread act on ``stage`` (an in-memory stage,

@@ -1,4 +1,4 @@
-"""Isaac compat area: Isaac Sim's pre-4.5 names (``omni.isaac.*`` and friends) import as the modules replacing them.
+"""Isaac compat area: Isaac Sim's pre-4.5 names (``omni.isaac.*`` and friends) import as their replacements.
 
 A large share of published Isaac code predates Isaac Sim 4.5's rename
 (``from omni.isaac.kit import SimulationApp``, ``from omni.isaac.core import World``,

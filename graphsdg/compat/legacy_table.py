@@ -1,4 +1,4 @@
-"""Isaac Sim 4.5's rename table as data: pre-4.5 module and extension names and what replaced them.
+"""Isaac Sim 4.5's rename table as data. Pre-4.5 module and extension names and what replaced them.
 
 Isaac Sim 4.5 renamed its ``omni.isaac.*`` extensions (and a few ``omni.*`` ones)
 to ``isaacsim.*``; until 5.0 the old extensions stayed as shims, each old module

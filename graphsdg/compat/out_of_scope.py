@@ -1,4 +1,4 @@
-"""Isaac Sim capabilities graphsdg's compat mode leaves out on purpose, each with the reason it gives.
+"""Isaac Sim capabilities graphsdg's compat mode leaves out on purpose. Each with the reason it gives.
 
 Importing one of these modules, or enabling one of these extensions, fails with
 :class:`~graphsdg.compat.modules.CompatImportError` naming the module and saying

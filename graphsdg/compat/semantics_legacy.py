@@ -1,4 +1,4 @@
-"""Isaac compat area: the semantics API of Isaac Sim 2022.x to 5.x, which published scripts still use.
+"""Isaac compat area: the semantics API of Isaac Sim 2022.x to 5.x. Published scripts still use it.
 
 Before ``UsdSemantics.LabelsAPI``, Isaac labelled prims with Kit's multiple-apply schema
 ``Semantics.SemanticsAPI`` (``from pxr import Semantics``): an instance (``"Semantics"`` by

@@ -1,4 +1,4 @@
-"""Isaac compat: the debug-draw writers of RTX sensors, headless: they write the point clouds they would draw.
+"""Isaac compat: the debug-draw writers of RTX sensors, headless. They write the point clouds they would draw.
 
 In Kit, ``RtxLidarDebugDrawPointCloud``, ``RtxLidarDebugDrawPointCloudBuffer``, ``RtxRadarDebugDrawPointCloud``
 and ``RtxSensorDebugDrawPointCloud`` (the sensor runtimes' ``"draw-point-cloud"``) draw a sensor's points in the

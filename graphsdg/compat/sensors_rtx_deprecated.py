@@ -1,5 +1,5 @@
-"""Isaac compat area: the deprecated ``isaacsim.sensors.rtx`` (``LidarRtx``, ``get_gmo_data``, the Kit commands
-``IsaacSensorCreateRtxLidar`` / ``IsaacSensorCreateRtxRadar``) over graphsdg's ray-cast sensors.
+"""Isaac compat area: the deprecated ``isaacsim.sensors.rtx`` over graphsdg's ray-cast sensors. ``LidarRtx``,
+``get_gmo_data`` and the Kit commands ``IsaacSensorCreateRtxLidar`` / ``IsaacSensorCreateRtxRadar``.
 
 * The commands (registered while compat mode is installed, as Kit registers them at startup) create an
   ``OmniLidar`` / ``OmniRadar`` prim at the next free ``path`` under ``parent`` (which must exist), placed by

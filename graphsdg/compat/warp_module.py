@@ -1,4 +1,4 @@
-"""``import warp`` in compat mode when warp-lang is not installed: an error naming graphsdg's ``warp`` extra.
+"""``import warp`` in compat mode without warp-lang installed. It raises an error naming graphsdg's ``warp`` extra.
 
 Isaac's augmentation scripts import Warp at the top (``import warp as wp``) even when they run their NumPy
 path. Warp is an optional dependency of graphsdg (``pip install 'graphsdg[warp]'``, Warp kernels run on

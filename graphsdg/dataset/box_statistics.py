@@ -1,4 +1,4 @@
-"""Box statistics of a dataset: totals, empty frames and a per-class table (instances, frames, box sizes).
+"""Box statistics of a dataset. Totals, empty frames and a per-class table (instances, frames, box sizes).
 
 Example:
     >>> from graphsdg.dataset.view_frame import ViewBox, ViewFrame

@@ -1,4 +1,4 @@
-"""The classes of a dataset as the viewers show them: one id and one colour per class name.
+"""The classes of a dataset as the viewers show them. One id and one colour per class name.
 
 A class's colour depends on its name only (the same in every dataset, format and
 viewer: the contact sheet, the HTML gallery and the Rerun recording); its id is

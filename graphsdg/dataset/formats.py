@@ -1,4 +1,4 @@
-"""Reading the frames of a BasicWriter, COCO, KITTI or YOLO dataset into one shape, for viewing.
+"""BasicWriter, COCO, KITTI or YOLO frames read into one shape, for viewing.
 
 :func:`detect_format` tells the layout from its files (``coco_annotations*.json``;
 ``label_02/`` or ``object_detection/`` with ``.txt`` labels; ``data.yaml`` with

@@ -1,4 +1,4 @@
-"""``graphsdg view DIR --rerun``: every frame of a dataset logged to a Rerun recording (``.rrd``) or viewer.
+"""``graphsdg view DIR --rerun``: a dataset's frames logged to a Rerun recording (``.rrd``) or viewer.
 
 Needs the ``viewer`` extra (``pip install 'graphsdg[viewer]'``: the ``rerun-sdk``
 package). Frames are logged on the ``frame`` timeline (each camera's frames 0, 1,

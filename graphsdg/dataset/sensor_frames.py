@@ -1,4 +1,4 @@
-"""Lidar and radar scans written by PointCloudWriter, as view frames: their points, classes and a bird's-eye view.
+"""PointCloudWriter's lidar and radar scans as view frames. Their points, classes and a bird's-eye view.
 
 PointCloudWriter (:mod:`graphsdg.io.writers.point_cloud`) writes, per render product of a sensor prim,
 ``<rp>/pointcloud_{n}.json`` (modality, frame, sensor pose, object id -> prim path and labels) beside the

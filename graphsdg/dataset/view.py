@@ -1,4 +1,5 @@
-"""``graphsdg view``: a contact sheet (and a gallery page) of a dataset with boxes, names and masks drawn.
+"""``graphsdg view``: a contact sheet (and a gallery page) of a dataset. Boxes, names and masks are drawn over the
+images.
 
 Reads BasicWriter, COCO, KITTI and YOLO outputs, in a folder or under an
 ``s3://bucket/prefix`` (:mod:`graphsdg.dataset.formats` detects which) and

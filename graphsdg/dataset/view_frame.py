@@ -1,4 +1,4 @@
-"""One frame of a dataset as the viewers see it, whatever the format: its image and what lies over it.
+"""One frame of a dataset as the viewers see it, whatever the format. Its image and what lies over it.
 
 :class:`ViewFrame` holds what every format has (the image and its 2D boxes) and
 loaders for what only some have: loose boxes, semantic and instance masks,

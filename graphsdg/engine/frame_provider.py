@@ -1,4 +1,4 @@
-"""The engine's one question to the graph: what a step fires, and how long a run lasts.
+"""The engine's question to the graph: what a step fires, how long a run lasts.
 
 The capture engine and the run loop never call the graph's scheduler: they ask the runtime's
 :class:`FrameProvider` (``runtime().frame_provider``). The node graph installs its scheduler there

@@ -1,4 +1,5 @@
-"""Progress of long runs: a live bar on a terminal, periodic log lines elsewhere, and a final summary.
+"""Progress of long runs: a live bar, log lines, and a final summary. The bar shows on a terminal, periodic log
+lines elsewhere.
 
 Example:
     >>> with Progress(total=3, enabled=False) as bar:

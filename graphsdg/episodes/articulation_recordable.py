@@ -1,4 +1,5 @@
-"""The world poses of every link of an articulation, as one (L, 3) / (L, 4) pair of channels per frame.
+"""The world poses of every link of an articulation, recorded per frame. One (L, 3) / (L, 4) pair of channels a
+frame.
 
 The links are the articulation root and the rigid bodies below it (or, for a
 tree without rigid bodies, every xformable prim below it), in depth-first child

@@ -1,4 +1,4 @@
-"""What one recorded signal looks like, how often recordables are sampled, and how strict replay is.
+"""What one recorded signal looks like. Also how often recordables are sampled, and how strict replay is.
 
 :class:`ChannelDescriptor` is the per-frame shape and dtype of one dataset of a
 session file (plus units, space and quaternion order, stored as dataset

@@ -1,4 +1,4 @@
-"""Recordables of one prim's pose: a rigid body, any xform (world or local), a camera with its lens.
+"""Recordables of one prim's pose. A rigid body, any xform (world or local), a camera with its lens.
 
 Each records ``position`` (3, metres) and ``orientation`` (4, quaternion w, x, y,
 z). World-space ones take part in the session's pose batch (one read of every

@@ -1,4 +1,4 @@
-"""The plugin a session records: one HDF5 group of channels, sampled per tick and applied back on replay.
+"""The plugin a session records: one HDF5 group of channels. Sampled per tick and applied back on replay.
 
 A :class:`Recordable` declares its channels (:meth:`~Recordable.describe_channels`),
 returns one frame of them per tick (:meth:`~Recordable.sample`), puts one frame

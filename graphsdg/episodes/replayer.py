@@ -1,4 +1,4 @@
-"""Replaying a recorded episode on the live stage, frame by frame, with writers free to capture each frame.
+"""Replaying a recorded episode on the live stage, frame by frame. Writers are free to capture each frame.
 
 An :class:`EpisodeReplayer` opens a session file, rebuilds its recordables from
 the manifest (:mod:`graphsdg.episodes.registry`), binds them to the current stage

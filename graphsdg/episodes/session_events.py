@@ -1,4 +1,4 @@
-"""Observers of a recorder's session and episode transitions (for panels and tools that show its state).
+"""Observers of a recorder's session and episode transitions. For panels and tools that show its state.
 
 Example:
     >>> events = SessionEvents()

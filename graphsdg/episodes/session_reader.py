@@ -1,4 +1,4 @@
-"""Reading a session file: its manifest, episodes, and frames or whole channels of a recordable group."""
+"""Reading a session file. Its manifest, episodes, and frames or whole channels of a recordable group."""
 from __future__ import annotations
 
 import json

@@ -1,4 +1,4 @@
-"""A USD copy of the stage next to recorded sessions (``stage_snapshot.usd``) and a JSON note describing it.
+"""A USD copy of the stage next to recorded sessions. ``stage_snapshot.usd``, and a JSON note describing it.
 
 Sessions in one folder share one snapshot; a session opened where the snapshot
 already exists names it in its ``stage_snapshot`` root attribute, so a replay

@@ -1,4 +1,4 @@
-"""Finding what to record under a prim: articulations, loose rigid bodies, plain xforms, by HDF5-safe names.
+"""Finding what to record under a prim. Articulations, loose rigid bodies and plain xforms, by HDF5-safe names.
 
 Each function walks the prims below ``root_path`` (depth-first, the last child
 first: a stable order, so name collisions resolve the same way every time) and

@@ -1,4 +1,4 @@
-"""One value for all prims, or one per prim: how every per-prim argument is spread over N prims.
+"""One value for all prims, or one per prim. How every per-prim argument is spread over N prims.
 
 The functional calls (``pose``, ``display_color``, ``create_batch``, ``texture``) and the graph's
 modify and create nodes all read per-prim arguments through :func:`per_prim_array`.

@@ -1,4 +1,4 @@
-"""The current graph: the one new nodes join, its lifetime, and the sublayers its edits go to.
+"""The current graph: the one new nodes join, its lifetime and its edits' sublayers.
 
 A graph lives as long as its stage and its ``/Replicator`` root: a new stage,
 the root's removal or :func:`release_graph` (``rep.graph.clear``) end it, and

@@ -1,5 +1,5 @@
-"""The node model: typed ports, the :class:`Node` base class, the items that reference a node's output, and the
-execution context a node computes in.
+"""The node model: typed ports, the :class:`Node` base class and its execution context. It also holds the items that
+reference a node's output.
 
 A node type declares its ``inputs`` and ``outputs`` as :class:`Port` s and
 implements :meth:`Node.compute`. An input holds either a plain value or a

@@ -1,4 +1,4 @@
-"""How the value of a per-prim argument is spread over the N prims a node edits (Replicator's value shapes).
+"""How a per-prim argument's value is spread over a node's prims (Replicator's value shapes).
 
 Every graph call that edits prims (``rep.modify.*``, ``rep.randomizer.*``, the re-sampled arguments of
 ``rep.create.*``, ``rep.physics.*``) reads its per-prim arguments through :func:`spread_value` and

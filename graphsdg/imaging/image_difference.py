@@ -1,4 +1,4 @@
-"""How far apart two images (or any two arrays of the same shape) are: the numbers image tests compare.
+"""How far apart two images (or any two same-shape arrays) are. These are the numbers image tests compare.
 
 * :func:`difference_metrics`: mean and largest absolute difference, root mean square
   error and percentiles of the absolute differences over the elements finite in

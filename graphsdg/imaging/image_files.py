@@ -1,4 +1,4 @@
-"""Reading an image file into a numpy array, with a clear error for a file that holds no image.
+"""Reading an image file into a numpy array. A file that holds no image raises a clear error.
 
 Golden images in source trees are often Git LFS pointers (a few lines of text
 naming the real file's hash) when the checkout did not fetch LFS objects;

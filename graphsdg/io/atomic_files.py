@@ -1,4 +1,4 @@
-"""Files that appear whole or not at all: a temporary name in the same folder, then a rename.
+"""Files that appear whole or not at all. Written under a temporary name in the same folder, then renamed.
 
 This module depends on nothing else of graphsdg (no settings, no counters): the writer processes of
 :mod:`graphsdg.io.write_processes` import it without the package. :mod:`graphsdg.io.backends` wraps it

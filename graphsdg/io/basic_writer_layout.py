@@ -1,5 +1,6 @@
-"""BasicWriter's file layout, the one table that the writer (:mod:`graphsdg.io.writers.basic`) writes by and
-the dataset reader (:mod:`graphsdg.dataset.basic_writer`) reads by.
+"""BasicWriter's file layout: the one table its writer and reader share. The writer
+(:mod:`graphsdg.io.writers.basic`) writes by it and the dataset reader (:mod:`graphsdg.dataset.basic_writer`) reads
+by it.
 
 A flag of BasicWriter requests an annotator and names the file stem its data goes under (:data:`FLAGS`); each
 stem writes a few files per frame (:func:`files_of`): ``<stem><suffix>_<frame>.<ext>``, e.g.

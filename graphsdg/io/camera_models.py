@@ -1,5 +1,5 @@
-"""Projecting camera-frame points to pixels for the camera models ``camera_params`` describes, and the pose and
-box helpers the pose writers share (Isaac's ``isaacsim.replicator.writers.scripts.utils``).
+"""Camera-frame points projected to pixels for the camera models ``camera_params`` describes. It also holds the pose
+and box helpers the pose writers share (Isaac's ``isaacsim.replicator.writers.scripts.utils``).
 
 Camera-frame points are USD's (-Z forward, +Y up), as homogeneous rows ``[x, y, z, w]``. Pixel coordinates
 start at the top-left corner and are rounded to whole pixels (Python's ``round``: halves to even), as Isaac's

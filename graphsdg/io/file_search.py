@@ -1,5 +1,5 @@
-"""Finding asset files in a folder: USD files (``rep.utils.get_usd_files``) and texture sets grouped by suffix
-(``rep.utils.get_files_group``).
+"""Finding asset files in a folder: USD files and texture sets. USD files for ``rep.utils.get_usd_files``, texture
+sets grouped by suffix for ``rep.utils.get_files_group``.
 
 Local folders are listed with :mod:`os`; an ``omniverse://`` URL lists the local folder holding it (the asset
 pack or a Nucleus mirror) and names its files by URL; other URLs are not listed (nothing is fetched at run time)

@@ -1,4 +1,4 @@
-"""A real S3-compatible server on the loopback address, for tests, benchmarks and trying S3 output offline.
+"""A real S3-compatible server on the loopback address. For tests, benchmarks and trying S3 output offline.
 
 :class:`LocalS3Server` runs moto's server (``python -m moto.server``, from ``pip install 'moto[server]'``)
 as a child process on ``127.0.0.1``, makes an IAM user with an access key allowed ``s3:*`` and then

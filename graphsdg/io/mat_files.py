@@ -1,4 +1,4 @@
-"""Writing MATLAB Level 5 MAT files of numeric arrays (the YCB Video dataset's ``-meta.mat``), without SciPy.
+"""Writing MATLAB Level 5 MAT files of numeric arrays, without SciPy. The YCB Video dataset's ``-meta.mat``.
 
 A file is a 128-byte header (a text line, no subsystem data, version 0x0100, little-endian mark ``IM``) then
 one ``miMATRIX`` element per variable: array flags (the MATLAB class), dimensions, name and the values in

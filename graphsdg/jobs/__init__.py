@@ -1,2 +1,2 @@
-"""The job machinery around a script: the ``graphsdg`` command line, job specs, running a script, frame
-plans for shards and resumes, Ray scale-out, interrupts, progress and each process's share of the cores."""
+"""The job machinery around a script: the ``graphsdg`` command line and what it runs. Job specs, running a script or
+a folder of scripts, Ray scale-out, the GPU each process renders on, kernel warmup and the demo scene."""

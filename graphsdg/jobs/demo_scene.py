@@ -1,4 +1,4 @@
-"""The built-in demo scene of ``graphsdg demo`` (and of ``graphsdg warmup``): a floor, ten shapes, a camera.
+"""The built-in demo scene of ``graphsdg demo`` and ``graphsdg warmup``. A floor, ten shapes, a camera.
 
 Example:
     >>> import tempfile

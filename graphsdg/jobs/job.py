@@ -1,4 +1,4 @@
-"""A dataset job: one script run with its seed, output root, frame count and frame plan.
+"""A dataset job: one script run, with its seed, output root, frame count and plan.
 
 ``graphsdg run`` builds a :class:`JobSpec`; :func:`run_job` runs it in this
 process (the whole job, or one shard of a sharded job) and returns a summary.

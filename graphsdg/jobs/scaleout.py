@@ -1,4 +1,4 @@
-"""Scale-out on Ray: ``graphsdg run SCRIPT --workers K`` runs K shards of one job and merges them.
+"""Scale-out on Ray: K shards of one job, then merged. ``graphsdg run SCRIPT --workers K`` runs them.
 
 Each shard is a Ray actor: its own process, so its own GL context and MuJoCo
 model. Shard ``i`` runs the whole script with the job's seed and captures the

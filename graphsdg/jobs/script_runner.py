@@ -1,4 +1,4 @@
-"""Run a user's script the way ``graphsdg run`` does: optional Isaac compat, seed and output overrides.
+"""Run a user's script the way ``graphsdg run`` does. Optional Isaac compat, seed and output overrides.
 
 Scripts written for Isaac Sim's Script Editor schedule a coroutine with
 ``asyncio.ensure_future(...)`` and rely on Kit's running loop; after the script

@@ -1,4 +1,5 @@
-"""Run every script of a folder as ``graphsdg run`` would, one fresh process each, and report a verdict per script.
+"""Run every script of a folder as ``graphsdg run`` would, with a verdict each. Each script runs in a fresh process
+of its own.
 
 A script passes when its process exits 0, prints no line matching the failure
 pattern, and, if its source contains the pass marker (Isaac's examples print

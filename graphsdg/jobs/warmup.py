@@ -1,4 +1,4 @@
-"""``graphsdg warmup``: the pbr backend's kernels compiled into the node's cache before a job needs them.
+"""``graphsdg warmup``: the pbr backend's kernels compiled into the node's cache before jobs need them.
 
 It renders one small frame of each scene (``demo``: ``graphsdg demo``'s; ``bench``: ``graphsdg bench``'s,
 with rgb, depth, semantic segmentation and tight boxes) with the pbr backend, so that the kernels those

@@ -1,1 +1,2 @@
-"""Pure numpy maths that every room (stage/, sim/, render/, compat/, io/) can use; imports nothing of graphsdg's."""
+"""Pure numpy maths that every room can use. Used by stage/, sim/, render/, compat/ and io/; imports nothing of
+graphsdg's."""

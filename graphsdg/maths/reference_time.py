@@ -1,4 +1,4 @@
-"""A capture's simulation time as Replicator's reference time: a fraction with a denominator of at most 10^6.
+"""A capture's simulation time as Replicator's reference time. A fraction with a denominator of at most 10^6.
 
 The value is ``fractions.Fraction(seconds).limit_denominator(1_000_000)`` (the closest such fraction, the
 smaller denominator on a tie), worked out on plain integers: a frame asks for it once or twice, and the

@@ -1,5 +1,6 @@
-"""Rotations: Euler angles in USD's rotation orders, quaternions, matrices, and the split of a transform into
-translate / rotate / scale, for one rotation or a stack of them.
+"""Rotations: Euler angles, quaternions, matrices and transform decomposition, for one or many. Euler angles come in
+USD's rotation orders; a transform splits into translate / rotate / scale; every function takes one rotation or a
+stack of them.
 
 Conventions (USD's): rotation matrices act on column vectors (``v' = R @ v``); 4x4 transforms are row-vector
 (``p_world = p_local @ M``, translation in the last row); Euler angles are degrees and ``rotateXYZ`` applies

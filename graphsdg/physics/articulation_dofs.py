@@ -1,4 +1,4 @@
-"""The degrees of freedom, joints and links of one articulation in the compiled MuJoCo model, DOF by DOF.
+"""One articulation's degrees of freedom, joints and links in the compiled MuJoCo model. Listed DOF by DOF.
 
 :class:`ArticulationDofs` is the per-DOF face of an articulation (the tree below an
 ``ArticulationRootAPI`` prim): its DOFs are the revolute and prismatic joints of the

@@ -1,4 +1,4 @@
-"""Mass and inertia of compiled bodies, read from and written into MuJoCo's model by body path.
+"""Mass and inertia of compiled bodies, by body path. Read from and written into MuJoCo's model.
 
 A body's inertia is MuJoCo's principal moments ``body_inertia`` in the principal
 frame ``body_iquat``; PhysX's views give it as a 3x3 matrix in the body's frame

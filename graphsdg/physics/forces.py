@@ -1,4 +1,4 @@
-"""One-step pushes on rigid bodies: a force (or impulse, velocity change, acceleration) at a world point.
+"""One-step pushes on rigid bodies at a world point. A force, an impulse, a velocity change or an acceleration.
 
 :func:`apply_force_at_pos` queues a push for the next physics step, as PhysX's
 ``addForceAtPos`` does: the push acts during that one step only and is then gone

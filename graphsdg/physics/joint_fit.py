@@ -1,4 +1,4 @@
-"""Joint positions that put the links of a MuJoCo kinematic tree at given world poses (inverse of kinematics).
+"""Joint positions that put a MuJoCo kinematic tree's links at given world poses. The inverse of kinematics.
 
 A link's world pose is its parent's pose, then its fixed offset from the parent
 (``body_pos``, ``body_quat``), then the motion of its joint. Given the world

@@ -1,4 +1,4 @@
-"""Forces that act on bodies for exactly one physics step (PhysX's ``addForce``, the tensor API's ``apply_forces``).
+"""Forces that act on bodies for exactly one physics step. PhysX's ``addForce``, the tensor API's ``apply_forces``.
 
 MuJoCo's ``xfrc_applied`` keeps acting until it is cleared; PhysX clears applied
 forces after each simulation step. :func:`apply_for_one_step` adds a force to a

@@ -1,4 +1,4 @@
-"""World poses of prims as the simulation has them, read in a batch and written back in a batch.
+"""World poses of prims as the simulation has them, read and written in batches.
 
 Reading: a simulated rigid body's pose comes from MuJoCo (current even inside a
 physics step, before the stage is written back), a prim below a body follows that

@@ -1,4 +1,5 @@
-"""Which EGL device renders: the one of the GPU a scheduler (Ray, ``graphsdg bench --gpus``) gave this process.
+"""Which EGL device renders: the GPU a scheduler gave this process. The scheduler is Ray or ``graphsdg bench
+--gpus``.
 
 MuJoCo picks its EGL device by ``MUJOCO_EGL_DEVICE_ID``: older releases as an index into
 ``eglQueryDevicesEXT``'s list, whose order need not match CUDA's, MuJoCo 4 as a position among the GPUs that

@@ -1,4 +1,5 @@
-"""Which GPU each process of a job renders on: the host's GPUs, their share of processes, and each one's environment.
+"""Which GPU each process of a job renders on. The host's GPUs, their share of processes, and each process's
+environment.
 
 A process renders on one GPU: its CUDA device (Warp, the pbr backend) and its EGL device (the classic
 rasteriser, pbr's unoccluded footprints) must be that GPU, chosen before anything in the process

@@ -1,5 +1,5 @@
-"""Meshes whose vertices changed in ways no rescale map describes (deformables): new vertices into the PBR
-render context's BVHs.
+"""Deformed meshes' new vertices uploaded into the PBR render context's BVHs. These are vertex changes no rescale
+map describes (deformables).
 
 Rescaled meshes need none of this: they are traced through their rescale folded into the geom frame
 (:mod:`graphsdg.render.mesh_folds`). For the others, each changed mesh's Warp BVH gets its new vertices and

@@ -1,4 +1,4 @@
-"""Ray-cast sensors over the live MuJoCo model: lidar and radar scans, their USD schemas and profiles.
+"""Ray-cast sensors over the live MuJoCo model. Lidar and radar scans, their USD schemas and profiles.
 
 The room sits beside ``render/``: it reads the compiled scene (``sim/``) and the stage (``stage/``) and casts
 rays with MuJoCo (``mj_multiRay`` on the CPU, MuJoCo Warp on a GPU). ``docs/sensors.md`` describes the sensor

@@ -1,4 +1,4 @@
-"""A lidar's profile: how it scans (rates, emitters, range, noise), read from and written to its USD prim.
+"""A lidar's profile: how it scans, read from and written to its USD prim. Rates, emitters, range and noise.
 
 A profile is what Isaac's lidar configuration files describe, held as a :class:`LidarProfile`: the scan type
 (``ROTARY``: the emitter column turns at ``scan_rate_hz``; ``SOLID_STATE``: a fixed pattern), the firing rate

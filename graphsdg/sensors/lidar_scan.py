@@ -1,4 +1,4 @@
-"""A lidar at work: the beams fired since the last capture, cast into the scene, measured and accumulated.
+"""A lidar at work: beams fired since the last capture, cast, measured and accumulated.
 
 Each capture at simulation time ``now`` fires the beams of the window since the previous capture
 (:class:`~graphsdg.sensors.scan_pattern.ScanPattern`), each from where the sensor is when it fires and against

@@ -1,4 +1,4 @@
-"""Keeping MuJoCo's mesh bounding-volume trees true to meshes rescaled in place, so rays hit what renders draw.
+"""Keeping MuJoCo's mesh bounding-volume trees true to meshes rescaled in place. Rays then hit what renders draw.
 
 graphsdg rescales a mesh geom without recompiling (:mod:`graphsdg.sim.mesh_scaling`): it maps the mesh's
 vertices and its geom's bounds, and renderers draw their uploaded copy through the same map. ``mj_ray`` and

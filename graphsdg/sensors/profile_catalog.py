@@ -1,4 +1,4 @@
-"""graphsdg's lidar and radar profiles: the data files in ``profiles/`` and the profiles built from them.
+"""graphsdg's lidar and radar profiles. The data files in ``profiles/`` and the profiles built from them.
 
 Each ``profiles/*.json`` holds configs keyed by the name Isaac Sim gives the sensor's asset (``OS1``,
 ``Example_Rotary``, ``SICK_picoScan100``, ...), written from the vendors' published specifications (field of

@@ -1,4 +1,4 @@
-"""Which ray caster the sensors use: ``mj_multiRay`` on CPU threads, or MuJoCo Warp on a GPU.
+"""Which ray caster the sensors use. ``mj_multiRay`` on CPU threads, or MuJoCo Warp on a GPU.
 
 Chosen like the render backend, from the setting ``/graphsdg/sensors/rayBackend``:
 

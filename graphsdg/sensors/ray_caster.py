@@ -1,4 +1,4 @@
-"""Casting sensor rays into the live MuJoCo model on the CPU: ``mj_multiRay`` over threads, in time slices.
+"""Casting sensor rays into the live MuJoCo model on the CPU. ``mj_multiRay`` over threads, in time slices.
 
 A batch of rays comes with each ray's origin and the time it is cast at, relative to the capture (``dt <= 0``
 seconds). Rays cast at the same time from the same origin form a *slice*: the moving geoms are posed at that

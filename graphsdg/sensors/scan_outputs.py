@@ -1,4 +1,4 @@
-"""A scan as its outputs: the GenericModelOutput buffer, point clouds and the flat scan of a 2D lidar.
+"""A scan as its outputs. The GenericModelOutput buffer, point clouds and the flat scan of a 2D lidar.
 
 Coordinates follow the sensor's output options: ``SENSOR`` frame (the sensor at each beam's firing, as a real
 lidar reports, not motion compensated) or ``WORLD`` frame; ``SPHERICAL`` (azimuth and elevation in degrees,

@@ -1,4 +1,4 @@
-"""When each beam of a lidar fires and where it points: the firing schedule of a :class:`LidarProfile`.
+"""When each beam of a lidar fires and where it points. The firing schedule of a :class:`LidarProfile`.
 
 Time is the simulation clock, kept in whole nanoseconds. Scan ``s`` starts at ``s`` scan periods
 (``round(1e9 / scanRateBaseHz)`` ns each); tick ``k`` belongs to scan ``k // ticks_per_scan`` and starts

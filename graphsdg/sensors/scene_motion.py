@@ -1,4 +1,4 @@
-"""How the scene moves while a sensor scans: geom poses and point velocities at times near the present.
+"""How the scene moves while a sensor scans. Geom poses and point velocities at times near the present.
 
 A lidar's beams fire over the whole frame, while MuJoCo holds the scene at one instant (the capture's). A beam
 fired ``dt`` seconds before it (``dt <= 0``) must see each body where it was then: moving geoms are posed at

@@ -1,4 +1,4 @@
-"""Where a sensor prim is and how it moves: its world pose now and over the frame its beams fire in.
+"""Where a sensor prim is and how it moves. Its world pose now and over the frame its beams fire in.
 
 The pose is the prim's USD world transform (simulated rigid bodies are written back to the stage every
 step, so a sensor under a robot's link follows it). Its velocity is that of the simulated body it rides on

@@ -1,4 +1,4 @@
-"""A sensor seen as a camera: the view a render product of a lidar or radar carries.
+"""A sensor seen as a camera. The view a render product of a lidar or radar carries.
 
 A render product made of an ``OmniLidar`` / ``OmniRadar`` prim (Isaac Sim's way to run an RTX sensor) has no
 lens; its annotators read the sensor's scans instead of pixels. The capture still gives every product a

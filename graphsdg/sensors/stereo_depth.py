@@ -1,4 +1,4 @@
-"""A single-view stereo depth sensor: the depth a structured-light / active-stereo camera measures from a true one.
+"""A single-view stereo depth sensor. The depth a structured-light / active-stereo camera measures from a true one.
 
 Isaac's RTX post-process ``OmniSensorDepthSensorSingleViewAPI`` (on a render product) turns the rendered depth
 into what a stereo depth camera reports. graphsdg's model, from the product's ``omni:rtx:post:depthSensor:*``

@@ -1,4 +1,4 @@
-"""Casting sensor rays on a GPU with MuJoCo Warp: batched ``rays`` over a BVH of the scene.
+"""Casting sensor rays on a GPU with MuJoCo Warp. Batched ``rays`` over a BVH of the scene.
 
 The same interface and results as :class:`~graphsdg.sensors.ray_caster.CpuRayCaster`. The compiled model is
 put on the device once (again after a recompile) with a render context whose BVH covers the geoms renders draw

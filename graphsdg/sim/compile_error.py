@@ -1,4 +1,4 @@
-"""The error a compile raises when the stage holds something that cannot become a MuJoCo model."""
+"""The error a compile raises for a stage that cannot become a MuJoCo model."""
 from __future__ import annotations
 
 

@@ -1,4 +1,4 @@
-"""What an edit of a prim's properties means for its compiled geoms: the aspects to sync live.
+"""What an edit of a prim's properties means for its compiled geoms. The aspects to sync live.
 
 A changed property maps to one aspect (``pose``, ``shape``, ``visibility``,
 ``material``, ``color``); semantic labels and rigid-body velocities need no geom

@@ -1,4 +1,4 @@
-"""UsdGeom gprims as MuJoCo geoms: which prims are drawn, their sizes and mesh arrays, live resizes.
+"""UsdGeom gprims as MuJoCo geoms. Which prims are drawn, their sizes and mesh arrays, live resizes.
 
 Reads ``UsdGeom.Cube``, ``Sphere``, ``Cylinder``, ``Capsule`` and ``Plane``
 (implicit primitives: a MuJoCo box, sphere / ellipsoid, cylinder or capsule

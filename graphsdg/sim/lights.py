@@ -1,4 +1,4 @@
-"""UsdLux lights as MuJoCo lights, the ambient term and the skybox; live sync of light edits.
+"""UsdLux lights as MuJoCo lights, the ambient term and the skybox, synced live.
 
 USD light intensity is photometric (nits for area/sphere/dome lights, lux-like
 for distant lights, each times ``2**exposure`` and ``color``). MuJoCo's classic

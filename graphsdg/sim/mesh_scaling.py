@@ -1,4 +1,4 @@
-"""Rescale a compiled mesh geom in place, so a scale edit of a mesh prim needs no recompile.
+"""Rescaling a compiled mesh geom in place. A scale edit of a mesh prim then needs no recompile.
 
 The compiler bakes a mesh prim's world scale into its vertices, and MuJoCo stores
 them in the mesh's own frame (``geom_pos``/``geom_quat`` place that frame in the

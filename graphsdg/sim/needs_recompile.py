@@ -1,4 +1,4 @@
-"""The signal live sync raises when an edit cannot be written into the compiled model's fields.
+"""The signal live sync raises when an edit cannot be written into the compiled model.
 
 Each aspect's sync (:mod:`~graphsdg.sim.geom_poses`, :mod:`~graphsdg.sim.materials`,
 :mod:`~graphsdg.sim.lights`, ...) raises :class:`NeedsRecompile`;

@@ -1,4 +1,4 @@
-"""Simulated rigid-body poses and velocities authored back on the stage (as PhysX does for USD readers).
+"""Simulated rigid-body poses and velocities authored on the stage, as PhysX does for USD readers.
 
 :class:`PoseWriter` writes one body's pose into its translate / orient (or
 rotateXYZ) ops each step, and its world-frame ``physics:velocity`` /

@@ -1,4 +1,4 @@
-"""What a simulation tells the scene its renderers draw: compile needs and model data changed in place.
+"""What a simulation tells the scene its renderers draw. Compile needs, and model data changed in place.
 
 The simulation sits below rendering: it cannot import the render scene
 (:class:`graphsdg.render.render_scene.RenderScene`), which keeps what renderers need beside the model

@@ -1,4 +1,4 @@
-"""Stage-wide metadata that changes how the scene is read: the up axis and the stage unit.
+"""Stage-wide metadata that changes how the scene is read: the up axis and unit.
 
 Both are authored on the root layer (as Replicator does, so they survive a save)
 and make the next simulation update recompile the MuJoCo model, whose gravity,

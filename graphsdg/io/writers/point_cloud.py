@@ -1,4 +1,4 @@
-"""PointCloudWriter: each lidar or radar scan as a point cloud file, with intensities, ids and labels.
+"""PointCloudWriter: each lidar or radar scan as a point cloud file. With intensities, ids and labels.
 
 Attach it to render products of ``OmniLidar`` / ``OmniRadar`` prims (``rep.functional.create.omni_lidar``,
 Isaac's ``LidarSensor``, ...). For each render product and each new report with points (a lidar reports at

@@ -1,4 +1,4 @@
-"""PoseWriter: per frame, each visible object's 6-DoF pose in the camera frame and its projected 3D box.
+"""PoseWriter: each visible object's 6-DoF pose and projected 3D box, per frame. Poses are in the camera frame.
 
 Isaac Sim's PoseWriter (``isaacsim.replicator.writers``) layout and keys. Per
 render product and frame, numbered ``{n}`` (``frame_padding`` digits; without

@@ -1,4 +1,5 @@
-"""Where a pose edit lands: authored on the stage, written into MuJoCo, or kept beside the stage for a camera.
+"""Where a pose edit lands: the stage, MuJoCo, or the camera pose store. Authored on the stage, written into MuJoCo,
+or kept beside the stage for a camera.
 
 Replicator's write-to-fabric (``/exts/omni.replicator.core/enableWriteToFabric``) writes randomized values
 without authoring USD. :mod:`.plan` picks, for one ``rep.functional.modify.pose`` call, the paths to try:

@@ -1,4 +1,4 @@
-"""The pose planner: which paths one pose edit tries, in order (camera, MuJoCo, then the stage).
+"""The pose planner: the paths one pose edit tries, in order (camera, MuJoCo, stage).
 
 Write-to-fabric takes a pose only when it can write it exactly: the camera path needs every prim to be a
 camera with graphsdg's op stack and no scale, the MuJoCo path every prim a plain compiled gprim and no aim,

@@ -1,4 +1,4 @@
-"""Uniform rescales of a batch of prims written into MuJoCo in a handful of array operations.
+"""Uniform rescales of a batch of prims, written into MuJoCo in a few array operations.
 
 A randomizer that scales a batch (``rep.functional.modify.pose(prims, scale_value=...)`` with
 write-to-fabric) most often gives each prim one factor for all three axes. The general path of
