@@ -3,8 +3,9 @@
 One :class:`Runtime` ties together what a capture needs: the current stage, its
 :class:`~graphsdg.sim.scene.SimScene` and the :class:`~graphsdg.render.render_scene.RenderScene`
 the renderers draw of it, the :class:`Rasterizer` (which owns the GL context and so
-lives on the thread that captures), the timeline, and the label tables. The annotators and writers attached to render products are held
-in :data:`graphsdg.render.attachments.attachments`, which the runtime reads. The
+lives on the thread that captures), the timeline, and the label tables. The
+annotators and writers attached to render products are held in
+:data:`graphsdg.render.attachments.attachments`, which the runtime reads. The
 orchestrator drives it.
 """
 from __future__ import annotations
