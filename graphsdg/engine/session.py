@@ -32,6 +32,7 @@ from pxr import Usd
 from graphsdg.annotate.motion import history as motion_history
 from graphsdg.base.profiling import tables as profiling
 from graphsdg.base.settings_store import store as settings
+from graphsdg.io.run_state import ledgers as run_state
 from graphsdg.io.write_queue import process_queue as write_queue
 from graphsdg.render.attachments import attachments
 from graphsdg.render.motion_blur import recorder as motion_blur
@@ -62,6 +63,7 @@ class Session:
         "settings",          # the settings store (rep.settings, carb's settings in compat mode)
         "profiling",         # seconds per named phase (graphsdg bench --profile, orchestrator.get_profile)
         "write_queue",       # the writers' queue and its threads or processes (drained at exit, not per stage)
+        "run_state",         # each writer folder's frame ledger behind graphsdg_run.json (a run spans stages)
         "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
         "motion_blur",       # the motion of the last step, recorded for a blurred capture
         "motion_history",    # each live render product's last capture, for motion vectors (held weakly)
@@ -75,6 +77,7 @@ class Session:
         self.settings = settings
         self.profiling = profiling
         self.write_queue = write_queue
+        self.run_state = run_state
         self.render_products = render_products
         self.attachments = attachments
         self.scanners = scanners

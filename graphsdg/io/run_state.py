@@ -198,12 +198,6 @@ class FrameLedger:
         return writer is None or writer not in attachments.writers
 
 
-_ledgers: dict[tuple[int, str], FrameLedger] = {}
-_present: set[str] = set()        # output folders whose run-state file this process wrote or resumed from
-_registry_lock = threading.Lock()
-_last_save = 0.0
-
-
 def enabled() -> bool:
     return bool(settings.get("/graphsdg/io/runState", True))
 
@@ -213,50 +207,12 @@ def _output_dir(writer: Any) -> str | None:
     return out if isinstance(out, str) and out else None
 
 
-def ledger_for(writer: Any, create: bool = True) -> FrameLedger | None:
-    """The ledger of ``writer``'s current output folder (``None`` for writers without one)."""
-    out = _output_dir(writer)
-    if out is None or not enabled():
-        return None
-    key = (id(writer), out)
-    with _registry_lock:
-        ledger = _ledgers.get(key)
-        if ledger is not None and ledger.writer_ref() is not writer:   # an id reused by a new object
-            ledger = None
-        if ledger is None and create:
-            ledger = _ledgers[key] = FrameLedger(writer, out)
-            if settings.get("/graphsdg/run/resume", False):     # graphsdg run --resume: keep what was complete
-                earlier = _read_quietly(out)
-                if earlier is not None:
-                    _present.add(out)         # the earlier run's file goes when this run completes the folder
-                if earlier is not None and ledger.name in earlier["writers"]:
-                    ledger.restore(earlier["writers"][ledger.name])
-        return ledger
-
-
 def _read_quietly(output_dir: str) -> dict | None:
     try:
         return read(output_dir)
     except ValueError as exc:
         log.warning("graphsdg: ignoring the run-state file in %s: %s", output_dir, exc)
         return None
-
-
-def frame(writer: Any, step: int, frame_index: int | None = None) -> contextlib.AbstractContextManager:
-    """A ``with`` block around one ``writer._write(data)``: the tasks it schedules make up one frame (the
-    frame is registered as the block is made, which ``with`` does at once).
-
-    ``frame_index``: the frame's number in the whole dataset, when the run assigns
-    one (sharded and resumed runs pass ``data["frame_index"]``).
-    """
-    ledger = ledger_for(writer)
-    if ledger is None:
-        return contextlib.nullcontext()
-    first = ledger.status != "writing" or ledger.begun == 0
-    number = ledger.begin(step, frame_index)
-    if first:     # the file exists whenever frames are in flight, so a killed run always leaves one
-        _save_quietly()
-    return get_write_queue().group(lambda ok: ledger.files_done(number, ok))
 
 
 def file_name() -> str:
@@ -268,111 +224,162 @@ def file_name() -> str:
     return f"{FILE_NAME[:-5]}.shard-{int(settings.get('/graphsdg/run/shardIndex', 0) or 0)}-of-{int(count)}.json"
 
 
-def _save_dir(output_dir: str, ledgers: list[FrameLedger]) -> None:
-    location = open_location(output_dir)      # a folder, or an s3:// prefix
-    writers: dict[str, dict] = {}
-    for ledger in ledgers:
-        name = ledger.name
-        i = 2
-        while name in writers:
-            name, i = f"{ledger.name}#{i}", i + 1
-        writers[name] = ledger.entry()
-    if all(ledger.all_complete() and ledger.status in _CLEAN for ledger in ledgers):
-        if output_dir in _present:    # only a file this process wrote or found (no request for the others: S3)
-            location.delete(file_name())
-            _present.discard(output_dir)
-        return
-    lines = [f' "format": {json.dumps(FORMAT)},', f' "version": {VERSION},', ' "writers": {']
-    lines += [f'  {json.dumps(name)}: {json.dumps(entry)}{"," if i < len(writers) - 1 else ""}'
-              for i, (name, entry) in enumerate(writers.items())]
-    location.write(file_name(), ("{\n" + "\n".join(lines) + "\n }\n}\n").encode(), count=False)
-    _present.add(output_dir)
+class RunLedgers:
+    """The ledger of every writer's output folder, and which folders' run-state files this process wrote."""
+
+    def __init__(self) -> None:
+        self._ledgers: dict[tuple[int, str], FrameLedger] = {}
+        self._present: set[str] = set()   # output folders whose run-state file this process wrote or resumed from
+        self._lock = threading.Lock()
+        self._last_save = 0.0
+
+    def ledger_for(self, writer: Any, create: bool = True) -> FrameLedger | None:
+        """The ledger of ``writer``'s current output folder (``None`` for writers without one)."""
+        out = _output_dir(writer)
+        if out is None or not enabled():
+            return None
+        key = (id(writer), out)
+        with self._lock:
+            ledger = self._ledgers.get(key)
+            if ledger is not None and ledger.writer_ref() is not writer:   # an id reused by a new object
+                ledger = None
+            if ledger is None and create:
+                ledger = self._ledgers[key] = FrameLedger(writer, out)
+                if settings.get("/graphsdg/run/resume", False):     # graphsdg run --resume: keep what was complete
+                    earlier = _read_quietly(out)
+                    if earlier is not None:
+                        self._present.add(out)    # the earlier run's file goes when this run completes the folder
+                    if earlier is not None and ledger.name in earlier["writers"]:
+                        ledger.restore(earlier["writers"][ledger.name])
+            return ledger
+
+    def frame(self, writer: Any, step: int, frame_index: int | None = None) -> contextlib.AbstractContextManager:
+        """A ``with`` block around one ``writer._write(data)``: the tasks it schedules make up one frame (the
+        frame is registered as the block is made, which ``with`` does at once).
+
+        ``frame_index``: the frame's number in the whole dataset, when the run assigns
+        one (sharded and resumed runs pass ``data["frame_index"]``).
+        """
+        ledger = self.ledger_for(writer)
+        if ledger is None:
+            return contextlib.nullcontext()
+        first = ledger.status != "writing" or ledger.begun == 0
+        number = ledger.begin(step, frame_index)
+        if first:     # the file exists whenever frames are in flight, so a killed run always leaves one
+            self._save_quietly()
+        return get_write_queue().group(lambda ok: ledger.files_done(number, ok))
+
+    def _save_dir(self, output_dir: str, ledgers: list[FrameLedger]) -> None:
+        location = open_location(output_dir)      # a folder, or an s3:// prefix
+        writers: dict[str, dict] = {}
+        for ledger in ledgers:
+            name = ledger.name
+            i = 2
+            while name in writers:
+                name, i = f"{ledger.name}#{i}", i + 1
+            writers[name] = ledger.entry()
+        if all(ledger.all_complete() and ledger.status in _CLEAN for ledger in ledgers):
+            if output_dir in self._present:   # only a file this process wrote or found (no request for others: S3)
+                location.delete(file_name())
+                self._present.discard(output_dir)
+            return
+        lines = [f' "format": {json.dumps(FORMAT)},', f' "version": {VERSION},', ' "writers": {']
+        lines += [f'  {json.dumps(name)}: {json.dumps(entry)}{"," if i < len(writers) - 1 else ""}'
+                  for i, (name, entry) in enumerate(writers.items())]
+        location.write(file_name(), ("{\n" + "\n".join(lines) + "\n }\n}\n").encode(), count=False)
+        self._present.add(output_dir)
+
+    def save(self, force: bool = False) -> None:
+        """Write the run-state file of every folder whose frames changed (``force``: every folder)."""
+        with self._lock:
+            ledgers = list(self._ledgers.values())
+        by_dir: dict[str, list[FrameLedger]] = {}
+        for ledger in ledgers:
+            by_dir.setdefault(ledger.output_dir, []).append(ledger)
+        for output_dir, group in by_dir.items():
+            if force or any(ledger.changed for ledger in group):
+                for ledger in group:
+                    ledger.changed = False
+                self._save_dir(output_dir, group)
+        self._last_save = time.monotonic()
+
+    def _save_quietly(self) -> None:
+        """Save during capture: a failure (a full disk) is logged, and the frames' own writes report it."""
+        try:
+            self.save()
+        except Exception as exc:  # noqa: BLE001 - bookkeeping must not stop the capture
+            log.error("graphsdg: could not update the run-state file: %s", exc)
+
+    def checkpoint(self) -> None:
+        """Called after each captured frame: save at most about once a second."""
+        if self._ledgers and time.monotonic() - self._last_save >= CHECKPOINT_EVERY_S:
+            self._save_quietly()
+
+    def drained(self, status: str = "flushed", only_writing: bool = False) -> None:
+        """Every attached writer was flushed and the write queue is empty: record ``status``, save (or remove
+        the files of folders that are complete), forget detached writers.
+
+        ``only_writing`` leaves entries whose status is already final (used at interpreter exit).
+        """
+        if status not in STATUSES:
+            raise ValueError(f"run-state status must be one of {STATUSES}, got {status!r}")
+        with self._lock:
+            ledgers = list(self._ledgers.values())
+        for ledger in ledgers:
+            if not only_writing or ledger.status == "writing":
+                ledger.drained(status)
+        self.save()
+        with self._lock:
+            for key, ledger in list(self._ledgers.items()):
+                if ledger.writer_gone():
+                    del self._ledgers[key]
+
+    def mark_failed(self) -> None:
+        """A write failed: record it in every open entry (the failed frames are already left out of
+        ``complete``).
+
+        Never raises (it runs while another error is on its way to the script); a run-state
+        file that cannot be written is logged.
+        """
+        with self._lock:
+            ledgers = list(self._ledgers.values())
+        for ledger in ledgers:
+            if ledger.status == "writing":
+                with ledger._lock:
+                    ledger.status = "failed"
+                    ledger.changed = True
+        self._save_quietly()
+
+    def summary(self) -> list[str]:
+        """One line per tracked writer whose frames are not all complete (for error messages)."""
+        out = []
+        with self._lock:
+            ledgers = list(self._ledgers.values())
+        for ledger in ledgers:
+            if not ledger.all_complete():
+                entry = ledger.entry()
+                ranges = ", ".join(f"{a}-{b}" if a != b else f"{a}" for a, b in entry["complete"]) or "none"
+                failed = f", failed {entry['failed']}" if entry["failed"] else ""
+                out.append(f"{ledger.output_dir}: {ledger.name} was given frames up to {entry['next_frame'] - 1}, "
+                           f"complete {ranges}{failed} (see {file_name()} there)")
+        return out
+
+    def open_ledgers(self) -> int:
+        """How many writers' entries are being tracked (for leak checks)."""
+        return len(self._ledgers)
 
 
-def save(force: bool = False) -> None:
-    """Write the run-state file of every folder whose frames changed (``force``: every folder)."""
-    global _last_save
-    with _registry_lock:
-        ledgers = list(_ledgers.values())
-    by_dir: dict[str, list[FrameLedger]] = {}
-    for ledger in ledgers:
-        by_dir.setdefault(ledger.output_dir, []).append(ledger)
-    for output_dir, group in by_dir.items():
-        if force or any(ledger.changed for ledger in group):
-            for ledger in group:
-                ledger.changed = False
-            _save_dir(output_dir, group)
-    _last_save = time.monotonic()
+#: The process's ledgers (held by the session, :mod:`graphsdg.engine.session`).
+ledgers = RunLedgers()
 
-
-def _save_quietly() -> None:
-    """Save during capture: a failure (a full disk) is logged, and the frames' own writes report it."""
-    try:
-        save()
-    except Exception as exc:  # noqa: BLE001 - bookkeeping must not stop the capture
-        log.error("graphsdg: could not update the run-state file: %s", exc)
-
-
-def checkpoint() -> None:
-    """Called after each captured frame: save at most about once a second."""
-    if _ledgers and time.monotonic() - _last_save >= CHECKPOINT_EVERY_S:
-        _save_quietly()
-
-
-def drained(status: str = "flushed", only_writing: bool = False) -> None:
-    """Every attached writer was flushed and the write queue is empty: record ``status``, save (or remove
-    the files of folders that are complete), forget detached writers.
-
-    ``only_writing`` leaves entries whose status is already final (used at interpreter exit).
-    """
-    if status not in STATUSES:
-        raise ValueError(f"run-state status must be one of {STATUSES}, got {status!r}")
-    with _registry_lock:
-        ledgers = list(_ledgers.values())
-    for ledger in ledgers:
-        if not only_writing or ledger.status == "writing":
-            ledger.drained(status)
-    save()
-    with _registry_lock:
-        for key, ledger in list(_ledgers.items()):
-            if ledger.writer_gone():
-                del _ledgers[key]
-
-
-def mark_failed() -> None:
-    """A write failed: record it in every open entry (the failed frames are already left out of ``complete``).
-
-    Never raises (it runs while another error is on its way to the script); a run-state
-    file that cannot be written is logged.
-    """
-    with _registry_lock:
-        ledgers = list(_ledgers.values())
-    for ledger in ledgers:
-        if ledger.status == "writing":
-            with ledger._lock:
-                ledger.status = "failed"
-                ledger.changed = True
-    _save_quietly()
-
-
-def summary() -> list[str]:
-    """One line per tracked writer whose frames are not all complete (for error messages)."""
-    out = []
-    with _registry_lock:
-        ledgers = list(_ledgers.values())
-    for ledger in ledgers:
-        if not ledger.all_complete():
-            entry = ledger.entry()
-            ranges = ", ".join(f"{a}-{b}" if a != b else f"{a}" for a, b in entry["complete"]) or "none"
-            failed = f", failed {entry['failed']}" if entry["failed"] else ""
-            out.append(f"{ledger.output_dir}: {ledger.name} was given frames up to {entry['next_frame'] - 1}, "
-                       f"complete {ranges}{failed} (see {file_name()} there)")
-    return out
-
-
-def open_ledgers() -> int:
-    """How many writers' entries are being tracked (for leak checks)."""
-    return len(_ledgers)
+ledger_for = ledgers.ledger_for
+frame = ledgers.frame
+save = ledgers.save
+checkpoint = ledgers.checkpoint
+drained = ledgers.drained
+mark_failed = ledgers.mark_failed
+summary = ledgers.summary
+open_ledgers = ledgers.open_ledgers
 
 
 def read(output_dir: str | os.PathLike) -> dict | None:
