@@ -26,7 +26,7 @@ from graphsdg.annotate.motion import PoseSnapshot, history
 from graphsdg.annotate.semantic_filter import ALL_LABELS, SemanticFilter
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
-from graphsdg.render.rasterizer import RenderOutputs
+from graphsdg.render.backend import RenderOutputs
 from graphsdg.render.raycast import surface_normals
 from graphsdg.render.render_product import RenderProduct
 from graphsdg.sim import geom_subsets
@@ -220,7 +220,7 @@ class FrameView:
 
     def _code_boxes(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The renderer's pixel bounds of each id code and the code -> geom table, or None where it made none
-        (:class:`~graphsdg.render.rasterizer.RenderOutputs`)."""
+        (:class:`~graphsdg.render.backend.RenderOutputs`)."""
         if self.outputs is None or self.outputs.id_lut is None:
             return None
         boxes = self.outputs.code_boxes

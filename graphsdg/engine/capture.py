@@ -234,7 +234,7 @@ def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -
     """Render ``render_products`` now, outside a capture: no annotators, no writers, no time advance (Kit's
     viewport redraw on an app update). The render observers hear of it as of a capture's renders.
 
-    Returns each product's :class:`~graphsdg.render.rasterizer.RenderOutputs` (``.get("color")``).
+    Returns each product's :class:`~graphsdg.render.backend.RenderOutputs` (``.get("color")``).
     """
     rt = runtime()
     rt.complete_capture()   # a pipelined step's pixels first: one GL context, one pass at a time

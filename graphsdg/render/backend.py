@@ -2,7 +2,7 @@
 
 Render products, annotators and writers only see :class:`RenderBackend`: a
 ``render(scene, view, passes, subframes, defer, motion)`` that returns
-:class:`~graphsdg.render.rasterizer.RenderOutputs`, and ``render_batch(scene, requests)``
+:class:`RenderOutputs`, and ``render_batch(scene, requests)``
 for a step's render products at once (:class:`RenderRequest`; the pbr backend draws
 several in one launch, the classic one draw by draw), in one layout (uint8 RGBA
 colour, linear float ``hdr``, planar-z depth with ``inf`` background, int32 geom
@@ -34,9 +34,16 @@ import importlib.util
 import logging
 import sys
 from dataclasses import dataclass
-from typing import Any, Callable, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Callable, Protocol, Sequence, runtime_checkable
+
+import numpy as np
 
 from graphsdg.base import settings_store as settings
+
+if TYPE_CHECKING:   # type names only: the cameras, the motion samples and the render scene import no backend
+    from graphsdg.render.camera import CameraView
+    from graphsdg.render.motion_blur import MotionSamples
+    from graphsdg.render.render_scene import RenderScene
 
 log = logging.getLogger("graphsdg.render")
 
@@ -69,24 +76,81 @@ class RenderRequest:
     ``motion``: motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`) or None.
     """
 
-    view: Any
+    view: CameraView
     passes: set[str]
     subframes: int = 1
     defer: bool = False
-    motion: Any = None
+    motion: MotionSamples | None = None
+
+
+Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)
+
+
+class RenderOutputs:
+    """What one render of one camera produced (each ``None`` if not requested).
+
+    * ``color``: uint8 (H, W, 4) RGBA, alpha 255
+    * ``hdr``: float32 (H, W, 3) linear colour in [0, 1]
+    * ``depth``: float32 (H, W) planar z, inf on background
+    * ``geom_ids``: int32 (H, W) geom id per pixel, -1 on background
+    * ``id_codes`` and ``id_lut``: the same ids as read back, uint16/uint32 (H, W)
+      codes, and the table ``id_lut[code]`` -> geom id (so a per-geom table can
+      be applied to the pixels in one lookup: ``table[id_lut][id_codes]``)
+    * ``code_boxes``: int32 (n, 4) inclusive pixel bounds (x_min, y_min, x_max,
+      y_max) of each id code, row = code (n at most ``len(id_lut)``), -1 rows for
+      codes no pixel has; made
+      where the ids are (the pbr backend's GPU) when the backend can, else absent
+      and derived from the pixels by the annotators
+    * ``render_isolated``: follow-up renders of the same view and state,
+      ``(geom ids, crop) -> int32 ids of the crop``
+
+    A pass whose pixels are still being copied off the GPU (a deferred render)
+    is finished on first access.
+    """
+
+    def __init__(self) -> None:
+        self._values: dict[str, np.ndarray | None] = {}
+        self._pending: dict[str, Callable[[], np.ndarray]] = {}
+        self.id_lut: np.ndarray | None = None
+        self.render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
+
+    def put(self, name: str, value: np.ndarray | Callable[[], np.ndarray] | None) -> None:
+        """Store a pass's pixels, or a callable that finishes them when first asked for."""
+        if callable(value):
+            self._pending[name] = value
+        else:
+            self._values[name] = value
+
+    def get(self, name: str) -> np.ndarray | None:
+        """A pass's pixels (finished first if still copying); None if it was not rendered."""
+        if name in self._pending:
+            self._values[name] = self._pending.pop(name)()
+        return self._values.get(name)
+
+    def finish(self) -> None:
+        """Finish every pending pass (the GL context must still exist)."""
+        for name in list(self._pending):
+            self.get(name)
+
+    color = property(lambda self: self.get("color"))
+    hdr = property(lambda self: self.get("hdr"))
+    depth = property(lambda self: self.get("depth"))
+    geom_ids = property(lambda self: self.get("geom_ids"))
+    id_codes = property(lambda self: self.get("id_codes"))
+    code_boxes = property(lambda self: self.get("code_boxes"))
 
 
 @runtime_checkable
 class RenderBackend(Protocol):
     """What render products' captures call; both backends return the same :class:`RenderOutputs` layout."""
 
-    def render(self, scene, view, passes: set[str], subframes: int = 1, defer: bool = False,
-               motion=None):   # -> graphsdg.render.rasterizer.RenderOutputs
+    def render(self, scene: RenderScene, view: CameraView, passes: set[str], subframes: int = 1,
+               defer: bool = False, motion: MotionSamples | None = None) -> RenderOutputs:
         """Render ``passes`` (``color``, ``hdr``, ``depth``, ``segmentation``) of ``view`` of ``scene`` (a
         :class:`~graphsdg.render.render_scene.RenderScene`, the scene description both backends share) now."""
         ...
 
-    def render_batch(self, scene, requests: list[RenderRequest]) -> list:
+    def render_batch(self, scene: RenderScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
         """Render every request of one step (one :class:`RenderOutputs` each, in order)."""
         ...
 

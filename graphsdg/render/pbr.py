@@ -2,7 +2,7 @@
 
 :class:`PbrRenderer` is a :class:`~graphsdg.render.backend.RenderBackend`: it
 renders graphsdg's compiled model (the classic path's model and state) with
-mujoco-warp-pbr and returns :class:`~graphsdg.render.rasterizer.RenderOutputs` in
+mujoco-warp-pbr and returns :class:`~graphsdg.render.backend.RenderOutputs` in
 the classic layout, so annotators and writers do not know which backend drew.
 
 * **Same state.** Each render writes the simulation's geom, light and camera poses
@@ -52,12 +52,12 @@ from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
 from graphsdg.imaging import environment_map
 from graphsdg.render import mesh_folds, pbr_scene
-from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderRequest, launch_groups, pbr_missing,
-                                     requested_backend)
+from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderOutputs, RenderRequest, launch_groups,
+                                     pbr_missing, requested_backend)
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
 from graphsdg.maths.rotations import decompose
-from graphsdg.render.rasterizer import PASSES, Rasterizer, RenderOutputs
+from graphsdg.render.rasterizer import PASSES, Rasterizer
 from graphsdg.render.render_scene import RenderScene
 from graphsdg.sim import lights as lightmap
 from graphsdg.sim.visual import UNDRAWN_GROUPS, drawn_geom_mask, pbr_camera_name

@@ -6,7 +6,7 @@ The renderer leaves one camera's pixels in three device buffers: colour packed a
 ``inf`` on misses and past the far plane, and the geom drawn at each pixel as the
 classic path reads it back: id codes (geom id + 1, 0 for background) in the fewest
 bytes that hold them, with their code -> geom table
-(:class:`~graphsdg.render.rasterizer.RenderOutputs`), and each code's pixel bounds (the
+(:class:`~graphsdg.render.backend.RenderOutputs`), and each code's pixel bounds (the
 tight boxes' and drawn-geom lists' input, :class:`HostFrame`). One kernel converts all three
 where the pixels already are (one launch per camera of a batched render); a camera's outputs
 share one device allocation, so its asked-for arrays come back in one copy into page-locked

@@ -41,7 +41,7 @@ import numpy as np
 
 from graphsdg.base import profiling
 from graphsdg.render import gl_direct, sky
-from graphsdg.render.backend import RenderRequest
+from graphsdg.render.backend import Crop, RenderOutputs, RenderRequest
 from graphsdg.render.camera import CameraView
 from graphsdg.render.id_framebuffer import IdFramebuffer
 from graphsdg.render.lookup import lookup
@@ -53,61 +53,7 @@ from graphsdg.sim.mesh_scaling import MeshMaps
 from graphsdg.sim.visual import HIDDEN_GROUP, UNDRAWN_GROUPS, drawn_geom_mask, render_quality
 
 PASSES = ("color", "hdr", "depth", "segmentation")
-Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)
 SKY_FAR_FACTOR = 2.0
-
-
-class RenderOutputs:
-    """What one render of one camera produced (each ``None`` if not requested).
-
-    * ``color``: uint8 (H, W, 4) RGBA, alpha 255
-    * ``hdr``: float32 (H, W, 3) linear colour in [0, 1]
-    * ``depth``: float32 (H, W) planar z, inf on background
-    * ``geom_ids``: int32 (H, W) geom id per pixel, -1 on background
-    * ``id_codes`` and ``id_lut``: the same ids as read back, uint16/uint32 (H, W)
-      codes, and the table ``id_lut[code]`` -> geom id (so a per-geom table can
-      be applied to the pixels in one lookup: ``table[id_lut][id_codes]``)
-    * ``code_boxes``: int32 (n, 4) inclusive pixel bounds (x_min, y_min, x_max,
-      y_max) of each id code, row = code (n at most ``len(id_lut)``), -1 rows for
-      codes no pixel has; made
-      where the ids are (the pbr backend's GPU) when the backend can, else absent
-      and derived from the pixels by the annotators
-    * ``render_isolated``: follow-up renders of the same view and state,
-      ``(geom ids, crop) -> int32 ids of the crop``
-
-    A pass whose pixels are still being copied off the GPU (a deferred render)
-    is finished on first access.
-    """
-
-    def __init__(self) -> None:
-        self._values: dict[str, np.ndarray | None] = {}
-        self._pending: dict[str, Callable[[], np.ndarray]] = {}
-        self.id_lut: np.ndarray | None = None
-        self.render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
-
-    def put(self, name: str, value: np.ndarray | Callable[[], np.ndarray] | None) -> None:
-        """Store a pass's pixels, or a callable that finishes them when first asked for."""
-        if callable(value):
-            self._pending[name] = value
-        else:
-            self._values[name] = value
-
-    def get(self, name: str) -> np.ndarray | None:
-        if name in self._pending:
-            self._values[name] = self._pending.pop(name)()
-        return self._values.get(name)
-
-    def finish(self) -> None:
-        """Finish every pending pass (the GL context must still exist)."""
-        for name in list(self._pending):
-            self.get(name)
-
-    color = property(lambda self: self.get("color"))
-    hdr = property(lambda self: self.get("hdr"))
-    depth = property(lambda self: self.get("depth"))
-    geom_ids = property(lambda self: self.get("geom_ids"))
-    id_codes = property(lambda self: self.get("id_codes"))
-    code_boxes = property(lambda self: self.get("code_boxes"))
 
 
 def make_gl_context():
