@@ -32,6 +32,7 @@ from pxr import Usd
 from graphsdg.annotate.motion import history as motion_history
 from graphsdg.base.profiling import tables as profiling
 from graphsdg.base.settings_store import store as settings
+from graphsdg.io.frame_plan import writer_records as frame_plan
 from graphsdg.io.run_state import ledgers as run_state
 from graphsdg.io.write_queue import process_queue as write_queue
 from graphsdg.render.attachments import attachments
@@ -64,6 +65,7 @@ class Session:
         "profiling",         # seconds per named phase (graphsdg bench --profile, orchestrator.get_profile)
         "write_queue",       # the writers' queue and its threads or processes (drained at exit, not per stage)
         "run_state",         # each writer folder's frame ledger behind graphsdg_run.json (a run spans stages)
+        "frame_plan",        # the writers of this process's planned (sharded, resumed) runs, for the merge step
         "physics_steps",     # observers of every physics step (Isaac's step subscriptions outlive stages too)
         "motion_blur",       # the motion of the last step, recorded for a blurred capture
         "motion_history",    # each live render product's last capture, for motion vectors (held weakly)
@@ -78,6 +80,7 @@ class Session:
         self.profiling = profiling
         self.write_queue = write_queue
         self.run_state = run_state
+        self.frame_plan = frame_plan
         self.render_products = render_products
         self.attachments = attachments
         self.scanners = scanners

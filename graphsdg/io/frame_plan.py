@@ -105,25 +105,35 @@ class WriterRecord:
                 "info": dict(self.info)}
 
 
-_records: dict[int, WriterRecord] = {}
+class WriterRecords:
+    """The writers of this process's planned runs, by writer (what a shard returns to the merge step)."""
+
+    def __init__(self) -> None:
+        self._records: dict[int, WriterRecord] = {}
+
+    def record_writer(self, writer) -> None:
+        """Remember an attached writer of a planned run (the shard returns these to the merge step)."""
+        output_dir = getattr(writer, "output_dir", None) or getattr(getattr(writer, "backend", None), "output_dir",
+                                                                    None)
+        if output_dir is None:
+            return
+        info = writer.shard_info() if hasattr(writer, "shard_info") else {}
+        folder = output_dir if is_s3_url(output_dir) else os.path.abspath(output_dir)   # a folder or an S3 prefix
+        self._records[id(writer)] = WriterRecord(type(writer).__name__, folder,
+                                                 dict(info.pop("aggregates", {})), info)
+
+    def records(self) -> list[dict]:
+        """Every writer recorded by this process's planned runs."""
+        return [r.to_dict() for r in self._records.values()]
+
+    def clear_records(self) -> None:
+        """Forget the recorded writers (a new job starts)."""
+        self._records.clear()
 
 
-def record_writer(writer) -> None:
-    """Remember an attached writer of a planned run (the shard returns these to the merge step)."""
-    output_dir = getattr(writer, "output_dir", None) or getattr(getattr(writer, "backend", None), "output_dir", None)
-    if output_dir is None:
-        return
-    info = writer.shard_info() if hasattr(writer, "shard_info") else {}
-    folder = output_dir if is_s3_url(output_dir) else os.path.abspath(output_dir)   # a folder or an S3 prefix
-    _records[id(writer)] = WriterRecord(type(writer).__name__, folder,
-                                        dict(info.pop("aggregates", {})), info)
+#: The process's writer records (held by the session, :mod:`graphsdg.engine.session`).
+writer_records = WriterRecords()
 
-
-def records() -> list[dict]:
-    """Every writer recorded by this process's planned runs."""
-    return [r.to_dict() for r in _records.values()]
-
-
-def clear_records() -> None:
-    """Forget the recorded writers (a new job starts)."""
-    _records.clear()
+record_writer = writer_records.record_writer
+records = writer_records.records
+clear_records = writer_records.clear_records
