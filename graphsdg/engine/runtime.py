@@ -17,6 +17,7 @@ from pxr import Usd
 from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
 from graphsdg.engine.frame_provider import NO_GRAPH, FrameProvider
+from graphsdg.engine.session import session
 from graphsdg.render import render_product
 from graphsdg.render.attachments import OrderedSet, attachments
 from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
@@ -42,7 +43,6 @@ class Runtime:
         self.frame_provider: FrameProvider = NO_GRAPH   # the graph installs its scheduler here
         # called with the render product paths of every capture that rendered (Kit's new-frame events)
         self.render_observers: list[Callable[[list[str]], None]] = []
-        stage_context.subscribe_replaced(self._on_stage_replaced)
 
     @property
     def annotators(self) -> OrderedSet:
@@ -102,9 +102,9 @@ class Runtime:
         assert self._render_scene is not None
         return self._render_scene
 
-    def _on_stage_replaced(self, stage: Usd.Stage | None) -> None:
-        # The attachments released themselves first (graphsdg.render.attachments); the simulation and the
-        # label tables belonged to the old stage too.
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Forget the old stage's simulation, render scene and label tables (the session detached the
+        writers and annotators first, so they wrote what they held with these)."""
         self._sim = None
         self._render_scene = None
         self._sim_stage = None
@@ -117,12 +117,9 @@ class Runtime:
         attachments.check_live()
 
 
-_runtime: Runtime | None = None
-
-
 def runtime() -> Runtime:
-    """The process's :class:`Runtime` (created on first use)."""
-    global _runtime
-    if _runtime is None:
-        _runtime = Runtime()
-    return _runtime
+    """The process's :class:`Runtime` (created on first use, held by the session)."""
+    rt = session.runtime
+    if rt is None:
+        rt = session.adopt("runtime", Runtime())
+    return rt
