@@ -54,6 +54,7 @@ class Session:
         "graph",             # the current graph is released (its prims went with the old stage) and the
                              # builder's open blocks close
         "runtime",           # the old stage's simulation, render scene and label tables are dropped
+        "engine_state",      # the step count of the stage (the run-state file's steps) starts again at 0
         "scanners",          # lidar and radar scanners of the old stage's sensors are forgotten
         "forces",            # pushes not yet applied are dropped (they named the old stage's bodies)
         "randomization_targets",   # physics views registered for randomization are forgotten
@@ -73,7 +74,7 @@ class Session:
     )
 
     #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
-    ADOPTED: frozenset[str] = frozenset({"graph", "runtime", "forces", "randomization_targets"})
+    ADOPTED: frozenset[str] = frozenset({"graph", "runtime", "engine_state", "forces", "randomization_targets"})
 
     def __init__(self) -> None:
         self.stage_context = stage_context

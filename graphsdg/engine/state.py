@@ -10,8 +10,10 @@ from __future__ import annotations
 import enum
 from typing import Callable
 
+from pxr import Usd
+
+from graphsdg.engine.session import session
 from graphsdg.io.frame_plan import FramePlan
-from graphsdg.stage.context import stage_context
 
 
 class Status(enum.IntEnum):
@@ -48,6 +50,10 @@ class EngineState:
         self.frame_bases: dict[int, int] = {}   # writer -> frames it had written when the planned run began
         self.next_subframes = 0                 # the next capture's subframe request (set_next_rt_subframes)
 
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """Count steps from 0 again: the run-state file counts a stage's steps."""
+        self.stage_step = 0
+
     def set(self, status: Status) -> None:
         """Change the status; every status callback hears of a change."""
         if status != self.status:
@@ -56,11 +62,5 @@ class EngineState:
                 cb(status)
 
 
-engine_state = EngineState()
-
-
-def _on_stage_replaced(stage) -> None:
-    engine_state.stage_step = 0
-
-
-stage_context.subscribe_replaced(_on_stage_replaced)
+#: The process's engine state (held by the session, :mod:`graphsdg.engine.session`).
+engine_state = session.adopt("engine_state", EngineState())
