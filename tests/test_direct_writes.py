@@ -192,16 +192,16 @@ def test_a_batch_checked_valid_is_checked_again_after_a_removal():
     from graphsdg.stage import prims as prim_lookup
     rep.functional.create.xform(name="World")
     cubes = rep.functional.create_batch.cube(count=40, parent="/World")
-    assert prim_lookup.resolve_prims(cubes) == cubes and prim_lookup._checked.holds(cubes)
-    assert not prim_lookup._checked.holds(cubes[:-1]) and not prim_lookup._checked.holds(cubes[::-1])
+    assert prim_lookup.resolve_prims(cubes) == cubes and prim_lookup.checked_batch.holds(cubes)
+    assert not prim_lookup.checked_batch.holds(cubes[:-1]) and not prim_lookup.checked_batch.holds(cubes[::-1])
     cubes[0].GetStage().RemovePrim(cubes[7].GetPath())
-    assert not prim_lookup._checked.holds(cubes)
+    assert not prim_lookup.checked_batch.holds(cubes)
     with pytest.raises(PrimNotFoundError, match="Cube_07"):
         prim_lookup.resolve_prims(cubes)
     others = rep.functional.create_batch.cube(count=40, parent="/World")
     prim_lookup.resolve_prims(others)
     rep.stage.new_stage()                                                      # its prims expire with it
-    assert not prim_lookup._checked.holds(others)
+    assert not prim_lookup.checked_batch.holds(others)
 
 
 def _camera_rig(fabric: bool):

@@ -41,6 +41,7 @@ from graphsdg.render.render_product import registry as render_products
 from graphsdg.sensors.scanners import scanners
 from graphsdg.sim.physics_steps import steps as physics_steps
 from graphsdg.stage.context import stage_context
+from graphsdg.stage.prims import checked_batch, prim_facts, structure_clock
 
 
 class Session:
@@ -58,11 +59,14 @@ class Session:
         "scanners",          # lidar and radar scanners of the old stage's sensors are forgotten
         "forces",            # pushes not yet applied are dropped (they named the old stage's bodies)
         "randomization_targets",   # physics views registered for randomization are forgotten
+        "prim_structure",    # the structure clock ticks: what caches knew of the old stage's prims lapses
     )
 
     #: The pieces that outlive a stage (held, never reset by a replacement).
     PROCESS_PARTS: tuple[str, ...] = (
         "stage_context",     # the current stage and its change tracker; it calls stage_replaced
+        "checked_prims",     # the last large batch of prims found valid (valid while the clock stands still)
+        "prim_facts",        # paths and types of a frame's prims (valid while the clock stands still)
         "settings",          # the settings store (rep.settings, carb's settings in compat mode)
         "profiling",         # seconds per named phase (graphsdg bench --profile, orchestrator.get_profile)
         "write_queue",       # the writers' queue and its threads or processes (drained at exit, not per stage)
@@ -86,6 +90,9 @@ class Session:
         self.render_products = render_products
         self.attachments = attachments
         self.scanners = scanners
+        self.prim_structure = structure_clock
+        self.checked_prims = checked_batch
+        self.prim_facts = prim_facts
         self.physics_steps = physics_steps
         self.motion_blur = motion_blur
         self.motion_history = motion_history

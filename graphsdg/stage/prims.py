@@ -7,7 +7,7 @@ from typing import Iterable, Sequence, Union
 from pxr import Sdf, Tf, Usd
 
 from graphsdg.errors import InvalidPrimError, PrimNotFoundError
-from graphsdg.stage.context import get_stage, stage_context
+from graphsdg.stage.context import get_stage
 
 PrimLike = Union[Usd.Prim, str, Sdf.Path]
 _NAME_RE = re.compile(r"[^A-Za-z0-9_]")
@@ -39,16 +39,16 @@ def resolve_prims(value: PrimLike | Iterable[PrimLike], stage: Usd.Stage | None 
         return [resolve_prim(value, stage)]
     if value is None:
         raise InvalidPrimError("expected a prim or a list of prims, got None")
-    if isinstance(value, (list, tuple)) and _checked.holds(value):
+    if isinstance(value, (list, tuple)) and checked_batch.holds(value):
         return list(value)
     if isinstance(value, (list, tuple)) and all(type(v) is Usd.Prim for v in value) and \
             all(map(Usd.Prim.IsValid, value)):
-        _checked.remember(value)
+        checked_batch.remember(value)
         return list(value)   # the common case of a batch of live prims, without a Python call per prim
     return [resolve_prim(v, stage) for v in value]
 
 
-class _StructureClock:
+class StructureClock:
     """Counts structural changes: resyncs on any stage (``ObjectsChanged`` notices with resynced paths) and
     stage replacements. What is known about a prim object holds while the count stands still: a prim is
     removed, deactivated or retyped only by a resync of it or an ancestor."""
@@ -58,30 +58,31 @@ class _StructureClock:
         self._listener = None
 
     def start(self) -> None:
-        """Begin counting (once; the count is only read by caches that started it)."""
+        """Begin counting resyncs (once; the count is only read by caches that started it)."""
         if self._listener is None:
             self._listener = Tf.Notice.RegisterGlobally(Usd.Notice.ObjectsChanged, self._changed)
-            stage_context.subscribe_replaced(self._replaced)
 
     def _changed(self, notice, sender) -> None:
         if notice.GetResyncedPaths():
             self.count += 1
 
-    def _replaced(self, stage) -> None:
+    def on_stage_replaced(self, stage: Usd.Stage | None) -> None:
+        """A replaced stage changes the structure: what was known about prims no longer holds."""
         self.count += 1
 
 
-_structure = _StructureClock()
+#: The process's structure clock (held by the session, :mod:`graphsdg.engine.session`).
+structure_clock = StructureClock()
 
 
 def structure_version() -> int:
     """A number that changes whenever any stage's structure changes (a prim added, removed, deactivated,
     retyped; a stage replaced): what a cache of prim objects is valid for."""
-    _structure.start()
-    return _structure.count
+    structure_clock.start()
+    return structure_clock.count
 
 
-class _CheckedBatch:
+class CheckedBatch:
     """The last large batch of prims found valid, kept until any stage's structure changes.
 
     Randomizers pass the same list of the same prims every frame, and ``IsValid``
@@ -89,7 +90,7 @@ class _CheckedBatch:
     benchmark). A prim stops being valid only when it or an ancestor is removed or
     deactivated, which resyncs it, or when its stage is released (a stage replaced, or every prim of it
     expired: the first one is checked each time). So a batch of the same prim objects as the one checked,
-    with no resync since (:class:`_StructureClock`), is valid without asking each prim again.
+    with no resync since (:class:`StructureClock`), is valid without asking each prim again.
     """
 
     MIN_SIZE = 32   # smaller batches are checked each time (a few microseconds)
@@ -101,12 +102,12 @@ class _CheckedBatch:
     def remember(self, prims: Sequence[Usd.Prim]) -> None:
         if len(prims) < self.MIN_SIZE:
             return
-        _structure.start()
-        self._prims, self._at = list(prims), _structure.count
+        structure_clock.start()
+        self._prims, self._at = list(prims), structure_clock.count
 
     def holds(self, prims: Sequence[Usd.Prim]) -> bool:
         """Whether ``prims`` are the remembered prims (each the same object) and nothing was resynced since."""
-        if self._at != _structure.count or len(prims) != len(self._prims) or not self._prims:
+        if self._at != structure_clock.count or len(prims) != len(self._prims) or not self._prims:
             return False
         # list equality compares identical elements without calling Usd.Prim.__eq__ (~5 us for 5,000); the
         # first prim expires with its stage
@@ -138,7 +139,7 @@ class PrimFacts:
         self._at = -1
 
     def _of(self, prim: Usd.Prim) -> dict:
-        if self._at != _structure.count or self._at < 0:
+        if self._at != structure_clock.count or self._at < 0:
             self._facts.clear()
             self._at = structure_version()
         entry = self._facts.get(id(prim))
@@ -165,7 +166,8 @@ class PrimFacts:
         return known
 
 
-_checked = _CheckedBatch()
+#: The last large batch of prims found valid, and what is known of a frame's prims (held by the session).
+checked_batch = CheckedBatch()
 prim_facts = PrimFacts()
 
 
