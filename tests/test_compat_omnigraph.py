@@ -175,8 +175,8 @@ def test_controller_edit_builds_a_push_graph_of_replicator_nodes_and_dr_writers(
     assert model.geom_solref[g, 1] == pytest.approx(-math.log(0.4) / math.sqrt(math.pi ** 2 + math.log(0.4) ** 2))
     # an attribute path reads back what the writer wrote
     assert np.allclose(og.Controller.get("/World/DRGraph/write.outputs:values"), [[0.2, 0.3, 0.4]])
-    with pytest.raises(CompatError, match="omni.graph.action.OnPlaybackTick"):
-        og.Controller.edit("/World/DRGraph", {keys.CREATE_NODES: [("tick", "omni.graph.action.OnPlaybackTick")]})
+    with pytest.raises(CompatError, match="omni.graph.action.OnKeyboardInput"):   # action graphs: test_action_graphs
+        og.Controller.edit("/World/DRGraph", {keys.CREATE_NODES: [("key", "omni.graph.action.OnKeyboardInput")]})
     with pytest.raises(KeyError, match="has no attribute 'inputs:nope'"):
         nodes[0].get_attribute("inputs:nope")
 

@@ -21,11 +21,11 @@ wheel axle, and it carries ``xformOp:translate`` / ``xformOp:orient`` (scripts
 read where it is from them).
 
 ``/Isaac/Samples/Replicator/OmniGraph/nova_carter_nav_only.usd`` references the
-robot as its default prim and adds the ``targetXform`` child that Isaac's
-navigation graph drives the robot towards (the AMR navigation and Cosmos
-warehouse examples set its ``xformOp:translate``). The navigation graph itself
-is not part of the stand-in: graphsdg does not run Isaac's wheeled-robot
-OmniGraph nodes (see the module's tests and ``docs/assets.md``).
+robot as its default prim and adds the ``targetXform`` child and the navigation
+action graph ``ActionGraph`` that drives the robot to it
+(:mod:`graphsdg.assets.nova_carter_navigation`; the AMR navigation and Cosmos
+warehouse examples set the target's ``xformOp:translate``). graphsdg runs the
+graph in compat mode while the timeline plays (:mod:`graphsdg.compat.omnigraph_action`).
 
 Example:
     >>> WHEEL_RADIUS, TRACK_WIDTH
@@ -41,6 +41,7 @@ from pxr import Gf, Kind, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade
 from graphsdg.assets import authoring, geometry, textures
 from graphsdg.assets.camera_calibration import HAWK_BASELINE, define_hawk_camera
 from graphsdg.assets.entries import UsdAsset, pack_file
+from graphsdg.assets.nova_carter_navigation import define_navigation_graph
 from graphsdg.assets.props import part_texture
 
 CARTER_PATH = "/Isaac/Robots/NVIDIA/NovaCarter/nova_carter.usd"
@@ -152,11 +153,15 @@ def _sensors(stage: Usd.Stage) -> None:
 
 
 def build_nav_only(root: str) -> list[str]:
-    """Write ``nova_carter_nav_only.usd``: the robot plus its navigation target ``targetXform``."""
+    """Write ``nova_carter_nav_only.usd``: the robot, its navigation target ``targetXform`` and the action graph
+    driving it there."""
     stage, prim = authoring.new_asset_stage(pack_file(root, NAV_ONLY_PATH), "nova_carter_nav",
                                             kind=Kind.Tokens.component)
     prim.GetReferences().AddReference("../../../Robots/NVIDIA/NovaCarter/nova_carter.usd")
     _xform(stage, "/nova_carter_nav/targetXform", (0.0, 0.0, 0.0))
+    define_navigation_graph(stage, "/nova_carter_nav/ActionGraph", "/nova_carter_nav/chassis_link",
+                            "/nova_carter_nav/targetXform", ["joint_wheel_left", "joint_wheel_right"], WHEEL_RADIUS,
+                            TRACK_WIDTH)
     authoring.save(stage)
     return [NAV_ONLY_PATH]
 
@@ -179,8 +184,8 @@ ASSETS: list[UsdAsset] = [
              "chassis_link/sensors/front_hawk/{left/camera_left,right/camera_right}, XT_32 lidar mount",
              build_carter),
     UsdAsset("nova_carter_nav_only", NAV_ONLY_PATH, CARTER_SIZE,
-             "the Nova Carter with its navigation target child `targetXform` (Replicator's AMR sample; the "
-             "navigation graph itself is not included)", build_nav_only),
+             "the Nova Carter with its navigation target child `targetXform` and the action graph `ActionGraph` "
+             "driving it there (Replicator's AMR sample; graphsdg runs it in compat mode)", build_nav_only),
     UsdAsset("nova_carter_ros", ROS_PATH, CARTER_SIZE,
              "the Nova Carter (Isaac's ROS 2 sample adds ROS 2 publisher graphs, which are not included)",
              build_ros_sample),

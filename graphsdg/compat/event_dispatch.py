@@ -8,7 +8,10 @@ calls every matching observer at once, in ascending ``order`` (equal orders in
 registration order), skipping observers whose ``filter`` items the payload does
 not carry. As Kit documents: an observer added during a dispatch is not called
 for that event; one reset during a dispatch is not called again; an exception in
-an observer is logged (logger ``carb``) and the dispatch goes on.
+an observer is logged (logger ``carb``) and the dispatch goes on. An observer is
+not re-entered: a dispatch that its own callback causes (a timeline tick sent by
+``rep.orchestrator.step()`` called from a tick observer) skips it, as Isaac's
+scripts that capture from a tick observer (``amr_navigation.py``) expect.
 
 The events Kit itself sends are bridged from graphsdg's real sources the first
 time anything observes or waits for an event:
@@ -116,6 +119,7 @@ class Observer(CompatObject):
                                                                                   filter, name)
         self._enabled = True
         self._alive = True
+        self._calling = False    # in its callback now: a dispatch its own callback causes skips it
 
     @property
     def name(self) -> str:
@@ -216,13 +220,16 @@ class EventDispatcher(CompatObject):
         payload = dict(payload or {})
         called = 0
         for guard in self._live(event_name):   # observers added from here on wait for the next dispatch
-            if not guard._alive or not guard._enabled or not guard._matches(payload):
+            if not guard._alive or not guard._enabled or not guard._matches(payload) or guard._calling:
                 continue
             called += 1
+            guard._calling = True
             try:
                 guard._on_event(Event(event_name, payload))
             except Exception:  # noqa: BLE001 - Kit logs an observer's error and goes on with the dispatch
                 log.exception("observer %r of event %r raised", guard.name, event_name)
+            finally:
+                guard._calling = False
         return called
 
     def has_observers(self, event_name: str, filter: dict[str, Any] | None = None) -> bool:  # noqa: A002

@@ -15,6 +15,7 @@ up to their next wait, as Kit's loop does.
 from __future__ import annotations
 
 import asyncio
+import builtins
 import enum
 import inspect
 import logging
@@ -295,6 +296,7 @@ class SimulationApp(CompatObject):
     def __init__(self, launch_config: dict | None = None, experience: str = "") -> None:
         self.config = dict(launch_config or {})
         self._closed = False
+        builtins.ISAAC_LAUNCHED_FROM_TERMINAL = False    # Isaac's SimulationApp marks a standalone run
         for key, value in command_line_settings(sys.argv[1:]).items():   # Kit reads them from the command line
             _carb_settings.set(key, value)
 

@@ -38,6 +38,7 @@ from typing import Any, Callable
 
 from graphsdg.compat.modules import CompatError, CompatModule, CompatObject, ForwardingModule, PORTING
 from graphsdg.graph import attributes, ogn, scheduler
+from graphsdg.graph.action_graph import ActionGraph
 from graphsdg.graph.attributes import Attribute
 from graphsdg.graph.builder import add_node
 from graphsdg.graph.current import current_graph
@@ -48,6 +49,8 @@ from graphsdg.graph.scopes import implicit_targets
 from graphsdg.stage.context import stage_context
 
 GRAPH_PATH = REPLICATOR_GRAPH_PATH
+# OmniGraph's evaluators graphsdg has: push graphs run when evaluated by hand, execution graphs are action graphs
+GRAPH_EVALUATORS = ("push", "dirty_push", "execution")
 ExecutionAttributeState = ogn.ExecutionState
 
 # Replicator's OmniGraph names of graphsdg's node types (and of their ports)
@@ -273,10 +276,12 @@ def node_type(type_name: str) -> type[Node]:
         found = _load_node_type(name)
         if found is not None:
             return found
+    omnigraph_types = sorted(n for n in NodeRegistry.types() if "." in n and n.split(".")[0] in ("omni", "isaacsim"))
     raise CompatError(f"OmniGraph node type {type_name!r} is not available in graphsdg's compat mode: graphsdg "
-                      f"runs its own node types, Replicator's names for them ({', '.join(sorted(REPLICATOR_TYPES))}) "
-                      f"and Python OmniGraph nodes of an extension's nodes folder (.ogn + .py); C++ node "
-                      f"libraries (omni.graph.action, omni.graph.nodes, ...) have no counterpart. {PORTING}")
+                      f"runs its own node types, Replicator's names for them ({', '.join(sorted(REPLICATOR_TYPES))}), "
+                      f"the OmniGraph node types it implements ({', '.join(omnigraph_types)}) and Python OmniGraph "
+                      f"nodes of an extension's nodes folder (.ogn + .py); other C++ node libraries have no "
+                      f"counterpart. {PORTING}")
 
 
 def new_node(type_name: str, name: str | None = None, **values: Any) -> Node:
@@ -404,7 +409,12 @@ class Controller(CompatObject):
             raise ValueError(f"create_graph needs an absolute graph path, got {graph_id!r}")
         if path == GRAPH_PATH:
             return GraphHandle(GRAPH_PATH)
-        graph = Graph()
+        evaluator = graph_id.get("evaluator_name", "push") if isinstance(graph_id, dict) else "push"
+        if evaluator not in GRAPH_EVALUATORS:
+            raise CompatError(f"og.Controller: graph evaluator {evaluator!r} (for {path}) is not available in "
+                              f"graphsdg's compat mode; evaluators: {sorted(GRAPH_EVALUATORS)}. {PORTING}")
+        # "execution": an action graph, evaluated on timeline ticks (graphsdg.compat.omnigraph_action)
+        graph = ActionGraph() if evaluator == "execution" else Graph()
         graph.path = str(path)
         _graphs[str(path)] = graph
         return GraphHandle(str(path))
@@ -470,7 +480,7 @@ class Controller(CompatObject):
         disconnect, set values, delete nodes); returns (graph, nodes made, [], {})."""
         path = graph_id.get("graph_path") if isinstance(graph_id, dict) else graph_id
         handle = _graph_handle(path) if isinstance(path, GraphHandle) or str(path) == GRAPH_PATH or \
-            str(path) in _graphs else cls.create_graph(path)
+            str(path) in _graphs else cls.create_graph(graph_id if isinstance(graph_id, dict) else path)
         made: list[Node] = []
         for key, value in (edit_commands or {}).items():
             items = value if isinstance(value, list) else [value]
@@ -509,6 +519,22 @@ def _delete_node(handle: GraphHandle, node: Node) -> None:
         handle.graph.remove(node)
     except ValueError as exc:
         raise CompatError(f"og.Controller.edit: {exc}; disconnect them first") from None
+
+
+def add_graph(graph: Graph) -> GraphHandle:
+    """Know ``graph`` (made elsewhere, such as an action graph read from the stage) at its ``path``."""
+    _graphs[str(graph.path)] = graph
+    return GraphHandle(str(graph.path))
+
+
+def remove_graph(path: str) -> None:
+    """Forget the graph at ``path`` (OmniGraph's graph prim was removed)."""
+    _graphs.pop(str(path), None)
+
+
+def made_graphs() -> dict[str, Graph]:
+    """The graphs made by path (``Controller.create_graph`` / ``edit``, or read from the stage), by path."""
+    return dict(_graphs)
 
 
 def get_graph_by_path(path: str) -> GraphHandle | None:

@@ -96,7 +96,10 @@ class AttributeType:
         for role in _ROLE_TYPES:       # role types are tuples of a float kind: colorf[3] and the like
             if base == role:
                 base = {"f": "float", "d": "double", "h": "half"}.get(role[-1], "double")
-                count = count if count > 1 else (16 if role == "matrixd" else 4 if role.startswith("quat") else 3)
+                if role in ("matrixd", "frame"):   # matrixd[4] is a 4 x 4 matrix: 16 values
+                    count = count * count if count > 1 else 16
+                else:
+                    count = count if count > 1 else (4 if role.startswith("quat") else 3)
         if base not in _BASE_TYPES:
             raise ValueError(f"{where}: attribute type {text!r} is not one graphsdg reads; known base types: "
                              f"{sorted(_BASE_TYPES)} (with [n] tuples and [] arrays)")
@@ -129,21 +132,25 @@ def _attributes(section: dict, where: str) -> dict[str, tuple[AttributeType, Any
     return out
 
 
+def definition_from_spec(type_name: str, spec: dict, where: str = "") -> Definition:
+    """The :class:`Definition` of node type ``type_name`` from its OGN JSON ``spec`` (one entry of an
+    ``.ogn`` file: ``description``, ``inputs`` / ``outputs`` / ``state`` with ``type`` and ``default``)."""
+    where = where or type_name
+    text = spec.get("description", "")
+    description = " ".join(text) if isinstance(text, list) else str(text)
+    return Definition(type_name, description, _attributes(spec.get("inputs"), f"{where}: input"),
+                      _attributes(spec.get("outputs"), f"{where}: output"),
+                      _attributes(spec.get("state"), f"{where}: state"))
+
+
 def parse_definition(path: Path, extension: str) -> list[Definition]:
     """The node types defined in ``.ogn`` file ``path`` (names without a dot get ``extension.`` in front)."""
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise ValueError(f"{path}: not valid OGN JSON ({exc})") from None
-    out = []
-    for key, spec in data.items():
-        name = key if "." in key else f"{extension}.{key}"
-        text = spec.get("description", "")
-        description = " ".join(text) if isinstance(text, list) else str(text)
-        out.append(Definition(name, description, _attributes(spec.get("inputs"), f"{path}: input"),
-                              _attributes(spec.get("outputs"), f"{path}: output"),
-                              _attributes(spec.get("state"), f"{path}: state")))
-    return out
+    return [definition_from_spec(key if "." in key else f"{extension}.{key}", spec, str(path))
+            for key, spec in data.items()]
 
 
 class _Values:
@@ -329,4 +336,4 @@ def definition_types(ogn_path: Path, extension: str) -> list[str]:
 
 
 __all__ = ["ExecutionState", "AttributeType", "Definition", "Database", "OgnNode", "node_class", "load_file",
-           "load_folder", "parse_definition", "definition_types"]
+           "load_folder", "parse_definition", "definition_from_spec", "definition_types"]
