@@ -3,10 +3,11 @@
 Each piece of process state is one object made by the room that uses it, so
 that the low floors bind it at import without reaching up; the session holds
 every one of them and is the only thing that resets them. Pieces of the rooms
-below the engine are taken at import here; pieces of the rooms above it (the
-graph, the runtime, physics, Replicator's face) hand themselves over with
+below the engine are taken at import here; pieces of the rooms at or above it
+(the engine's runtime and state, the graph, physics) hand themselves over with
 :meth:`Session.adopt` into a slot named here, so the order below never depends
-on which module was imported first.
+on which module was imported first. ``docs/design.md`` ("Process state: one
+session") lists every piece.
 
 When the stage is replaced or closed, the stage context calls its owner,
 :meth:`Session.stage_replaced`, before any subscriber (compat's contexts, a
@@ -77,7 +78,8 @@ class Session:
         "motion_history",    # each live render product's last capture, for motion vectors (held weakly)
     )
 
-    #: The slots that rooms above the engine fill with :meth:`adopt` (empty until that room is imported).
+    #: The slots that rooms at or above the engine fill with :meth:`adopt` (empty until that room is imported;
+    #: the runtime's until its first use).
     ADOPTED: frozenset[str] = frozenset({"graph", "runtime", "engine_state", "forces", "randomization_targets"})
 
     def __init__(self) -> None:
@@ -101,7 +103,7 @@ class Session:
         stage_context.own(self.stage_replaced)
 
     def adopt(self, name: str, part: Any) -> Any:
-        """Hold ``part`` (made by a room above the engine) in the slot ``name``; returns ``part``."""
+        """Hold ``part`` (made by a room at or above the engine) in the slot ``name``; returns ``part``."""
         if name not in self.ADOPTED:
             raise ValueError(f"the session has no slot {name!r} for a room to fill; slots: {sorted(self.ADOPTED)}")
         held = getattr(self, name)
