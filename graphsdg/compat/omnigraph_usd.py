@@ -28,7 +28,8 @@ Example:
     >>> isaac.install()
     >>> import omni.usd
     >>> from pxr import Sdf
-    >>> stage = omni.usd.get_context().new_stage() or omni.usd.get_context().get_stage()
+    >>> _ = omni.usd.get_context().new_stage()
+    >>> stage = omni.usd.get_context().get_stage()
     >>> graph_prim = stage.DefinePrim("/Graph", "OmniGraph")
     >>> _ = graph_prim.CreateAttribute("evaluator:type", Sdf.ValueTypeNames.Token).Set("execution")
     >>> node = stage.DefinePrim("/Graph/tick", "OmniGraphNode")

@@ -8,7 +8,8 @@ Here an :class:`Attribute` names one port of a graphsdg :class:`~graphsdg.graph.
 * ``get()`` reads an input (its connection's current output, else its value or
   default) or an output (the node's last computed value); a distribution's
   samples read as the array of its ``num_samples`` draws;
-* ``set(value)`` gives an unconnected input a plain value;
+* ``set(value)`` gives an unconnected input a plain value (on an OmniGraph node
+  type's connected input, the value goes to the upstream output it reads);
 * ``connect(dest)`` feeds input ``dest`` from this output: a data edge of the
   graph, exactly as passing an item to a graph call makes one. Connecting a
   trigger's ``outputs:execOut`` to a node's ``inputs:execIn`` gates the node by
@@ -196,10 +197,16 @@ class Attribute:
         if self.section == "state":
             self.node.__dict__.setdefault("state_values", {})[self.port] = value
             return True
-        if self.get_upstream_connections():
+        upstream = self.get_upstream_connections()
+        if upstream and getattr(self.node, "omnigraph_type", ""):
+            # an OmniGraph node's connected input reads its upstream output's data: a value set lands there
+            # (until that node computes again), as OmniGraph does
+            for source in upstream:
+                source.node.output_values[source.port] = value
+            return True
+        if upstream:
             raise ValueError(f"{self.get_path()} is connected to "
-                             f"{[a.get_path() for a in self.get_upstream_connections()]}; disconnect it before "
-                             f"setting a value")
+                             f"{[a.get_path() for a in upstream]}; disconnect it before setting a value")
         self.node.set_input(self.port, value)
         return True
 

@@ -122,7 +122,7 @@ class StanleyPathFollower:
         turn = speed / base * math.tan(steer)
         if forward > 0:      # tighten the turn with the differential drive's inner wheel
             turn *= 1.0 + abs(self.wheel_base * turn / forward) * gain / self.step
-        return forward, turn
+        return float(forward), float(turn)
 
 
 __all__ = ["StanleyPathFollower", "SteeringGains", "speed_profile", "wrap_angle"]

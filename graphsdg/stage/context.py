@@ -86,6 +86,9 @@ class StageContext:
         path = resolve_asset_path(path)   # an omniverse:// URL opens its local file
         if not os.path.isfile(path):
             raise FileNotFoundError(f"cannot open stage: no USD file at {path!r}")
+        open_layer = Sdf.Layer.Find(path)
+        if open_layer is not None and open_layer.dirty:   # still held, edited: opening a file reads the file, as Kit
+            open_layer.Reload(force=True)
         try:
             stage = Usd.Stage.Open(path)
         except Exception as exc:  # pxr raises Tf.ErrorException
