@@ -350,7 +350,8 @@ def test_articulation_controller_refuses_a_command_of_the_wrong_length(compat):
                                   "graphsdg.maths.stanley_steering", "graphsdg.maths.differential_drive",
                                   "graphsdg.assets.omnigraph_authoring", "graphsdg.compat.omnigraph_action",
                                   "graphsdg.compat.omnigraph_usd", "graphsdg.compat.omnigraph_scene_nodes",
-                                  "graphsdg.compat.core_node_types", "graphsdg.compat.usdrt_names"])
+                                  "graphsdg.compat.core_node_types", "graphsdg.compat.usdrt_names",
+                                  "graphsdg.compat.wheeled_robot_nodes"])
 def test_docstring_examples(name):
     import doctest
     import importlib

@@ -10,8 +10,9 @@
   annotators from, so they raise Replicator's registration error naming the Python alternatives;
 * ``scripts.utils.set_target_prims``: points a prim's relationship at target prims.
 
-The extension's OmniGraph node types (``IsaacCreateRenderProduct``, ...) run in action graphs
-(``omni.graph.action.OnTick``), which graphsdg's OmniGraph layer does not have.
+Of the extension's OmniGraph node types, ``IsaacArticulationController`` and ``IsaacComputeOdometry`` run in
+action graphs (:mod:`graphsdg.compat.core_node_types`); the others (``IsaacCreateRenderProduct``, ...) raise
+``CompatError`` naming them.
 """
 from __future__ import annotations
 

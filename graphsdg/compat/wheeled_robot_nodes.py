@@ -23,9 +23,8 @@ Quaternions are OmniGraph's ``(x, y, z, w)``; positions are metres, angles radia
 Inputs and defaults are those of Isaac Sim 6.0.1's ``.ogn`` files for these nodes.
 
 Example:
-    >>> state = _DriveState()
-    >>> state.drive is None
-    True
+    >>> round(yaw_of((0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5))), 6)     # +90 degrees about Z, (x, y, z, w)
+    1.570796
 """
 from __future__ import annotations
 
