@@ -37,7 +37,7 @@ from typing import Callable
 
 import mujoco
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom
+from pxr import Sdf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.sim import deformables, geom_subsets
 from graphsdg.sim import joints as jointmap
@@ -152,10 +152,30 @@ class SimScene:
                 raise NeedsRecompile
             self._apply_edits(changes)
         except NeedsRecompile:
+            self._move_bodies_before_recompile(changes)
             self.recompile()
             return
         self.stats["syncs"] += 1
         self.stats["sync_s"] += time.perf_counter() - start
+
+    def _move_bodies_before_recompile(self, changes: ChangeSet) -> None:
+        """Put the rigid bodies that the edits moved (a body's or an ancestor's transform) where the stage now
+        says, so the state a recompile carries over has them there (a script that moves a prop and loads an
+        environment in one go)."""
+        c = self.compiled
+        assert c is not None
+        index = self._subtree_index()
+        cache = UsdGeom.XformCache(Usd.TimeCode.Default())
+        for path, names in changes.edited.items():
+            if "pose" not in edit_aspects(names) & INHERITED_ASPECTS:
+                continue
+            for kind, bound in index.get(str(path), ()):
+                prim = self.stage.GetPrimAtPath(bound)
+                if kind == "b" and prim and prim.HasAPI(UsdPhysics.RigidBodyAPI):
+                    try:
+                        self._refresh_body(bound, cache)
+                    except NeedsRecompile:
+                        pass    # a body the recompile rebuilds from the stage anyway
 
     @staticmethod
     def _is_structural(changes: ChangeSet) -> bool:
