@@ -30,6 +30,7 @@ from graphsdg import orchestrator, stage
 from graphsdg.base import settings_store as settings
 from graphsdg.compat import event_names, extensions, viewport
 from graphsdg.compat.event_names import StageEventType
+from graphsdg.compat.experiences import apply_experience
 from graphsdg.compat.kit_commands import COMMANDS
 from graphsdg.compat.modules import CompatError, CompatObject, available_names, missing
 from graphsdg.graph import clear as clear_graph
@@ -289,12 +290,14 @@ get_app_interface = get_app
 
 
 class SimulationApp(CompatObject):
-    """isaacsim.SimulationApp: graphsdg needs no Kit; the launch config is kept and otherwise ignored."""
+    """isaacsim.SimulationApp: graphsdg needs no Kit; the launch config is kept, an experience's settings applied."""
 
     _compat_name = "isaacsim.SimulationApp"
 
     def __init__(self, launch_config: dict | None = None, experience: str = "") -> None:
         self.config = dict(launch_config or {})
+        if experience:   # Kit starts from the experience's settings, then the command line's
+            self.config["experience"] = apply_experience(experience)
         self._closed = False
         builtins.ISAAC_LAUNCHED_FROM_TERMINAL = False    # Isaac's SimulationApp marks a standalone run
         for key, value in command_line_settings(sys.argv[1:]).items():   # Kit reads them from the command line
