@@ -155,6 +155,26 @@ def test_exec_flow_and_data_nodes_pulled_only_for_nodes_that_run(compat):
     assert og.Controller.get(planner.get_attribute("outputs:targetChanged")) is False  # planned on the first run
 
 
+def test_an_execution_input_runs_on_any_of_its_connections(compat):
+    import omni.graph.core as og
+    import omni.timeline
+    keys = og.Controller.Keys
+    _, (every_2nd, every_3rd, drive), _, _ = og.Controller.edit({"graph_path": "/FanIn", "evaluator_name": "execution"}, {
+        keys.CREATE_NODES: [("every_2nd", "omni.graph.action.OnTick"), ("every_3rd", "omni.graph.action.OnTick"),
+                            ("drive", "isaacsim.robot.wheeled_robots.DifferentialController")],
+        keys.CONNECT: [("every_2nd.outputs:tick", "drive.inputs:execIn"), ("every_3rd.outputs:tick", "drive.inputs:execIn")],
+        keys.SET_VALUES: [("every_2nd.inputs:framePeriod", 1), ("every_3rd.inputs:framePeriod", 2),
+                          ("drive.inputs:wheelRadius", 0.1), ("drive.inputs:wheelDistance", 0.5)]})
+    omni.timeline.get_timeline_interface().play()
+    _updates(6)
+    assert drive.exec_count == 4                                  # updates 1, 3, 5 and 1, 4: 1, 3, 4, 5
+    og.Controller.disconnect("/FanIn/every_2nd.outputs:tick", "/FanIn/drive.inputs:execIn")
+    assert [a.get_path() for a in drive.get_attribute("inputs:execIn").get_upstream_connections()] == \
+        ["/FanIn/every_3rd.outputs:tick"]
+    _updates(6)
+    assert drive.exec_count == 6                                  # updates 7 and 10
+
+
 def test_controller_built_navigation_graph_drives_the_carter_to_its_goal(compat):
     """Isaac's setup_robot_og and test_drive_goal_carter_v2 graph, on the stand-in on a ground plane."""
     import omni.graph.core as og

@@ -167,7 +167,10 @@ class Node:
             self.graph.invalidate()
             return
         if dest_port in dest.inputs:
-            dest.values[dest_port] = ReplicatorItem(self, port)
+            item, current = ReplicatorItem(self, port), list(iter_refs(dest.values.get(dest_port)))
+            # an execution input takes any number of connections (execution from any of them runs the node)
+            fan_in = dest.inputs[dest_port].type == "execution" and current
+            dest.values[dest_port] = [*current, item] if fan_in else item
         else:      # an exec pin graphsdg's node has no port for: it orders the two nodes
             dest.__dict__.setdefault("exec_sources", []).append((self, port))
         self.graph.connect(self, dest, port, dest_port)
@@ -177,7 +180,8 @@ class Node:
         if port == EXEC_IN and up.family == "trigger" and self.trigger is up:
             self.trigger = None
         elif port in self.inputs and any(r.node is up and r.output == up_port for r in iter_refs(self.values.get(port))):
-            self.values[port] = None
+            rest = [r for r in iter_refs(self.values.get(port)) if not (r.node is up and r.output == up_port)]
+            self.values[port] = rest if len(rest) > 1 else rest[0] if rest else None
         elif (up, up_port) in self.__dict__.get("exec_sources", []):
             self.exec_sources.remove((up, up_port))
         else:

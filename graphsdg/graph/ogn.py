@@ -13,10 +13,11 @@ type: its ports are the definition's attributes, its compute builds a
 
 Values a compute reads: ``target`` attributes give the prims' paths
 (``Sdf.Path``), arrays give numpy arrays, a distribution's samples the array of
-its draws. Execution attributes: a node whose ``execIn`` is fed by another
-node's ``execOut`` runs only when that node ran in the same evaluation and set
-its ``execOut`` to anything but :attr:`ExecutionState.DISABLED`; a compute that
-leaves ``execOut`` unset enables it when it returns True.
+its draws. Execution attributes: a node whose ``execIn`` is fed by other nodes'
+``execOut`` (any number of them) runs only when one of them ran in the same
+evaluation and set its ``execOut`` to anything but
+:attr:`ExecutionState.DISABLED`; a compute that leaves ``execOut`` unset enables
+it when it returns True.
 
 Example:
     >>> import json, pathlib, tempfile
@@ -256,13 +257,13 @@ class OgnNode(Node):
         self.warnings: list[str] = []
 
     def exec_input_state(self, frame: int) -> ExecutionState:
-        """ENABLED unless an upstream ``execOut`` feeding ``execIn`` is disabled or did not run on ``frame``."""
-        for up, port in self.input_sources(EXEC_IN):
-            if up.family == "trigger":
-                continue
-            if up.last_frame != frame or up.output_values.get(port) == ExecutionState.DISABLED:
-                return ExecutionState.DISABLED
-        return ExecutionState.ENABLED
+        """ENABLED when nothing but triggers feeds ``execIn``, or when one of the execution outputs feeding it ran
+        on ``frame`` and is not disabled."""
+        sources = [(up, port) for up, port in self.input_sources(EXEC_IN) if up.family != "trigger"]
+        if not sources or any(up.last_frame == frame and up.output_values.get(port) != ExecutionState.DISABLED
+                              for up, port in sources):
+            return ExecutionState.ENABLED
+        return ExecutionState.DISABLED
 
     def compute(self, ctx: ExecContext) -> dict[str, Any] | None:
         exec_outputs = [n for n, (t, _) in self.definition.outputs.items() if t.base == "execution"]
