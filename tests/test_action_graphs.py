@@ -124,6 +124,30 @@ def test_differential_controller_node_in_an_action_graph(compat):
     assert og.Controller.get(tick.get_attribute("outputs:frame")) == pytest.approx(4.0)
 
 
+def test_evaluating_by_hand_controller_instances_and_reset_on_stop(compat):
+    import omni.graph.core as og
+    import omni.timeline
+    keys = og.Controller.Keys
+    graph, (_, drive), _, _ = og.Controller.edit({"graph_path": "/Hand", "evaluator_name": "execution"}, {
+        keys.CREATE_NODES: [("tick", "omni.graph.action.OnPlaybackTick"),
+                            ("drive", "isaacsim.robot.wheeled_robots.DifferentialController")],
+        keys.CONNECT: [("tick.outputs:tick", "drive.inputs:execIn")],
+        keys.SET_VALUES: [("drive.inputs:wheelRadius", 0.25), ("drive.inputs:wheelDistance", 1.0)]})
+    og.Controller(og.Controller.attribute("inputs:linearVelocity", drive)).set(0.5)
+    command = og.Controller(og.Controller.attribute("outputs:velocityCommand", drive))
+    og.Controller.evaluate_sync(graph)
+    assert drive.exec_count == 0                          # OnPlaybackTick does not fire while stopped
+    timeline = omni.timeline.get_timeline_interface()
+    timeline.play()
+    og.Controller.evaluate_sync(graph)
+    assert drive.exec_count == 1 and list(command.get()) == pytest.approx([2.0, 2.0])
+    timeline.stop()                                       # Isaac's node zeroes its commanded velocities on stop
+    assert og.Controller.get(og.Controller.attribute("/Hand/drive.inputs:linearVelocity")) == 0.0
+    import omni.graph.core.tests as ogts
+    import omni.kit.test
+    assert issubclass(ogts.OmniGraphTestCase, omni.kit.test.AsyncTestCase)
+
+
 def test_exec_flow_and_data_nodes_pulled_only_for_nodes_that_run(compat):
     import omni.graph.core as og
     import omni.timeline

@@ -62,15 +62,20 @@ def articulation_root(path: str) -> str:
 
 # ---- IsaacArticulationController --------------------------------------------------------------------------
 class _ControllerState:
-    """The articulation being commanded and the DOFs selected."""
+    """The articulation being commanded and the DOFs selected (a reset also empties the commands, as Isaac's node
+    does)."""
 
     def __init__(self) -> None:
         self.dofs: ArticulationDofs | None = None
         self.selection: tuple | None = None        # (names, indices) the DOF indices were resolved for
         self.dof_indices: np.ndarray | None = None  # None: every DOF
         self.warned_undriven = False
+        self.node: Any = None
 
     def reset(self) -> None:
+        if self.dofs is not None and self.node is not None:
+            for name in ("positionCommand", "velocityCommand", "effortCommand"):
+                self.node.get_attribute(f"inputs:{name}").set(np.zeros(0))
         self.dofs, self.selection, self.dof_indices = None, None, None
 
 

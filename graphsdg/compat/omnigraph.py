@@ -10,7 +10,10 @@ ports (:mod:`graphsdg.graph.attributes`), and:
   ``evaluate_sync`` / ``await evaluate`` of it runs one step of it by hand
   (triggers poll, gated nodes run), without rendering;
 * ``og.Controller.create_graph(path)`` makes a graph of its own (OmniGraph's
-  push graph); evaluating it runs every node in it once, in order;
+  push graph); evaluating it runs every node in it once, in order; with
+  ``{"graph_path": path, "evaluator_name": "execution"}`` it makes an action
+  graph, run on timeline ticks (:mod:`graphsdg.compat.omnigraph_action`), whose
+  evaluation by hand runs its execution flow once now;
 * ``Controller.create_node`` / ``rep.utils.create_node`` take graphsdg's type
   names, Replicator's OmniGraph names of them (``omni.replicator.core.OgnSampleUniform``)
   and Python OmniGraph node types: a type ``<ext>.<Name>`` not registered yet is
@@ -21,14 +24,15 @@ ports (:mod:`graphsdg.graph.attributes`), and:
   call: ``input_prims`` comes from the enclosing ``with item:``, nodes it makes
   are gated by the enclosing trigger (or, outside any, run once when it returns).
 
-What OmniGraph has and graphsdg does not (action-graph node libraries such as
-``omni.graph.action.*``, bundles, GPU attributes, graph pipeline stages running
-on their own) raises :class:`~graphsdg.compat.modules.CompatError` naming it.
+What OmniGraph has and graphsdg does not (native node types beyond those the
+action-graph areas implement, bundles, GPU attributes, graph pipeline stages
+running on their own) raises :class:`~graphsdg.compat.modules.CompatError` naming it.
 """
 from __future__ import annotations
 
 import asyncio
 import enum
+import functools
 import inspect
 import sys
 import tomllib
@@ -38,7 +42,9 @@ from typing import Any, Callable
 
 from graphsdg.compat.modules import CompatError, CompatModule, CompatObject, ForwardingModule, PORTING
 from graphsdg.graph import attributes, ogn, scheduler
-from graphsdg.graph.action_graph import ActionGraph
+from graphsdg.engine.runtime import runtime
+from graphsdg.graph import action_graph
+from graphsdg.graph.action_graph import ActionGraph, Tick
 from graphsdg.graph.attributes import Attribute
 from graphsdg.graph.builder import add_node
 from graphsdg.graph.current import current_graph
@@ -213,6 +219,12 @@ def _evaluate(graph: Any = None) -> None:
     handle = GraphHandle(GRAPH_PATH) if graph is None else _graph_handle(graph)
     if handle._path == GRAPH_PATH:
         scheduler.graph_step()
+    elif isinstance(handle.graph, ActionGraph):
+        # one evaluation now, at the timeline's time: every event node decides whether it fires
+        timeline = runtime().timeline
+        time = timeline.get_current_time()
+        action_graph.evaluate(handle.graph, Tick(time, 0.0, time * timeline.get_time_codes_per_seconds(),
+                                                 timeline.is_playing(), "evaluate"))
     else:
         scheduler.evaluate_all(handle.graph)
 
@@ -392,6 +404,25 @@ class Keys:
     PROMOTE_ATTRIBUTES = "promote_attributes"
 
 
+class _class_or_instance:  # noqa: N801 - used as a decorator
+    """A method called on the class (``og.Controller.get(attr)``) or on an instance (``og.Controller(attr).get()``):
+    it gets the class and the instance (None on the class)."""
+
+    def __init__(self, fn: Callable[..., Any]) -> None:
+        self._fn = fn
+        self.__doc__ = fn.__doc__
+
+    def __get__(self, instance: Any, owner: type) -> Callable[..., Any]:
+        return functools.partial(self._fn, owner, instance)
+
+
+def _bound_attribute(instance: "Controller | None", method: str) -> Attribute:
+    attribute = getattr(instance, "_attribute", None)
+    if attribute is None:
+        raise TypeError(f"og.Controller.{method} needs the attribute (or an og.Controller(attribute) instance)")
+    return attribute
+
+
 class Controller(CompatObject):
     """``og.Controller``: make graphs and nodes, connect, set and read attributes, evaluate (class or instance)."""
 
@@ -399,7 +430,8 @@ class Controller(CompatObject):
     Keys = Keys
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        pass
+        # og.Controller(attribute).get() / .set(value): an instance may be made for one attribute
+        self._attribute = args[0] if len(args) == 1 and isinstance(args[0], Attribute) else None
 
     @classmethod
     def create_graph(cls, graph_id: Any, *args: Any, **kwargs: Any) -> GraphHandle:
@@ -456,12 +488,20 @@ class Controller(CompatObject):
     def disconnect(cls, src: Any, dst: Any, *args: Any, **kwargs: Any) -> None:
         _attribute(src).disconnect(_attribute(dst))
 
-    @classmethod
-    def get(cls, attribute: Any, *args: Any, **kwargs: Any) -> Any:
+    @_class_or_instance
+    def get(cls, instance: "Controller | None", *args: Any, **kwargs: Any) -> Any:
+        """``og.Controller.get(attribute)``, or ``og.Controller(attribute).get()``."""
+        attribute = args[0] if args else kwargs.get("attribute", _bound_attribute(instance, "get"))
         return _attribute(attribute).get()
 
-    @classmethod
-    def set(cls, attribute: Any, value: Any, *args: Any, **kwargs: Any) -> bool:
+    @_class_or_instance
+    def set(cls, instance: "Controller | None", *args: Any, **kwargs: Any) -> bool:
+        """``og.Controller.set(attribute, value)``, or ``og.Controller(attribute).set(value)``."""
+        if len(args) == 1 and "value" not in kwargs:
+            attribute, value = _bound_attribute(instance, "set"), args[0]
+        else:
+            attribute = args[0] if args else kwargs["attribute"]
+            value = args[1] if len(args) > 1 else kwargs["value"]
         return _attribute(attribute).set(value)
 
     @classmethod

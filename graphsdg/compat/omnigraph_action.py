@@ -67,7 +67,7 @@ class OnPlaybackTick:
         db.outputs.time = tick.time
         db.outputs.deltaSeconds = tick.delta_seconds
         db.outputs.frame = tick.frame
-        db.outputs.tick = ExecutionState.ENABLED
+        db.outputs.tick = ExecutionState.ENABLED if tick.playing else ExecutionState.DISABLED
         return True
 
 
@@ -192,6 +192,18 @@ class ActionGraphRunner:
 _runner = ActionGraphRunner()
 
 
+class OmniGraphTestCase(kit.AsyncTestCase):
+    """``omni.graph.core.tests.OmniGraphTestCase``: an async test case that starts and ends on a new stage with a
+    stopped timeline (the base of Isaac's OmniGraph node tests)."""
+
+    async def setUp(self) -> None:
+        await kit.get_context().new_stage_async()
+
+    async def tearDown(self) -> None:
+        runtime().timeline.stop()
+        await kit.get_context().new_stage_async()
+
+
 def install() -> None:
     """Start evaluating action graphs (compat mode was installed)."""
     _runner.start()
@@ -206,4 +218,5 @@ def modules() -> list[types.ModuleType]:
     """``omni.graph.action``'s node types (registered) and the module's name."""
     register_node_types(NODE_TYPES)
     return [CompatModule("omni.graph.action", hint="graphsdg runs the action graphs' event nodes OnPlaybackTick "
-                                                   "and OnTick; make graphs with omni.graph.core.Controller.edit")]
+                                                   "and OnTick; make graphs with omni.graph.core.Controller.edit"),
+            CompatModule("omni.graph.core.tests", OmniGraphTestCase=OmniGraphTestCase)]

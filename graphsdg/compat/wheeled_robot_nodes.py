@@ -230,13 +230,18 @@ class StanleyControlPID:
 
 # ---- DifferentialController -------------------------------------------------------------------------------
 class _DriveState:
-    """The drive configured on the first compute after a reset."""
+    """The drive configured on the first compute after a reset (the timeline stopped: the commanded velocities go
+    back to 0, as Isaac's node resets them)."""
 
     def __init__(self) -> None:
         self.drive: DifferentialDrive | None = None
+        self.node: Any = None
 
     def reset(self) -> None:
         self.drive = None
+        if self.node is not None:
+            for name in ("inputs:linearVelocity", "inputs:angularVelocity"):
+                self.node.get_attribute(name).set(0.0)
 
 
 class DifferentialController:

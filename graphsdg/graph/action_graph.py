@@ -7,8 +7,9 @@ connections. :class:`ActionGraph` holds one; :func:`evaluate` runs it for one
 :class:`Tick`:
 
 1. every event node (a node type whose implementation names the ``event`` it
-   answers) computes, reading the tick from :attr:`ActionGraph.tick`; those that
-   fire set an execution output to enabled;
+   answers; all of them for an evaluation by hand) computes, reading the tick
+   from :attr:`ActionGraph.tick`; those that fire set an execution output to
+   enabled;
 2. the other nodes with an execution input run in the graph's order (data and
    execution connections both order it, upstream first) when an execution
    output feeding them ran in this evaluation and is enabled (a node whose
@@ -43,8 +44,9 @@ from graphsdg.graph.ogn import ExecutionState
 
 log = logging.getLogger("graphsdg.action_graph")
 
-#: the events an event node may answer: a playback tick (timeline playing), an app update (playing or not)
-EVENTS = ("playback_tick", "app_update")
+#: the events an event node may answer: a playback tick (timeline playing), an app update (playing or not); an
+#: evaluation by hand ("evaluate", og.Controller.evaluate) computes every event node, each deciding whether it fires
+EVENTS = ("playback_tick", "app_update", "evaluate")
 
 
 @dataclass(frozen=True)
@@ -142,7 +144,7 @@ def evaluate(graph: ActionGraph, tick: Tick) -> list[Node]:
         for node in graph.order:
             event = event_of(node)
             if event is not None:
-                if event == tick.event:
+                if event == tick.event or tick.event == "evaluate":
                     _run(graph, node, frame)
                     ran.append(node)
                 continue

@@ -6,9 +6,10 @@ A Kit extension ships a node type as two files in its ``nodes`` folder:
 defining class ``OgnFoo`` whose static ``compute(db)`` reads ``db.inputs.<name>``,
 writes ``db.outputs.<name>`` and returns True on success (optionally
 ``internal_state()``, the per-node object ``db.per_instance_state`` /
-``db.internal_state``). :func:`load_folder` turns each pair into a graphsdg node
-type: its ports are the definition's attributes, its compute builds a
-:class:`Database` and calls the class's. A type named without dots
+``db.internal_state``; a state with a ``node`` attribute left None gets the
+node, as Kit's ``init_instance`` hooks give it). :func:`load_folder` turns each
+pair into a graphsdg node type: its ports are the definition's attributes, its
+compute builds a :class:`Database` and calls the class's. A type named without dots
 (``"OgnFoo"``) is registered as ``<extension>.OgnFoo``, as Kit does.
 
 Values a compute reads: ``target`` attributes give the prims' paths
@@ -251,6 +252,8 @@ class OgnNode(Node):
         super().__init__(name=name, **values)
         make_state = getattr(self.implementation, "internal_state", None)
         self.instance_state = make_state() if callable(make_state) else None
+        if getattr(self.instance_state, "node", False) is None:
+            self.instance_state.node = self     # what a node's init_instance(node, ...) gives its state in Kit
         self.state_values: dict[str, Any] = {n: d for n, (_, d) in self.definition.state.items()}
         self.output_values = {n: d for n, (_, d) in self.definition.outputs.items()}
         self.errors: list[str] = []
