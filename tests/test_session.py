@@ -26,7 +26,8 @@ from graphsdg.sim import physics_steps
 from graphsdg.stage.context import stage_context
 from graphsdg.stage.prims import structure_version
 
-#: The modules whose state the session took over (the rooms migrated by issue 34's third item).
+#: The modules whose state the session took over (the rooms migrated by issue 34's third item), and the rest of
+#: the engine room and Replicator's face over it, which keep none.
 MIGRATED = (
     "graphsdg.stage.context", "graphsdg.stage.prims", "graphsdg.render.attachments", "graphsdg.render.render_product",
     "graphsdg.render.motion_blur", "graphsdg.annotate.motion", "graphsdg.sensors.scanners",
@@ -34,6 +35,8 @@ MIGRATED = (
     "graphsdg.io.write_queue", "graphsdg.io.run_state", "graphsdg.io.frame_plan", "graphsdg.graph.current",
     "graphsdg.graph.scopes", "graphsdg.engine.runtime", "graphsdg.engine.state", "graphsdg.engine.session",
     "graphsdg.physics.forces", "graphsdg.physics.domain_randomization",
+    "graphsdg.engine.capture", "graphsdg.engine.run_loop", "graphsdg.engine.frame_provider",
+    "graphsdg.engine.progress", "graphsdg.graph.frame_provider", "graphsdg.orchestrator",
 )
 
 #: Upper-case module tables that are constants (filled once at import, only read after): the only mutable
@@ -43,6 +46,7 @@ CONSTANT_TABLES = {
     "graphsdg.base.settings_store": {"KNOWN_KEYS", "VALIDATORS"},
     "graphsdg.physics.domain_randomization": {"ATTRIBUTES", "_ARTICULATION_TABLES"},
     "graphsdg.engine.runtime": {"NO_GRAPH"},
+    "graphsdg.engine.frame_provider": {"NO_GRAPH"},
 }
 
 #: Values that hold no state: immutable ones, and the process-wide logging configuration.
