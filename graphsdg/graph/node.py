@@ -22,8 +22,9 @@ Example:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Iterator
+from typing import Any, ClassVar, Iterator, Protocol
 
+import networkx
 import numpy as np
 from pxr import Sdf, Usd
 
@@ -35,11 +36,21 @@ from graphsdg.graph.scopes import scopes
 from graphsdg.graph.value_shapes import Shape, spread
 from graphsdg.stage.prims import resolve_prim
 
-if TYPE_CHECKING:  # type names only: the graph module imports this one
-    from graphsdg.graph.graph import Graph
 
 # "gate": a node inside a trigger's block that picks which rows (environments) the nodes in its own block change
 FAMILIES = ("distribution", "trigger", "create", "get", "modify", "randomizer", "gate", "physics")
+
+
+class NodeGraph(Protocol):
+    """What a node asks of the graph that holds it (:class:`graphsdg.graph.graph.Graph` is one)."""
+
+    dag: networkx.DiGraph
+
+    def invalidate(self) -> None:
+        """Forget the execution order worked out from the edges."""
+
+    def connect(self, up: "Node", down: "Node", out_port: str, in_port: str) -> None:
+        """Connect ``up``'s output ``out_port`` to ``down``'s input ``in_port``."""
 
 
 @dataclass(frozen=True)
@@ -80,7 +91,7 @@ class Node:
         self.values: dict[str, Any] = {k: v for k, v in values.items()}
         self.user_name = name
         self.name: str = name or ""          # unique in its graph; set when added
-        self.graph: "Graph | None" = None
+        self.graph: NodeGraph | None = None
         self.trigger: "Node | None" = None   # the trigger node gating this node (None: runs once)
         self.layer = None                    # the Sdf.Layer its edits go to (rep.new_layer), if any
         self.seq = -1                        # build order in its graph

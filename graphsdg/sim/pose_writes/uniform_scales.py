@@ -25,13 +25,12 @@ Example:
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, Protocol
 
 import mujoco
 import numpy as np
 
 if TYPE_CHECKING:
-    from graphsdg.sim.pose_writes.targets import DirectTargets
     from graphsdg.sim.scene import SimScene
 
 _EYE = np.eye(3)
@@ -44,15 +43,25 @@ class PreparedScales(NamedTuple):
     mesh_factors: np.ndarray
 
 
+class ScaleTargets(Protocol):
+    """What a plan reads of a batch's targets (:class:`~graphsdg.sim.pose_writes.targets.DirectTargets` is one)."""
+
+    geom_ids: np.ndarray     # each row's MuJoCo geom
+    is_mesh: np.ndarray      # each row is a mesh geom
+    mesh_rows: np.ndarray    # the rows that are meshes
+    simple: np.ndarray       # each row's primitive is sized by one product of its scale
+    is_capsule: np.ndarray   # each row is a capsule
+
 class UniformScalePlan:
     """What a batch's uniform rescale writes where, worked out once per target list and compile.
 
-    Built by :meth:`DirectTargets.uniform_plan`, which gives None where the batch does not fit: a primitive
+    Built by :meth:`DirectTargets.uniform_plan <graphsdg.sim.pose_writes.targets.DirectTargets.uniform_plan>`,
+    which gives None where the batch does not fit: a primitive
     sized otherwise than by a product (capsules, tubes along x or y, planes), repeated meshes, or mesh
     vertices not in one run.
     """
 
-    def __init__(self, t: DirectTargets, model: mujoco.MjModel, unit_sizes: np.ndarray,
+    def __init__(self, t: ScaleTargets, model: mujoco.MjModel, unit_sizes: np.ndarray,
                  unit_half_extents: np.ndarray) -> None:
         self.prim_rows = np.flatnonzero(~t.is_mesh)
         self.prim_geoms = t.geom_ids[self.prim_rows]
@@ -69,7 +78,7 @@ class UniformScalePlan:
         self.vertex_rows = np.repeat(order, counts[order])
 
     @staticmethod
-    def fits(t: DirectTargets, model: mujoco.MjModel) -> bool:
+    def fits(t: ScaleTargets, model: mujoco.MjModel) -> bool:
         """Whether ``t``'s batch can be rescaled by a plan."""
         prims = ~t.is_mesh
         if not t.simple[prims].all() or t.is_capsule[prims].any():
