@@ -39,6 +39,7 @@ import threading
 import time
 
 import graphsdg as rep
+from graphsdg.io.write_queue import get_write_queue
 from graphsdg.jobs.cli import run_demo
 from graphsdg.io import run_state
 from graphsdg.render.render_product import registry as rp_registry
@@ -104,7 +105,7 @@ def soak_frames(out: str, frames: int, every: int, resolution: tuple[int, int], 
             if state["n"] % every == 0:
                 gc.collect()
                 fps = state["n"] / (time.perf_counter() - state["t0"])
-                samples.append((state["n"], rss_mb(), fps, rep.orchestrator.get_write_queue().pending()))
+                samples.append((state["n"], rss_mb(), fps, get_write_queue().pending()))
 
     handle = rep.orchestrator.register_status_callback(on_status)
     try:
@@ -141,7 +142,7 @@ def soak_pipelined(out: str, frames: int, every: int, resolution: tuple[int, int
         rep.orchestrator.step(wait_for_render=False)
         if n % every == 0:
             gc.collect()
-            samples.append((n, rss_mb(), n / (time.perf_counter() - t0), rep.orchestrator.get_write_queue().pending()))
+            samples.append((n, rss_mb(), n / (time.perf_counter() - t0), get_write_queue().pending()))
             print(f"frame {n}: RSS {samples[-1][1]:.1f} MB, {samples[-1][2]:.1f} frames/s", file=sys.stderr,
                   flush=True)   # a run cut short still shows its samples
     rep.orchestrator.wait_until_complete()
