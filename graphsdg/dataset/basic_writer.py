@@ -23,6 +23,7 @@ import numpy as np
 from PIL import Image
 
 from graphsdg.dataset.label_images import colour_ids, decode_image
+from graphsdg.dataset.npy_bytes import array_from_npy
 from graphsdg.io.basic_writer_layout import FLAGS, json_companions
 from graphsdg.io.location import Location, open_location
 
@@ -175,8 +176,9 @@ class Frame:
         return out
 
     def depth(self, kind: str = "distance_to_image_plane") -> np.ndarray | None:
+        """The frame's depth of ``kind`` (a read-only array), or None where it was not written."""
         name = self.files.get(kind)
-        return np.load(io.BytesIO(self.read(name))) if name else None
+        return array_from_npy(self.read(name)) if name else None
 
 
 class BasicWriterDataset:
