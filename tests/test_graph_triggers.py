@@ -106,7 +106,12 @@ class CountingWriter(rep.Writer):
         self.finals += 1
 
 
-rep.WriterRegistry.register(CountingWriter)
+@pytest.fixture(autouse=True, scope="module")
+def counting_writer():
+    """CountingWriter registered for this module's tests only (other modules list the registry's writers)."""
+    rep.WriterRegistry.register(CountingWriter)
+    yield
+    rep.WriterRegistry.unregister("CountingWriter")
 
 
 def test_run_stops_when_every_trigger_reached_max_execs_and_calls_on_final_frame():
