@@ -83,7 +83,9 @@ def main() -> None:
         write_dataset(data, args.frames, args.resolution, args.layers)
         print(f"wrote {args.frames} frames of {args.resolution}x{args.resolution} to {data} in "
               f"{time.perf_counter() - start:.1f} s")
+    from graphsdg.base.heap import keep_freed_buffers
     from graphsdg.dataset.rerun_recording import record
+    keep_freed_buffers()   # as `graphsdg view --rerun` does before it records
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(args.rounds):
             rrd = os.path.join(tmp, f"bench_{r}.rrd")

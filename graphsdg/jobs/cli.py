@@ -97,7 +97,9 @@ def run_view(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if args.rerun is not None:
+            from graphsdg.base.heap import keep_freed_buffers
             from graphsdg.dataset.rerun_recording import record
+            keep_freed_buffers()   # a frame's decoded masks and depth are megabyte buffers made and dropped
             target = args.rerun
             result = record(args.dir, None if target in ("", "spawn") or target.startswith("rerun") else target,
                             spawn=target == "spawn", connect=target if target.startswith("rerun") else None,
