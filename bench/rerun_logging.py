@@ -19,50 +19,21 @@ import os
 import tempfile
 import time
 
-import numpy as np
+from graphsdg.jobs.demo_scene import DEMO_ANNOTATORS, run_demo
 
 
 LAYERS = {
     # what `graphsdg demo` writes (rgb, tight boxes, class masks, depth), and the camera to place the depth in 3D
-    "demo": {"rgb": True, "bounding_box_2d_tight": True, "semantic_segmentation": True,
-             "distance_to_image_plane": True, "camera_params": True},
+    "demo": {**DEMO_ANNOTATORS, "camera_params": True},
     # and loose boxes and instance masks
-    "full": {"rgb": True, "bounding_box_2d_tight": True, "bounding_box_2d_loose": True, "semantic_segmentation": True,
-             "instance_segmentation": True, "distance_to_image_plane": True, "camera_params": True},
+    "full": {**DEMO_ANNOTATORS, "camera_params": True, "bounding_box_2d_loose": True,
+             "instance_segmentation": True},
 }
 
 
 def write_dataset(out: str, frames: int, resolution: int, layers: str = "full", seed: int = 7) -> None:
     """The demo scene's frames with the BasicWriter flags of ``LAYERS[layers]``."""
-    import graphsdg as rep
-    rep.stage.new_stage()
-    rep.set_global_seed(seed)
-    rng = np.random.default_rng(seed)
-    rep.orchestrator.set_capture_on_play(False)
-    rep.functional.create.xform(name="World")
-    rep.functional.create.dome_light(intensity=450, parent="/World", name="Sky")
-    rep.functional.create.distant_light(intensity=900, parent="/World", name="Sun", rotation=(35, 20, 0))
-    rep.functional.create.plane(parent="/World", name="Floor", scale=(8, 8, 1), semantics={"class": "floor"})
-    shapes = []
-    for kind in ("cube", "sphere", "cylinder", "cone", "torus"):
-        shapes += getattr(rep.functional.create_batch, kind)(count=2, parent="/World", name=kind.capitalize(),
-                                                             semantics={"class": kind})
-    cam = rep.functional.create.camera(position=(4.5, -4.5, 3.5), look_at=(0, 0, 0.3), parent="/World",
-                                       name="Camera")
-    rp = rep.create.render_product(cam, (resolution, resolution), name="bench")
-    writer = rep.writers.get("BasicWriter")
-    writer.initialize(output_dir=out, **LAYERS[layers])
-    writer.attach(rp)
-    n = len(shapes)
-    for _ in range(frames):
-        xy = rng.uniform(-1.8, 1.8, size=(n, 2))
-        scale = rng.uniform(0.4, 0.9, size=(n, 1)).repeat(3, 1)
-        rep.functional.modify.pose(shapes, position_value=[(x, y, s[2] / 2) for (x, y), s in zip(xy, scale)],
-                                   rotation_value=[(0.0, 0.0, a) for a in rng.uniform(0, 360, size=n)],
-                                   scale_value=scale)
-        rep.orchestrator.step()
-    rep.orchestrator.wait_until_complete()
-    writer.detach()
+    run_demo(out, frames, (resolution, resolution), seed, LAYERS[layers])
 
 
 def main() -> None:

@@ -10,9 +10,17 @@ from __future__ import annotations
 
 import time
 
+#: what ``graphsdg demo`` writes: BasicWriter's flags
+DEMO_ANNOTATORS = {"rgb": True, "semantic_segmentation": True, "bounding_box_2d_tight": True,
+                   "distance_to_image_plane": True}
 
-def run_demo(out: str, frames: int, resolution: tuple[int, int], seed: int) -> dict:
-    """Build the demo scene, capture ``frames`` randomized frames into ``out``; return a summary."""
+
+def run_demo(out: str, frames: int, resolution: tuple[int, int], seed: int,
+             annotators: dict[str, bool] | None = None) -> dict:
+    """Build the demo scene, capture ``frames`` randomized frames into ``out``; return a summary.
+
+    ``annotators``: BasicWriter's flags (default :data:`DEMO_ANNOTATORS`).
+    """
     import graphsdg as rep
 
     start = time.perf_counter()
@@ -34,8 +42,7 @@ def run_demo(out: str, frames: int, resolution: tuple[int, int], seed: int) -> d
                                        name="Camera")
     rp = rep.create.render_product(cam, resolution, name="demo")
     writer = rep.writers.get("BasicWriter")
-    writer.initialize(output_dir=out, rgb=True, semantic_segmentation=True, bounding_box_2d_tight=True,
-                      distance_to_image_plane=True)
+    writer.initialize(output_dir=out, **(DEMO_ANNOTATORS if annotators is None else annotators))
     writer.attach(rp)
     n = len(shapes)
     for _ in range(frames):
