@@ -122,6 +122,9 @@ class CpuRayCaster:
                     xpos, xmat = motion.poses_at(data, posed_at)
                     scratch.geom_xpos[motion.geoms] = xpos
                     scratch.geom_xmat[motion.geoms] = xmat
+                    # mj_multiRay culls bodies by spheres about their inertial centres: move those too
+                    bodies = model.geom_bodyid[motion.geoms]
+                    scratch.xipos[bodies] = motion.points_at(data.xipos[bodies], posed_at)
                 mujoco.mj_multiRay(model, scratch, sorted_origin[lo], vec[3 * lo:3 * hi], group, 1, -1,
                                    geom[lo:hi], dist[lo:hi], normal[3 * lo:3 * hi], hi - lo, cutoff)
 
@@ -164,6 +167,7 @@ class CpuRayCaster:
         for scratch in self._scratch[:max(1, workers)]:
             scratch.geom_xpos[:] = data.geom_xpos
             scratch.geom_xmat[:] = data.geom_xmat
+            scratch.xipos[:] = data.xipos      # mj_multiRay's body culling spheres sit on these
             if model.nflex:
                 scratch.flexvert_xpos[:] = data.flexvert_xpos
                 scratch.flexelem_aabb[:] = data.flexelem_aabb

@@ -80,14 +80,17 @@ class GeomMotion:
 
     def poses_at(self, data: mujoco.MjData, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """(geom_xpos (M, 3), geom_xmat (M, 9)) of the moving geoms ``dt`` seconds from the capture."""
-        xpos = np.asarray(data.geom_xpos)[self.geoms]
         xmat = np.asarray(data.geom_xmat)[self.geoms].reshape(-1, 3, 3)
         turn = rotation_matrices(self.angular * dt)          # (M, 3, 3)
-        # a rigid motion about the pivot: p(t) = pivot + v t + R(w t) (p - pivot)
-        rel = xpos - self.pivot
-        new_pos = self.pivot + self.linear * dt + np.einsum("mij,mj->mi", turn, rel)
         new_mat = np.einsum("mij,mjk->mik", turn, xmat).reshape(-1, 9)
-        return new_pos, new_mat
+        return self.points_at(np.asarray(data.geom_xpos)[self.geoms], dt, turn), new_mat
+
+    def points_at(self, points: np.ndarray, dt: float, turn: np.ndarray | None = None) -> np.ndarray:
+        """Where ``points`` (M, 3), one fixed to each moving geom's body, are ``dt`` seconds from the capture."""
+        turn = rotation_matrices(self.angular * dt) if turn is None else turn
+        # a rigid motion about the pivot: p(t) = pivot + v t + R(w t) (p - pivot)
+        rel = np.asarray(points) - self.pivot
+        return self.pivot + self.linear * dt + np.einsum("mij,mj->mi", turn, rel)
 
 
 def refresh_velocities(model: mujoco.MjModel, data: mujoco.MjData) -> None:

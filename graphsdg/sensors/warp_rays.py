@@ -1,10 +1,12 @@
-"""Casting sensor rays on a GPU with MuJoCo Warp. Batched ``rays`` over a BVH of the scene.
+"""Casting sensor rays on a GPU with Warp. The same interface and results as the CPU caster.
 
-The same interface and results as :class:`~graphsdg.sensors.ray_caster.CpuRayCaster`. The compiled model is
-put on the device once (again after a recompile) with a render context whose BVH covers the geoms renders draw
-(groups 0-3, and the model's flexes); each cast copies the geoms' current poses onto the device, refits the
-BVH, and launches one ``rays`` kernel per slice of rays that share a time and origin (one for a still scene and
-sensor). Needs the ``graphsdg[gpu]`` extra (``warp-lang``, ``mujoco-warp``; Python >= 3.12) and a CUDA GPU.
+The compiled model is put on the device once (again after a recompile). A model whose drawn geoms are
+primitives and meshes goes to a :class:`~graphsdg.sensors.warp_ray_scene.WorldRayScene` (its meshes as one
+world-space triangle mesh, its primitives in a BVH); one with drawn height fields, SDFs or flexes to MuJoCo
+Warp's batched ``rays`` over a render context's BVH. Each cast poses the geoms as the data holds them (refits
+only what moved) and launches once for a still scene, or once per firing time for moving geoms; each ray
+carries its own origin. Needs the ``graphsdg[gpu]`` extra (``warp-lang``, ``mujoco-warp``; Python >= 3.12)
+and a CUDA GPU.
 
 Example:
     >>> caster = WarpRayCaster()    # doctest: +SKIP
@@ -19,6 +21,7 @@ import numpy as np
 
 from graphsdg.sensors.ray_caster import RayHits, drawn_group_mask, slice_bounds
 from graphsdg.sensors.scene_motion import GeomMotion
+from graphsdg.sensors.warp_ray_scene import WorldRayScene, covers
 
 
 class WarpRayCaster:
@@ -33,7 +36,23 @@ class WarpRayCaster:
         wp.init()
         self._wp, self._mjw, self.device = wp, mjw, device
         self._model: mujoco.MjModel | None = None
+        self._scene = None
         self._lock = threading.Lock()
+
+    def _drawn(self, model: mujoco.MjModel, extra: np.ndarray | None = None) -> np.ndarray:
+        """One flag per geom: whether renders draw its group, or ``extra`` (a group mask) names it."""
+        groups = np.clip(np.asarray(model.geom_group), 0, 5)
+        mask = drawn_group_mask() if extra is None else drawn_group_mask() | (np.asarray(extra) != 0)
+        return mask[groups].astype(bool)
+
+    def _enabled(self, model: mujoco.MjModel, geomgroup: np.ndarray | None) -> np.ndarray:
+        """One flag per geom: drawn, in ``geomgroup``'s groups and visible (``mj_ray``'s rules)."""
+        groups = np.clip(np.asarray(model.geom_group), 0, 5)
+        mask = drawn_group_mask() if geomgroup is None else np.asarray(geomgroup)
+        matid = np.asarray(model.geom_matid)
+        alpha = np.where(matid >= 0, np.asarray(model.mat_rgba)[np.maximum(matid, 0), 3] if model.nmat
+                         else 1.0, np.asarray(model.geom_rgba)[:, 3])
+        return (mask[groups] != 0) & (alpha != 0)
 
     def _prepare(self, model: mujoco.MjModel, data: mujoco.MjData, mesh_stamps: np.ndarray | None = None) -> None:
         """Put ``model`` on the device (when it changed), the meshes whose stamps moved, and ``data``'s geom and
@@ -43,6 +62,13 @@ class WarpRayCaster:
             if self._model is not model:
                 self._stamps = np.array(mesh_stamps if mesh_stamps is not None else [], dtype=np.int64)
                 self._sizes = None
+                drawn = self._drawn(model)
+                if covers(model, drawn):
+                    self._scene = WorldRayScene(model, drawn, self.device)
+                    self._model = model
+                    self._scene.pose(model, data.geom_xpos, data.geom_xmat)
+                    return
+                self._scene = None
                 self._m = mjw.put_model(model)
                 self._d = mjw.put_data(model, data)
                 groups = [g for g in range(6) if drawn_group_mask()[g]]
@@ -51,6 +77,9 @@ class WarpRayCaster:
                 self._model = model
             elif mesh_stamps is not None:
                 self._refit_meshes(model, np.asarray(mesh_stamps, dtype=np.int64))
+            if self._scene is not None:
+                self._scene.pose(model, data.geom_xpos, data.geom_xmat)
+                return
             self._sync_geom_sizes(model)
             self._d.geom_xpos.assign(np.asarray(data.geom_xpos, dtype=np.float32)[None])
             self._d.geom_xmat.assign(np.asarray(data.geom_xmat, dtype=np.float32).reshape(1, -1, 3, 3))
@@ -78,6 +107,10 @@ class WarpRayCaster:
         changed = np.flatnonzero(now != seen)
         if not changed.size:
             return
+        self._stamps = now
+        if self._scene is not None:
+            self._scene.remesh(model)
+            return
         ids = self._rc.mesh_bvh_id.numpy()
         bounds = self._rc.mesh_bounds_size.numpy()
         for mesh_id in changed.tolist():
@@ -90,13 +123,22 @@ class WarpRayCaster:
             mesh.refit()
             bounds[mesh_id] = np.abs(verts).max(axis=0)
         self._rc.mesh_bounds_size.assign(bounds)
-        self._stamps = now
 
-    def device_scene(self, model: mujoco.MjModel, data: mujoco.MjData) -> tuple:
-        """(MuJoCo Warp model, data, render context) on the device, posed as ``data`` (for batched kernels)."""
-        with self._lock:
+    def device_cast(self, model: mujoco.MjModel, data: mujoco.MjData, pnt, vec, cutoff: float, dist, geom,
+                    normal) -> None:
+        """Cast rays already on the device (1-D Warp arrays of origins and directions) into 1-D outputs, with
+        the scene posed as ``data``; no host copies (for kernels that keep their rays on the device)."""
+        with self._lock, self._wp.ScopedDevice(self.device):
             self._prepare(model, data)
-            return self._m, self._d, self._rc
+            if self._scene is not None:
+                self._scene.enable(self._enabled(model, None) & self._scene.held)
+                self._scene.launch(pnt, vec, cutoff, dist, geom, normal)
+                return
+            count = pnt.shape[0]
+            exclude = self._wp.full(count, -1, dtype=int)
+            self._mjw.rays(self._m, self._d, pnt.reshape((1, count)), vec.reshape((1, count)), self.group_mask(),
+                           True, exclude, dist.reshape((1, count)), geom.reshape((1, count)),
+                           normal.reshape((1, count)), self._rc)
 
     def group_mask(self, geomgroup: np.ndarray | None = None):
         """``rays``' geom-group mask: the drawn groups, or ``geomgroup``."""
@@ -114,37 +156,75 @@ class WarpRayCaster:
         hits = RayHits.empty(count)
         if count == 0:
             return hits
-        wp, mjw = self._wp, self._mjw
         motion = motion if motion is not None else GeomMotion.still()
         origins = np.asarray(origins, dtype=np.float64)
-        order, bounds = slice_bounds(origins, np.asarray(dt, dtype=np.float64), motion)
-        mask = self.group_mask(geomgroup)
-        with self._lock, wp.ScopedDevice(self.device):
+        dt = np.asarray(dt, dtype=np.float64)
+        with self._lock, self._wp.ScopedDevice(self.device):
             self._prepare(model, data, mesh_stamps)
-            pnt = wp.array(origins[order].astype(np.float32)[None], dtype=wp.vec3)
-            vec = wp.array(np.asarray(directions, dtype=np.float32)[order][None], dtype=wp.vec3)
-            dist = wp.empty((1, count), dtype=float)
-            geom = wp.empty((1, count), dtype=int)
-            normal = wp.empty((1, count), dtype=wp.vec3)
-            base_xpos = self._d.geom_xpos.numpy() if motion else None
-            base_xmat = self._d.geom_xmat.numpy() if motion else None
-            sorted_dt = np.asarray(dt, dtype=np.float64)[order]
-            for lo, hi in zip(bounds[:-1].tolist(), bounds[1:].tolist()):
-                if motion:
-                    xpos, xmat = motion.poses_at(data, float(sorted_dt[lo]))
-                    moved_pos, moved_mat = base_xpos.copy(), base_xmat.copy()
-                    moved_pos[0, motion.geoms] = xpos
-                    moved_mat[0, motion.geoms] = xmat.reshape(-1, 3, 3)
-                    self._d.geom_xpos.assign(moved_pos)
-                    self._d.geom_xmat.assign(moved_mat)
-                    mjw.refit_bvh(self._m, self._d, self._rc)
-                exclude = wp.full(hi - lo, -1, dtype=int)
-                mjw.rays(self._m, self._d, pnt[:, lo:hi], vec[:, lo:hi], mask, True, exclude, dist[:, lo:hi],
-                         geom[:, lo:hi], normal[:, lo:hi], self._rc)
-            wp.synchronize_device(self.device)
-            d_np, g_np, n_np = dist.numpy()[0], geom.numpy()[0], normal.numpy()[0]
+            if self._scene is not None:
+                d_np, g_np, n_np, order = self._cast_scene(model, data, origins, directions, dt, motion, cutoff,
+                                                           geomgroup)
+            else:
+                d_np, g_np, n_np, order = self._cast_rays(model, data, origins, directions, dt, motion, geomgroup)
         far = (d_np < 0) | (d_np > cutoff)
         hits.distance[order] = np.where(far, -1.0, d_np)
         hits.geom[order] = np.where(far, -1, g_np)
         hits.normal[order] = np.where(far[:, None], 0.0, n_np)
         return hits
+
+    def _cast_scene(self, model, data, origins, directions, dt, motion, cutoff, geomgroup):
+        """The world scene's cast: one launch, or one per firing time when geoms move."""
+        if geomgroup is not None and not np.all(self._scene.held[self._drawn(model, geomgroup)]):
+            # groups renders do not draw, asked for by name: a scene that holds them too
+            self._scene = WorldRayScene(model, self._drawn(model, geomgroup), self.device)
+            self._scene.pose(model, data.geom_xpos, data.geom_xmat)
+        scene = self._scene
+        scene.enable(self._enabled(model, geomgroup) & scene.held)
+        if not motion:
+            dist, geom, normal = scene.cast(origins, directions, min(cutoff, 3.0e38))
+            return dist, geom, normal, np.arange(len(directions))
+        order = np.argsort(dt, kind="stable")
+        sorted_dt = dt[order]
+        bounds = np.concatenate([[0], np.flatnonzero(np.diff(sorted_dt)) + 1, [len(dt)]])
+        parts = []
+        for lo, hi in zip(bounds[:-1].tolist(), bounds[1:].tolist()):
+            xpos, xmat = motion.poses_at(data, float(sorted_dt[lo]))
+            moved_pos = np.array(data.geom_xpos)
+            moved_mat = np.array(data.geom_xmat)
+            moved_pos[motion.geoms] = xpos
+            moved_mat[motion.geoms] = xmat.reshape(-1, 9)
+            scene.pose(model, moved_pos, moved_mat)
+            idx = order[lo:hi]
+            parts.append(scene.cast(origins[idx], np.asarray(directions)[idx], min(cutoff, 3.0e38)))
+        scene.pose(model, data.geom_xpos, data.geom_xmat)
+        return (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
+                np.concatenate([p[2] for p in parts]), order)
+
+    def _cast_rays(self, model, data, origins, directions, dt, motion, geomgroup):
+        """MuJoCo Warp's ``rays`` over the render context: one launch per slice of one time and origin."""
+        wp, mjw = self._wp, self._mjw
+        count = len(directions)
+        order, bounds = slice_bounds(origins, dt, motion)
+        mask = self.group_mask(geomgroup)
+        pnt = wp.array(origins[order].astype(np.float32)[None], dtype=wp.vec3)
+        vec = wp.array(np.asarray(directions, dtype=np.float32)[order][None], dtype=wp.vec3)
+        dist = wp.empty((1, count), dtype=float)
+        geom = wp.empty((1, count), dtype=int)
+        normal = wp.empty((1, count), dtype=wp.vec3)
+        base_xpos = self._d.geom_xpos.numpy() if motion else None
+        base_xmat = self._d.geom_xmat.numpy() if motion else None
+        sorted_dt = dt[order]
+        for lo, hi in zip(bounds[:-1].tolist(), bounds[1:].tolist()):
+            if motion:
+                xpos, xmat = motion.poses_at(data, float(sorted_dt[lo]))
+                moved_pos, moved_mat = base_xpos.copy(), base_xmat.copy()
+                moved_pos[0, motion.geoms] = xpos
+                moved_mat[0, motion.geoms] = xmat.reshape(-1, 3, 3)
+                self._d.geom_xpos.assign(moved_pos)
+                self._d.geom_xmat.assign(moved_mat)
+                mjw.refit_bvh(self._m, self._d, self._rc)
+            exclude = wp.full(hi - lo, -1, dtype=int)
+            mjw.rays(self._m, self._d, pnt[:, lo:hi], vec[:, lo:hi], mask, True, exclude, dist[:, lo:hi],
+                     geom[:, lo:hi], normal[:, lo:hi], self._rc)
+        wp.synchronize_device(self.device)
+        return dist.numpy()[0], geom.numpy()[0], normal.numpy()[0], order
