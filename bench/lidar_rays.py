@@ -134,7 +134,12 @@ def agreement(ref, got, tolerance: float) -> str:
     agree = close | ((ref[1] < 0) & (got[1] < 0))
     ties = int((close & (ref[1] != got[1])).sum())
     err = float(np.abs(ref[0][both] - got[0][both]).max()) if both.any() else 0.0
-    verdict = "ok" if agree.all() else f"MISMATCH on {int((~agree).sum())} rays"
+    if agree.all():
+        verdict = "ok"
+    else:
+        first = int(np.flatnonzero(~agree)[0])
+        verdict = (f"MISMATCH on {int((~agree).sum())} rays (ray {first}: plain {ref[0][first]:.4f} m on geom "
+                   f"{ref[1][first]}, this caster {got[0][first]:.4f} m on geom {got[1][first]})")
     return f"{verdict} ({ties} ties on coincident surfaces, max range diff {err:.1e} m)"
 
 
@@ -208,6 +213,9 @@ def run_scene(scene: str, args, lines: list[str]) -> None:
 
         gpu = WarpRayCaster(device=args.gpu_device)
         caster_loop(gpu, sim, origins, directions, bounds, cutoff)          # compiles the kernels
+        gpu = WarpRayCaster(device=args.gpu_device)
+        build = timed(lambda: caster_loop(gpu, sim, origins, directions, bounds, cutoff))
+        lines.append(f"| WarpRayCaster first call (puts the scene on the device) | {build:.3f} | | | |")
         gpu_seconds = timed(lambda: caster_loop(gpu, sim, origins, directions, bounds, cutoff), args.repeats)
         got = caster_loop(gpu, sim, origins, directions, bounds, cutoff)
         lines.append(f"| WarpRayCaster per slice (host in/out) | {gpu_seconds:.3f} | {n / gpu_seconds:,.0f} | "

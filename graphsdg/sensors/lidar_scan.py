@@ -79,8 +79,9 @@ class LidarReturns:
         return len(self.time_s)
 
     def take(self, keep: np.ndarray) -> "LidarReturns":
-        """The returns selected by ``keep``."""
-        return LidarReturns(*(getattr(self, f.name)[keep] for f in fields(self)))
+        """The returns selected by ``keep`` (a boolean mask)."""
+        rows = np.flatnonzero(keep)
+        return LidarReturns(*(getattr(self, f.name).take(rows, axis=0) for f in fields(self)))
 
     @staticmethod
     def concat(parts: list["LidarReturns"]) -> "LidarReturns":
@@ -144,7 +145,7 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
     dt = np.zeros(len(firings)) if frozen else firings.time - now
     origins, rotations = pose.at(dt)
     dirs_sensor = firings.directions()
-    dirs_world = np.einsum("nij,nj->ni", rotations, dirs_sensor)
+    dirs_world = rotate(rotations, dirs_sensor)
     motion = GeomMotion.still() if frozen else GeomMotion.of(m, d)
     sync_mesh_trees(sim)
     hits = ray_caster().cast(m, d, origins, dirs_world, dt, motion, cutoff=profile.far_range_m / mpu,
@@ -164,13 +165,16 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
     if profile.range_resolution_m > 0:
         reported = np.round(reported / profile.range_resolution_m) * profile.range_resolution_m
     azimuth, elevation = firings.azimuth_deg.copy(), firings.elevation_deg.copy()
+    exact_angles = True
     if profile.azimuth_error_std_deg > 0 or profile.azimuth_error_mean_deg:
+        exact_angles = False
         azimuth = azimuth + profile.azimuth_error_mean_deg + noise.normal(0.0, profile.azimuth_error_std_deg, count)
     if profile.elevation_error_std_deg > 0 or profile.elevation_error_mean_deg:
+        exact_angles = False
         elevation = elevation + profile.elevation_error_mean_deg + \
             noise.normal(0.0, profile.elevation_error_std_deg, count)
     reported = np.where(valid, np.maximum(reported, 0.0), 0.0)
-    reported_dirs = unit_directions(azimuth, elevation)
+    reported_dirs = dirs_sensor if exact_angles else unit_directions(azimuth, elevation)
     hit_units = origins + dirs_world * np.where(hits.geom >= 0, hits.distance, 0.0)[:, None]
     velocity = point_velocities(m, d, hits.geom, hit_units) * mpu
     returns = LidarReturns(
@@ -180,10 +184,18 @@ def measure(sim: SimScene, pose: SensorPose, profile: LidarProfile, firings: Fir
         geom=np.where(valid, hits.geom, -1).astype(np.int32),
         material_id=np.where(valid, surface.material_id[hits.geom], 0).astype(np.uint32),
         flags=np.where(valid, VALID_FLAG, 0).astype(np.uint8),
-        direction_world=np.einsum("nij,nj->ni", rotations, reported_dirs), sensor_position=origins * mpu,
+        direction_world=rotate(rotations, reported_dirs), sensor_position=origins * mpu,
         hit_world=hit_units * mpu, normal_world=np.where(valid[:, None], hits.normal, 0.0),
         velocity_world=np.where(valid[:, None], velocity, 0.0))
     return returns if keep_invalid else returns.take(valid)
+
+
+def rotate(rotations: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """(N, 3) ``vectors`` (N, 3) turned by ``rotations`` (N, 3, 3); one product when all rotations are one
+    (a sensor that does not turn)."""
+    if rotations.strides[0] == 0:
+        return vectors @ rotations[0].T
+    return np.einsum("nij,nj->ni", rotations, vectors)
 
 
 def _pose_at(pose: SensorPose, dt: float, mpu: float) -> tuple[np.ndarray, np.ndarray]:

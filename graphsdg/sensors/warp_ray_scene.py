@@ -30,6 +30,7 @@ PLANE = int(mujoco.mjtGeom.mjGEOM_PLANE)
 UNCOVERED_TYPES = (int(mujoco.mjtGeom.mjGEOM_HFIELD), int(mujoco.mjtGeom.mjGEOM_SDF))
 CULL_STEPS = 8                 # back faces (or skipped geoms) a ray may pass before it gives up, as MuJoCo Warp
 STEP_REL, STEP_ABS = 1.0e-6, 1.0e-6
+MESH_BVH = "sah"               # built once a model; the best tree to walk, refit as geoms move
 
 
 def covers(model: mujoco.MjModel, drawn: np.ndarray) -> bool:
@@ -211,7 +212,8 @@ class WorldRayScene:
             world = wp.empty(len(self._vert_src), dtype=wp.vec3)
             wp.launch(_world_vertices, dim=len(self._vert_src),
                       inputs=[self._local, self._vert_geom, self._xpos, self._xmat, world])
-            self._mesh = wp.Mesh(points=world, indices=wp.array(self._faces.reshape(-1), dtype=wp.int32))
+            self._mesh = wp.Mesh(points=world, indices=wp.array(self._faces.reshape(-1), dtype=wp.int32),
+                                 bvh_constructor=MESH_BVH)
             return
         wp.launch(_world_vertices, dim=len(self._vert_src),
                   inputs=[self._local, self._vert_geom, self._xpos, self._xmat, self._mesh.points])
