@@ -214,8 +214,8 @@ def run_scene(scene: str, args, lines: list[str]) -> None:
         gpu = WarpRayCaster(device=args.gpu_device)
         caster_loop(gpu, sim, origins, directions, bounds, cutoff)          # compiles the kernels
         gpu = WarpRayCaster(device=args.gpu_device)
-        build = timed(lambda: caster_loop(gpu, sim, origins, directions, bounds, cutoff))
-        lines.append(f"| WarpRayCaster first call (puts the scene on the device) | {build:.3f} | | | |")
+        first = timed(lambda: caster_loop(gpu, sim, origins, directions, bounds, cutoff))
+        lines.append(f"| WarpRayCaster first call (puts the scene on the device) | {first:.3f} | | | |")
         gpu_seconds = timed(lambda: caster_loop(gpu, sim, origins, directions, bounds, cutoff), args.repeats)
         got = caster_loop(gpu, sim, origins, directions, bounds, cutoff)
         lines.append(f"| WarpRayCaster per slice (host in/out) | {gpu_seconds:.3f} | {n / gpu_seconds:,.0f} | "
