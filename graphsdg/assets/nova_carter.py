@@ -8,13 +8,14 @@ robot with Isaac's prim layout:
   the sensor mast and two low-friction caster balls;
 * ``wheel_left`` / ``wheel_right`` (0.14 m radius, 0.413 m apart) turn on the
   revolute joints ``chassis_link/joint_wheel_left`` / ``joint_wheel_right``
-  (about the chassis' Y axis, velocity drives: ``WheeledRobot(...,
+  (about the chassis' Y axis, velocity drives, 0.5 kg m^2 of motor armature: ``WheeledRobot(...,
   wheel_dof_names=["joint_wheel_left", "joint_wheel_right"])`` drives them);
 * sensors under ``chassis_link/sensors``: the front Hawk stereo pair
   ``front_hawk/left/camera_left`` and ``front_hawk/right/camera_right``
   (``UsdGeom.Camera`` looking along the robot's +X, 0.15 m baseline, the Hawk's
   optics as in :mod:`graphsdg.assets.camera_calibration`) and the
-  ``XT_32`` lidar mount on the mast.
+  ``XT_32`` lidar mount on the mast with its Hesai XT32 ``OmniLidar``
+  ``XT_32/PandarXT_32_10hz`` (10 Hz, 32 channels, as Isaac's asset carries it).
 
 The robot's front is +X; ``chassis_link``'s origin is on the floor under the
 wheel axle, and it carries ``xformOp:translate`` / ``xformOp:orient`` (scripts
@@ -54,6 +55,9 @@ HAWK_POSITION = (0.31, 0.0, 0.36)
 CARTER_SIZE = (0.68, 0.473, 0.62)
 MASSES = {"chassis_link": 42.0, "wheel_left": 2.0, "wheel_right": 2.0}
 WHEEL_DRIVE = (400.0, 25.0)        # velocity drives: damping N m s / rad, max torque N m (more would wheelie)
+# the wheel motors' reflected rotor inertia (kg m^2, physxJoint:armature): with the 2 kg wheels' own 0.02 kg m^2,
+# the torque-limited drives chatter at Isaac's 60 Hz physics step (25 N m for 1/60 s is 20 rad/s of spin)
+WHEEL_ARMATURE = 0.5
 
 def _xform(stage: Usd.Stage, path: str, translate, orient: Gf.Quatf | None = None) -> UsdGeom.Xform:
     x = UsdGeom.Xform.Define(stage, path)
@@ -137,6 +141,7 @@ def build_carter(root: str) -> list[str]:
         drive.CreateDampingAttr(WHEEL_DRIVE[0] * math.pi / 180.0)       # USD: per degree per second
         drive.CreateMaxForceAttr(WHEEL_DRIVE[1])
         drive.CreateTargetVelocityAttr(0.0)
+        joint.GetPrim().CreateAttribute("physxJoint:armature", Sdf.ValueTypeNames.Float).Set(WHEEL_ARMATURE)
     _sensors(stage)
     authoring.save(stage)
     return written
@@ -150,6 +155,42 @@ def _sensors(stage: Usd.Stage) -> None:
         _xform(stage, f"{base}/front_hawk/{side}", (0.0, sign * HAWK_BASELINE / 2, 0.0))
         define_hawk_camera(stage, f"{base}/front_hawk/{side}/camera_{side}")
     _xform(stage, f"{base}/XT_32", (-0.25, 0.0, 0.62))
+    _xt32_lidar(stage, f"{base}/XT_32/PandarXT_32_10hz")
+
+
+# the Hesai XT32 as published (graphsdg's HESAI_XT32_SD10 lidar config): 32 channels 1 degree apart from +15 to
+# -16 degrees fired 1.5 us apart, 2000 firings a turn at 10 Hz, 0.05-120 m; the attributes are the
+# OmniSensorGenericLidarCoreAPI's (graphsdg.sensors.lidar_profile reads them)
+XT32_CHANNELS, XT32_TOP_DEG, XT32_FIRE_SPACING_NS = 32, 15.0, 1500
+XT32_FLOATS = {"scanRateBaseHz": 10.0, "patternFiringRateHz": 20000.0, "nearRangeM": 0.05, "farRangeM": 120.0,
+               "rangeResolutionM": 0.004, "rangeAccuracyM": 0.01, "validStartAzimuthDeg": -180.0,
+               "validEndAzimuthDeg": 180.0, "minReflectance": 0.1, "minReflectionRangeM": 80.0,
+               "wavelengthNm": 905.0}
+
+
+def _xt32_lidar(stage: Usd.Stage, path: str) -> None:
+    """The mast's ``OmniLidar``: a Hesai XT32 scanning at 10 Hz (Isaac's asset carries its sensor prim too)."""
+    prim = stage.DefinePrim(path, "OmniLidar")
+    prim.AddAppliedSchema("OmniSensorGenericLidarCoreAPI")
+    prim.AddAppliedSchema("OmniSensorGenericLidarCoreEmitterStateAPI:s001")
+    core, n = "omni:sensor:Core:", XT32_CHANNELS
+    for name, value in XT32_FLOATS.items():
+        prim.CreateAttribute(core + name, Sdf.ValueTypeNames.Float).Set(value)
+    prim.CreateAttribute(core + "scanType", Sdf.ValueTypeNames.Token).Set("ROTARY")
+    for name in ("numberOfChannels", "numberOfEmitters"):
+        prim.CreateAttribute(core + name, Sdf.ValueTypeNames.UInt).Set(n)
+    for name in ("emitterStateCount", "maxReturns"):
+        prim.CreateAttribute(core + name, Sdf.ValueTypeNames.UInt).Set(1)
+    prim.CreateAttribute("omni:sensor:tickRate", Sdf.ValueTypeNames.Float).Set(XT32_FLOATS["scanRateBaseHz"])
+    for name, value in (("modelName", "XT32"), ("modelVendor", "HESAI"), ("marketName", "XT32")):
+        prim.CreateAttribute(f"omni:sensor:{name}", Sdf.ValueTypeNames.String).Set(value)
+    state = core + "emitterState:s001:"
+    elevation = [XT32_TOP_DEG - i for i in range(n)]
+    prim.CreateAttribute(state + "azimuthDeg", Sdf.ValueTypeNames.FloatArray).Set([0.0] * n)
+    prim.CreateAttribute(state + "elevationDeg", Sdf.ValueTypeNames.FloatArray).Set(elevation)
+    prim.CreateAttribute(state + "fireTimeNs", Sdf.ValueTypeNames.IntArray).Set(
+        [i * XT32_FIRE_SPACING_NS for i in range(n)])
+    prim.CreateAttribute(state + "channelId", Sdf.ValueTypeNames.IntArray).Set(list(range(n)))
 
 
 def build_nav_only(root: str) -> list[str]:
@@ -181,7 +222,8 @@ ASSETS: list[UsdAsset] = [
     UsdAsset("nova_carter", CARTER_PATH, CARTER_SIZE,
              "Nova Carter differential-drive AMR: chassis_link (articulation root, floating), wheel_left/right on "
              "joint_wheel_left/right (velocity drives), caster balls, Hawk stereo cameras at "
-             "chassis_link/sensors/front_hawk/{left/camera_left,right/camera_right}, XT_32 lidar mount",
+             "chassis_link/sensors/front_hawk/{left/camera_left,right/camera_right}, the XT32 lidar "
+             "chassis_link/sensors/XT_32/PandarXT_32_10hz",
              build_carter),
     UsdAsset("nova_carter_nav_only", NAV_ONLY_PATH, CARTER_SIZE,
              "the Nova Carter with its navigation target child `targetXform` and the action graph `ActionGraph` "

@@ -34,6 +34,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 import graphsdg
 from graphsdg import functional
 from graphsdg.compat import kit_command_registry
+from graphsdg.compat.core_world import BaseSensor
 from graphsdg.compat.modules import CompatError, CompatModule
 from graphsdg.compat.sensors_checker import CHECKER_NAMES
 from graphsdg.compat.sensors_rtx import generic_model_output_module
@@ -247,8 +248,8 @@ def get_gmo_data(dataPtr: Any) -> Any:
     return parse_generic_model_output_data(dataPtr)
 
 
-class LidarRtx:
-    """``isaacsim.sensors.rtx.LidarRtx`` (module docstring)."""
+class LidarRtx(BaseSensor):
+    """``isaacsim.sensors.rtx.LidarRtx`` (module docstring): a ``BaseSensor``, so ``World.scene.add`` takes it."""
 
     _VISUALIZATION_WRITER = "RtxLidarDebugDrawPointCloud"
 
@@ -281,6 +282,7 @@ class LidarRtx:
                                                     **kwargs).do()
         self._prim = prim
         self._name = name
+        BaseSensor.__init__(self, str(prim.GetPath()), name=name)
         if position is not None or translation is not None or orientation is not None:
             self.set_world_pose(position, orientation) if translation is None else \
                 self.set_local_pose(translation, orientation)
