@@ -247,3 +247,24 @@ def test_deprecated_wheeled_robot_arguments(compat):
         WheeledRobot(prim_path="/World/Nowhere", wheel_dof_indices=[0, 1])
     with pytest.raises(ValueError, match="no valid usd path"):
         WheeledRobot(prim_path="/World/Nowhere", wheel_dof_indices=[0, 1], create_robot=True)
+
+
+def test_the_carter_mast_lidar_is_graphsdg_hesai_xt32(compat):
+    """The lidar the deprecated script wraps is the stand-in's own: the HESAI_XT32_SD10 profile, attribute for
+    attribute (the asset authors it by hand, below the sensors room)."""
+    import dataclasses
+    from graphsdg.assets.root import builtin_pack_root
+    from graphsdg.sensors.lidar_profile import read_lidar_profile
+    from graphsdg.sensors.profile_catalog import lidar_profile
+    stage = Usd.Stage.Open(builtin_pack_root() + CARTER)
+    mast = read_lidar_profile(stage.GetPrimAtPath(f"/nova_carter/{LIDAR}"))
+    xt32 = lidar_profile("HESAI_XT32_SD10")
+    for field in dataclasses.fields(xt32):
+        ours, theirs = getattr(mast, field.name), getattr(xt32, field.name)
+        if isinstance(theirs, float):
+            assert ours == pytest.approx(theirs, rel=1e-6), field.name       # float32 on the prim
+        elif field.name not in ("name", "emitter_states"):
+            assert ours == theirs, field.name
+    for ours, theirs in zip(mast.emitter_states, xt32.emitter_states, strict=True):
+        for field in dataclasses.fields(ours):
+            np.testing.assert_allclose(getattr(ours, field.name), getattr(theirs, field.name))
