@@ -169,3 +169,29 @@ def test_warp_world_scene_follows_moving_bodies_and_rescaled_meshes():
     assert (geom == 3).sum() > 10
     np.testing.assert_array_equal(grown.geom, geom)
     np.testing.assert_allclose(grown.distance, dist, atol=1e-4)
+
+
+TWO_SIDED = """<mujoco><asset>
+<mesh name="plate" inertia="shell" vertex="0 -1 -1  0 1 -1  0 1 1  0 -1 1  -0.01 0 0"
+      face="0 1 2  0 2 3  0 2 1  0 3 2"/>
+</asset><worldbody><body pos="3 0 1"><geom type="mesh" mesh="plate"/></body></worldbody></mujoco>"""
+
+
+@needs_warp
+def test_warp_world_scene_sees_two_sided_surfaces_from_both_sides():
+    """A plate made of the same triangles wound both ways: from either side, the front-facing copy is hit
+    at the plate's distance (a back face at the same distance must not hide it)."""
+    model = mujoco.MjModel.from_xml_string(TWO_SIDED)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    rng = np.random.default_rng(4)
+    count = 500
+    targets = np.column_stack([np.full(count, 3.0), rng.uniform(-0.9, 0.9, count), rng.uniform(0.1, 1.9, count)])
+    origins = np.where(np.arange(count)[:, None] % 2 == 0, [[0.0, 0.0, 1.0]], [[6.0, 0.0, 1.0]])
+    directions = targets - origins
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    dist, geom = mj_ray_truth(model, data, origins, directions)
+    assert (geom == 0).all()
+    hits = _warp_caster().cast(model, data, origins, directions, np.zeros(count), cutoff=50.0)
+    np.testing.assert_array_equal(hits.geom, geom)
+    np.testing.assert_allclose(hits.distance, dist, atol=1e-5)

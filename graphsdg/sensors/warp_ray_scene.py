@@ -1,19 +1,19 @@
-"""A MuJoCo scene on a GPU for ray casting: its meshes as one world-space triangle mesh, its primitives in a BVH.
+"""A MuJoCo scene on a GPU, in world coordinates, for casting rays.
 
 MuJoCo Warp's ``rays`` walks a BVH of geoms and, for each mesh geom whose box a ray crosses, a second BVH of
 that mesh's triangles in the mesh's own frame. Where many mesh assets overlap (a pile of thousands), a ray
 crosses dozens of mesh boxes before it finds its first surface, and each costs a whole mesh query. This scene
-instead keeps every drawn mesh geom's triangles in world coordinates in one ``warp.Mesh`` (one BVH over all
-triangles, refit when geoms move) and the other drawn geoms (boxes, spheres, capsules, cylinders, ellipsoids)
-in a BVH of their bounding spheres, intersected with MuJoCo Warp's own analytic primitive tests; planes are
-tested directly. Hits follow ``mj_ray``'s rules: back faces of meshes are culled, geoms of excluded groups and
-invisible geoms are skipped, and a hit farther than the cutoff is a miss.
+keeps every held mesh geom's triangles in world coordinates under one BVH of triangle boxes (refit when geoms
+move) and the other geoms (boxes, spheres, capsules, cylinders, ellipsoids) in a BVH of their bounding
+spheres, intersected with MuJoCo Warp's own analytic primitive tests; planes are tested directly. Hits follow
+``mj_ray``'s rules: a mesh triangle counts only from its front (a back face, or the back of a two-sided
+surface, is looked through), geoms not enabled are skipped, and a hit farther than the cutoff is a miss.
 
-Models with drawn height fields, SDF geoms or flexes are not covered (:func:`covers` says so); the caster uses
+Models with height fields, SDF geoms or flexes are not covered (:func:`covers` says so); the caster uses
 MuJoCo Warp's ``rays`` for them.
 
 Example:
-    >>> scene = WorldRayScene(model, "cuda:0")                       # doctest: +SKIP
+    >>> scene = WorldRayScene(model, held, "cuda:0")                  # doctest: +SKIP
     >>> scene.pose(model, data.geom_xpos, data.geom_xmat)             # doctest: +SKIP
     >>> scene.enable(flags)                                           # doctest: +SKIP
     >>> dist, geom, normal = scene.cast(origins, directions, cutoff)  # doctest: +SKIP
@@ -28,9 +28,7 @@ from mujoco_warp._src.ray import ray_geom   # MuJoCo Warp's analytic primitive t
 MESH = int(mujoco.mjtGeom.mjGEOM_MESH)
 PLANE = int(mujoco.mjtGeom.mjGEOM_PLANE)
 UNCOVERED_TYPES = (int(mujoco.mjtGeom.mjGEOM_HFIELD), int(mujoco.mjtGeom.mjGEOM_SDF))
-CULL_STEPS = 8                 # back faces (or skipped geoms) a ray may pass before it gives up, as MuJoCo Warp
-STEP_REL, STEP_ABS = 1.0e-6, 1.0e-6
-MESH_BVH = "sah"               # built once a model; the best tree to walk, refit as geoms move
+TRIANGLE_BVH = "sah"           # built once a model (the best tree to walk), refit as geoms move
 
 
 def covers(model: mujoco.MjModel, drawn: np.ndarray) -> bool:
@@ -57,24 +55,44 @@ def _sphere_bounds(geoms: wp.array(dtype=wp.int32), xpos: wp.array(dtype=wp.vec3
     upper[i] = xpos[g] + wp.vec3(r, r, r)
 
 
+@wp.kernel
+def _triangle_bounds(world: wp.array(dtype=wp.vec3), faces: wp.array(dtype=wp.vec3i),
+                     lower: wp.array(dtype=wp.vec3), upper: wp.array(dtype=wp.vec3)):
+    f = wp.tid()
+    face = faces[f]
+    a, b, c = world[face[0]], world[face[1]], world[face[2]]
+    lower[f] = wp.min(a, wp.min(b, c))
+    upper[f] = wp.max(a, wp.max(b, c))
+
+
 @wp.func
-def _first_mesh_hit(mesh: wp.uint64, face_geom: wp.array(dtype=wp.int32), enabled: wp.array(dtype=wp.int32),
-                    pnt: wp.vec3, vec: wp.vec3, max_t: float):
-    """(distance, geom, normal) of the first front face of an enabled geom within ``max_t``, else geom -1."""
-    offset = float(0.0)
-    for _step in range(CULL_STEPS):
-        hit = wp.mesh_query_ray(mesh, pnt + vec * offset, vec, max_t - offset)
-        if not hit.result:
-            return float(-1.0), int(-1), wp.vec3()
-        g = face_geom[hit.face]
-        if enabled[g] != 0 and wp.dot(vec, hit.normal) < 0.0:
-            return offset + hit.t, g, wp.normalize(hit.normal)
-        offset += hit.t * (1.0 + STEP_REL) + STEP_ABS
-    return float(-1.0), int(-1), wp.vec3()
+def _front_face_hit(a: wp.vec3, b: wp.vec3, c: wp.vec3, pnt: wp.vec3, vec: wp.vec3):
+    """(distance, unit normal) where the ray meets triangle abc from its front (counter-clockwise side), else
+    distance -1 (Moller-Trumbore with the back faces culled)."""
+    e1 = b - a
+    e2 = c - a
+    pvec = wp.cross(vec, e2)
+    det = wp.dot(e1, pvec)          # -dot(vec, e1 x e2): positive when the ray meets the front
+    if det <= 0.0:
+        return float(-1.0), wp.vec3()
+    inv = 1.0 / det
+    tvec = pnt - a
+    u = wp.dot(tvec, pvec) * inv
+    if u < 0.0 or u > 1.0:
+        return float(-1.0), wp.vec3()
+    qvec = wp.cross(tvec, e1)
+    v = wp.dot(vec, qvec) * inv
+    if v < 0.0 or u + v > 1.0:
+        return float(-1.0), wp.vec3()
+    t = wp.dot(e2, qvec) * inv
+    if t < 0.0:
+        return float(-1.0), wp.vec3()
+    return t, wp.normalize(wp.cross(e1, e2))
 
 
 @wp.kernel
-def _cast(mesh: wp.uint64, has_mesh: int, face_geom: wp.array(dtype=wp.int32),
+def _cast(tris: wp.uint64, has_tris: int, world: wp.array(dtype=wp.vec3), faces: wp.array(dtype=wp.vec3i),
+          face_geom: wp.array(dtype=wp.int32),
           bvh: wp.uint64, has_bvh: int, bvh_geoms: wp.array(dtype=wp.int32), planes: wp.array(dtype=wp.int32),
           geom_type: wp.array(dtype=wp.int32), geom_size: wp.array(dtype=wp.vec3), xpos: wp.array(dtype=wp.vec3),
           xmat: wp.array(dtype=wp.mat33), enabled: wp.array(dtype=wp.int32),
@@ -86,12 +104,18 @@ def _cast(mesh: wp.uint64, has_mesh: int, face_geom: wp.array(dtype=wp.int32),
     best = cutoff
     best_geom = int(-1)
     best_normal = wp.vec3()
-    if has_mesh != 0:
-        t, g, n = _first_mesh_hit(mesh, face_geom, enabled, p, d, cutoff)
-        if g >= 0 and t <= best:
-            best = t
-            best_geom = g
-            best_normal = n
+    if has_tris != 0:
+        query = wp.bvh_query_ray(tris, p, d)
+        f = int(0)
+        while wp.bvh_query_next(query, f, best):
+            g = face_geom[f]
+            if enabled[g] != 0:
+                face = faces[f]
+                t, n = _front_face_hit(world[face[0]], world[face[1]], world[face[2]], p, d)
+                if t >= 0.0 and t < best:
+                    best = t
+                    best_geom = g
+                    best_normal = n
     if has_bvh != 0:
         query = wp.bvh_query_ray(bvh, p, d)
         item = int(0)
@@ -149,8 +173,13 @@ class WorldRayScene:
             self._vert_geom = wp.array(vert_geom, dtype=wp.int32)
             self._face_geom = wp.array(face_geom if len(face_geom) else np.zeros(1, np.int32), dtype=wp.int32)
             self._local = wp.array(self._local_vertices(model), dtype=wp.vec3)
-            self._mesh = self._bvh = None
+            self._tris = self._bvh = None
             self._faces = faces
+            nface = max(len(faces), 1)
+            self._face_dev = wp.array(faces if len(faces) else np.zeros((1, 3), np.int32), dtype=wp.vec3i)
+            self._world = wp.zeros(max(len(self._vert_src), 1), dtype=wp.vec3)
+            self._tri_lower = wp.zeros(nface, dtype=wp.vec3)
+            self._tri_upper = wp.zeros(nface, dtype=wp.vec3)
             self._lower = wp.zeros(max(len(self._primitives), 1), dtype=wp.vec3)
             self._upper = wp.zeros(max(len(self._primitives), 1), dtype=wp.vec3)
 
@@ -208,16 +237,14 @@ class WorldRayScene:
     def _place_meshes(self) -> None:
         if not len(self._faces):
             return
-        if self._mesh is None:
-            world = wp.empty(len(self._vert_src), dtype=wp.vec3)
-            wp.launch(_world_vertices, dim=len(self._vert_src),
-                      inputs=[self._local, self._vert_geom, self._xpos, self._xmat, world])
-            self._mesh = wp.Mesh(points=world, indices=wp.array(self._faces.reshape(-1), dtype=wp.int32),
-                                 bvh_constructor=MESH_BVH)
-            return
         wp.launch(_world_vertices, dim=len(self._vert_src),
-                  inputs=[self._local, self._vert_geom, self._xpos, self._xmat, self._mesh.points])
-        self._mesh.refit()
+                  inputs=[self._local, self._vert_geom, self._xpos, self._xmat, self._world])
+        wp.launch(_triangle_bounds, dim=len(self._faces),
+                  inputs=[self._world, self._face_dev, self._tri_lower, self._tri_upper])
+        if self._tris is None:
+            self._tris = wp.Bvh(self._tri_lower, self._tri_upper, constructor=TRIANGLE_BVH)
+        else:
+            self._tris.refit()
 
     def _place_primitives(self) -> None:
         if not len(self._primitives):
@@ -253,10 +280,11 @@ class WorldRayScene:
 
     def launch(self, pnt, vec, cutoff: float, dist, geom, normal) -> None:
         """The cast kernel over device arrays (for callers that keep their rays on the device)."""
-        mesh_id = self._mesh.id if self._mesh is not None else wp.uint64(0)
+        tris_id = self._tris.id if self._tris is not None else wp.uint64(0)
         bvh_id = self._bvh.id if self._bvh is not None else wp.uint64(0)
         wp.launch(_cast, dim=pnt.shape[0],
-                  inputs=[mesh_id, int(self._mesh is not None), self._face_geom, bvh_id, int(self._bvh is not None),
+                  inputs=[tris_id, int(self._tris is not None), self._world, self._face_dev, self._face_geom,
+                          bvh_id, int(self._bvh is not None),
                           self._bvh_geoms, self._plane_dev, self._type, self._size, self._xpos, self._xmat,
                           self._enabled_dev, pnt, vec, float(cutoff)],
                   outputs=[dist, geom, normal])

@@ -1,8 +1,8 @@
-"""Casting sensor rays on a GPU with Warp. The same interface and results as the CPU caster.
+"""A ray caster on a GPU with Warp: the CPU caster's interface and results.
 
 The compiled model is put on the device once (again after a recompile). A model whose drawn geoms are
-primitives and meshes goes to a :class:`~graphsdg.sensors.warp_ray_scene.WorldRayScene` (its meshes as one
-world-space triangle mesh, its primitives in a BVH); one with drawn height fields, SDFs or flexes to MuJoCo
+primitives and meshes goes to a :class:`~graphsdg.sensors.warp_ray_scene.WorldRayScene` (its mesh triangles
+in world coordinates under one BVH, its primitives in another); one with drawn height fields, SDFs or flexes to MuJoCo
 Warp's batched ``rays`` over a render context's BVH. Each cast poses the geoms as the data holds them (refits
 only what moved) and launches once for a still scene, or once per firing time for moving geoms; each ray
 carries its own origin. Needs the ``graphsdg[gpu]`` extra (``warp-lang``, ``mujoco-warp``; Python >= 3.12)
