@@ -37,8 +37,12 @@ def _boxes(f: Frame, kind: str) -> list[ViewBox]:
     if found is None:
         return []
     rows, labels, _ = found
-    return [ViewBox(label_text(labels.get(str(int(r["semanticId"])), int(r["semanticId"]))),
-                    int(r["x_min"]), int(r["y_min"]), int(r["x_max"]), int(r["y_max"])) for r in rows]
+    names: dict[int, str] = {}   # a frame's boxes share a few classes: each label's text made once
+    for sid in set(rows["semanticId"].tolist()):
+        names[sid] = label_text(labels.get(str(sid), sid))
+    # whole columns as Python ints at once: a structured row's fields cost a NumPy scalar each
+    columns = [rows[k].tolist() for k in ("semanticId", "x_min", "y_min", "x_max", "y_max")]
+    return [ViewBox(names[sid], x0, y0, x1, y1) for sid, x0, y0, x1, y1 in zip(*columns)]
 
 
 def semantic_masks(f: Frame, ids: IdOf | None = None) -> tuple[np.ndarray, dict[int, str]] | None:
@@ -147,9 +151,10 @@ def point_clouds_of(f: Frame) -> list[PointCloud]:
     return out
 
 
-def basic_frames(location: Location) -> list[ViewFrame]:
-    """Every frame of the BasicWriter output at ``location`` that has an ``rgb`` image."""
-    ds = BasicWriterDataset(location)
+def basic_frames(location: Location, listing: dict[str, int] | None = None) -> list[ViewFrame]:
+    """Every frame of the BasicWriter output at ``location`` that has an ``rgb`` image (``listing``: its files,
+    where the caller has listed them already)."""
+    ds = BasicWriterDataset(location, listing)
     out = []
     for key in ds.frame_ids:
         f = ds.frame(key)

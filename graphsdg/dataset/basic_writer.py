@@ -22,7 +22,7 @@ from typing import Callable
 import numpy as np
 from PIL import Image
 
-from graphsdg.dataset.label_images import colour_ids, decode_image
+from graphsdg.dataset.label_images import colour_ids, decode_image, png_colour_ids
 from graphsdg.dataset.npy_bytes import array_from_npy
 from graphsdg.io.basic_writer_layout import FLAGS, json_companions
 from graphsdg.io.location import Location, open_location
@@ -50,6 +50,18 @@ def _color_key(key: str) -> tuple[int, ...] | None:
     if key.startswith("(") and key.endswith(")"):
         return tuple(int(v) for v in key.strip("()").split(","))
     return None
+
+
+def _colorized(mapping: dict, keys: list[str], shift: bool, keep: Callable[[object], bool] | None,
+               value_of: Callable[[object, int], int] | None) -> tuple[list, list | None, int, dict]:
+    """(colours, per-colour values, value of a colour not listed, value -> mapping entry) of a colorized
+    segmentation's mapping, as :meth:`Frame.segmentation` documents them."""
+    colours = [_color_key(k) for k in keys]
+    if value_of is not None:
+        return colours, [value_of(mapping[k], i) for i, k in enumerate(keys)], 0, \
+            dict(enumerate(mapping[k] for k in keys))
+    values = [i + 1 if keep is None or keep(mapping[k]) else 0 for i, k in enumerate(keys)] if shift else None
+    return colours, values, 0 if shift else -1, {i + shift: mapping[k] for i, k in enumerate(keys)}
 
 
 @dataclass
@@ -88,12 +100,12 @@ class Frame:
 
     def boxes(self, kind: str = "bounding_box_2d_tight",
               paths: bool = True) -> tuple[np.ndarray, dict, list[str]] | None:
-        """(rows, idToLabels, primPaths) of a box annotator, or None if not written (``paths=False``: the prim
-        paths file is not read and the list is empty)."""
+        """(rows, idToLabels, primPaths) of a box annotator (the rows a read-only structured array), or None if not
+        written (``paths=False``: the prim paths file is not read and the list is empty)."""
         name = self.files.get(kind)
         if not name:
             return None
-        rows = np.load(io.BytesIO(self.read(name)))
+        rows = array_from_npy(self.read(name))
         return rows, self._json(self.companion(kind, "_labels")), \
             self._json(self.companion(kind, "_prim_paths")) if paths else []
 
@@ -112,17 +124,17 @@ class Frame:
             return None
         suffix = "_labels" if kind == "semantic_segmentation" else "_mapping"
         mapping = self._json(self.companion(kind, suffix))
-        img = decode_image(self.read(name), rgb_order=False)
+        data = self.read(name)
+        keys = [k for k in mapping if _color_key(k) is not None]
+        colorized = _colorized(mapping, keys, shift, keep, value_of) if keys else None
+        if colorized is not None:   # graphsdg's own PNGs are read run by run, straight to the values
+            ids = png_colour_ids(data, *colorized[:3])
+            if ids is not None:
+                return ids, colorized[3]
+        img = decode_image(data, rgb_order=False)
         if img.ndim == 3:   # colorized: pixel colours index the mapping's "(r, g, b, a)" keys
-            keys = [k for k in mapping if _color_key(k) is not None]
-            colours = [_color_key(k) for k in keys]
-            if value_of is not None:
-                values = [value_of(mapping[k], i) for i, k in enumerate(keys)]
-                return colour_ids(img, colours, bgr=True, values=values, missing=0), dict(enumerate(mapping[k]
-                                                                                                  for k in keys))
-            values = [i + 1 if keep is None or keep(mapping[k]) else 0 for i, k in enumerate(keys)] if shift else None
-            ids = colour_ids(img, colours, bgr=True, values=values, missing=0 if shift else -1)
-            return ids, {i + shift: mapping[k] for i, k in enumerate(keys)}
+            colours, values, missing, names = colorized or _colorized(mapping, keys, shift, keep, value_of)
+            return colour_ids(img, colours, bgr=True, values=values, missing=missing), names
         ids = img.astype(np.int64)
         mapping = {int(k): v for k, v in mapping.items()}
         if not shift and value_of is None:
@@ -184,17 +196,18 @@ class Frame:
 class BasicWriterDataset:
     """All frames of a BasicWriter output directory (and of its per-render-product folders).
 
-    ``root``: a folder or an ``s3://bucket/prefix`` (:mod:`graphsdg.io.location`); it is listed once.
+    ``root``: a folder or an ``s3://bucket/prefix`` (:mod:`graphsdg.io.location`); it is listed once, unless
+    ``listing`` (its :meth:`~graphsdg.io.location.Location.files`, listed by the caller) is given.
     """
 
-    def __init__(self, root: str | Location) -> None:
+    def __init__(self, root: str | Location, listing: dict[str, int] | None = None) -> None:
         self.location = open_location(root)
         if not self.location.is_folder():
             raise NotADirectoryError(f"dataset directory {self.location.url!r} does not exist")
         self.root = self.location.url
         self.frames: dict[tuple[str, str], Frame] = {}
         self.stray: list[str] = []                 # relative paths of temporary and hidden files
-        self.listing = self.location.files()       # relative path -> size
+        self.listing = self.location.files() if listing is None else listing   # relative path -> size
         for rel in self.listing:
             folder, name = posixpath.split(rel)
             if name.endswith(".tmp") or name.startswith("."):

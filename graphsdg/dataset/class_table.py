@@ -18,7 +18,7 @@ from typing import Iterable
 import numpy as np
 
 from graphsdg.annotate.ids import color_of
-from graphsdg.dataset.view_frame import relabel
+from graphsdg.dataset.view_frame import relabel, smallest_uint
 from graphsdg.rng import stable_key
 
 
@@ -48,6 +48,10 @@ class ClassTable:
                     found = self._ids[name] = len(self.names)
         return found
 
+    def known(self, name: str) -> int | None:
+        """The id of class ``name`` if the table has it (the table unchanged)."""
+        return self._ids.get(name)
+
     def colour(self, name: str) -> tuple[int, int, int]:
         """The class's colour (:func:`class_colour`)."""
         return class_colour(name)
@@ -59,3 +63,44 @@ class ClassTable:
 
     def __len__(self) -> int:
         return len(self.names)
+
+
+#: the first stand-in id: above any table's ids
+STAND_IN = 1 << 30
+
+
+class DeferredIds:
+    """One frame's class ids, looked up on a reader thread without adding names to the table.
+
+    A name the table has gets its id; a name it lacks gets a stand-in id (``STAND_IN``, ``STAND_IN + 1``, ...
+    in the order met) until :meth:`settle`, called for frame after frame on one thread, adds the frame's new
+    names to the table in that order and puts their ids in place. Ids then do not depend on which reader
+    thread ran first: they are those of reading the frames one by one.
+    """
+
+    def __init__(self, table: ClassTable) -> None:
+        self.table = table
+        self.new: dict[str, int] = {}   # name -> its stand-in id
+
+    def __call__(self, name: str) -> int:
+        found = self.table.known(name)
+        if found is None:
+            found = self.new.setdefault(name, STAND_IN + len(self.new))
+        return found
+
+    def settle(self, found: tuple[np.ndarray, dict[int, str]] | None) -> tuple[np.ndarray, dict[int, str]] | None:
+        """A mask read with these ids, ``(values, {id: name})``, with every stand-in replaced by the table's id
+        of its name (the frame's new names added to the table, in the order they were met)."""
+        if not self.new:
+            return found
+        real = np.array([self.table.id_of(name) for name in self.new], dtype=np.int64)
+        if found is None:
+            return None
+        values, names = found
+        out = values.astype(np.int64)
+        stand_in = out >= STAND_IN
+        out[stand_in] = real[out[stand_in] - STAND_IN]
+        ids = [int(real[i - STAND_IN]) if i >= STAND_IN else i for i in names]
+        # stand-ins made the values 32-bit; the frame's own ids decide (as read without stand-ins)
+        dtype = smallest_uint(max(ids, default=0)) if values.dtype == np.uint32 else values.dtype
+        return out.astype(dtype), dict(zip(ids, names.values()))

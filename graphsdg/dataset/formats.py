@@ -95,7 +95,7 @@ def read_dataset(root: str | Location, fmt: str | None = None) -> tuple[str, lis
     fmt = fmt or _detect(listing)
     if fmt not in FORMATS:
         raise ValueError(f"unknown dataset format {fmt!r}; known: {FORMATS}")
-    frames = {"basic": lambda loc, _: basic_frames(loc), "coco": _coco, "kitti": _kitti, "yolo": _yolo,
+    frames = {"basic": basic_frames, "coco": _coco, "kitti": _kitti, "yolo": _yolo,
               "pointcloud": lambda loc, _: []}[fmt](location, listing)
     if fmt in ("basic", "pointcloud"):   # PointCloudWriter's scans, beside the images or alone
         scans = sensor_frames(location, listing)

@@ -26,7 +26,10 @@ package). Frames are logged on the ``frame`` timeline (each camera's frames 0, 1
 Each layer is one ``log_*`` function of :data:`LAYERS`; a new kind of data is one
 more. Frames are read and decoded on worker threads ahead of the logging
 thread (decoding releases the GIL); the image files go into the recording as
-written (no decode, no re-encode).
+written (no decode, no re-encode), and images go to Rerun as Arrow columns over
+the arrays' own memory. Readers do not number new class or instance names: the
+logging thread does, frame by frame (:class:`DeferredIds`), so the recording is
+the same for any number of reader threads.
 """
 from __future__ import annotations
 
@@ -42,7 +45,7 @@ import cv2
 import numpy as np
 
 from graphsdg.annotate.ids import color_of
-from graphsdg.dataset.class_table import ClassTable
+from graphsdg.dataset.class_table import ClassTable, DeferredIds
 from graphsdg.dataset.view import read_view_frames
 from graphsdg.dataset.view_frame import DepthMap, PointCloud, ViewBox, ViewBox3D, ViewFrame
 from graphsdg.io.camera_geometry import PinholeCamera
@@ -91,15 +94,18 @@ class PreparedFrame:
     camera: PinholeCamera | None = None
     boxes_3d: list[ViewBox3D] = field(default_factory=list)
     clouds: list[PointCloud] = field(default_factory=list)
+    # the masks' ids, their new names not yet in the tables (FrameLogger.log settles them, frame by frame)
+    ids: tuple[DeferredIds, DeferredIds] | None = None
 
 
 def prepare(frame: ViewFrame, classes: ClassTable, instances: ClassTable) -> PreparedFrame:
     """Read and decode every layer of ``frame``, its arrays made ready to log: class masks as ``classes``' ids,
-    instance masks as ``instances``' ids (both straight from the decoded pixels), depth as z-depth with 0 where
-    there is none (Rerun's "no depth")."""
-    p = PreparedFrame(frame, frame.image_bytes() if frame.has_image else b"", frame.masks(classes.id_of),
-                      frame.instances(instances.id_of),
-                      frame.depth(), frame.camera(), frame.boxes_3d(), frame.point_clouds())
+    instance masks as ``instances``' ids (both straight from the decoded pixels; names the tables lack get
+    stand-in ids, see :class:`DeferredIds`), depth as z-depth with 0 where there is none (Rerun's "no depth")."""
+    class_ids, instance_ids = DeferredIds(classes), DeferredIds(instances)
+    p = PreparedFrame(frame, frame.image_bytes() if frame.has_image else b"", frame.masks(class_ids),
+                      frame.instances(instance_ids), frame.depth(), frame.camera(), frame.boxes_3d(),
+                      frame.point_clouds(), (class_ids, instance_ids))
     if p.depth is not None:
         values, kind = np.asarray(p.depth.values, dtype=np.float32), p.depth.kind
         if kind == "distance_to_camera" and p.camera is not None:
@@ -110,14 +116,14 @@ def prepare(frame: ViewFrame, classes: ClassTable, instances: ClassTable) -> Pre
 
 def no_depth_as_zero(values: np.ndarray) -> np.ndarray:
     """Depth (float32) with 0 wherever it is not a finite positive distance, in place where it may be (the loaders'
-    arrays are fresh). OpenCV's threshold and NaN patching: one pass each, ~20x NumPy's nan_to_num here."""
+    arrays are fresh); a read-only array (a view of the file's bytes) is read by the first pass, which writes a new
+    one. OpenCV's threshold and NaN patching: one pass each, ~20x NumPy's nan_to_num here."""
     values = np.ascontiguousarray(values, dtype=np.float32)
-    if not values.flags.writeable:
-        values = values.copy()
-    cv2.threshold(values, float(np.finfo(np.float32).max), 0.0, cv2.THRESH_TOZERO_INV, dst=values)   # inf -> 0
-    cv2.threshold(values, 0.0, 0.0, cv2.THRESH_TOZERO, dst=values)                                   # < 0 -> 0
-    cv2.patchNaNs(values, 0.0)
-    return values
+    out = values if values.flags.writeable else np.empty_like(values)
+    cv2.threshold(values, float(np.finfo(np.float32).max), 0.0, cv2.THRESH_TOZERO_INV, dst=out)   # inf -> 0
+    cv2.threshold(out, 0.0, 0.0, cv2.THRESH_TOZERO, dst=out)                                      # < 0 -> 0
+    cv2.patchNaNs(out, 0.0)
+    return out
 
 
 def plane_depth(distance: np.ndarray, camera: PinholeCamera) -> np.ndarray:
@@ -133,13 +139,47 @@ class FrameLogger:
     contexts current (static: a context names ids over the whole timeline)."""
 
     def __init__(self, rr, rec, classes: ClassTable, instances: ClassTable) -> None:
-        self.rr, self.rec, self.classes, self.instances = rr, rec, classes, instances
+        import pyarrow   # comes with the Rerun SDK
+        self.rr, self.rec, self.classes, self.instances, self._pa = rr, rec, classes, instances, pyarrow
         self._logged_size: dict[str, int] = {}           # entity -> table size its context was logged with
         self._cameras: dict[str, tuple] = {}              # stream entity -> the last camera logged there
+        self._formats: dict[tuple, Any] = {}              # (height, width, dtype) -> its Rerun image format column
+        self._media_types: dict[str, Any] = {}            # media type -> its Rerun column
         self.counts: dict[str, int] = {"boxes_tight": 0, "boxes_loose": 0, "boxes_3d": 0, "points": 0}
 
     def class_ids(self, names: list[str]) -> np.ndarray:
         return np.array([self.classes.id_of(n) for n in names], dtype=np.uint16)
+
+    # Rerun's archetype constructors copy an image's bytes twice (tobytes, then into one Arrow array) and build
+    # its format anew for every frame; the same Arrow columns, built on the arrays' own memory and formats kept
+    # per shape, cost a sixth of that on the logging thread, and the recording holds the same values.
+    def bytes_column(self, data: bytes | np.ndarray):
+        """A one-row Rerun blob (image buffer) column viewing ``data``'s bytes (C order), not copying them."""
+        pa = self._pa
+        buffer = pa.py_buffer(data if isinstance(data, bytes) else np.ascontiguousarray(data))
+        values = pa.Array.from_buffers(pa.uint8(), buffer.size, [None, buffer])
+        return pa.ListArray.from_arrays(pa.array([0, buffer.size], pa.int32()), values,
+                                        type=self.rr.components.ImageBufferBatch._ARROW_DATATYPE)
+
+    def format_column(self, image: np.ndarray):
+        """The Rerun image format column of a single-channel ``image`` (made once per shape and type)."""
+        if image.ndim != 2:
+            raise ValueError(f"expected a single-channel (H, W) image to log, got shape {image.shape}")
+        key = (*image.shape, image.dtype.str)
+        found = self._formats.get(key)
+        if found is None:
+            rr = self.rr
+            found = self._formats[key] = rr.components.ImageFormatBatch(rr.components.ImageFormat(
+                width=image.shape[1], height=image.shape[0],
+                channel_datatype=rr.encodings.ChannelDatatype.from_np_dtype(image.dtype))).as_arrow_array()
+        return found
+
+    def media_type_column(self, media_type: str):
+        """The Rerun media type column of ``media_type`` (made once)."""
+        found = self._media_types.get(media_type)
+        if found is None:
+            found = self._media_types[media_type] = self.rr.components.MediaTypeBatch(media_type).as_arrow_array()
+        return found
 
     def sync_context(self, entity: str = "/", table: ClassTable | None = None,
                      colour: Callable[[int, str], tuple] | None = None) -> None:
@@ -156,6 +196,10 @@ class FrameLogger:
         self._logged_size[entity] = len(names)
 
     def log(self, p: PreparedFrame) -> None:
+        """Log frame ``p`` (frames in order: its masks' new class and instance names join the tables here)."""
+        if p.ids is not None:
+            p.semantic, p.instances = p.ids[0].settle(p.semantic), p.ids[1].settle(p.instances)
+            p.ids = None
         self.rec.set_time(TIMELINE, sequence=p.frame.index)
         base = camera_path(p.frame.stream)
         for layer in LAYERS:
@@ -183,7 +227,8 @@ def log_camera(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
 def log_image(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """The image file's bytes, as written (a scan has none: its points are its data)."""
     if p.frame.has_image:
-        lg.rec.log(f"{base}/image/rgb", lg.rr.EncodedImage(contents=p.image, media_type=p.frame.media_type))
+        lg.rec.log(f"{base}/image/rgb", lg.rr.EncodedImage.from_fields(
+            blob=lg.bytes_column(p.image), media_type=lg.media_type_column(p.frame.media_type)))
 
 
 def _boxes_2d(lg: FrameLogger, boxes: list[ViewBox]):
@@ -203,18 +248,20 @@ def log_boxes_2d(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
 def log_masks(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """Semantic masks as class ids; instance masks as dataset-wide instance ids, named ("prim path (class)") by
     the instance entity's own context."""
-    rr = lg.rr
-    if p.semantic is not None:
-        lg.rec.log(f"{base}/image/semantic", rr.SegmentationImage(p.semantic[0]))
+    for kind, found in (("semantic", p.semantic), ("instance", p.instances)):
+        if found is not None:
+            lg.rec.log(f"{base}/image/{kind}", lg.rr.SegmentationImage.from_fields(
+                buffer=lg.bytes_column(found[0]), format=lg.format_column(found[0])))
     if p.instances is not None:
-        lg.rec.log(f"{base}/image/instance", rr.SegmentationImage(p.instances[0]))
         lg.sync_context(f"{base}/image/instance", lg.instances, lambda i, _: color_of(i + 1)[:3])
 
 
 def log_depth(lg: FrameLogger, base: str, p: PreparedFrame) -> None:
     """Depth as a z-depth image (radial depth converted where the camera is known; 0 = no depth)."""
     if p.depth is not None:
-        lg.rec.log(f"{base}/image/depth", lg.rr.DepthImage(p.depth.values, meter=1.0 / p.depth.meters_per_unit))
+        values = p.depth.values
+        lg.rec.log(f"{base}/image/depth", lg.rr.DepthImage.from_fields(
+            buffer=lg.bytes_column(values), format=lg.format_column(values), meter=1.0 / p.depth.meters_per_unit))
 
 
 def _boxes_3d(lg: FrameLogger, boxes: list[ViewBox3D]):

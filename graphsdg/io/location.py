@@ -115,12 +115,13 @@ class LocalLocation(Location):
 
     def files(self, rel: str = "") -> dict[str, int]:
         out = {}
+        cut = len(self.url.rstrip(os.sep)) + 1   # walked paths start with the root and a separator
         for folder, dirs, names in os.walk(self._full(rel)):
             dirs.sort()
             for name in names:
                 path = os.path.join(folder, name)
                 try:
-                    out[os.path.relpath(path, self.url).replace(os.sep, "/")] = os.path.getsize(path)
+                    out[path[cut:].replace(os.sep, "/")] = os.path.getsize(path)
                 except FileNotFoundError:     # removed while walking (a temporary file renamed)
                     pass
         return dict(sorted(out.items()))
