@@ -104,6 +104,26 @@ def _cast(tris: wp.uint64, has_tris: int, world: wp.array(dtype=wp.vec3), faces:
     best = cutoff
     best_geom = int(-1)
     best_normal = wp.vec3()
+    # planes and primitives first: their cheap tests often shorten the ray before the triangles are walked
+    for k in range(planes.shape[0]):
+        g = planes[k]
+        if enabled[g] != 0:
+            t, n = ray_geom(xpos[g], xmat[g], geom_size[g], p, d, geom_type[g])
+            if t >= 0.0 and t < best:
+                best = t
+                best_geom = g
+                best_normal = n
+    if has_bvh != 0:
+        query = wp.bvh_query_ray(bvh, p, d)
+        item = int(0)
+        while wp.bvh_query_next(query, item, best):
+            g = bvh_geoms[item]
+            if enabled[g] != 0:
+                t, n = ray_geom(xpos[g], xmat[g], geom_size[g], p, d, geom_type[g])
+                if t >= 0.0 and t < best:
+                    best = t
+                    best_geom = g
+                    best_normal = n
     if has_tris != 0:
         query = wp.bvh_query_ray(tris, p, d)
         f = int(0)
@@ -116,25 +136,6 @@ def _cast(tris: wp.uint64, has_tris: int, world: wp.array(dtype=wp.vec3), faces:
                     best = t
                     best_geom = g
                     best_normal = n
-    if has_bvh != 0:
-        query = wp.bvh_query_ray(bvh, p, d)
-        item = int(0)
-        while wp.bvh_query_next(query, item, best):
-            g = bvh_geoms[item]
-            if enabled[g] != 0:
-                t, n = ray_geom(xpos[g], xmat[g], geom_size[g], p, d, geom_type[g])
-                if t >= 0.0 and t < best:
-                    best = t
-                    best_geom = g
-                    best_normal = n
-    for k in range(planes.shape[0]):
-        g = planes[k]
-        if enabled[g] != 0:
-            t, n = ray_geom(xpos[g], xmat[g], geom_size[g], p, d, geom_type[g])
-            if t >= 0.0 and t < best:
-                best = t
-                best_geom = g
-                best_normal = n
     if best_geom < 0:
         dist_out[i] = -1.0
     else:
