@@ -533,15 +533,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+FRAME_LOOPS = ("demo", "run", "run-folder", "bench")     # commands whose steady state makes and drops frames
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``graphsdg`` console script; returns the exit code."""
     parser = build_parser()
+    from_console = argv is None      # a process of its own (a library caller keeps its allocator as it is)
     argv = list(sys.argv[1:] if argv is None else argv)
     script_args: list[str] = []
     if "--" in argv:   # everything after "--" belongs to the script (graphsdg run SCRIPT ... -- ARGS)
         cut = argv.index("--")
         argv, script_args = argv[:cut], argv[cut + 1:]
     args = parser.parse_args(argv)
+    if from_console and args.command in FRAME_LOOPS:
+        from graphsdg.base.heap import keep_freed_buffers_here_and_in_children
+        keep_freed_buffers_here_and_in_children()   # each frame's megabyte buffers, made and dropped
     try:
         if args.command == "demo":
             summary = run_demo(args.out, args.frames, tuple(args.resolution), args.seed)

@@ -44,9 +44,10 @@ SHARD_COLUMNS = ("shard", "frames", "seconds", "node", "pid", "gpu_ids", "egl_de
                  "image_threads")   # per-shard summary
 # what the shards need from the driver's environment: rendering, reproducible dates, and where S3 is (the
 # endpoint and region; credentials come from each node's own AWS chain, never through Ray), and the node's
-# Warp kernel cache (graphsdg.render.kernel_cache: a worker loads what another compiled)
+# Warp kernel cache (graphsdg.render.kernel_cache: a worker loads what another compiled), and the allocator's
+# settings (graphsdg.base.heap: large freed blocks kept)
 FORWARDED_ENV = ("MUJOCO_GL", "PYOPENGL_PLATFORM", "SOURCE_DATE_EPOCH", "GRAPHSDG_KERNEL_CACHE",
-                 "WARP_CACHE_PATH") + object_store.ENVIRONMENT
+                 "WARP_CACHE_PATH", "MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_") + object_store.ENVIRONMENT
 
 
 class RayMissingError(ImportError):
