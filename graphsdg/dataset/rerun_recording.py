@@ -158,8 +158,13 @@ class FrameLogger:
         pa = self._pa
         buffer = pa.py_buffer(data if isinstance(data, bytes) else np.ascontiguousarray(data))
         values = pa.Array.from_buffers(pa.uint8(), buffer.size, [None, buffer])
-        return pa.ListArray.from_arrays(pa.array([0, buffer.size], pa.int32()), values,
-                                        type=self.rr.components.ImageBufferBatch._ARROW_DATATYPE)
+        return pa.ListArray.from_arrays(pa.array([0, buffer.size], pa.int32()), values, type=self._blob_type())
+
+    def _blob_type(self):
+        """Rerun's image-buffer Arrow type (a list of non-null bytes); read from the SDK where it says it."""
+        pa = self._pa
+        return getattr(self.rr.components.ImageBufferBatch, "_ARROW_DATATYPE", None) or \
+            pa.list_(pa.field("item", pa.uint8(), nullable=False))
 
     def format_column(self, image: np.ndarray):
         """The Rerun image format column of a single-channel ``image`` (made once per shape and type)."""
