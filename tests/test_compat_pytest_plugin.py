@@ -92,3 +92,42 @@ def test_an_extension_under_test_has_its_folder_as_extension_path(tmp_path):
                           str(root / "python" / "tests" / "test_path.py")],
                          capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
+
+
+def test_a_test_imports_another_extensions_test_helpers_from_its_source_folder(tmp_path):
+    """Kit loads an extension's ``tests`` package with it; one extension's tests import another's helpers."""
+    tree = tmp_path / "source"
+    helper = tree / "deprecated" / "isaacsim.sensors.rtx"          # graphsdg maps the module, not its tests
+    (helper / "config").mkdir(parents=True)
+    (helper / "config" / "extension.toml").write_text(
+        '[[python.module]]\nname = "isaacsim.sensors.rtx"\n\n[[python.module]]\nname = "isaacsim.sensors.rtx.tests"\n')
+    (helper / "python" / "tests").mkdir(parents=True)
+    (helper / "python" / "tests" / "__init__.py").write_text("")
+    (helper / "python" / "tests" / "common.py").write_text("def answer():\n    return 6 * 7\n")
+    user = tree / "extensions" / "my.ext"
+    (user / "config").mkdir(parents=True)
+    (user / "config" / "extension.toml").write_text(
+        '[dependencies]\n"isaacsim.sensors.rtx" = {}\n\n[[python.module]]\nname = "my.ext"\n')
+    (user / "python" / "tests").mkdir(parents=True)
+    (user / "python" / "tests" / "__init__.py").write_text("")
+    (user / "python" / "tests" / "test_uses_helper.py").write_text(textwrap.dedent('''
+        import isaacsim.sensors.rtx
+        from isaacsim.sensors.rtx.tests.common import answer
+
+        def test_helper():
+            assert answer() == 42
+            assert hasattr(isaacsim.sensors.rtx, "LidarRtx")        # still graphsdg's module
+    '''))
+    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "graphsdg.compat.pytest_plugin",
+                          "--import-mode=importlib", "-p", "no:cacheprovider", str(user / "python" / "tests")],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "1 passed" in run.stdout
+    # a module under a mapped name that no stood-in folder holds still fails naming what is mapped
+    (user / "python" / "tests" / "test_missing.py").write_text(
+        "def test_missing():\n    import isaacsim.sensors.rtx.nowhere\n")
+    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "graphsdg.compat.pytest_plugin",
+                          "--import-mode=importlib", "-p", "no:cacheprovider",
+                          str(user / "python" / "tests" / "test_missing.py")],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert run.returncode == 1 and "isaacsim.sensors.rtx.nowhere is not available" in run.stdout

@@ -18,7 +18,9 @@ extension path), its ``[dependencies]`` and the ``dependencies`` of each
 ``--/path=value`` arguments that name a setting graphsdg honours are applied,
 before the file is imported (the rest tune Kit's renderer and app loop, which
 graphsdg does not have). Extensions graphsdg does not know are not enabled: a
-name the test then imports from one fails there, naming the module.
+name the test then imports from one fails there, naming the module. The test
+helpers those extensions declare (``<module>.tests``) are read from their
+folders in the same source tree, as Kit loads them with the extension.
 """
 from __future__ import annotations
 
@@ -83,6 +85,44 @@ def stand_in_source_packages(test_file: Path) -> list[str]:
             continue   # a real module of that name: leave it
         package = types.ModuleType(name, f"Stand-in for the source package {chain[0]} (graphsdg compat tests).")
         package.__path__ = [str(chain[0])]
+        package.__package__ = name
+        package.__graphsdg_stand_in__ = True
+        sys.modules[name] = package
+        names.append(name)
+    return names
+
+
+def extension_folder(beside: Path, name: str) -> Path | None:
+    """The folder of extension ``name`` in the source tree that holds the extension folder ``beside`` (Isaac keeps
+    extensions under ``extensions/`` and ``deprecated/``), if it is there."""
+    for tree in (beside.parent, *(beside.parent.parent / kind for kind in ("extensions", "deprecated"))):
+        if (tree / name / "config" / "extension.toml").is_file():
+            return tree / name
+    return None
+
+
+def stand_in_test_helpers(folder: Path | None) -> list[str]:
+    """Packages in ``sys.modules`` for the test-helper modules (``<module>.tests``) extension ``folder`` declares.
+
+    Kit loads an extension's ``tests`` package with it, so one extension's tests import another's helpers
+    (``from isaacsim.sensors.experimental.rtx.tests.common import ...``). In compat mode the extension's modules
+    are graphsdg's, so its ``tests`` package is stood in by one whose ``__path__`` is that folder in the source
+    tree: the helpers are the extension's own files, read from there. Returns the names stood in.
+    """
+    import types
+    manifest = _load(folder / "config" / "extension.toml") if folder is not None else None
+    names = []
+    for module in (manifest or {}).get("python", {}).get("module", []):
+        name = module.get("name", "")
+        if not name.endswith(".tests") or name in sys.modules:
+            continue
+        root = name[:-len(".tests")]
+        source = next((c for c in (folder / "python" / "tests", folder.joinpath(*root.split("."), "tests"))
+                       if (c / "__init__.py").is_file()), None)
+        if source is None:
+            continue
+        package = types.ModuleType(name, f"Stand-in for the test helpers of {folder.name} (graphsdg compat tests).")
+        package.__path__ = [str(source)]
         package.__package__ = name
         package.__graphsdg_stand_in__ = True
         sys.modules[name] = package
@@ -179,6 +219,8 @@ def prepare_extension_test(test_file: Path) -> list[str]:
     wanted = [folder.name, *manifest.get("dependencies", {})]
     for entry in entries:
         wanted += list(entry.get("dependencies", []))
+    for name in dict.fromkeys(wanted):
+        stand_in_test_helpers(extension_folder(folder, name))
     enabled = []
     for name in dict.fromkeys(wanted):
         try:
