@@ -12,15 +12,28 @@ and a ``CollisionPlane`` (a ``UsdGeom.Plane`` with ``CollisionAPI``: an infinite
 plane to MuJoCo as to PhysX). PhysX makes that plane ``purpose = guide``;
 graphsdg compiles only default / render purpose gprims, so here it is authored
 invisible instead (it collides and is never drawn).
+
+Isaac Sim 6's ground planes also take visual ``templates`` (the default is
+``"wireframe-blue"``): a template binds an ``OmniPbrMaterial`` at
+``<ground>/visualMaterial`` to the ``CollisionMesh``, textured with a blue grid
+(graphsdg's own ``ground_templates/wireframe-blue.png``: one 1 x 1 tile, a
+light cell with quarter lines and a darker border line) and with
+``project_uvw`` on. graphsdg's rasteriser maps textures by a mesh's UVs and does
+not read ``project_uvw``; the input is authored on the shader all the same, and
+the template gives the mesh (where it has no UV set) ``primvars:st`` equal to its
+in-plane object coordinates, which is what OmniPBR's projection computes for a
+flat square: the grid tiles once per stage unit, as in Isaac.
 """
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade, Vt
 
 from graphsdg.compat.experimental_arguments import as_paths, color_rows, resolve_indices, rows, tokens, warn_once
+from graphsdg.compat.experimental_materials import OmniPbrMaterial
 from graphsdg.compat.experimental_prim_base import Prim
 from graphsdg.compat.experimental_prims import GeomPrim, XformPrim
 from graphsdg.compat.warp_arrays import WarpLikeArray
@@ -528,19 +541,54 @@ def _ground_plane_parts(stage: Usd.Stage, path: str) -> tuple[str, str]:
     return planes[0], meshes[0]
 
 
+#: visual templates of Isaac Sim 6's ground planes -> graphsdg's texture of each
+GROUND_TEMPLATE_TEXTURES = {"wireframe-blue": Path(__file__).parent / "ground_templates" / "wireframe-blue.png"}
+
+
+def _template_rows(templates: str | Sequence[str], count: int) -> list[str]:
+    """``templates`` (a name, or a list of names: one, or one per prim) as ``count`` checked names."""
+    names = [templates] if isinstance(templates, str) else list(templates)
+    for name in names:
+        if name not in GROUND_TEMPLATE_TEXTURES:
+            raise ValueError(f"unsupported ground plane template {name!r}; supported templates: "
+                             f"{list(GROUND_TEMPLATE_TEXTURES)}")
+    if len(names) not in (1, count):
+        raise ValueError(f"templates {templates!r}: {len(names)} names for {count} ground planes; expected 1 or "
+                         f"{count}")
+    return names * count if len(names) == 1 else names
+
+
+def _give_planar_uvs(mesh: UsdGeom.Mesh) -> None:
+    """Give a flat ``mesh`` without a UV set ``primvars:st``: its in-plane object coordinates (project_uvw's map)."""
+    if any(pv.GetTypeName() in (Sdf.ValueTypeNames.TexCoord2fArray, Sdf.ValueTypeNames.Float2Array)
+           for pv in UsdGeom.PrimvarsAPI(mesh).GetPrimvarsWithValues()):
+        return
+    points = np.asarray(mesh.GetPointsAttr().Get() or [], dtype=np.float64).reshape(-1, 3)
+    if not len(points):
+        return
+    normal_axis = int(np.argmin(np.ptp(points, axis=0)))
+    # the two other axes in cyclic order, so the map is not mirrored seen from the normal's side
+    u_axis, v_axis = (normal_axis + 1) % 3, (normal_axis + 2) % 3
+    st = [Gf.Vec2f(float(p[u_axis]), float(p[v_axis])) for p in points]
+    UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray,
+                                            UsdGeom.Tokens.vertex).Set(Vt.Vec2fArray(st))
+
+
 class GroundPlane(XformPrim):
     """``isaacsim.core.experimental.objects.GroundPlane``: ground planes (see the module docstring for the layout).
 
-    ``sizes`` (edge of the rendered square, default 100 m) and ``colors`` (rgb or a colour string; default
-    50 % grey) apply to new ground planes only; collision and physics-material methods act on their ``planes``.
-    Isaac Sim 6's visual ``templates`` are not mapped (graphsdg's ground is its display colour).
+    ``sizes`` (edge of the rendered square, default 100 m) applies to new ground planes only (they are made
+    50 % grey); ``colors`` (rgb or a colour string) then sets the display colour of the planes and meshes, and
+    ``templates`` (``"wireframe-blue"`` by default, as Isaac Sim 6; ``None`` for none) then binds the template's
+    visual material, which shows instead of the colour. Collision and physics-material methods act on ``planes``.
     """
 
     _compat_name = "isaacsim.core.experimental.objects.GroundPlane"
 
     def __init__(self, paths: str | Sequence[str], *, resolve_paths: bool = True, sizes: Any = 100.0,
-                 colors: Any = None, positions: Any = None, translations: Any = None,
-                 orientations: Any = None, scales: Any = None, reset_xform_op_properties: bool = True) -> None:
+                 colors: Any = None, templates: str | Sequence[str] | None = "wireframe-blue",
+                 positions: Any = None, translations: Any = None, orientations: Any = None, scales: Any = None,
+                 reset_xform_op_properties: bool = True) -> None:
         stage = get_stage()
         existent, nonexistent = Prim.resolve_paths(paths) if resolve_paths else (
             [p for p in ([paths] if isinstance(paths, str) else paths) if stage.GetPrimAtPath(p)],
@@ -548,13 +596,15 @@ class GroundPlane(XformPrim):
         if existent and nonexistent:
             raise ValueError(f"paths mix existing prims ({existent[0]!r}) and missing ones ({nonexistent[0]!r})")
         found = existent or nonexistent
+        color = None if colors is None else color_rows(colors, len(found))
+        if templates is not None:
+            _template_rows(templates, len(found))    # bad names raise before any prim is made
         if not existent:
             size = rows(sizes, len(found), 1, "sizes")[:, 0]
             if np.any(size <= 0):
                 raise ValueError(f"sizes {sizes!r} must be positive")
-            color = color_rows((0.5, 0.5, 0.5) if colors is None else colors, len(found))
-            for path, s, c in zip(found, size, color):
-                _define_ground_plane(stage, path, float(s), c)
+            for path, s in zip(found, size):
+                _define_ground_plane(stage, path, float(s), np.array([0.5, 0.5, 0.5]))
         parts = [_ground_plane_parts(stage, p) for p in found]
         super().__init__(found, resolve_paths=False, positions=positions, translations=translations,
                          orientations=orientations, scales=scales,
@@ -562,6 +612,11 @@ class GroundPlane(XformPrim):
         self._planes = Plane([p for p, _ in parts], resolve_paths=False, reset_xform_op_properties=False)
         self._meshes = Mesh([m for _, m in parts], resolve_paths=False, reset_xform_op_properties=False)
         self._geom_prims = GeomPrim(self._planes.paths, resolve_paths=False)
+        if color is not None:
+            self._planes.set_display_colors(color)
+            self._meshes.set_display_colors(color)
+        if templates is not None:
+            self.apply_visual_templates(templates)
 
     @property
     def planes(self) -> Plane:
@@ -605,3 +660,19 @@ class GroundPlane(XformPrim):
     def get_applied_physics_materials(self, indices: Any = None) -> list:
         """The physics material bound to each plane (None where none)."""
         return self._geom_prims.get_applied_physics_materials(indices=indices)
+
+    def apply_visual_templates(self, templates: str | Sequence[str], *, indices: Any = None) -> None:
+        """Bind a visual template's material to the ground planes ``indices`` selects (all by default).
+
+        ``templates``: one name for all, or one per index. The material is an ``OmniPbrMaterial`` at
+        ``<ground>/visualMaterial`` (made there, or the one already there), textured by the template with
+        ``project_uvw`` on (see the module docstring for how graphsdg renders that).
+        """
+        idx = resolve_indices(indices, len(self))
+        for i, name in zip(idx, _template_rows(templates, len(idx))):
+            material = OmniPbrMaterial(f"{self.paths[i]}/visualMaterial", resolve_paths=False)
+            material.set_input_values("diffuse_texture", str(GROUND_TEMPLATE_TEXTURES[name]))
+            # authored for Isaac's readers; graphsdg renders the projection through the UVs given below
+            material.shaders[0].CreateInput("project_uvw", Sdf.ValueTypeNames.Bool).Set(True)
+            _give_planar_uvs(self._meshes.geoms[i])
+            self._meshes.apply_visual_materials(material, indices=[i])

@@ -125,7 +125,7 @@ def _kit_template(stage: Usd.Stage, template: str) -> None:
         dome = UsdLux.DomeLight.Define(stage, "/Environment/Dome")
         dome.CreateIntensityAttr().Set(1000.0)
         with stage_scope(stage):
-            GroundPlane("/Environment/GroundPlane", sizes=100.0, colors=(0.5, 0.5, 0.5))
+            GroundPlane("/Environment/GroundPlane", sizes=100.0, colors=(0.5, 0.5, 0.5), templates=None)
 
 
 def _check_template(template: str | None) -> None:
