@@ -4,7 +4,9 @@ Gravity and the physics step (``physxScene:timeStepsPerSecond``) drive MuJoCo
 (:mod:`graphsdg.sim.physics_scene`); PhysX's solver, broadphase, CCD,
 stabilisation, GPU and buffer settings are authored on the scene with their
 PhysX names and have no MuJoCo counterpart (graphsdg's compiler warns once per
-such attribute; docs/porting.md). :mod:`graphsdg.compat.core_simulation_context`
+such attribute; docs/porting.md). They are written and read through
+:mod:`graphsdg.compat.physx_scene_settings`, as ``SimulationManager``'s are, so
+the two see each other's settings. :mod:`graphsdg.compat.core_simulation_context`
 builds ``SimulationContext`` on it.
 
 Example:
@@ -24,6 +26,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from graphsdg.base import settings_store as settings
+from graphsdg.compat import physx_scene_settings as scene_settings
 from graphsdg.compat.modules import CompatError, CompatObject
 from graphsdg.compat.simulation_manager import SimulationManager
 from graphsdg.engine.runtime import runtime
@@ -46,7 +49,9 @@ class PhysicsContext(CompatObject):
     broadphase, CCD, stabilisation, GPU and buffer settings have no MuJoCo
     counterpart: their setters author them (and the compiler warns once per
     name); Isaac's defaults for them (TGS, MBP, CCD on, stabilisation off, no GPU
-    dynamics) are what the getters report until set, without being authored.
+    dynamics) are what the getters, and ``SimulationManager``'s, report until set:
+    they are recorded in the scene's ``customData`` rather than authored
+    (:func:`graphsdg.compat.physx_scene_settings.record_defaults`).
     """
 
     _compat_name = "isaacsim.core.api.PhysicsContext"
@@ -67,12 +72,16 @@ class PhysicsContext(CompatObject):
         if physx_schemas.authored_value(current, _SCENE, "timeStepsPerSecond") is None:
             self._author("timeStepsPerSecond", 60)   # what PhysX simulates where nothing is authored
         cuda = "cuda" in str(SimulationManager.get_physics_sim_device())
-        # Isaac's PhysX-only defaults are reported by the getters but not authored: the compiler warns about every
-        # authored PhysX setting MuJoCo cannot use, and these were asked for by nobody
-        self._implied: dict[str, Any] = {"broadphaseType": "GPU" if cuda else "MBP", "enableGPUDynamics": cuda}
+        # Isaac's PhysX-only defaults are recorded, not authored: the compiler warns about every authored PhysX
+        # setting MuJoCo cannot use, and these were asked for by nobody
+        defaults: dict[str, Any] = {"broadphaseType": "GPU" if cuda else "MBP", "enableGPUDynamics": cuda}
+        if cuda:
+            defaults["enableCCD"] = False   # PhysX has no CCD on the GPU pipeline
+        if sim_params is None and set_defaults:
+            defaults.update(enableStabilization=False, enableCCD=not cuda, solverType="TGS")
+        scene_settings.record_defaults(current, defaults)
         if sim_params is None and set_defaults:
             self.set_gravity(-9.81 / (UsdGeom.GetStageMetersPerUnit(stage) or 1.0))
-            self._implied.update(enableStabilization=False, enableCCD=not cuda, solverType="TGS")
             self.set_physics_dt(1.0 / 60.0)
         if sim_params is not None:
             self._apply_sim_params(sim_params)
@@ -153,18 +162,11 @@ class PhysicsContext(CompatObject):
         return None
 
     def _author(self, name: str, value: Any) -> None:
-        definition = physx_schemas.schema(_SCENE).attribute(name)
-        variability = Sdf.VariabilityUniform if definition.uniform else Sdf.VariabilityVarying
-        self._scene_prim().CreateAttribute(f"physxScene:{name}", definition.value_type, False,
-                                           variability).Set(value)
+        scene_settings.author(self._scene_prim(), name, value)
 
     def _read(self, name: str) -> Any:
-        """The authored value, else Isaac's default this context stands for, else PhysX's fallback."""
-        prim = self._scene_prim()
-        authored = physx_schemas.authored_value(prim, _SCENE, name)
-        if authored is not None:
-            return authored
-        return self._implied[name] if name in self._implied else physx_schemas.resolved_value(prim, _SCENE, name)
+        """The authored value, else Isaac's default a context stands for, else PhysX's fallback."""
+        return scene_settings.read(self._scene_prim(), name)
 
     def warm_start(self) -> None:
         """Nothing to do (deprecated in Isaac too)."""
@@ -230,8 +232,9 @@ class PhysicsContext(CompatObject):
 
     # ---- PhysX-only scene settings (authored; docs/porting.md) ---------------------------------------------------
     def enable_ccd(self, flag: bool) -> None:
-        """Author ``physxScene:enableCCD``."""
-        self._author("enableCCD", bool(flag))
+        """Author ``physxScene:enableCCD`` (``SimulationManager.enable_ccd`` on this scene, as Isaac: refused with
+        a warning on a CUDA device)."""
+        SimulationManager.enable_ccd(flag, physics_scene=str(self._scene_prim().GetPath()))
 
     def is_ccd_enabled(self) -> bool:
         """``physxScene:enableCCD``."""
@@ -239,7 +242,7 @@ class PhysicsContext(CompatObject):
 
     def enable_stabilization(self, flag: bool) -> None:
         """Author ``physxScene:enableStabilization``."""
-        self._author("enableStabilization", bool(flag))
+        scene_settings.enable_stabilization(self._scene_prim(), flag)
 
     enable_stablization = enable_stabilization
 
@@ -248,18 +251,18 @@ class PhysicsContext(CompatObject):
         return bool(self._read("enableStabilization"))
 
     def enable_gpu_dynamics(self, flag: bool) -> None:
-        """Author ``physxScene:enableGPUDynamics``."""
-        self._author("enableGPUDynamics", bool(flag))
+        """Author ``physxScene:enableGPUDynamics`` (``SimulationManager.enable_gpu_dynamics`` on this scene, as
+        Isaac: enabling it turns CCD off)."""
+        SimulationManager.enable_gpu_dynamics(flag, physics_scene=str(self._scene_prim().GetPath()))
 
     def is_gpu_dynamics_enabled(self) -> bool:
         """``physxScene:enableGPUDynamics``."""
         return bool(self._read("enableGPUDynamics"))
 
     def set_broadphase_type(self, broadcast_type: str) -> None:
-        """Author ``physxScene:broadphaseType`` (``MBP``, ``GPU``, ``SAP``)."""
-        if broadcast_type not in ("MBP", "GPU", "SAP"):
-            raise ValueError(f"broadphase type must be 'MBP', 'GPU' or 'SAP', got {broadcast_type!r}")
-        self._author("broadphaseType", broadcast_type)
+        """Author ``physxScene:broadphaseType`` (``MBP``, ``GPU``, ``SAP``; ``SimulationManager.set_broadphase_type``
+        on this scene, as Isaac)."""
+        SimulationManager.set_broadphase_type(broadcast_type, physics_scene=str(self._scene_prim().GetPath()))
 
     def get_broadphase_type(self) -> str:
         """``physxScene:broadphaseType``."""
@@ -267,9 +270,7 @@ class PhysicsContext(CompatObject):
 
     def set_solver_type(self, solver_type: str) -> None:
         """Author ``physxScene:solverType`` (``TGS`` or ``PGS``)."""
-        if solver_type not in ("TGS", "PGS"):
-            raise ValueError(f"solver_type must be 'TGS' or 'PGS', got {solver_type!r}")
-        self._author("solverType", solver_type)
+        scene_settings.set_solver_type(self._scene_prim(), solver_type)
 
     def get_solver_type(self) -> str:
         """``physxScene:solverType``."""

@@ -17,7 +17,11 @@ count, owns the physics step size and dispatches simulation events. Here:
   ``physxScene:timeStepsPerSecond`` (graphsdg's default is 120 Hz, PhysX's 60 Hz);
 * lifecycle events (setup, started, resumed, paused, stopped) follow the timeline
   and ``initialize_physics()``; a new stage resets everything, callbacks included
-  (Isaac does the same on stage open).
+  (Isaac does the same on stage open);
+* Isaac's deprecated scene settings (``set_solver_type``, ``set_broadphase_type``,
+  ``enable_ccd``, ``enable_gpu_dynamics``, ``enable_stablization`` and their getters)
+  author ``physxScene:*`` on the scene as Isaac stores them and read them back, but
+  MuJoCo has no counterpart for them (:mod:`graphsdg.compat.simulation_manager_scenes`).
 
 Example:
     >>> import graphsdg as rep
@@ -44,11 +48,14 @@ import warnings
 import weakref
 from typing import Any, Callable
 
-from pxr import Tf, Usd, UsdPhysics
+from pxr import Tf, Usd
 
 from graphsdg.compat.event_dispatch import get_eventdispatcher
 from graphsdg.compat.modules import CompatModule, CompatObject
 from graphsdg.compat.physics_views import PhysicsScene, SimulationView
+from graphsdg.compat.simulation_manager_scenes import PhysicsSceneMethods
+from graphsdg.compat.simulation_manager_scenes import physics_scenes as _physics_scenes
+from graphsdg.compat.simulation_manager_scenes import scene_prim as _scene_prim
 from graphsdg.functional.physics import create_physics_scene
 from graphsdg.engine.runtime import runtime
 from graphsdg.sim import physics_steps
@@ -96,7 +103,6 @@ _TIMELINE_EVENTS = {SimulationEvent.SIMULATION_PAUSED: TimelineEventType.PAUSE,
                     SimulationEvent.SIMULATION_STOPPED: TimelineEventType.STOP,
                     IsaacEvents.TIMELINE_STOP: TimelineEventType.STOP}
 _DELETION_EVENTS = (SimulationEvent.PRIM_DELETED, IsaacEvents.PRIM_DELETION)
-PHYSX_STEPS_PER_SECOND = 60   # PhysxSceneAPI's physxScene:timeStepsPerSecond fallback
 _DEVICE = re.compile(r"^(cpu|cuda)(?::(\d+))?$")
 _warned: set[str] = set()
 
@@ -173,10 +179,11 @@ class _Deletions:
             self._listener = None
 
 
-class SimulationManager:
+class SimulationManager(PhysicsSceneMethods):
     """``isaacsim.core.simulation_manager.SimulationManager`` (class methods only, as in Isaac).
 
-    See the module docstring for how it maps onto graphsdg's physics.
+    See the module docstring for how it maps onto graphsdg's physics; the physics-scene methods
+    (default scene, PhysX settings) are :class:`graphsdg.compat.simulation_manager_scenes.PhysicsSceneMethods`.
     """
 
     _initialized = False                     # Isaac's "simulation view created" (warm-up done)
@@ -189,7 +196,8 @@ class SimulationManager:
     _started = False
     _step_observer: int | None = None
     _timeline_subscriptions: list = []
-    _defaults = {"warm_start": True, "on_stop": True, "stage_open": True, "stage_close": True}
+    _defaults = {"warm_start": True, "on_stop": True, "stage_open": True, "stage_close": True,
+                 "post_warm_start": True}   # the last one is deprecated in Isaac and does nothing there either
 
     # ---- lifecycle ---------------------------------------------------------------
     @classmethod
@@ -254,6 +262,7 @@ class SimulationManager:
         cls.deregister_all_callbacks()
         cls.invalidate_physics()
         cls._device = PhysicsDevice("cpu")
+        cls._default_scene = None
 
     @staticmethod
     def _dispatch(event: SimulationEvent | IsaacEvents) -> None:
@@ -394,6 +403,38 @@ class SimulationManager:
         """Isaac's older name for :meth:`get_physics_simulation_view`."""
         return cls.get_physics_simulation_view()
 
+    # ---- physics engine ---------------------------------------------------------------------
+    _engine = "physx"
+
+    @classmethod
+    def get_active_physics_engine(cls) -> str:
+        """``"physx"``: the engine whose USD interface graphsdg reads (PhysX's schemas and scene settings);
+        MuJoCo simulates it. Isaac's other engines (``newton``, ``remotesim``) are not available."""
+        return cls._engine
+
+    @classmethod
+    def get_available_physics_engines(cls, verbose: bool = False) -> list[tuple[str, bool]]:
+        """``[("physx", True)]``: the one engine interface, active (printed when ``verbose``, as Isaac)."""
+        engines = [(cls._engine, True)]
+        if verbose:
+            print("Available physics engines:")
+            for name, active in engines:
+                print(f"  {name}: {'active' if active else 'inactive'}")
+            print("-" * 60)
+        return engines
+
+    @classmethod
+    def switch_physics_engine(cls, engine_name: str, verbose: bool = False) -> bool:
+        """True for ``"physx"`` (already active); any other engine is not available: an error is logged naming
+        it and False returned, as Isaac does for an engine it does not find."""
+        if str(engine_name).lower() == cls._engine:
+            if verbose:
+                log.warning(f"Physics engine is already set to {engine_name}")
+            return True
+        log.error(f"Engine '{engine_name}' not found. Available: {cls._engine} (graphsdg simulates PhysX's USD "
+                  f"interface with MuJoCo; see docs/porting.md)")
+        return False
+
     # ---- device and fabric ----------------------------------------------------------------
     @classmethod
     def set_device(cls, device: str | Any) -> None:
@@ -531,6 +572,27 @@ class SimulationManager:
         """Turn every default handler on or off."""
         cls.enable_default_callbacks(enable_warm_start=enable, enable_on_stop=enable, enable_stage_open=enable,
                                      enable_stage_close=enable)
+        cls.enable_post_warm_start_callback(enable)
+
+    @classmethod
+    def enable_warm_start_callback(cls, enable: bool = True) -> None:
+        """Isaac's older form of ``enable_default_callbacks(enable_warm_start=enable)``."""
+        cls.enable_default_callbacks(enable_warm_start=enable)
+
+    @classmethod
+    def enable_on_stop_callback(cls, enable: bool = True) -> None:
+        """Isaac's older form of ``enable_default_callbacks(enable_on_stop=enable)``."""
+        cls.enable_default_callbacks(enable_on_stop=enable)
+
+    @classmethod
+    def enable_stage_open_callback(cls, enable: bool = True) -> None:
+        """Isaac's older form of ``enable_default_callbacks(enable_stage_open=enable)``."""
+        cls.enable_default_callbacks(enable_stage_open=enable)
+
+    @classmethod
+    def enable_post_warm_start_callback(cls, enable: bool = True) -> None:
+        """Record the ``post_warm_start`` state; Isaac deprecated the event it stood for and ignores it too."""
+        cls._defaults["post_warm_start"] = bool(enable)
 
     @classmethod
     def is_default_callback_enabled(cls, callback_name: str) -> bool:
@@ -548,26 +610,6 @@ class _Ended:
 
     def __init__(self, end: Callable[[], None]) -> None:
         self.end = end
-
-
-def _physics_scenes(create: bool = False) -> list[str]:
-    """Paths of the stage's physics scenes, in stage order (``/PhysicsScene`` is made when ``create`` and none)."""
-    paths = [str(p.GetPath()) for p in get_stage().Traverse() if p.IsA(UsdPhysics.Scene)]
-    if not paths and create:
-        # Isaac's SimulationManager makes a PhysX scene here; PhysxSceneAPI's rate defaults to 60 steps per
-        # second, which graphsdg (120 Hz without the attribute) only follows when it is authored.
-        prim = create_physics_scene("/PhysicsScene", time_steps_per_second=PHYSX_STEPS_PER_SECOND)
-        prim.AddAppliedSchema("PhysxSceneAPI")
-        paths = [str(prim.GetPath())]
-    return paths
-
-
-def _scene_prim(path: str) -> Usd.Prim:
-    prim = get_stage().GetPrimAtPath(str(path))
-    if not prim or not prim.IsA(UsdPhysics.Scene):
-        raise ValueError(f"physics scene {path!r} is not a UsdPhysics.Scene prim on the stage; scenes: "
-                         f"{_physics_scenes() or 'none'}")
-    return prim
 
 
 def uninstall() -> None:
