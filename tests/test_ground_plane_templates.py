@@ -50,7 +50,9 @@ def test_the_template_texture_is_a_blue_grid_on_a_light_cell_and_is_packaged():
     cell = image[n // 8, n // 8]                                          # inside a cell: light, near grey
     assert cell.min() > 220 and cell.max() - cell.min() < 10
     package_data = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
-    relative = file.relative_to(REPO / "graphsdg" / "compat").as_posix()
+    import graphsdg.compat
+    # relative to the package as imported: the source tree (editable) or site-packages (CI installs the wheel)
+    relative = Path(file).resolve().relative_to(Path(graphsdg.compat.__file__).resolve().parent).as_posix()
     assert any(fnmatch.fnmatch(relative, pattern) for pattern in package_data["graphsdg.compat"])
 
 
