@@ -1,6 +1,8 @@
 """Isaac's camera sensor classes (isaacsim.sensors.camera): frames, projections and tiles against analytic truth."""
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 import pytest
 
@@ -118,6 +120,9 @@ def test_camera_view_batches_and_tiles(kit) -> None:
     np.testing.assert_allclose(view.get_focal_lengths(), [2.0, 3.0, 4.0])
     view.set_shutter_properties([(0.0, 0.01), (0.0, 0.02), (0.005, 0.03)])
     assert view.get_shutter_properties(indices=[2]) == [(0.005, pytest.approx(0.03))]
+    if importlib.util.find_spec("torch") is None:      # Isaac's get_rgb returns torch tensors: say what is missing
+        with pytest.raises(ModuleNotFoundError, match="CameraView.get_rgb returns torch tensors.*pip install torch"):
+            view.get_rgb()
 
 
 def test_single_view_depth_sensor_stereo_model(kit) -> None:

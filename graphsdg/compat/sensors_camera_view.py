@@ -70,6 +70,17 @@ def default_device() -> str:
     return "cuda" if wp.get_cuda_device_count() > 0 else "cpu"
 
 
+
+def _torch(what: str) -> Any:
+    """PyTorch, which ``what`` returns its data in (as Isaac's ``CameraView`` does), or an error naming it."""
+    try:
+        import torch
+    except ModuleNotFoundError as exc:
+        raise ModuleNotFoundError(f"{what} returns torch tensors, as Isaac Sim's CameraView does, and PyTorch is "
+                                  f"not installed: pip install torch (with CUDA for device='cuda'), or use "
+                                  f"get_rgb_tiled / get_depth_tiled / get_data with device='cpu'", name="torch") from exc
+    return torch
+
 class CameraView(XFormPrim):
     """``isaacsim.sensors.camera.CameraView`` (module docstring)."""
 
@@ -240,13 +251,13 @@ class CameraView(XFormPrim):
         data = self.get_data(kind, tiled=True)[0]
         if out is None:
             if device == "cuda":
-                import torch
-                return torch.as_tensor(data.numpy(), device="cuda")
+                return _torch(f"get_*_tiled(device={device!r})").as_tensor(data.numpy(), device="cuda")
             return data.numpy()
         if isinstance(out, np.ndarray):
             out[:] = data.numpy().reshape(out.shape)
         else:
-            out.copy_(__import__("torch").as_tensor(data.numpy(), device=out.device).reshape(out.shape))
+            out.copy_(_torch("get_*_tiled(out=<tensor>)").as_tensor(data.numpy(), device=out.device)
+                      .reshape(out.shape))
         return out
 
     def get_rgb_tiled(self, out: Any = None, device: str = "cpu") -> Any:
@@ -258,8 +269,7 @@ class CameraView(XFormPrim):
         return self._host_or_torch("distance_to_image_plane", out, device)
 
     def _torch_batch(self, kind: str, out: Any) -> Any:
-        import torch
-
+        torch = _torch(f"CameraView.get_{'rgb' if kind == 'rgb' else 'depth'}")
         data = torch.as_tensor(self.get_data(kind)[0].numpy(),
                                device=out.device if out is not None else default_device())
         if out is None:
