@@ -1,11 +1,11 @@
-"""Which ray caster the sensors use. ``mj_multiRay`` on CPU threads, or MuJoCo Warp on a GPU.
+"""Which ray caster the sensors use. ``mj_multiRay`` on CPU threads, or Warp on a GPU.
 
 Chosen like the render backend, from the setting ``/graphsdg/sensors/rayBackend``:
 
 * ``cpu``: :class:`~graphsdg.sensors.ray_caster.CpuRayCaster` (``/graphsdg/sensors/rayThreads`` threads);
-* ``gpu``: :class:`~graphsdg.sensors.warp_rays.WarpRayCaster` (MuJoCo Warp's batched ``rays`` over a BVH of
-  the scene, on ``cuda:0``); it needs the ``graphsdg[gpu]`` extra and a CUDA GPU, and raises naming what is
-  missing;
+* ``gpu``: :class:`~graphsdg.sensors.warp_rays.WarpRayCaster` (the scene's triangles and primitives in world
+  coordinates under BVHs, :mod:`graphsdg.sensors.warp_ray_scene`, on ``cuda:0``); it needs the ``graphsdg[gpu]``
+  extra and a CUDA GPU, and raises naming what is missing;
 * ``auto`` (default): ``gpu`` where it can run, else ``cpu``.
 
 Both return the same :class:`~graphsdg.sensors.ray_caster.RayHits` for the same rays.
