@@ -90,6 +90,17 @@ def _front_face_hit(a: wp.vec3, b: wp.vec3, c: wp.vec3, pnt: wp.vec3, vec: wp.ve
     return t, wp.normalize(wp.cross(e1, e2))
 
 
+@wp.func
+def _primitive_hit(g: int, enabled: wp.array(dtype=wp.int32), geom_type: wp.array(dtype=wp.int32),
+                   geom_size: wp.array(dtype=wp.vec3), xpos: wp.array(dtype=wp.vec3), xmat: wp.array(dtype=wp.mat33),
+                   pnt: wp.vec3, vec: wp.vec3):
+    """(distance, normal) where the ray meets primitive geom ``g`` (MuJoCo Warp's test), distance -1 if it misses
+    or ``g`` is not enabled."""
+    if enabled[g] == 0:
+        return float(-1.0), wp.vec3()
+    return ray_geom(xpos[g], xmat[g], geom_size[g], pnt, vec, geom_type[g])
+
+
 @wp.kernel
 def _cast(tris: wp.uint64, has_tris: int, world: wp.array(dtype=wp.vec3), faces: wp.array(dtype=wp.vec3i),
           face_geom: wp.array(dtype=wp.int32),
@@ -107,23 +118,21 @@ def _cast(tris: wp.uint64, has_tris: int, world: wp.array(dtype=wp.vec3), faces:
     # planes and primitives first: their cheap tests often shorten the ray before the triangles are walked
     for k in range(planes.shape[0]):
         g = planes[k]
-        if enabled[g] != 0:
-            t, n = ray_geom(xpos[g], xmat[g], geom_size[g], p, d, geom_type[g])
-            if t >= 0.0 and t < best:
-                best = t
-                best_geom = g
-                best_normal = n
+        t, n = _primitive_hit(g, enabled, geom_type, geom_size, xpos, xmat, p, d)
+        if t >= 0.0 and t < best:
+            best = t
+            best_geom = g
+            best_normal = n
     if has_bvh != 0:
         query = wp.bvh_query_ray(bvh, p, d)
         item = int(0)
         while wp.bvh_query_next(query, item, best):
             g = bvh_geoms[item]
-            if enabled[g] != 0:
-                t, n = ray_geom(xpos[g], xmat[g], geom_size[g], p, d, geom_type[g])
-                if t >= 0.0 and t < best:
-                    best = t
-                    best_geom = g
-                    best_normal = n
+            t, n = _primitive_hit(g, enabled, geom_type, geom_size, xpos, xmat, p, d)
+            if t >= 0.0 and t < best:
+                best = t
+                best_geom = g
+                best_normal = n
     if has_tris != 0:
         query = wp.bvh_query_ray(tris, p, d)
         f = int(0)
