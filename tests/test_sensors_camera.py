@@ -125,6 +125,34 @@ def test_camera_view_batches_and_tiles(kit) -> None:
             view.get_rgb()
 
 
+def test_camera_view_reports_the_scaled_resolution(kit) -> None:
+    """A run's resolution scale shrinks the products: the view's sizes say so, so a buffer sized from them fits."""
+    app, timeline, rep = kit
+    from isaacsim.sensors.camera import CameraView
+
+    from graphsdg.base import settings_store
+    settings_store.set("/graphsdg/render/resolutionScale", 0.5)
+    try:
+        for i in range(4):
+            rep.functional.create.camera(position=(i, 0, 1.0 + i), look_at=(i, 0, 0), parent="/World",
+                                         name=f"Scaled{i}")
+        view = CameraView(prim_paths_expr="/World/Scaled[0-9]", camera_resolution=(32, 32),
+                          output_annotators=["rgb", "depth"])
+    finally:
+        settings_store.set("/graphsdg/render/resolutionScale", 1.0)
+    assert view.camera_resolution == view.get_resolutions() == (16, 16)
+    assert view.tiled_resolution == (32, 32)                    # 2 x 2 tiles of 16 x 16
+    timeline.play()
+    app.update()
+    app.update()
+    out = np.zeros((*view.tiled_resolution, 1), dtype=np.float32)
+    view.get_depth_tiled(out=out, device="cpu")
+    for i, (row, column) in enumerate([(0, 0), (0, 1), (1, 0), (1, 1)]):
+        np.testing.assert_allclose(out[row * 16:(row + 1) * 16, column * 16:(column + 1) * 16], 1.0 + i, atol=2e-4)
+    view.set_resolutions((32, 32))                                # unchanged request: the products stay
+    assert view.camera_resolution == (16, 16)
+
+
 def test_single_view_depth_sensor_stereo_model(kit) -> None:
     app, timeline, rep = kit
     from isaacsim.sensors.camera import SingleViewDepthSensor

@@ -8,6 +8,9 @@ product at ``camera_resolution`` (the same images) and lays them out on request:
   as many columns as needed, camera ``i`` at row ``i // columns``, column ``i % columns`` (unused tiles zero);
   ``tiled_resolution`` is its ``(width, height)``.
 
+A run's ``/graphsdg/render/resolutionScale`` scales the products, and ``camera_resolution`` /
+``tiled_resolution`` then report the scaled sizes, so buffers a script sizes from them fit what it gets back.
+
 Arrays come back as Warp arrays (``out`` filled where given; on ``cuda`` when Warp sees a GPU, else on the CPU) with
 the channel counts and types of :data:`ANNOTATOR_SPEC` (``rgb`` drops alpha). ``get_rgb_tiled`` /
 ``get_depth_tiled`` return NumPy on ``cpu`` and torch tensors on ``cuda``; ``get_rgb`` / ``get_depth`` torch
@@ -101,7 +104,8 @@ class CameraView(XFormPrim):
             if kind not in ANNOTATOR_TYPES:
                 raise ValueError(f"Unsupported annotator type: {kind!r}. Supported types are "
                                  f"{list(ANNOTATOR_TYPES)}")
-        self.camera_resolution = tuple(int(v) for v in camera_resolution)
+        self._requested_resolution = tuple(int(v) for v in camera_resolution)
+        self.camera_resolution = self._requested_resolution
         self._products: list[Any] = []
         self._annotators: dict[str, Any] = {}
         self._setup_tiled_sensor()
@@ -127,10 +131,12 @@ class CameraView(XFormPrim):
 
     def _setup_tiled_sensor(self) -> None:
         self._clean_up_tiled_sensor()
-        self.tiled_resolution = tile_grid(len(self.prims), self.camera_resolution)
-        self._products = [graphsdg.create.render_product(path, self.camera_resolution, force_new=True,
+        self._products = [graphsdg.create.render_product(path, self._requested_resolution, force_new=True,
                                                           name=f"{self.name}_tile_{i}")
                           for i, path in enumerate(self.prim_paths)]
+        if self._products:   # as rendered: a run's resolution scale applies to every product alike
+            self.camera_resolution = tuple(int(v) for v in self._products[0].resolution)
+        self.tiled_resolution = tile_grid(len(self.prims), self.camera_resolution)
         self._render_product_path = self._products[0].path if self._products else None
         for kind in self._output_annotators:
             source = ANNOTATOR_TYPES[kind][0]
@@ -148,13 +154,13 @@ class CameraView(XFormPrim):
         return [product.path for product in self._products]
 
     def set_resolutions(self, resolution: tuple[int, int]) -> None:
-        """Render every camera at ``(width, height)``."""
-        if tuple(resolution) != self.camera_resolution:
-            self.camera_resolution = tuple(int(v) for v in resolution)
+        """Render every camera at ``(width, height)`` (times a run's resolution scale)."""
+        if tuple(resolution) != self._requested_resolution:
+            self._requested_resolution = tuple(int(v) for v in resolution)
             self._setup_tiled_sensor()
 
     def get_resolutions(self) -> tuple[int, int]:
-        """Each camera's (width, height)."""
+        """Each camera's (width, height) as rendered."""
         return self.camera_resolution
 
     def get_aspect_ratios(self) -> float:
