@@ -7,7 +7,7 @@ Markdown row: label, processes, seconds to the first frame (slowest copy, and th
 end, modules Warp compiled and loaded from the cache, summed over the copies.
 
 Usage: python3 bench/cold_start.py --label "fresh machine" --watch OUT{i} [--processes N] [--header] \
-           -- graphsdg demo --frames 8 --out OUT{i}
+           [--log LOG{i}] -- graphsdg demo --frames 8 --out OUT{i}
 """
 from __future__ import annotations
 
@@ -25,6 +25,7 @@ def main() -> int:
     parser.add_argument("--watch", required=True, help="folder whose first rgb_* file is the first frame")
     parser.add_argument("--processes", type=int, default=1)
     parser.add_argument("--header", action="store_true", help="print the table's header first")
+    parser.add_argument("--log", help="write each copy's output here ({i} as in --watch): Warp's per-module times")
     parser.add_argument("command", nargs=argparse.REMAINDER)
     args = parser.parse_args()
     command = args.command[1:] if args.command[:1] == ["--"] else args.command
@@ -56,6 +57,10 @@ def main() -> int:
     for t in threads:
         t.join()
     failed = [i for i, p in enumerate(procs) if p.returncode != 0]
+    if args.log:
+        for i, log in enumerate(logs):
+            with open(args.log.replace("{i}", str(i)), "w", encoding="utf-8") as f:
+                f.writelines(log)
     text = "".join(line for log in logs for line in log)
     compiled = sum(1 for line in text.splitlines() if line.startswith("Module ") and line.endswith("(compiled)"))
     cached = sum(1 for line in text.splitlines() if line.startswith("Module ") and line.endswith("(cached)"))

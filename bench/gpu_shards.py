@@ -6,9 +6,11 @@ Each shard is its own process started as ``graphsdg bench --gpus`` starts its pr
 to it at import) and runs :func:`graphsdg.jobs.job.run_job` for its frame plan, as a Ray shard does; the
 parent merges the shards (:func:`graphsdg.dataset.merge.merge_shards`) and compares every file with a
 one-process run of the same job on GPU 0. ``--kill-after S`` SIGKILLs shard 1 that many seconds into its
-run, then reruns every shard with ``--resume`` and compares again.
+run, then reruns every shard with ``--resume`` and compares again. ``--shards-per-gpu N`` puts N shards on
+each GPU, under CUDA MPS as ``--mps`` says (:mod:`graphsdg.render.cuda_mps`; default auto).
 
 Usage (on the GPU host): python3 bench/gpu_shards.py --gpus 4 --frames 48 [--kill-after 20] [--backend pbr]
+                         [--shards-per-gpu 2] [--mps auto|on|off]
 Prints one Markdown table row per check; exits 1 if any check fails.
 """
 from __future__ import annotations
@@ -75,12 +77,12 @@ def _summary(process) -> dict:
     return json.loads([line for line in out.splitlines() if line.startswith("SHARD ")][-1][6:])
 
 
-def _run(script, out, frames, gpus, resume=False, kill_after=None) -> tuple[list[dict], float]:
-    """Every shard at once, one GPU each (dealt in turn); shard 1 killed after ``kill_after`` s if given."""
+def _run(script, out, frames, gpus, resume=False, kill_after=None, per_gpu=1) -> tuple[list[dict], float]:
+    """Every shard at once, ``per_gpu`` a GPU (dealt in turn); shard 1 killed after ``kill_after`` s if given."""
     from graphsdg.dataset import merge
     from graphsdg.jobs.job import JobSpec, check_job_file
     check_job_file(JobSpec(script, seed=7, out=out, frames=frames, resume=resume))
-    count = len(gpus) if len(gpus) > 1 else 1
+    count = len(gpus) * per_gpu
     start = time.perf_counter()
     procs = [_start(script, out, frames, i, count, resume, gpus[i % len(gpus)]) for i in range(count)]
     if kill_after is not None:
@@ -106,6 +108,32 @@ def _digest(root: str) -> dict[str, str]:
     return out
 
 
+def _sharded_checks(args, script: str, work: str, gpus, one: dict, one_s: float, mps) -> bool:
+    """The sharded run against the one-process files, then (``--kill-after``) a killed shard resumed; prints a
+    row each and says whether every check held."""
+    per_gpu = args.shards_per_gpu
+    results, many_s = _run(script, os.path.join(work, "many"), args.frames, gpus, per_gpu=per_gpu)
+    many = _digest(os.path.join(work, "many"))
+    ok = one == many and len(one) > 0
+    differ = sorted(k for k in one if one.get(k) != many.get(k))
+    print("| check | GPUs | frames | files | seconds | result |\n|---|---|---|---|---|---|")
+    print(f"| one process on GPU 0 | 1 | {args.frames} | {len(one)} | {one_s:.1f} | reference |")
+    print(f"| {len(gpus) * per_gpu} shards, {per_gpu} a GPU ({mps.describe()}) | {len(gpus)} | "
+          f"{sum(r['frames'] for r in results)} | {len(many)} | "
+          f"{many_s:.1f} | {'byte-identical' if ok else f'DIFFERENT: {len(differ)} files, e.g. {differ[:3]}'} |")
+    if args.kill_after is not None and len(gpus) * per_gpu > 1:
+        out = os.path.join(work, "killed")
+        _run(script, out, args.frames, gpus, kill_after=args.kill_after, per_gpu=per_gpu)
+        partial = len(os.listdir(os.path.join(out, "basic"))) if os.path.isdir(os.path.join(out, "basic")) else 0
+        _, resume_s = _run(script, out, args.frames, gpus, resume=True, per_gpu=per_gpu)
+        resumed = _digest(out)
+        same = resumed == one
+        ok = ok and same
+        print(f"| shard 1 killed after {args.kill_after:g} s ({partial} files), all resumed | {len(gpus)} | "
+              f"{args.frames} | {len(resumed)} | {resume_s:.1f} | {'byte-identical' if same else 'DIFFERENT'} |")
+    return ok
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--gpus", type=int, default=4)
@@ -113,6 +141,8 @@ def main() -> int:
     parser.add_argument("--size", type=int, default=512)
     parser.add_argument("--backend", default="pbr", choices=("pbr", "classic"))
     parser.add_argument("--kill-after", type=float)
+    parser.add_argument("--shards-per-gpu", type=int, default=1)
+    parser.add_argument("--mps", default="auto", choices=("auto", "on", "off"))
     parser.add_argument("--shard", type=int)
     parser.add_argument("--count", type=int)
     parser.add_argument("--script")
@@ -130,24 +160,9 @@ def main() -> int:
         f.write(JOB.format(backend=args.backend, size=args.size))
     _, one_s = _run(script, os.path.join(work, "one"), args.frames, gpus[:1])
     one = _digest(os.path.join(work, "one"))
-    results, many_s = _run(script, os.path.join(work, "many"), args.frames, gpus)
-    many = _digest(os.path.join(work, "many"))
-    ok = one == many and len(one) > 0
-    differ = sorted(k for k in one if one.get(k) != many.get(k))
-    print("| check | GPUs | frames | files | seconds | result |\n|---|---|---|---|---|---|")
-    print(f"| one process on GPU 0 | 1 | {args.frames} | {len(one)} | {one_s:.1f} | reference |")
-    print(f"| {len(gpus)} shards, one a GPU | {len(gpus)} | {sum(r['frames'] for r in results)} | {len(many)} | "
-          f"{many_s:.1f} | {'byte-identical' if ok else f'DIFFERENT: {len(differ)} files, e.g. {differ[:3]}'} |")
-    if args.kill_after is not None and len(gpus) > 1:
-        out = os.path.join(work, "killed")
-        _run(script, out, args.frames, gpus, kill_after=args.kill_after)
-        partial = len(os.listdir(os.path.join(out, "basic"))) if os.path.isdir(os.path.join(out, "basic")) else 0
-        _, resume_s = _run(script, out, args.frames, gpus, resume=True)
-        resumed = _digest(out)
-        same = resumed == one
-        ok = ok and same
-        print(f"| shard 1 killed after {args.kill_after:g} s ({partial} files), all resumed | {len(gpus)} | "
-              f"{args.frames} | {len(resumed)} | {resume_s:.1f} | {'byte-identical' if same else 'DIFFERENT'} |")
+    from graphsdg.render.cuda_mps import shared_gpus
+    with shared_gpus(args.mps, args.shards_per_gpu) as mps:
+        ok = _sharded_checks(args, script, work, gpus, one, one_s, mps)
     return 0 if ok else 1
 
 

@@ -7,8 +7,9 @@
 #   bake      a cache baked without the GPU (warmup --arch 90 --device cpu, CUDA_VISIBLE_DEVICES empty) then demo,
 #             graphsdg warmup on the GPU then demo, 2 Ray workers on an empty cache
 #   scale     graphsdg bench --gpus 1 2 4 (or what the host has), 8 processes a GPU, pbr: per-GPU rows, scaling
+#             (CUDA MPS as --mps auto decides; MPS=off in the environment runs without it)
 #   classic   the same with the classic rasteriser
-#   procs     one GPU: 4, 8, 16 processes on it (pbr), and 16 under CUDA MPS where the host allows it
+#   procs     one GPU: 4, 8, 16 processes on it (pbr) without CUDA MPS, then 8 and 16 with it where the host has it
 #   shards    a job sharded over every GPU writes the bytes of one process on GPU 0; a killed shard resumes to them
 #
 # Usage: bash bench/multi_gpu.sh PART [REPORT.md]
@@ -72,28 +73,18 @@ scale|classic)
   backend=pbr; [ "$part" = classic ] && backend=classic
   warm_cache
   "${gsdg[@]}" bench "${four[@]}" --backend "$backend" --gpus "${counts[@]}" --processes-per-gpu 8 \
-    --seconds 20 --num-frames 20000 --report "$report"
+    --seconds 20 --num-frames 20000 --mps "${MPS:-auto}" --report "$report"
   ;;
 procs)
   warm_cache
   for n in 4 8 16; do
     "${gsdg[@]}" bench "${four[@]}" --backend pbr --gpus 1 --processes-per-gpu "$n" --seconds 20 --num-frames 20000 \
-      --report "$report"
+      --mps off --report "$report"
   done
-  if command -v nvidia-cuda-mps-control >/dev/null; then
-    export CUDA_MPS_PIPE_DIRECTORY=$work/mps CUDA_MPS_LOG_DIRECTORY=$work/mps-log
-    mkdir -p "$CUDA_MPS_PIPE_DIRECTORY" "$CUDA_MPS_LOG_DIRECTORY"
-    if nvidia-cuda-mps-control -d; then
-      say "(CUDA MPS daemon started for the next run)"
-      "${gsdg[@]}" bench "${four[@]}" --backend pbr --gpus 1 --processes-per-gpu 16 --seconds 20 --num-frames 20000 \
-        --report "$report" || say "(the MPS run failed)"
-      echo quit | nvidia-cuda-mps-control || true
-    else
-      say "(CUDA MPS: the daemon would not start on this host)"
-    fi
-  else
-    say "(CUDA MPS: nvidia-cuda-mps-control is not on this host)"
-  fi
+  for n in 8 16; do   # the same under CUDA MPS (graphsdg starts the daemon; auto says so where the host has none)
+    "${gsdg[@]}" bench "${four[@]}" --backend pbr --gpus 1 --processes-per-gpu "$n" --seconds 20 --num-frames 20000 \
+      --mps auto --report "$report"
+  done
   ;;
 shards)
   warm_cache

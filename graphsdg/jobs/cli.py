@@ -6,10 +6,12 @@ semantics of ``run --workers`` (sharding on Ray) and ``run --resume``.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 
 from graphsdg.jobs.demo_scene import run_demo  # noqa: F401  (graphsdg demo; importable from here as before)
+from graphsdg.render.cuda_mps import MODES as MPS_MODES
 
 
 def run_bench(args: argparse.Namespace) -> None:
@@ -59,8 +61,10 @@ def run_bench(args: argparse.Namespace) -> None:
     if args.gpus:
         table = _bench_on_gpus(args, config)
     elif args.processes:
-        row = throughput.run_processes(config, args.processes)
-        table = throughput.format_table([row])
+        from graphsdg.render.cuda_mps import shared_gpus
+        with shared_gpus(args.mps, args.processes) as mps:     # every process on the one GPU CUDA shows
+            row = throughput.run_processes(config, args.processes)
+        table = f"{throughput.format_table([row])}\n\n{mps.describe()}"
     else:
         rounds = [throughput.run_pair(config) if not args.no_baseline else (throughput.run_graphsdg(config), None)
                   for _ in range(args.rounds)]
@@ -118,6 +122,7 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
     scaling table. Every count is checked against the machine before anything runs."""
     from graphsdg.benchmark import multi_gpu
     from graphsdg.benchmark.throughput import format_table
+    from graphsdg.render.cuda_mps import shared_gpus
     from graphsdg.render.gpu_assignment import check_egl_sees, choose_gpus, default_processes_per_gpu
     if args.processes and args.processes_per_gpu:
         raise ValueError(f"--processes {args.processes} and --processes-per-gpu {args.processes_per_gpu} both say "
@@ -129,10 +134,11 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
     runs, parts = [], []
     for count, gpus in chosen.items():
         processes = args.processes or count * (args.processes_per_gpu or default_processes_per_gpu(count))
-        run = multi_gpu.run_on_gpus(config, processes, gpus)
+        with shared_gpus(args.mps, math.ceil(processes / count)) as mps:
+            run = multi_gpu.run_on_gpus(config, processes, gpus)
         runs.append(run)
         parts.append(f"#### {count} GPU(s), {processes} processes\n\n{format_table([run.total])}\n\n"
-                     f"{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}")
+                     f"{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}\n\n{mps.describe()}")
     if len(runs) > 1:
         parts.append("#### Scaling\n\n" + format_table(multi_gpu.scaling_rows(runs)))
     return "\n\n".join(parts)
@@ -216,7 +222,7 @@ def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
         import_ray()                      # says how to get Ray before anything runs
         check_job_file(job)
         summary = run_sharded(job, args.workers, address=args.address, gpus_per_worker=args.gpus_per_worker,
-                              gpus=args.gpus)
+                              gpus=args.gpus, mps=args.mps)
     else:
         check_job_file(job)
         summary = run_job(job)
@@ -226,6 +232,7 @@ def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
         gpu_line = format_gpu_rows(summary)
         if gpu_line:
             print(f"graphsdg run: {gpu_line}")
+        print(f"graphsdg run: {summary['mps']}")
     if summary.get("index"):
         print(f"graphsdg run: index {summary['index']}")
     return 0
@@ -419,6 +426,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--processes-per-gpu", type=_positive, metavar="N",
                        help="with --gpus: N processes on each GPU (default: --processes spread over the GPUs, or "
                             "the cores' share of each GPU, at most 8)")
+    bench.add_argument("--mps", choices=MPS_MODES, default="auto",
+                       help="with --processes or --gpus: CUDA MPS for the processes that share a GPU, so their "
+                            "kernels run side by side (auto: when a GPU has several processes and the host has "
+                            "nvidia-cuda-mps-control; on: required; off; default: auto)")
     bench.add_argument("--no-baseline", action="store_true", help="skip the hand-written MuJoCo loop")
     bench.add_argument("--rounds", type=_positive, default=1,
                        help="run graphsdg and the hand-written loop this many times each, alternately, in one "
@@ -471,6 +482,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--gpus-per-worker", type=_fraction, metavar="F",
                      help="GPUs per worker, may be a fraction (default: 1/ceil(workers/GPUs), so the workers fill "
                           "every GPU; 1 with fewer workers than GPUs; 0 without GPUs)")
+    run.add_argument("--mps", choices=MPS_MODES, default="auto",
+                     help="with --workers on this machine: CUDA MPS for the workers that share a GPU, so their "
+                          "kernels run side by side (auto: when a GPU has several workers and the host has "
+                          "nvidia-cuda-mps-control; on: required; off; default: auto)")
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: frames complete on disk are kept, the rest are captured")
     folder = sub.add_parser("run-folder", parents=[common],

@@ -25,13 +25,16 @@ Ray is optional: ``pip install 'graphsdg[ray]'``.
 """
 from __future__ import annotations
 
+import contextlib
 import logging
+import math
 import os
 import tempfile
 import time
 from dataclasses import replace
 
 from graphsdg.base.cpu_share import cores_per_process
+from graphsdg.render.cuda_mps import MpsSession, check_mode, shared_gpus
 from graphsdg.render.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
 from graphsdg.io import object_store
 from graphsdg.io.location import normalize
@@ -117,13 +120,15 @@ def script_here(job: JobSpec) -> JobSpec:
 
 
 def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gpus_per_worker: float | None = None,
-                num_cpus: int | None = None, gpus: int | None = None) -> dict:
+                num_cpus: int | None = None, gpus: int | None = None, mps: str = "auto") -> dict:
     """Run ``job`` as ``workers`` Ray shards (``"auto"``: :func:`default_workers`), merge them; return the job
     summary (with per-shard and per-GPU rows).
 
     ``gpus``: use that many GPUs (default: all the cluster's); more than the machine or cluster has is an
     error naming both counts. Each worker asks for :func:`~graphsdg.render.gpu_assignment.gpu_share` of a GPU
-    unless ``gpus_per_worker`` says otherwise.
+    unless ``gpus_per_worker`` says otherwise. ``mps`` (auto, on, off): CUDA MPS for the workers that share a
+    GPU of the local cluster (:mod:`graphsdg.render.cuda_mps`); a cluster joined with ``address`` runs its
+    nodes' own daemons.
     """
     from graphsdg.dataset import merge
     from graphsdg.render.gpu_assignment import choose_gpus, gpu_share
@@ -133,9 +138,16 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
     if job.out is None:
         raise ValueError("--workers needs --out DIR: the shards write into one output root (on a shared "
                          "filesystem, or an s3://bucket/prefix, when the cluster has several machines)")
+    check_mode(mps)
+    if address and mps == "on":
+        raise ValueError(f"--mps on starts a CUDA MPS daemon on this machine; the nodes of the cluster at {address} "
+                         f"run their own (start one on each node), so give --mps auto or off with --address")
     ray = import_ray()
     start = time.perf_counter()
     started_here = not ray.is_initialized()
+    daemon = contextlib.ExitStack()
+    mps_session = MpsSession(False, "a cluster joined with --address runs its nodes' own daemons" if address else
+                             "Ray was already running in this process")
     if started_here:
         if address:
             ray.init(address=address, log_to_driver=True)
@@ -145,6 +157,9 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
             # address="local": a new cluster of this process's own, never one another run left on the machine
             cores = num_cpus or os.cpu_count() or 1
             wanted = default_workers(local_gpus, cores) if workers == "auto" else workers
+            # before Ray starts, so its workers (children of this process) find the daemon's pipe
+            mps_session = daemon.enter_context(
+                shared_gpus(mps, math.ceil(wanted / local_gpus) if local_gpus else 0))
             ray.init(address="local", num_cpus=max(wanted, cores), num_gpus=local_gpus,
                      include_dashboard=False, log_to_driver=True)
     try:
@@ -194,6 +209,7 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
     finally:
         if started_here:
             ray.shutdown()
+        daemon.close()
     results.sort(key=lambda r: r["shard"])
     datasets = merge.merge_shards(results)
     seconds = time.perf_counter() - start
@@ -203,6 +219,7 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
                "bytes": sum(r["bytes"] for r in results), "seconds": round(seconds, 3),
                "frames/s": round(frames / seconds, 2) if seconds > 0 else 0.0, "workers": workers,
                "gpus_per_worker": per_worker, "gpus": len(per_gpu), "per_gpu": per_gpu,
+               "mps": mps_session.describe(),
                "shards": [{k: r[k] for k in SHARD_COLUMNS} for r in results]}
     job_info = job.describe()
     summary["index"] = merge.write_index(job.out, {**job_info, "workers": workers, "shards": summary["shards"]},
