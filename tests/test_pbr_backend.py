@@ -78,6 +78,56 @@ def test_pbr_follows_poses_and_is_deterministic(renderer):
     assert np.array_equal(moved.geom_ids, classic.geom_ids)
 
 
+def _leaf_order(renderer) -> list[int]:
+    """The geoms' order in the depth-first walk of the scene tree the renderer last traced: the tree's shape."""
+    import warp as wp
+
+    @wp.kernel(enable_backward=False)
+    def walk(bvh: wp.uint64, order: wp.array[int], count: wp.array[int]):
+        query = wp.bvh_query_aabb(bvh, wp.vec3(-1.0e6), wp.vec3(1.0e6))
+        index = int(0)
+        n = int(0)
+        while wp.bvh_query_next(query, index):
+            order[n] = index
+            n += 1
+        count[0] = n
+
+    (ctx,) = renderer._contexts.values()
+    bvh = ctx.rc.base.bvh
+    order = wp.zeros(4096, dtype=int, device=bvh.device)
+    count = wp.zeros(1, dtype=int, device=bvh.device)
+    wp.launch(walk, dim=1, inputs=[bvh.id], outputs=[order, count], device=bvh.device)
+    return order.numpy()[:count.numpy()[0]].tolist()
+
+
+def test_a_frame_is_traced_through_its_own_boxes_tree_whatever_frame_the_model_was_compiled_at():
+    """A process that compiled its model at one arrangement and moved on traces a frame through the tree a
+    process that compiled at that frame does (a shard or resumed run compiles where it starts): its pixels do
+    not depend on where the run started."""
+    rep.functional.create.dome_light(intensity=600)
+    boxes = [rep.functional.create.cube(position=(i - 3.5, 0, 0.3), scale=0.5, name=f"Box{i}") for i in range(8)]
+    cam = rep.functional.create.camera(position=(0, -9, 4), look_at=(0, 0, 0.3))
+    sim, scene = runtime().sim, runtime().render_scene
+    view = camera_view(cam, W, H)
+    started_early, started_late = PbrRenderer(device=DEVICE), PbrRenderer(device=DEVICE)
+    try:
+        started_early.render(scene, view, {"color"})                 # compiled with the boxes in a row
+        for box, x in zip(boxes, [3.5, -3.5, 0.5, -0.5, 2.5, -2.5, 1.5, -1.5]):   # shuffled along it
+            rep.functional.modify.pose(box, position_value=(x, 0.0, 0.3))
+        sim.sync_dirty_prims()
+        sim.forward()
+        early = started_early.render(scene, view, {"color", "depth", "segmentation"})
+        early_order = _leaf_order(started_early)
+        sim.recompile()                                              # as a run starting here compiles
+        late = started_late.render(scene, view, {"color", "depth", "segmentation"})
+        assert early_order == _leaf_order(started_late)
+        for name in ("color", "depth", "geom_ids"):
+            assert np.array_equal(getattr(early, name), getattr(late, name))
+    finally:
+        started_early.close()
+        started_late.close()
+
+
 def test_id_codes_use_the_fewest_bytes_and_their_table_maps_them_to_geoms():
     assert code_format(10) == (np.uint8, 256) and code_format(254) == (np.uint8, 256)
     assert code_format(255) == (np.uint16, 65536) and code_format(70000) == (np.uint32, 70002)

@@ -7,8 +7,9 @@ the classic layout, so annotators and writers do not know which backend drew.
 
 * **Same state.** Each render writes the simulation's geom, light and camera poses
   (``geom_xpos``/``geom_xmat`` as MuJoCo computed them on the CPU: mocap poses,
-  physics, randomizers) straight into the renderer's data and refits the scene
-  BVH; no kinematics run on the GPU. Colours, material bindings, sizes and light
+  physics, randomizers) straight into the renderer's data and rebuilds the scene
+  BVH from them (:mod:`graphsdg.render.pbr_scene_bvh`: each frame traced through the tree of its
+  own boxes, whatever frame the context was built at); no kinematics run on the GPU. Colours, material bindings, sizes and light
   colours go into the renderer's model when they differ from the last upload
   (per-world arrays: nothing recompiles); meshes rescaled in place are traced through
   their rescale folded into the geom frame (no BVH refit), meshes deformed otherwise get
@@ -117,10 +118,11 @@ class PbrRenderer:
         import mujoco_warp_pbr as mjpbr
         import warp as wp
 
-        from graphsdg.render import backend, pbr_meshes, pbr_outputs, pbr_uploads
+        from graphsdg.render import backend, pbr_meshes, pbr_outputs, pbr_scene_bvh, pbr_uploads
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads
+        self._scene_bvh = pbr_scene_bvh
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
         self._renders: dict[tuple, int] = {}     # per launch's camera paths: the seed of its next launch
@@ -397,7 +399,7 @@ class PbrRenderer:
             if model.nlight:
                 rc.light_intensity.assign(world.light_intensity[None])
             ctx.uploaded["surfaces"] = True
-        self._mjw.refit_bvh(m, d, rc.base)
+        self._scene_bvh.rebuild_scene_bvh(self._mjw, m, d, rc.base)   # the frame's own tree (pbr_scene_bvh)
 
     def _traced_frames(self, scene: RenderScene, ctx: _Context, xmat: np.ndarray) -> np.ndarray:
         """Geom frames for the tracer: rescaled meshes folded in, other vertex changes refit into their BVHs

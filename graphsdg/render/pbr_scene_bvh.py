@@ -1,0 +1,41 @@
+"""The pbr backend's scene BVH, rebuilt from each frame's geom boxes, so a frame's pixels are its own.
+
+mujoco-warp-pbr finds a ray's hit by walking one BVH over the scene's geoms. MuJoCo Warp builds that tree
+with the render context and afterwards only refits it: the tree keeps the shape it had for the poses of the
+frame the context was built at. The walk visits geoms in the tree's order, and where two surfaces lie
+within the renderer's tie tolerance of each other the order decides which one a pixel shows. So a pixel
+could depend on where the run started: a shard or a resumed run, whose context was built at a later frame,
+drew an occasional pixel unlike a one-process run (issue 37's 4-GPU check found one in 640 frames).
+
+:func:`rebuild_scene_bvh` computes the frame's boxes as the refit does, then rebuilds the tree from them
+(Warp's LBVH on a GPU, its SAH builder on the CPU; both deterministic), and points each world at its
+subtree again: every frame is traced through the tree of its own boxes.
+
+Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import warp as wp
+
+
+@wp.kernel(enable_backward=False)
+def _group_roots(bvh: wp.uint64, roots: wp.array[int]):
+    world = wp.tid()
+    roots[world] = wp.bvh_get_group_root(bvh, world)
+
+
+def rebuild_scene_bvh(mjw: Any, m: Any, d: Any, context: Any) -> None:
+    """The frame's geom boxes into ``context``'s scene BVH (MuJoCo Warp's ``refit_bvh``, flexes included),
+    then its tree rebuilt from them and each world's root found again.
+
+    ``mjw``: the ``mujoco_warp`` module; ``m``, ``d``: its model and data; ``context``: the render context
+    holding the tree (mujoco-warp-pbr's ``PbrRenderContext.base``)."""
+    mjw.refit_bvh(m, d, context)
+    context.bvh.rebuild()
+    wp.launch(_group_roots, dim=d.nworld, inputs=[context.bvh.id], outputs=[context.group_root],
+              device=context.group_root.device)
+
+
+__all__ = ["rebuild_scene_bvh"]
