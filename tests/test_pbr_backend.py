@@ -128,6 +128,32 @@ def test_a_frame_is_traced_through_its_own_boxes_tree_whatever_frame_the_model_w
         started_late.close()
 
 
+def test_path_samples_are_seeded_by_the_frame_not_by_what_the_process_drew_before():
+    """Path-traced noise is the frame's own: a process that drew frame 3 first draws frame 9 as one that did
+    not (a shard, a resumed run), and frames 3 and 9 draw different samples."""
+    from graphsdg.base import settings_store
+    from graphsdg.render.backend import DENOISER_KEY
+    cube, ball, cam = _scene()
+    scene, view = runtime().render_scene, camera_view(cam, W, H)
+    saved = {k: settings_store.get(k) for k in ("/rtx/rendermode", "/rtx/pathtracing/spp", DENOISER_KEY)}
+    settings_store.set("/rtx/rendermode", "PathTracing")
+    settings_store.set("/rtx/pathtracing/spp", 1)
+    settings_store.set(DENOISER_KEY, False)
+    drew_before, fresh = PbrRenderer(device=DEVICE), PbrRenderer(device=DEVICE)
+    try:
+        drew_before.render(scene, view, {"color"}, frame=3)
+        after = drew_before.render(scene, view, {"color"}, frame=9).color
+        alone = fresh.render(scene, view, {"color"}, frame=9).color
+        other = fresh.render(scene, view, {"color"}, frame=3).color
+    finally:
+        drew_before.close()
+        fresh.close()
+        for key, value in saved.items():
+            settings_store.set(key, value)
+    assert np.array_equal(after, alone)
+    assert not np.array_equal(alone, other)
+
+
 def test_id_codes_use_the_fewest_bytes_and_their_table_maps_them_to_geoms():
     assert code_format(10) == (np.uint8, 256) and code_format(254) == (np.uint8, 256)
     assert code_format(255) == (np.uint16, 65536) and code_format(70000) == (np.uint32, 70002)

@@ -199,6 +199,13 @@ def _capture(subframes: int, graph: GraphStep, defer: bool = False) -> None:
         capture.finish()
 
 
+def _frame_number(rt) -> int:
+    """The frame's number for its random render samples: the graph's frame, which a shard or a resumed run
+    seeks to, so the number is that of one uninterrupted run; the captures so far without a graph."""
+    frame = rt.frame_provider.frame()
+    return _state.frame_index if frame is None else int(frame)
+
+
 def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int, defer: bool) -> list[FrameView]:
     """Render every product's passes in one call to the backend (which may draw several in one launch)."""
     t = time.perf_counter()
@@ -213,7 +220,7 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
             passes |= a.spec.passes
         motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
         views.append(view)
-        requests.append(RenderRequest(view, passes, subframes, defer, motion) if passes else None)
+        requests.append(RenderRequest(view, passes, subframes, defer, motion, _frame_number(rt)) if passes else None)
     drawn = [r for r in requests if r is not None]
     outputs = iter(rt.renderer.render_batch(rt.render_scene, drawn) if drawn else [])   # sizes its buffers
     t = _timed("render", t)
@@ -243,7 +250,7 @@ def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -
     requests = []
     for rp in render_products:
         rp.check_alive()
-        requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None))
+        requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None, _frame_number(rt)))
     outputs = list(rt.renderer.render_batch(rt.render_scene, requests)) if requests else []
     for out in outputs:
         out.finish()   # hand the pixel buffers back once the colour is read

@@ -73,7 +73,9 @@ class RenderRequest:
 
     ``view``: the product's :class:`~graphsdg.render.camera.CameraView`; ``passes``: ``color``, ``hdr``,
     ``depth``, ``segmentation``; ``subframes``: renders accumulated; ``defer``: leave the pixels copying;
-    ``motion``: motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`) or None.
+    ``motion``: motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`) or None; ``frame``: the frame's
+    number in the run (the graph's frame, which a shard or resumed run seeks to), which seeds the frame's
+    random samples (soft shadows, path tracing), so they do not depend on what the process drew before.
     """
 
     view: CameraView
@@ -81,6 +83,7 @@ class RenderRequest:
     subframes: int = 1
     defer: bool = False
     motion: MotionSamples | None = None
+    frame: int = 0
 
 
 Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)

@@ -42,6 +42,7 @@ Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``
 from __future__ import annotations
 
 import math
+import zlib
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -65,6 +66,20 @@ from graphsdg.sim.visual import UNDRAWN_GROUPS, drawn_geom_mask, pbr_camera_name
 from graphsdg.stage.xform import world_matrix
 
 ENABLED_GROUPS = tuple(g for g in range(mujoco.mjNGROUP) if g not in UNDRAWN_GROUPS)
+LAUNCHES_A_FRAME = 4096     # seeds of one frame's launches (path launches times motion sub-frames) stay apart
+
+
+def launch_seed(frame: int, products: tuple[str, ...], launch: int) -> int:
+    """The seed of a frame's ``launch``-th render launch of render products ``products`` (their paths): a
+    function of those alone, so a frame draws the same samples in a one-process run, a shard and a resumed
+    run, and different products' launches draw different ones.
+
+    Example:
+        >>> launch_seed(7, ("/Render/rp",), 0) == launch_seed(7, ("/Render/rp",), 0) != launch_seed(8, ("/Render/rp",), 0)
+        True
+    """
+    products_code = zlib.crc32("\n".join(products).encode())
+    return (products_code + (int(frame) * LAUNCHES_A_FRAME + int(launch))) % (2 ** 31)
 
 
 @dataclass
@@ -102,6 +117,20 @@ class _MeshState:
     bounds: np.ndarray | None = None   # the mesh bounds last uploaded
 
 
+@dataclass
+class _LaunchSeeds:
+    """The seeds of one render's launches: :func:`launch_seed` of its frame, products and launch count."""
+
+    frame: int
+    products: tuple[str, ...]
+    launches: int = 0
+
+    def next(self) -> int:
+        seed = launch_seed(self.frame, self.products, self.launches)
+        self.launches += 1
+        return seed
+
+
 class PbrRenderer:
     """Renders :class:`~graphsdg.render.render_scene.RenderScene` views with mujoco-warp-pbr (see the module
     docstring)."""
@@ -125,7 +154,6 @@ class PbrRenderer:
         self._scene_bvh = pbr_scene_bvh
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
-        self._renders: dict[tuple, int] = {}     # per launch's camera paths: the seed of its next launch
         self._isolated = None                    # classic rasteriser for render_isolated footprints
         self.stats: dict[str, int] = {"color": 0, "contexts": 0, "products": 0}
         self._queued: list = []                  # pbr_outputs.QueuedReads of deferred renders not yet taken
@@ -224,16 +252,17 @@ class PbrRenderer:
 
     # ---- renders -------------------------------------------------------
     def render(self, scene: RenderScene, view: CameraView, passes: set[str], subframes: int = 1,
-               defer: bool = False, motion=None) -> RenderOutputs:
-        """Render ``passes`` of ``view``: colour, depth and ids from the same rays (see the module docstring)."""
+               defer: bool = False, motion=None, frame: int = 0) -> RenderOutputs:
+        """Render ``passes`` of ``view``: colour, depth and ids from the same rays (see the module docstring);
+        ``frame`` seeds the random samples (:func:`launch_seed`)."""
         scene.require_offscreen(view.width, view.height)   # the classic footprints of render_isolated draw there
-        return self._render_launch(scene, [RenderRequest(view, passes, subframes, defer, motion)])[0]
+        return self._render_launch(scene, [RenderRequest(view, passes, subframes, defer, motion, frame)])[0]
 
     def render_batch(self, scene: RenderScene, requests: list[RenderRequest]) -> list[RenderOutputs]:
         """Render a step's products: those one launch can draw together (no motion blur, one launch of samples,
         :func:`~graphsdg.render.backend.launch_groups`'s pixel limit) as cameras of one launch, the rest alone.
         A product's pixels do not depend on which products share its launch, except the soft-shadow and path
-        samples' seed (each launch's own, deterministic)."""
+        samples' seed (:func:`launch_seed` of the frame and the launch's products)."""
         for r in requests:   # the classic footprints of render_isolated draw in the offscreen buffer
             scene.require_offscreen(r.view.width, r.view.height)
         outputs: list[RenderOutputs | None] = [None] * len(requests)
@@ -268,13 +297,13 @@ class PbrRenderer:
         views = [r.view for r in requests]
         wp, first = self._wp, requests[0]
         ctx = self._context(scene, views, first.subframes)
-        seeds = tuple(v.path for v in views)
+        seeds = _LaunchSeeds(first.frame, tuple(v.path for v in views))
         with wp.ScopedDevice(self._device):
             with profiling.timed("render:pbr_upload"):
                 self._upload_state(scene, views, ctx)
             path = requested_backend().tier == "path"
             launches = max(1, math.ceil(first.subframes / max(1, ctx.rc.path_samples))) if path else 1
-            acc = self._motion_blur(scene, ctx, first.motion, launches) if first.motion is not None else None
+            acc = self._motion_blur(scene, ctx, first.motion, launches, seeds) if first.motion is not None else None
             if acc is not None:
                 self._upload_state(scene, views, ctx)     # labels from the capture's own instant
                 launches = 1
@@ -305,11 +334,9 @@ class PbrRenderer:
         for reads in queued:
             reads.hosts()
 
-    def _launch(self, ctx: _Context, seeds: tuple) -> None:
-        """One launch of every camera of ``ctx``, with the next seed of this set of products."""
-        seed = self._renders.get(seeds, 0)
-        self._renders[seeds] = seed + 1
-        self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seed)
+    def _launch(self, ctx: _Context, seeds: _LaunchSeeds) -> None:
+        """One launch of every camera of ``ctx``, with the frame's next seed for these products."""
+        self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seeds.next())
         self.stats["color"] += 1
 
     def _outputs_of(self, scene: RenderScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,
@@ -351,7 +378,8 @@ class PbrRenderer:
         self._mjpbr.get_rgb(ctx.rc, index, rgb)
         return rgb.numpy()[0]
 
-    def _motion_blur(self, scene: RenderScene, ctx: _Context, motion, launches: int) -> np.ndarray:
+    def _motion_blur(self, scene: RenderScene, ctx: _Context, motion, launches: int,
+                     seeds: _LaunchSeeds) -> np.ndarray:
         """Mean display colour of renders at the motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`):
         each sub-frame's geometry, lights and camera, and the next seed (its own soft-shadow and path samples)."""
         acc = None
@@ -360,7 +388,7 @@ class PbrRenderer:
                 posed, seen = motion.pose(i)
                 self._upload_state(scene, [seen], ctx, data=posed)
                 for _ in range(launches):
-                    self._launch(ctx, (seen.path,))
+                    self._launch(ctx, seeds)
                     acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
         return acc / (motion.count * launches)
 
