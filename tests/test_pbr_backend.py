@@ -123,6 +123,15 @@ def test_a_frame_is_traced_through_its_own_boxes_tree_whatever_frame_the_model_w
         assert early_order == _leaf_order(started_late)
         for name in ("color", "depth", "geom_ids"):
             assert np.array_equal(getattr(early, name), getattr(late, name))
+        # a frame whose boxes are the last rebuild's keeps its tree; a move rebuilds it
+        trees = started_late.stats["scene_trees"]
+        started_late.render(scene, view, {"color"})
+        assert started_late.stats["scene_trees"] == trees
+        rep.functional.modify.pose(boxes[0], position_value=(0.0, 1.0, 0.3))
+        sim.sync_dirty_prims()
+        sim.forward()
+        started_late.render(scene, view, {"color"})
+        assert started_late.stats["scene_trees"] == trees + 1
     finally:
         started_early.close()
         started_late.close()

@@ -98,6 +98,7 @@ class _Context:
     meshes: "_MeshState"     # how the device's mesh BVHs relate to the model's current vertices
     uploads: Any        # pbr_uploads.PinnedUploads: the per-frame copies' page-locked buffers
     uploaded: dict = field(default_factory=dict)   # field name -> host copy last uploaded
+    tree: Any = None    # pbr_scene_bvh.SceneTree: the scene BVH and the boxes it was last built from
     rgb: dict = field(default_factory=dict)        # camera index -> wp.array (1, H, W) vec3 (colour accumulation)
 
 
@@ -155,7 +156,7 @@ class PbrRenderer:
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
         self._isolated = None                    # classic rasteriser for render_isolated footprints
-        self.stats: dict[str, int] = {"color": 0, "contexts": 0, "products": 0}
+        self.stats: dict[str, int] = {"color": 0, "contexts": 0, "products": 0, "scene_trees": 0}
         self._queued: list = []                  # pbr_outputs.QueuedReads of deferred renders not yet taken
 
     # ---- contexts ------------------------------------------------------
@@ -402,9 +403,9 @@ class PbrRenderer:
         model, m, d, rc, uploads = sim.model, ctx.model, ctx.data, ctx.rc, ctx.uploads
         data = sim.data if data is None else data
         uploads.begin()
+        traced = self._traced_frames(scene, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3))
         uploads.put("geom_xpos", d.geom_xpos, data.geom_xpos)
-        uploads.put("geom_xmat", d.geom_xmat,
-                    self._traced_frames(scene, ctx, np.asarray(data.geom_xmat).reshape(-1, 3, 3)))
+        uploads.put("geom_xmat", d.geom_xmat, traced)
         if model.nlight:
             uploads.put("light_xpos", d.light_xpos, data.light_xpos)
             uploads.put("light_xdir", d.light_xdir, data.light_xdir)
@@ -427,7 +428,11 @@ class PbrRenderer:
             if model.nlight:
                 rc.light_intensity.assign(world.light_intensity[None])
             ctx.uploaded["surfaces"] = True
-        self._scene_bvh.rebuild_scene_bvh(self._mjw, m, d, rc.base)   # the frame's own tree (pbr_scene_bvh)
+        if ctx.tree is None:
+            ctx.tree = self._scene_bvh.SceneTree()
+        boxes_from = (data.geom_xpos, traced, model.geom_size, () if ctx.meshes.bounds is None else ctx.meshes.bounds)
+        if ctx.tree.update(self._mjw, m, d, rc.base, boxes_from, always=bool(model.nflex)):   # the frame's own
+            self.stats["scene_trees"] += 1                                                      # tree (pbr_scene_bvh)
 
     def _traced_frames(self, scene: RenderScene, ctx: _Context, xmat: np.ndarray) -> np.ndarray:
         """Geom frames for the tracer: rescaled meshes folded in, other vertex changes refit into their BVHs

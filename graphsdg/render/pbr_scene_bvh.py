@@ -9,7 +9,9 @@ drew an occasional pixel unlike a one-process run (issue 37's 4-GPU check found 
 
 :func:`rebuild_scene_bvh` computes the frame's boxes as the refit does, then rebuilds the tree from them
 (Warp's LBVH on a GPU, its SAH builder on the CPU; both deterministic), and points each world at its
-subtree again: every frame is traced through the tree of its own boxes.
+subtree again: every frame is traced through the tree of its own boxes. :class:`SceneTree` skips the
+rebuild, some fourteen short launches (docs/performance.md), when nothing the boxes are made of changed
+since the last one: the tree is then already the frame's.
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
 """
@@ -17,6 +19,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import warp as wp
 
 
@@ -38,4 +41,27 @@ def rebuild_scene_bvh(mjw: Any, m: Any, d: Any, context: Any) -> None:
               device=context.group_root.device)
 
 
-__all__ = ["rebuild_scene_bvh"]
+class SceneTree:
+    """A render context's scene BVH: rebuilt from a frame's boxes unless they are made of what the last
+    rebuild's were (geom positions, the frames the tracer uses, sizes, mesh bounds), so its tree is always
+    that of the frame's own boxes."""
+
+    def __init__(self) -> None:
+        self._built_from: tuple[np.ndarray, ...] | None = None    # None: still the tree of the compiled poses
+        self.rebuilds = 0
+
+    def update(self, mjw: Any, m: Any, d: Any, context: Any, inputs: tuple[Any, ...], always: bool = False) -> bool:
+        """Rebuild ``context``'s tree (:func:`rebuild_scene_bvh`) unless ``inputs``, the host arrays the
+        frame's boxes are computed from, equal the last rebuild's; ``always``: rebuild anyway (deformables,
+        whose boxes come from their vertices). Returns whether it rebuilt."""
+        inputs = tuple(np.asarray(a) for a in inputs)
+        if not always and self._built_from is not None and len(inputs) == len(self._built_from) and all(
+                a.shape == b.shape and np.array_equal(a, b) for a, b in zip(inputs, self._built_from)):
+            return False
+        rebuild_scene_bvh(mjw, m, d, context)
+        self._built_from = tuple(np.array(a, copy=True) for a in inputs)
+        self.rebuilds += 1
+        return True
+
+
+__all__ = ["SceneTree", "rebuild_scene_bvh"]
