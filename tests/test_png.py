@@ -67,3 +67,18 @@ def test_encode_image_writes_pngs_through_it():
 def test_bad_images_are_refused(bad):
     with pytest.raises(ValueError, match="PNG"):
         encode_png(bad)
+
+
+@pytest.mark.parametrize("array", [
+    np.linspace(0, 1, 512 * 512, dtype=np.float32).reshape(512, 512),      # a frame's depth
+    np.arange(10, dtype=np.int64), np.array(3.5), np.zeros((0, 4), np.uint8), np.zeros((2, 2), ">f8"),
+    np.array([(1, -2, 0.5)], dtype=[("semanticId", "<u4"), ("x_min", "<i4"), ("occlusionRatio", "<f4")]),
+    np.asfortranarray(np.arange(12.0).reshape(3, 4)), np.arange(24.0).reshape(4, 6)[:, ::2],
+    np.array([True, False])])
+def test_npy_bytes_are_numpys_own(array) -> None:
+    """encode_npy writes the bytes np.save does, for C-ordered arrays (its one-copy path) and the rest."""
+    from graphsdg.io.encode import encode_npy
+    reference = io.BytesIO()
+    np.save(reference, array, allow_pickle=False)
+    assert encode_npy(array) == reference.getvalue()
+    assert np.array_equal(np.load(io.BytesIO(encode_npy(array))), array)
