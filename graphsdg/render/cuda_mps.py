@@ -1,4 +1,4 @@
-"""CUDA MPS for the processes of one job that share a GPU: their kernels run side by side, not in turns.
+"""CUDA MPS for a job's processes that share a GPU: their kernels run side by side, not in turns.
 
 Without MPS, the CUDA contexts of several processes on one GPU take turns: each frame's short launches (BVH
 refit, uploads, the boxes kernel, the read-back) leave most of the GPU idle while it counts as busy, and the

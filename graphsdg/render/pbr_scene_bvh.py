@@ -5,7 +5,8 @@ with the render context and afterwards only refits it: the tree keeps the shape 
 frame the context was built at. The walk visits geoms in the tree's order, and where two surfaces lie
 within the renderer's tie tolerance of each other the order decides which one a pixel shows. So a pixel
 could depend on where the run started: a shard or a resumed run, whose context was built at a later frame,
-drew an occasional pixel unlike a one-process run (issue 37's 4-GPU check found one in 640 frames).
+drew an occasional pixel unlike a one-process run (issue 37's 4-GPU byte check found one;
+docs/performance.md).
 
 :func:`rebuild_scene_bvh` computes the frame's boxes as the refit does, then rebuilds the tree from them
 (Warp's LBVH on a GPU, its SAH builder on the CPU; both deterministic), and points each world at its
