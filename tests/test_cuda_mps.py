@@ -51,14 +51,17 @@ def test_a_daemon_that_will_not_start(no_daemon) -> None:
     assert set(os.listdir(no_daemon)) == before
 
 
-def test_the_machines_own_daemon_is_used_and_left_running(monkeypatch, tmp_path) -> None:
-    pipe = tmp_path / "pipe"
+def test_the_machines_own_daemon_is_used_and_left_running(no_daemon, monkeypatch) -> None:
+    pipe = no_daemon / "pipe"
     pipe.mkdir()
     os.mkfifo(pipe / "control")                  # what a running daemon keeps in its pipe folder
     monkeypatch.setenv(cuda_mps.PIPE_ENV, str(pipe))
-    with shared_gpus("on", processes_per_gpu=4, control="/bin/false") as mps:
+    with shared_gpus("on", processes_per_gpu=4) as mps:     # no control program to ask: the pipe stands
         assert mps.active and not mps.started_here and mps.pipe_dir == str(pipe)
     assert (pipe / "control").exists()
+    # a control program that cannot reach it: a dead daemon's pipe, so one of the run's own is started
+    with shared_gpus("auto", processes_per_gpu=4, control="/bin/false") as mps:
+        assert not mps.active and mps.reason.startswith("the MPS daemon would not start")
 
 
 def test_cli_bench_mps_on_without_mps_fails_before_any_process(no_daemon, capsys) -> None:

@@ -69,10 +69,22 @@ def check_mode(mode: str) -> str:
     return mode
 
 
-def running_daemon(environ=os.environ) -> str | None:
-    """The pipe folder of an MPS daemon already running for this process's environment, or None."""
+def running_daemon(control: str | None = None, environ=os.environ) -> str | None:
+    """The pipe folder of an MPS daemon already running for this process's environment, or None.
+
+    A folder holding a ``control`` pipe is asked for its servers through ``control`` (the control program,
+    when the host has one), so a pipe a dead daemon left behind does not count."""
     pipe_dir = environ.get(PIPE_ENV) or DEFAULT_PIPE_DIR
-    return pipe_dir if os.path.exists(os.path.join(pipe_dir, "control")) else None
+    if not os.path.exists(os.path.join(pipe_dir, "control")):
+        return None
+    if control is None:
+        return pipe_dir
+    try:
+        answered = subprocess.run([control], input="get_server_list\n", env={**environ, PIPE_ENV: pipe_dir},
+                                  capture_output=True, text=True, timeout=START_TIMEOUT_S).returncode == 0
+    except (OSError, subprocess.TimeoutExpired):
+        answered = False
+    return pipe_dir if answered else None
 
 
 @contextlib.contextmanager
@@ -93,11 +105,11 @@ def shared_gpus(mode: str, processes_per_gpu: float, control: str | None = None)
     if mode == "auto" and processes_per_gpu <= 1:
         yield MpsSession(False, "one process a GPU")
         return
-    existing = running_daemon()
+    control = control or shutil.which(CONTROL)
+    existing = running_daemon(control)
     if existing is not None:
         yield MpsSession(True, f"the machine's daemon at {existing}", pipe_dir=existing)
         return
-    control = control or shutil.which(CONTROL)
     if control is None:
         if mode == "on":
             raise MpsUnavailableError(f"--mps on needs CUDA MPS, but {CONTROL} is not on PATH (it comes with the "
