@@ -298,3 +298,26 @@ def test_basic_writer_expected_files_are_the_files_it_writes(tmp_path):
     written = set(_files(tmp_path / "w")) - {"metadata.txt"}
     assert set(writer.expected_files(0)) == written
     assert writer.frame_complete(0) and not writer.frame_complete(1)
+
+
+def test_a_shard_asks_the_renderer_for_the_frame_numbers_of_one_uninterrupted_run(job_script, tmp_path, monkeypatch):
+    """The frame number that seeds a frame's random render samples (soft shadows, path tracing) is the same in
+    a shard as in one process, so a shard's noise is that of one uninterrupted run."""
+    from graphsdg.engine.runtime import runtime
+    from graphsdg.render.rasterizer import Rasterizer
+    asked: list[list[int]] = []
+    original = Rasterizer.render_batch
+
+    def recording(self, scene, requests):
+        asked[-1].append(requests[0].frame)
+        return original(self, scene, requests)
+
+    monkeypatch.setattr(Rasterizer, "render_batch", recording)
+    assert isinstance(runtime().renderer, Rasterizer)
+    asked.append([])
+    run_job(JobSpec(job_script, seed=5, out=str(tmp_path / "one"), frames=6))
+    asked.append([])
+    run_job(JobSpec(job_script, seed=5, out=str(tmp_path / "shard"), frames=6), FramePlan(1, 3))
+    one, shard = asked
+    assert len(one) == 6 and len(set(one)) == 6
+    assert shard == [one[1], one[4]]

@@ -31,7 +31,8 @@ def test_auto_uses_mps_only_where_processes_share_a_gpu(no_daemon) -> None:
 
 
 def test_on_names_what_is_missing(no_daemon) -> None:
-    with pytest.raises(MpsUnavailableError, match="--mps on needs CUDA MPS, but nvidia-cuda-mps-control is not on PATH"):
+    with pytest.raises(MpsUnavailableError,
+                       match="--mps on needs CUDA MPS, but nvidia-cuda-mps-control is not on PATH"):
         with shared_gpus("on", processes_per_gpu=8):
             pass
     with pytest.raises(ValueError, match="--mps 'sometimes' is not one of auto, on, off"):

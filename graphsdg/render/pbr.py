@@ -9,7 +9,8 @@ the classic layout, so annotators and writers do not know which backend drew.
   (``geom_xpos``/``geom_xmat`` as MuJoCo computed them on the CPU: mocap poses,
   physics, randomizers) straight into the renderer's data and rebuilds the scene
   BVH from them (:mod:`graphsdg.render.pbr_scene_bvh`: each frame traced through the tree of its
-  own boxes, whatever frame the context was built at); no kinematics run on the GPU. Colours, material bindings, sizes and light
+  own boxes, whatever frame the context was built at); no kinematics run on the GPU.
+  Colours, material bindings, sizes and light
   colours go into the renderer's model when they differ from the last upload
   (per-world arrays: nothing recompiles); meshes rescaled in place are traced through
   their rescale folded into the geom frame (no BVH refit), meshes deformed otherwise get
@@ -75,7 +76,8 @@ def launch_seed(frame: int, products: tuple[str, ...], launch: int) -> int:
     run, and different products' launches draw different ones.
 
     Example:
-        >>> launch_seed(7, ("/Render/rp",), 0) == launch_seed(7, ("/Render/rp",), 0) != launch_seed(8, ("/Render/rp",), 0)
+        >>> rp = ("/Render/rp",)
+        >>> launch_seed(7, rp, 0) == launch_seed(7, rp, 0) != launch_seed(8, rp, 0) != launch_seed(7, rp, 1)
         True
     """
     products_code = zlib.crc32("\n".join(products).encode())
