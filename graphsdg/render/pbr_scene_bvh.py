@@ -11,7 +11,7 @@ docs/performance.md).
 :func:`rebuild_scene_bvh` computes the frame's boxes as the refit does, then rebuilds the tree from them
 (Warp's LBVH on a GPU, its SAH builder on the CPU; both deterministic), and points each world at its
 subtree again: every frame is traced through the tree of its own boxes. :class:`SceneTree` skips the
-rebuild, some fourteen short launches (docs/performance.md), when nothing the boxes are made of changed
+rebuild, a series of short launches (its cost: docs/performance.md), when nothing the boxes are made of changed
 since the last one: the tree is then already the frame's.
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
