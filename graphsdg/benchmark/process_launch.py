@@ -14,30 +14,16 @@ Example:
 """
 from __future__ import annotations
 
-import contextlib
 import multiprocessing
 import os
 import queue as queues
-from typing import Any, Callable, Iterator, Sequence
+from typing import Any, Callable, Sequence
+
+from graphsdg.base.environment import patched_environment
 
 
 class BenchProcessError(RuntimeError):
     """A benchmark process failed or died (the message names it and its error)."""
-
-
-@contextlib.contextmanager
-def patched_environment(env: dict[str, str]) -> Iterator[None]:
-    """``os.environ`` with ``env`` set, restored afterwards (a process started meanwhile keeps ``env``)."""
-    saved = {k: os.environ.get(k) for k in env}
-    os.environ.update(env)
-    try:
-        yield
-    finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
 
 
 def _run_task(target: Callable, args: tuple, barrier, results, index: int) -> None:

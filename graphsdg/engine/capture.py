@@ -212,6 +212,7 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
     sim, stage = rt.sim, rt.stage
     views: list[CameraView] = []
     requests: list[RenderRequest | None] = []
+    frame_number = _frame_number(rt)
     for rp, annotators in products.values():
         with profiling.timed("render:camera"):
             view = _camera_view(rt, rp)
@@ -220,7 +221,7 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
             passes |= a.spec.passes
         motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
         views.append(view)
-        requests.append(RenderRequest(view, passes, subframes, defer, motion, _frame_number(rt)) if passes else None)
+        requests.append(RenderRequest(view, passes, subframes, defer, motion, frame_number) if passes else None)
     drawn = [r for r in requests if r is not None]
     outputs = iter(rt.renderer.render_batch(rt.render_scene, drawn) if drawn else [])   # sizes its buffers
     t = _timed("render", t)
@@ -248,9 +249,10 @@ def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -
     sim = rt.sim
     sim.sync_dirty_prims()
     requests = []
+    frame_number = _frame_number(rt)
     for rp in render_products:
         rp.check_alive()
-        requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None, _frame_number(rt)))
+        requests.append(RenderRequest(_camera_view(rt, rp), set(passes), 1, False, None, frame_number))
     outputs = list(rt.renderer.render_batch(rt.render_scene, requests)) if requests else []
     for out in outputs:
         out.finish()   # hand the pixel buffers back once the colour is read

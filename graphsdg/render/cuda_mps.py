@@ -36,6 +36,8 @@ import tempfile
 from dataclasses import dataclass
 from typing import Iterator
 
+from graphsdg.base.environment import patched_environment
+
 CONTROL = "nvidia-cuda-mps-control"
 MODES = ("auto", "on", "off")
 PIPE_ENV = "CUDA_MPS_PIPE_DIRECTORY"
@@ -142,16 +144,10 @@ def _started_daemon(control: str, mode: str) -> Iterator[MpsSession]:
             raise MpsUnavailableError(f"--mps on: {control} -d would not start the MPS daemon: {failure}")
         yield MpsSession(False, f"the MPS daemon would not start: {failure}")
         return
-    saved = {key: os.environ.get(key) for key in (PIPE_ENV, LOG_ENV)}
-    os.environ[PIPE_ENV], os.environ[LOG_ENV] = env[PIPE_ENV], env[LOG_ENV]
     try:
-        yield MpsSession(True, "daemon started for this run", pipe_dir=env[PIPE_ENV], started_here=True)
+        with patched_environment({PIPE_ENV: env[PIPE_ENV], LOG_ENV: env[LOG_ENV]}):
+            yield MpsSession(True, "daemon started for this run", pipe_dir=env[PIPE_ENV], started_here=True)
     finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
         with contextlib.suppress(OSError, subprocess.TimeoutExpired):
             subprocess.run([control], input="quit\n", env=env, capture_output=True, text=True,
                            timeout=START_TIMEOUT_S)
