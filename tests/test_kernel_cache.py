@@ -107,7 +107,7 @@ def test_the_pbr_outputs_module_compiles_once_for_all_its_kernels(tmp_path):
     wp.launch(po._classic_layout, dim=h * w, inputs=[packed, distance, seg, 0, 0, 0, cosines, 0.1, 10.0, rgba, depth,
               codes], device="cpu")
     wp.launch(po._clear_boxes, dim=4, inputs=[boxes], device="cpu")
-    wp.launch(po._code_boxes, dim=h, inputs=[codes, w, boxes], device="cpu")
+    wp.launch(po._code_boxes, dim=(h, 1), inputs=[codes, w, boxes], device="cpu")
     assert codes.numpy().tolist() == [2] * (h * w) and boxes.numpy()[2].tolist() == [0, 0, w - 1, h - 1]
     assert rgba.numpy()[0] == 0xFF302010 and abs(float(depth.numpy()[0]) - 1.1) < 1e-6
     print(json.dumps(kernel_cache.stats))

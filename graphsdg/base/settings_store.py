@@ -82,6 +82,10 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                  "while their pixels add up to at most this many (one camera "
                                                  "each; bench/pbr_products.py measured where it pays); 0: one "
                                                  "launch per product"),
+    "/graphsdg/render/pbrKernel": ("compact", "how the pbr backend's render kernel is built: compact (ray "
+                                              "traversal called, not inlined; compiles in seconds) or inlined "
+                                              "(mujoco-warp-pbr's own build; compiles for tens of seconds); "
+                                              "graphsdg.render.pbr_kernel"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
     "/app/player/playSimulations": (True, "physics steps with the timeline's ticks; False: ticks advance time and "
@@ -192,6 +196,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/backend": _choice("classic", "pbr", "auto"),
     "/graphsdg/render/pbrDevice": _warp_device,
     "/graphsdg/render/pbrBatchPixels": _integer(0),
+    "/graphsdg/render/pbrKernel": _choice("compact", "inlined"),
     "/rtx/pathtracing/spp": _integer(1),
     "/rtx/pathtracing/optixDenoiser/enabled": _boolean,
     "/omni/replicator/captureMotionBlur": _boolean,

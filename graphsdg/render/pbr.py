@@ -54,7 +54,7 @@ from pxr import Usd, UsdGeom, UsdShade
 from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
 from graphsdg.imaging import environment_map
-from graphsdg.render import mesh_folds, pbr_scene
+from graphsdg.render import mesh_folds, pbr_kernel, pbr_scene
 from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderOutputs, RenderRequest, launch_groups,
                                      pbr_missing, requested_backend)
 from graphsdg.render.camera import CameraView
@@ -169,7 +169,7 @@ class PbrRenderer:
         per_axis = math.ceil(math.sqrt(subframes)) if request.tier == "realtime" else 1
         sizes = tuple((v.width, v.height) for v in views)
         return (id(model), scene.version, sizes, request.tier, request.path_samples, request.denoise, per_axis,
-                drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)))
+                drawn.tobytes(), float(settings.get("/graphsdg/render/exposure", 1.0)), pbr_kernel.requested_kind())
 
     def _context(self, scene: RenderScene, views: list[CameraView], subframes: int) -> _Context:
         sim = scene.sim
@@ -211,6 +211,7 @@ class PbrRenderer:
                 use_skybox=env is None, mesh_bvh_frame="mujoco",
                 tier=mjpbr.Tier.PATH if path else mjpbr.Tier.REALTIME, path_samples=request.path_samples,
                 denoise=path and request.denoise, camera_rays=[pbr_scene.camera_rays(v) for v in views])
+            rc.baked = pbr_kernel.baked_groups(key[-1], rc.baked)
         layouts = [self._layout(v, model.ngeom) for v in views]
         return _Context(key=key, model=m, data=d, rc=rc, cameras=cameras, env_yaw=yaw, layouts=layouts,
                         rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(scene, rc),
@@ -339,7 +340,8 @@ class PbrRenderer:
 
     def _launch(self, ctx: _Context, seeds: _LaunchSeeds) -> None:
         """One launch of every camera of ``ctx``, with the frame's next seed for these products."""
-        self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seeds.next())
+        with pbr_kernel.building(ctx.key[-1]):     # builds the megakernel on a context's first launch
+            self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seeds.next())
         self.stats["color"] += 1
 
     def _outputs_of(self, scene: RenderScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,

@@ -58,17 +58,24 @@ def _clear_boxes(boxes: wp.array2d[wp.int32]):
     boxes[i, 3] = -1
 
 
+#: pixels of a row one thread of :func:`_code_boxes` walks: a row a thread left 512 threads for a 512x512 frame,
+#: each walking 512 pixels one after another
+BOX_SPAN = 32
+
+
 @wp.kernel(enable_backward=False)
 def _code_boxes(codes: wp.array(dtype=Any), width: int, boxes: wp.array2d[wp.int32]):
-    # one thread a row, walking its runs of equal code: only a run's ends can be a code's extremes in x, and
-    # every run gives its row to y, so the atomics are per run, not per pixel
-    y = wp.tid()
+    # one thread a span of BOX_SPAN pixels of a row, walking its runs of equal code: only a run's ends can be a
+    # code's extremes in x, and every run gives its row to y, so the atomics are per run, not per pixel
+    y, part = wp.tid()
     row = y * width
-    start = int(0)
-    code = int(codes[row])
-    for x in range(1, width + 1):
+    first = part * BOX_SPAN
+    end = wp.min(first + BOX_SPAN, width)
+    start = first
+    code = int(codes[row + first])
+    for x in range(first + 1, end + 1):
         here = int(-1)
-        if x < width:
+        if x < end:
             here = int(codes[row + x])
         if here != code:
             wp.atomic_min(boxes, code, 0, start)
@@ -175,7 +182,7 @@ class ClassicLayout:
         annotators' tight boxes and drawn-geom lists need no pass over the pixels on the CPU."""
         h, w = self.shape
         wp.launch(_clear_boxes, dim=self.ngeom + 1, inputs=[self.boxes], device=self.device)
-        wp.launch(_code_boxes, dim=h, inputs=[self.codes, w, self.boxes], device=self.device)
+        wp.launch(_code_boxes, dim=(h, -(-w // BOX_SPAN)), inputs=[self.codes, w, self.boxes], device=self.device)
 
     def _parts(self) -> list[str]:
         colour, depth, ids = self._wanted

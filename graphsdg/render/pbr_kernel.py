@@ -1,0 +1,108 @@
+"""How the pbr backend has mujoco-warp-pbr build its render megakernel: ``compact`` or ``inlined``.
+
+mujoco-warp-pbr specialises one render megakernel on each scene (geom types, light count, the settings it
+bakes in as constants) and NVRTC compiles it on the first frame. NVRTC's optimiser works on a kernel as
+one function, so its time grows with every copy of the scene traversal inlined into it: the camera ray,
+each light's shadow ray (the light loop is unrolled), the headlight's shadow ray. On a fresh machine that
+compile was nearly all of the first frame (docs/performance.md, "Cold start"). Two builds:
+
+* ``compact`` (the default): the shadow-ray traversal (``trace_any``) is compiled once as a called
+  function (:data:`CALLED_TRAVERSALS`), lights are shaded in a loop, and every setting a graphsdg render
+  context holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight, tone mapper, ...) is compiled
+  in as a constant, so code for features a scene does not use is dropped before optimisation. The camera
+  ray's traversal stays inlined: called, it slowed drawing most (docs/performance.md, "Cold start").
+* ``inlined``: mujoco-warp-pbr's own build (its ``DEFAULT_BAKED`` settings): every traversal inlined,
+  lights unrolled up to six. It compiles several times longer and draws somewhat faster: for long runs
+  on a node whose kernel cache is already warm.
+
+Both are deterministic, and a run uses one: the choice is read when a render context is made (the
+setting :data:`KIND_KEY`) and is part of the context's key. The two are different binaries, so their
+images may differ in a few pixels.
+
+Example:
+    >>> sorted(baked_groups("compact", frozenset({"nlight", "has_env"})) - FIXED_GROUPS)
+    ['has_env']
+    >>> baked_groups("inlined", frozenset({"nlight"}))
+    frozenset({'nlight'})
+"""
+from __future__ import annotations
+
+import contextlib
+import threading
+from typing import Any, Callable, Iterator
+
+from graphsdg.base import settings_store as settings
+
+KIND_KEY = "/graphsdg/render/pbrKernel"
+KINDS = ("compact", "inlined")
+#: mujoco-warp-pbr's bake groups whose values a graphsdg render context never changes after it is made (its
+#: model, cameras and tier are fixed); resolution-dependent ones (ray counts, clip planes, the environment
+#: map's texel angle) stay runtime values so that products of other sizes share the kernel
+FIXED_GROUPS = frozenset({"any_rgb", "has_spot", "use_shadows", "shadow_samples", "shadow_light_fraction",
+                          "headlight_active", "headlight", "env_background", "specular_aa", "vertex_normals",
+                          "tone_mapper", "render_hdr"})
+#: the traversals a ``compact`` build compiles as called functions: ``closest`` (camera rays), ``any`` (shadow rays)
+CALLED_TRAVERSALS: tuple[str, ...] = ("any",)
+_building = threading.local()
+_install_lock = threading.Lock()
+
+
+def requested_kind() -> str:
+    """The build the setting :data:`KIND_KEY` asks for (validated by the settings store)."""
+    return str(settings.get(KIND_KEY, "compact"))
+
+
+def baked_groups(kind: str, default: frozenset[str]) -> frozenset[str]:
+    """The bake groups of a context built as ``kind``, from mujoco-warp-pbr's ``default`` set.
+
+    Raises:
+        ValueError: ``kind`` is not one of :data:`KINDS`.
+    """
+    if kind == "inlined":
+        return frozenset(default)
+    if kind == "compact":
+        return (frozenset(default) - {"nlight"}) | FIXED_GROUPS
+    raise ValueError(f"unknown pbr kernel build {kind!r}; expected one of {KINDS}")
+
+
+@contextlib.contextmanager
+def building(kind: str) -> Iterator[None]:
+    """While inside, megakernels this thread has mujoco-warp-pbr build follow ``kind`` (the traversal
+    calls of a ``compact`` build are not inlined); wrap every ``mujoco_warp_pbr.render`` call in it."""
+    if kind not in KINDS:
+        raise ValueError(f"unknown pbr kernel build {kind!r}; expected one of {KINDS}")
+    _install()
+    previous = getattr(_building, "kind", None)
+    _building.kind = kind
+    try:
+        yield
+    finally:
+        _building.kind = previous
+
+
+def _not_inlined(function: Any) -> Any:
+    """``function`` (a ``warp.Function``) marked to compile as a called function, in every overload."""
+    function.inline_hint = "noinline"
+    for overload in getattr(function, "user_overloads", {}).values():
+        overload.inline_hint = "noinline"
+    return function
+
+
+def _install() -> None:
+    """Wrap mujoco-warp-pbr's ``trace.make_trace`` (which both tiers' kernel builders call for their two
+    traversal functions), once per process."""
+    from mujoco_warp_pbr._src import trace
+    with _install_lock:
+        original: Callable = trace.make_trace
+        if getattr(original, "graphsdg_kernel_build", False):
+            return
+
+        def make_trace(*args, **kwargs):
+            closest, any_hit = original(*args, **kwargs)
+            if getattr(_building, "kind", None) == "compact":
+                closest = _not_inlined(closest) if "closest" in CALLED_TRAVERSALS else closest
+                any_hit = _not_inlined(any_hit) if "any" in CALLED_TRAVERSALS else any_hit
+            return closest, any_hit
+
+        make_trace.graphsdg_kernel_build = True
+        trace.make_trace = make_trace

@@ -1,0 +1,64 @@
+"""The pbr backend's own kernels on Warp's CPU device, and how it has mujoco-warp-pbr build its megakernel."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+wp = pytest.importorskip("warp")
+
+from graphsdg.base import settings_store  # noqa: E402
+from graphsdg.render import pbr_kernel  # noqa: E402
+from graphsdg.render import pbr_outputs as po  # noqa: E402
+
+
+def _numpy_bounds(codes: np.ndarray, n: int) -> np.ndarray:
+    bounds = np.tile(np.array([2**31 - 1, 2**31 - 1, -1, -1], dtype=np.int32), (n, 1))   # _clear_boxes' rows
+    for code in np.unique(codes):
+        ys, xs = np.nonzero(codes == code)
+        bounds[code] = (xs.min(), ys.min(), xs.max(), ys.max())
+    return bounds
+
+
+@pytest.mark.parametrize("width", [1, po.BOX_SPAN - 1, po.BOX_SPAN, 3 * po.BOX_SPAN + 7])
+def test_code_boxes_are_every_codes_pixel_bounds_whatever_the_row_spans(width):
+    rng = np.random.default_rng(width)
+    height, ncode = 23, 9
+    codes = np.zeros((height, width), dtype=np.uint8)
+    for code in range(1, ncode):          # rectangles that cross span boundaries, overlapping each other
+        x0, y0 = rng.integers(0, width), rng.integers(0, height)
+        codes[y0:y0 + rng.integers(1, height), x0:x0 + rng.integers(1, width + 1)] = code
+    codes[rng.integers(0, height), rng.integers(0, width)] = ncode - 1    # a lone pixel
+    device_codes = wp.array(codes.ravel(), dtype=wp.uint8, device="cpu")
+    boxes = wp.zeros((ncode, 4), dtype=wp.int32, device="cpu")
+    wp.launch(po._clear_boxes, dim=ncode, inputs=[boxes], device="cpu")
+    wp.launch(po._code_boxes, dim=(height, -(-width // po.BOX_SPAN)), inputs=[device_codes, width, boxes],
+              device="cpu")
+    assert np.array_equal(boxes.numpy(), _numpy_bounds(codes, ncode))
+
+
+def test_compact_build_loops_lights_and_bakes_what_a_context_holds_fixed():
+    default = frozenset({"samples_per_axis", "nlight", "has_env", "render_order"})
+    compact = pbr_kernel.baked_groups("compact", default)
+    assert "nlight" not in compact and {"samples_per_axis", "has_env", "render_order"} <= compact
+    assert pbr_kernel.FIXED_GROUPS <= compact
+    # what depends on a product's size stays a runtime value, so products of other sizes share the kernel
+    assert not {"total_rays", "clip", "inv_texel_angle"} & compact
+    assert pbr_kernel.baked_groups("inlined", default) == default
+
+
+def test_the_kernel_build_is_a_validated_setting():
+    assert pbr_kernel.requested_kind() == "compact"
+    with pytest.raises(ValueError, match="inlined"):
+        settings_store.set(pbr_kernel.KIND_KEY, "fast")
+    with pytest.raises(ValueError, match="'fast'"):
+        pbr_kernel.baked_groups("fast", frozenset())
+    settings_store.set(pbr_kernel.KIND_KEY, "inlined")
+    try:
+        assert pbr_kernel.requested_kind() == "inlined"
+    finally:
+        settings_store.set(pbr_kernel.KIND_KEY, "compact")
+
+
+def test_fixed_groups_are_mujoco_warp_pbr_bake_groups():
+    kernel_inputs = pytest.importorskip("mujoco_warp_pbr._src.kernel_inputs")
+    assert pbr_kernel.FIXED_GROUPS <= kernel_inputs.BAKE_GROUPS.keys()
