@@ -62,3 +62,19 @@ def test_the_kernel_build_is_a_validated_setting():
 def test_fixed_groups_are_mujoco_warp_pbr_bake_groups():
     kernel_inputs = pytest.importorskip("mujoco_warp_pbr._src.kernel_inputs")
     assert pbr_kernel.FIXED_GROUPS <= kernel_inputs.BAKE_GROUPS.keys()
+
+
+def test_a_compact_build_calls_the_shadow_traversal_and_inlines_the_camera_rays():
+    trace = pytest.importorskip("mujoco_warp_pbr._src.trace")
+    types = (6,)     # boxes
+    with pbr_kernel.building("compact"):
+        closest, any_hit = trace.make_trace(types, True)
+    assert (closest.inline_hint, any_hit.inline_hint) == (None, "noinline")
+    with pbr_kernel.building("inlined"):
+        closest, any_hit = trace.make_trace(types, True)
+    assert (closest.inline_hint, any_hit.inline_hint) == (None, None)
+    closest, any_hit = trace.make_trace(types, True)       # outside a build: mujoco-warp-pbr's own functions
+    assert any_hit.inline_hint is None
+    with pytest.raises(ValueError, match="'fast'"):
+        with pbr_kernel.building("fast"):
+            pass
