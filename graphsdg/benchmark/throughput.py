@@ -72,6 +72,7 @@ class BenchConfig:
     render_mode: str | None = None       # /rtx/rendermode (RaytracedLighting, PathTracing); None: the setting as it is
     path_spp: int | None = None          # /rtx/pathtracing/spp of the path tier; None: the setting as it is
     pbr_batch_pixels: int | None = None  # /graphsdg/render/pbrBatchPixels (0: a launch per product); None: as set
+    pbr_kernel: str | None = None        # /graphsdg/render/pbrKernel (compact, inlined); None: as set
     seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
     write_processes: int | str | None = None   # /graphsdg/io/writeProcesses (a count, 0, auto); None: as set
     temp_dir: str | None = None          # where each run makes (and then removes) its output folder; None: the
@@ -221,6 +222,8 @@ def build_scene(config: BenchConfig):
         rep.settings.set("/rtx/pathtracing/spp", int(config.path_spp))
     if config.pbr_batch_pixels is not None:
         rep.settings.set("/graphsdg/render/pbrBatchPixels", int(config.pbr_batch_pixels))
+    if config.pbr_kernel is not None:
+        rep.settings.set("/graphsdg/render/pbrKernel", config.pbr_kernel)
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)

@@ -40,6 +40,7 @@ def run_bench(args: argparse.Namespace) -> None:
         write_to_fabric=not args.no_replicator_write_to_fabric, write_threads=args.write_threads,
         msaa_samples=args.msaa, shadow_size=args.shadow_size, render_backend=args.backend, seconds=args.seconds,
         render_mode=args.rendermode, path_spp=args.spp, pbr_batch_pixels=args.pbr_batch_pixels,
+        pbr_kernel=args.pbr_kernel,
         write_processes=args.write_processes, temp_dir=args.temp_dir)
     quality = "".join([f", MSAA {args.msaa}" if args.msaa is not None else "",
                        f", shadow map {args.shadow_size}" if args.shadow_size is not None else "",
@@ -50,6 +51,7 @@ def run_bench(args: argparse.Namespace) -> None:
                        f", {args.rendermode}" if args.rendermode else "",
                        f", {args.spp} path samples" if args.spp else "",
                        f", pbr batch pixels {args.pbr_batch_pixels}" if args.pbr_batch_pixels is not None else "",
+                       f", pbr kernel {args.pbr_kernel}" if args.pbr_kernel is not None else "",
                        f", {args.rounds} rounds alternately" if args.rounds > 1 else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
@@ -334,6 +336,15 @@ EPILOG = ("exit codes: 0 success, 1 error (one line and a hint; --debug shows th
           "line, 130 interrupted (Ctrl-C). See docs/cli.md.")
 
 
+def _add_pbr_kernel(command: argparse.ArgumentParser) -> None:
+    """``--pbr-kernel``: the setting /graphsdg/render/pbrKernel for this command (graphsdg.render.pbr_kernel)."""
+    command.add_argument("--pbr-kernel", choices=("compact", "inlined"),
+                         help="how the pbr backend's render kernel is built: compact (compiles in seconds) or "
+                              "inlined (compiles for tens of seconds, draws faster); a kernel cache warmed with "
+                              "one holds nothing for the other (default: the setting /graphsdg/render/pbrKernel, "
+                              "compact)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``graphsdg`` argument parser (every command has ``--help``)."""
     common = argparse.ArgumentParser(add_help=False)
@@ -350,6 +361,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--frames", type=_positive, default=10, help="frames to capture (default: 10)")
     demo.add_argument("--resolution", type=_positive, nargs=2, default=(512, 512), metavar=("W", "H"))
     demo.add_argument("--seed", type=int, default=0)
+    _add_pbr_kernel(demo)
     bench = sub.add_parser(
         "bench", parents=[common], help="Isaac Sim's SDG benchmark scene vs a hand-written MuJoCo loop",
         description="Times Isaac Sim's benchmark_sdg.py scene (cube, cone, cylinder, sphere and torus assets with "
@@ -411,6 +423,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--spp", type=_positive,
                        help="path-traced samples per pixel of one launch, /rtx/pathtracing/spp (default: the larger of "
                             "the settings spp and totalSpp)")
+    _add_pbr_kernel(bench)
     bench.add_argument("--pbr-batch-pixels", type=_non_negative, metavar="N",
                        help="on pbr, draw a step's render products in one launch while their pixels add up to at "
                             "most N, 0 for a launch per product: /graphsdg/render/pbrBatchPixels (default: the "
@@ -456,6 +469,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "(90: H100, H200), which needs no GPU")
     warmup.add_argument("--device", help="Warp device to render the frames on: cuda:N (default: the setting "
                                          "/graphsdg/render/pbrDevice, cuda:0) or cpu (no GPU; slow)")
+    _add_pbr_kernel(warmup)
     run = sub.add_parser("run", parents=[common],
                          help="run a graphsdg (or, with --compat isaac, an Isaac Sim Replicator) script",
                          usage="graphsdg run SCRIPT [options] [-- SCRIPT_ARGS ...]",
@@ -564,6 +578,9 @@ def main(argv: list[str] | None = None) -> int:
     if from_console and args.command in FRAME_LOOPS:
         from graphsdg.base.heap import keep_freed_buffers_here_and_in_children
         keep_freed_buffers_here_and_in_children()   # each frame's megabyte buffers, made and dropped
+    if getattr(args, "pbr_kernel", None) is not None and args.command != "bench":   # bench's processes set it
+        from graphsdg.base import settings_store
+        settings_store.set("/graphsdg/render/pbrKernel", args.pbr_kernel)
     try:
         if args.command == "demo":
             summary = run_demo(args.out, args.frames, tuple(args.resolution), args.seed)
