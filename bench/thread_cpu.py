@@ -13,6 +13,7 @@ wall time, so the main thread's phases add up to its CPU per frame (docs/perform
 
 Usage (GPU host):
     MUJOCO_GL=egl python bench/thread_cpu.py --resolution 128 --write-threads 1 --hand
+    MUJOCO_GL=egl python bench/thread_cpu.py --resolution 512 --backend pbr --phase-cpu
 """
 from __future__ import annotations
 
@@ -92,6 +93,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--switch-interval", type=float, default=None, help="sys.setswitchinterval, seconds")
     p.add_argument("--pin-main", type=int, default=None, help="pin the main thread to this core after warm-up")
     p.add_argument("--hand", action="store_true", help="also time the hand-written loop")
+    p.add_argument("--backend", choices=("classic", "pbr"), default="classic", help="renderer (default: classic)")
     p.add_argument("--phase-cpu", action="store_true",
                    help="time phases (and frames) in the CPU time of the thread that runs them, not wall time")
     a = p.parse_args(argv)
@@ -103,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
         from graphsdg.io.write_queue import WriteQueue
         WriteQueue._start_threads = lambda self, wanted=1: False   # the queue's own fallback: run tasks in place
     config = BenchConfig(frames=a.frames, warmup=20, resolution=(a.resolution, a.resolution),
-                         asset_count=a.asset_count, annotators=FOUR, render_backend="classic",
+                         asset_count=a.asset_count, annotators=FOUR, render_backend=a.backend,
                          write_threads=a.write_threads, skip_write=a.skip_write, out_dir=a.out,
                          write_processes=a.write_processes)
     pin = (lambda: os.sched_setaffinity(0, {a.pin_main})) if a.pin_main is not None else None
