@@ -139,3 +139,30 @@ def test_a_gpu_binary_is_compiled_ahead_without_a_gpu(tmp_path):
         assert f.read(4) == b"\x7fELF"                 # a CUBIN is an ELF file of the GPU's code
     assert os.path.basename(os.path.dirname(out["paths"][0])).startswith("wp_kmod_")
     assert (out["compiled"], out["cached"]) == (2, 0)      # the CPU's object, then the GPU's CUBIN
+
+
+def test_modules_compiled_in_the_background_are_loaded_from_the_cache_at_their_first_launch(tmp_path):
+    (tmp_path / "kmod.py").write_text(KERNEL_MODULE)
+    (tmp_path / "kmod2.py").write_text(KERNEL_MODULE.replace("* k + 1.0", "* k + 2.0"))
+    code = '''
+    import json
+    from graphsdg.render import kernel_cache
+    kernel_cache.configure_warp()
+    import warp as wp
+    import kmod, kmod2
+    threads = kernel_cache.compile_in_background(("kmod", "kmod2"), "cpu")
+    for thread in threads:
+        thread.join()
+    ahead = dict(kernel_cache.stats)
+    a = wp.array([1.0, 2.0], dtype=float, device="cpu")
+    b = wp.zeros(2, dtype=float, device="cpu")
+    wp.launch(kmod.scale, dim=2, inputs=[a, b, 3.0], device="cpu")
+    c = wp.zeros(2, dtype=float, device="cpu")
+    wp.launch(kmod2.scale, dim=2, inputs=[a, c, 3.0], device="cpu")
+    print(json.dumps({"ahead": ahead, "b": b.numpy().tolist(), "c": c.numpy().tolist(), **kernel_cache.stats}))
+    '''
+    out = _stats(_python(code, tmp_path, tmp_path / "cache"))
+    assert (out["ahead"]["compiled"], out["ahead"]["cached"]) == (2, 0)     # both, by the threads
+    assert (out["compiled"], out["cached"]) == (2, 2)                       # the launches found them
+    assert out["b"] == [4.0, 7.0] and out["c"] == [5.0, 8.0]
+    assert out["warp"] and all(line.endswith("(cached)") for line in out["warp"]), out["warp"]

@@ -64,17 +64,21 @@ def test_fixed_groups_are_mujoco_warp_pbr_bake_groups():
     assert pbr_kernel.FIXED_GROUPS <= kernel_inputs.BAKE_GROUPS.keys()
 
 
-def test_a_compact_build_calls_the_shadow_traversal_and_inlines_the_camera_rays():
+def test_a_compact_build_calls_the_shadow_rays_geom_test_and_inlines_the_rest():
+    traverse = pytest.importorskip("mujoco_warp_pbr._src.traverse")
     trace = pytest.importorskip("mujoco_warp_pbr._src.trace")
-    types = (6,)     # boxes
-    with pbr_kernel.building("compact"):
-        closest, any_hit = trace.make_trace(types, True)
-    assert (closest.inline_hint, any_hit.inline_hint) == (None, "noinline")
-    with pbr_kernel.building("inlined"):
-        closest, any_hit = trace.make_trace(types, True)
-    assert (closest.inline_hint, any_hit.inline_hint) == (None, None)
-    closest, any_hit = trace.make_trace(types, True)       # outside a build: mujoco-warp-pbr's own functions
-    assert any_hit.inline_hint is None
+    types = (6, 7)     # boxes and meshes
+
+    def hints(kind):
+        with pbr_kernel.building(kind):
+            closest, any_hit = trace.make_trace(types, True, True)
+            shadow, camera = traverse.make_ordered_cast(types, True), traverse.make_ordered_cast(types, False)
+        return (closest.inline_hint, any_hit.inline_hint, pbr_kernel._geom_test(shadow).inline_hint,
+                pbr_kernel._geom_test(camera).inline_hint)
+
+    assert hints("compact") == (None, None, "noinline", None)
+    assert hints("inlined") == (None, None, None, None)
+    assert pbr_kernel._geom_test(traverse.make_ordered_cast(types, True)).inline_hint is None   # outside a build
     with pytest.raises(ValueError, match="'fast'"):
         with pbr_kernel.building("fast"):
             pass

@@ -147,18 +147,56 @@ class LaunchRecorder:
         wp.launch = self._original
 
 
+def _compile_variant(module: Any, block_dim: int, device: Any, arch: int | None = None) -> str:
+    """Compile one module variant into the cache (nothing when it is there); the binary's path. ``device`` a
+    Warp device (its architecture unless ``arch``), or None with ``arch`` for a GPU this machine lacks."""
+    import warp as wp
+    module.get_module_hash(block_dim)          # the variant's hash names its folder; Module.load's options
+    options = module.resolved_options[block_dim]
+    folder = os.path.join(wp.config.kernel_cache_dir, module.get_module_identifier(block_dim=block_dim))
+    if device is None:
+        name = module._get_compile_output_name(None, arch, "", use_ptx=False, block_dim=block_dim)
+        module._compile(None, folder, name, arch, False, options)
+    else:
+        arch = module._get_compile_arch(device)
+        name = module._get_compile_output_name(device, block_dim=block_dim)
+        module._compile(device, folder, name, arch, options=options)
+    return os.path.join(folder, name)
+
+
 def compile_ahead(recorder: LaunchRecorder, archs: list[int]) -> list[str]:
     """Compile every module variant ``recorder`` saw for each CUDA architecture in ``archs`` (90: H100 and
     H200) into the cache, as CUBINs, without a GPU; returns the binaries' paths (already there or new)."""
+    configure_warp()
+    return [_compile_variant(module, block_dim, None, arch)
+            for module, block_dim in recorder.variants.values() for arch in archs]
+
+
+def compile_in_background(module_names: tuple[str, ...], device: str) -> list[threading.Thread]:
+    """Start compiling the named Warp modules (imported already; the variant a launch that names no block
+    size uses) for ``device`` into the cache, one thread each, and return the threads.
+
+    A process's first frame compiles its modules one after another as it first launches each; compiled
+    beside each other ahead of that (NVRTC runs outside the interpreter lock, and Warp allows modules to
+    compile in parallel), the frame finds them in the cache. The threads only write the cache: loading stays
+    with the thread that launches (Warp's per-module load state is not shared across threads), and a module
+    a thread is still compiling is waited for by the module's file lock. A failure is logged and left to the
+    launch that needs the module, which compiles it again and raises."""
     import warp as wp
     configure_warp()
-    paths = []
-    for module, block_dim in recorder.variants.values():
-        module.get_module_hash(block_dim)          # the variant's hash names its folder; Module.load's options
-        options = module.resolved_options[block_dim]
-        folder = os.path.join(wp.config.kernel_cache_dir, module.get_module_identifier(block_dim=block_dim))
-        for arch in archs:
-            name = module._get_compile_output_name(None, arch, "", use_ptx=False, block_dim=block_dim)
-            module._compile(None, folder, name, arch, False, options)
-            paths.append(os.path.join(folder, name))
-    return paths
+    target = wp.get_device(device)
+
+    def compile_one(name: str) -> None:
+        try:
+            module = wp.get_module(name)
+            # the block size a launch that names none runs at: the module's on a GPU, one on the CPU
+            block_dim = 1 if target.is_cpu else int(module.options["block_dim"])
+            _compile_variant(module, block_dim, target)
+        except Exception as exc:  # noqa: BLE001 - the launch that needs the module reports its own error
+            log.warning("compiling Warp module %s ahead failed: %s", name, exc)
+
+    threads = [threading.Thread(target=compile_one, args=(name,), name=f"graphsdg-compile-{name}", daemon=True)
+               for name in module_names]
+    for thread in threads:
+        thread.start()
+    return threads

@@ -43,6 +43,7 @@ Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``
 from __future__ import annotations
 
 import math
+import sys
 import zlib
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -139,18 +140,26 @@ class PbrRenderer:
     docstring)."""
 
     MAX_CONTEXTS = 4    # live render contexts (device memory): a step's batch, plus products drawn alone
+    #: the Warp modules every first frame launches whatever the scene (the megakernel is the scene's own):
+    #: compiled side by side when the renderer starts (kernel_cache.compile_in_background)
+    FIRST_FRAME_MODULES = ("mujoco_warp._src.render_util", "mujoco_warp._src.bvh", "mujoco_warp_pbr._src.envmap",
+                           "mujoco_warp_pbr._src.ibl", "mujoco_warp_pbr._src.rays", "graphsdg.render.pbr_scene_bvh",
+                           "graphsdg.render.pbr_outputs")
 
     def __init__(self, device: str | None = None) -> None:
         lacks = pbr_missing()
         if lacks and device != "cpu":
             raise PbrUnavailableError("the pbr backend needs " + "; and ".join(lacks))
-        from graphsdg.render.kernel_cache import configure_warp
-        configure_warp()      # the node's kernel cache, each kernel compiled once (before Warp compiles any)
+        from graphsdg.render import kernel_cache
+        kernel_cache.configure_warp()   # the node's kernel cache, each kernel compiled once (before Warp compiles any)
         import mujoco_warp as mjw
         import mujoco_warp_pbr as mjpbr
         import warp as wp
 
         from graphsdg.render import backend, pbr_meshes, pbr_outputs, pbr_scene_bvh, pbr_uploads
+        if wp.get_device(device or "cuda:0").is_cuda:
+            kernel_cache.compile_in_background(
+                tuple(m for m in self.FIRST_FRAME_MODULES if m in sys.modules), device or "cuda:0")
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads

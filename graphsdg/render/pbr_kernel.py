@@ -6,14 +6,15 @@ one function, so its time grows with every copy of the scene traversal inlined i
 each light's shadow ray (the light loop is unrolled), the headlight's shadow ray. On a fresh machine that
 compile was nearly all of the first frame (docs/performance.md, "Cold start"). Two builds:
 
-* ``compact`` (the default): the shadow-ray traversal (``trace_any``) is compiled once as a called
-  function (:data:`CALLED_TRAVERSALS`), lights are shaded in a loop, and every setting a graphsdg render
-  context holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight, tone mapper, ...) is compiled
-  in as a constant, so code for features a scene does not use is dropped before optimisation. The camera
-  ray's traversal stays inlined: called, it slowed drawing most (docs/performance.md, "Cold start").
+* ``compact`` (the default): the shadow-ray traversal's test of one geom (spheres, boxes, meshes, ...) is
+  compiled once as a called function, the traversal's loop around it stays inlined
+  (:data:`CALLED_TRAVERSALS`); lights are shaded in a loop; and every setting a graphsdg render context
+  holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight, tone mapper, ...) is compiled in as
+  a constant, so code for features a scene does not use is dropped before optimisation. Calling more (the
+  camera rays' test, or whole traversals) compiles little faster and draws slower (docs/performance.md,
+  "Cold start").
 * ``inlined``: mujoco-warp-pbr's own build (its ``DEFAULT_BAKED`` settings): every traversal inlined,
-  lights unrolled up to six. It compiles several times longer and draws somewhat faster: for long runs
-  on a node whose kernel cache is already warm.
+  lights unrolled up to six. It compiles several times longer.
 
 Both are deterministic, and a run uses one: the choice is read when a render context is made (the
 setting :data:`KIND_KEY`) and is part of the context's key. The two are different binaries, so their
@@ -28,10 +29,13 @@ Example:
 from __future__ import annotations
 
 import contextlib
+import logging
 import threading
 from typing import Any, Callable, Iterator
 
 from graphsdg.base import settings_store as settings
+
+log = logging.getLogger("graphsdg.render")
 
 KIND_KEY = "/graphsdg/render/pbrKernel"
 KINDS = ("compact", "inlined")
@@ -41,8 +45,9 @@ KINDS = ("compact", "inlined")
 FIXED_GROUPS = frozenset({"any_rgb", "has_spot", "use_shadows", "shadow_samples", "shadow_light_fraction",
                           "headlight_active", "headlight", "env_background", "specular_aa", "vertex_normals",
                           "tone_mapper", "render_hdr"})
-#: the traversals a ``compact`` build compiles as called functions: ``closest`` (camera rays), ``any`` (shadow rays)
-CALLED_TRAVERSALS: tuple[str, ...] = ("any",)
+#: what a ``compact`` build compiles as called functions: a whole traversal (``closest``: camera rays, ``any``:
+#: shadow rays) or a traversal's test of one geom (``closest-geom``, ``any-geom``), whose loop stays inlined
+CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom",)
 _building = threading.local()
 _install_lock = threading.Lock()
 
@@ -88,14 +93,24 @@ def _not_inlined(function: Any) -> Any:
     return function
 
 
+def _geom_test(cast: Any) -> Any | None:
+    """The per-geom ray test (``intersect``) that mujoco-warp-pbr's ordered traversal ``cast`` calls, or None."""
+    code, cells = cast.func.__code__, cast.func.__closure__ or ()
+    for name, cell in zip(code.co_freevars, cells):
+        if name == "intersect":
+            return cell.cell_contents
+    return None
+
+
 def _install() -> None:
     """Wrap mujoco-warp-pbr's ``trace.make_trace`` (which both tiers' kernel builders call for their two
-    traversal functions), once per process."""
-    from mujoco_warp_pbr._src import trace
+    traversal functions) and ``traverse.make_ordered_cast`` (the traversal they wrap), once per process."""
+    from mujoco_warp_pbr._src import trace, traverse
     with _install_lock:
         original: Callable = trace.make_trace
         if getattr(original, "graphsdg_kernel_build", False):
             return
+        original_cast: Callable = traverse.make_ordered_cast
 
         def make_trace(*args, **kwargs):
             closest, any_hit = original(*args, **kwargs)
@@ -104,5 +119,17 @@ def _install() -> None:
                 any_hit = _not_inlined(any_hit) if "any" in CALLED_TRAVERSALS else any_hit
             return closest, any_hit
 
+        def make_ordered_cast(geom_ray_types, first_hit):
+            cast = original_cast(geom_ray_types, first_hit)
+            wanted = "any-geom" if first_hit else "closest-geom"
+            if getattr(_building, "kind", None) == "compact" and wanted in CALLED_TRAVERSALS:
+                test = _geom_test(cast)
+                if test is None:
+                    log.warning("mujoco-warp-pbr's traversal has no per-geom test to call; it stays inlined")
+                else:
+                    _not_inlined(test)
+            return cast
+
         make_trace.graphsdg_kernel_build = True
         trace.make_trace = make_trace
+        traverse.make_ordered_cast = make_ordered_cast
