@@ -82,3 +82,36 @@ def test_a_compact_build_calls_the_shadow_rays_geom_test_and_inlines_the_rest():
     with pytest.raises(ValueError, match="'fast'"):
         with pbr_kernel.building("fast"):
             pass
+
+
+def test_gathered_uploads_go_in_one_copy_and_keep_what_was_not_put():
+    from graphsdg.render.pbr_uploads import PinnedUploads
+    uploads = PinnedUploads("cpu")
+    poses = wp.array(np.arange(6, dtype=np.float32).reshape(2, 3), dtype=wp.vec3, device="cpu")
+    ids = wp.array(np.array([7, 8], dtype=np.int32), device="cpu")
+    empty = wp.zeros((1, 0), dtype=wp.vec3, device="cpu")
+    moved = uploads.gather({"poses": poses, "ids": ids, "empty": empty})
+    assert sorted(moved) == ["ids", "poses"]                  # the empty array stays where it is
+    assert moved["poses"].numpy().tolist() == [[0, 1, 2], [3, 4, 5]] and moved["ids"].numpy().tolist() == [7, 8]
+    copies = []
+    original = wp.copy
+    wp.copy = lambda *a, **k: (copies.append(a), original(*a, **k))[1]
+    try:
+        uploads.begin()
+        uploads.put("poses", moved["poses"], [[1, 1, 1], [2, 2, 2]])
+        assert moved["poses"].numpy()[0].tolist() == [0, 1, 2]   # sent at the round's end, not before
+        uploads.end()
+        assert len(copies) == 1
+        uploads.begin()
+        uploads.put("ids", moved["ids"], [5, 6])
+        uploads.put("own", ids, [1, 2])                          # not gathered: a copy of its own
+        uploads.end()
+    finally:
+        wp.copy = original
+    assert len(copies) == 3
+    assert moved["poses"].numpy().tolist() == [[1, 1, 1], [2, 2, 2]] and moved["ids"].numpy().tolist() == [5, 6]
+    assert ids.numpy().tolist() == [1, 2]
+    with pytest.raises(ValueError, match="'poses': 3 values"):
+        uploads.put("poses", moved["poses"], [1, 2, 3])
+    with pytest.raises(RuntimeError, match="already"):
+        uploads.gather({"ids": ids})

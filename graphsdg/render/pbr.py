@@ -140,6 +140,9 @@ class PbrRenderer:
     docstring)."""
 
     MAX_CONTEXTS = 4    # live render contexts (device memory): a step's batch, plus products drawn alone
+    #: the mujoco-warp Data and Model arrays a frame uploads (PbrRenderer._upload_state), sent in one copy
+    FRAME_DATA = ("geom_xpos", "geom_xmat", "light_xpos", "light_xdir", "cam_xpos", "cam_xmat")
+    FRAME_MODEL = ("geom_rgba", "geom_matid", "geom_size", "mat_rgba", "light_diffuse")
     #: the Warp modules every first frame launches whatever the scene (the megakernel is the scene's own):
     #: compiled side by side when the renderer starts (kernel_cache.compile_in_background)
     FIRST_FRAME_MODULES = ("mujoco_warp._src.render_util", "mujoco_warp._src.bvh", "mujoco_warp_pbr._src.envmap",
@@ -224,7 +227,17 @@ class PbrRenderer:
         layouts = [self._layout(v, model.ngeom) for v in views]
         return _Context(key=key, model=m, data=d, rc=rc, cameras=cameras, env_yaw=yaw, layouts=layouts,
                         rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(scene, rc),
-                        uploads=self._uploads.PinnedUploads(self._device))
+                        uploads=self._gathered_uploads(m, d))
+
+    def _gathered_uploads(self, m, d):
+        """The context's :class:`~graphsdg.render.pbr_uploads.PinnedUploads`, with the arrays a frame sends
+        (poses, and the model fields randomizers change) gathered into one allocation: one copy a frame."""
+        uploads = self._uploads.PinnedUploads(self._device)
+        owners = {name: d for name in self.FRAME_DATA} | {name: m for name in self.FRAME_MODEL}
+        moved = uploads.gather({name: getattr(owner, name) for name, owner in owners.items()})
+        for name, view in moved.items():
+            setattr(owners[name], name, view)
+        return uploads
 
     def _layout(self, view: CameraView, ngeom: int):
         return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
