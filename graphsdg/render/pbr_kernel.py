@@ -17,8 +17,8 @@ compile was nearly all of the first frame (docs/performance.md, "Cold start"). T
   lights unrolled up to six. It compiles several times longer.
 
 Both are deterministic, and a run uses one: the choice is read when a render context is made (the
-setting :data:`KIND_KEY`) and is part of the context's key. The two are different binaries, so their
-images may differ in a few pixels.
+setting :data:`KIND_KEY`) and is part of the context's key. The two are different binaries: their images
+are not promised to be identical, bit for bit.
 
 Example:
     >>> sorted(baked_groups("compact", frozenset({"nlight", "has_env"})) - FIXED_GROUPS)
