@@ -15,6 +15,9 @@ once a node:
   (``warp.config.cuda_output = "cubin"``), never to PTX that the driver would compile again at load: the
   files a GPU process looks for are then those a machine without a GPU writes ahead
   (:func:`compile_ahead`), and every process on one GPU model runs the same binary.
+* **Side by side.** :func:`compile_in_background` compiles a list of modules into the cache in threads
+  (NVRTC runs outside the interpreter lock), so the pbr renderer's first frame finds its scene-independent
+  modules compiled while it builds its scene.
 * **Compiled ahead.** ``graphsdg warmup`` (:mod:`graphsdg.jobs.warmup`) renders its scenes one frame each
   so their kernels land in the cache; with ``--arch`` it also compiles every module those frames launched
   for that GPU architecture, which needs no GPU (NVRTC runs on the CPU): a CPU build machine can bake the
