@@ -38,6 +38,7 @@ import contextlib
 import fcntl
 import logging
 import os
+import sys
 import threading
 import time
 from dataclasses import dataclass, field
@@ -176,8 +177,9 @@ def compile_ahead(recorder: LaunchRecorder, archs: list[int]) -> list[str]:
 
 
 def compile_in_background(module_names: tuple[str, ...], device: str) -> list[threading.Thread]:
-    """Start compiling the named Warp modules (imported already; the variant a launch that names no block
-    size uses) for ``device`` into the cache, one thread each, and return the threads.
+    """Start compiling the named Warp modules (the variant a launch that names no block size uses) for
+    ``device`` into the cache, one thread each, and return the threads. Names of Python modules not
+    imported yet are skipped (Warp would make them an empty module).
 
     A process's first frame compiles its modules one after another as it first launches each; compiled
     beside each other ahead of that (NVRTC runs outside the interpreter lock, and Warp allows modules to
@@ -199,7 +201,7 @@ def compile_in_background(module_names: tuple[str, ...], device: str) -> list[th
             log.warning("compiling Warp module %s ahead failed: %s", name, exc)
 
     threads = [threading.Thread(target=compile_one, args=(name,), name=f"graphsdg-compile-{name}", daemon=True)
-               for name in module_names]
+               for name in module_names if name in sys.modules]
     for thread in threads:
         thread.start()
     return threads

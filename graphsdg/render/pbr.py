@@ -43,7 +43,6 @@ Imports Warp, mujoco_warp and mujoco_warp_pbr on construction (``graphsdg[gpu]``
 from __future__ import annotations
 
 import math
-import sys
 import zlib
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -161,8 +160,7 @@ class PbrRenderer:
 
         from graphsdg.render import backend, pbr_meshes, pbr_outputs, pbr_scene_bvh, pbr_uploads
         if wp.get_device(device or "cuda:0").is_cuda:
-            kernel_cache.compile_in_background(
-                tuple(m for m in self.FIRST_FRAME_MODULES if m in sys.modules), device or "cuda:0")
+            kernel_cache.compile_in_background(self.FIRST_FRAME_MODULES, device or "cuda:0")
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads

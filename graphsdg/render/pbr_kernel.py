@@ -50,6 +50,7 @@ FIXED_GROUPS = frozenset({"any_rgb", "has_spot", "use_shadows", "shadow_samples"
 CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom",)
 _building = threading.local()
 _install_lock = threading.Lock()
+_installed = False
 
 
 def requested_kind() -> str:
@@ -104,11 +105,16 @@ def _geom_test(cast: Any) -> Any | None:
 
 def _install() -> None:
     """Wrap mujoco-warp-pbr's ``trace.make_trace`` (which both tiers' kernel builders call for their two
-    traversal functions) and ``traverse.make_ordered_cast`` (the traversal they wrap), once per process."""
+    traversal functions) and ``traverse.make_ordered_cast`` (the traversal they wrap), once per process
+    (:func:`building` runs every frame: after the first, this returns at once)."""
+    global _installed
+    if _installed:
+        return
     from mujoco_warp_pbr._src import trace, traverse
     with _install_lock:
         original: Callable = trace.make_trace
         if getattr(original, "graphsdg_kernel_build", False):
+            _installed = True
             return
         original_cast: Callable = traverse.make_ordered_cast
 
@@ -133,3 +139,4 @@ def _install() -> None:
         make_trace.graphsdg_kernel_build = True
         trace.make_trace = make_trace
         traverse.make_ordered_cast = make_ordered_cast
+        _installed = True
