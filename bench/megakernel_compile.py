@@ -9,10 +9,10 @@ Variants: ``inlined`` (mujoco-warp-pbr's own build), ``baked`` (every setting a 
 baked in, lights unrolled), ``looped`` (lights in a loop, mujoco-warp-pbr's baked settings), ``looped-baked``
 (both), and ``looped-baked+CUT`` with CUT one or more of ``closest``, ``any`` (a whole traversal called, not
 inlined), ``closest-geom``, ``any-geom`` (a traversal's per-geom test called), joined by commas:
-``looped-baked+any-geom`` is ``graphsdg.render.pbr_kernel``'s ``compact``.
+``looped-baked+any-geom,closest-geom`` is ``graphsdg.render.pbr_kernel``'s ``compact``.
 
 Usage (Python >= 3.12 with graphsdg[gpu]):
-    MUJOCO_GL=egl python3.12 bench/megakernel_compile.py --variant looped-baked+any-geom
+    MUJOCO_GL=egl python3.12 bench/megakernel_compile.py --variant looped-baked+any-geom,closest-geom
 """
 from __future__ import annotations
 

@@ -64,7 +64,7 @@ def test_fixed_groups_are_mujoco_warp_pbr_bake_groups():
     assert pbr_kernel.FIXED_GROUPS <= kernel_inputs.BAKE_GROUPS.keys()
 
 
-def test_a_compact_build_calls_the_shadow_rays_geom_test_and_inlines_the_rest():
+def test_a_compact_build_calls_each_traversals_geom_test_and_inlines_the_traversals():
     traverse = pytest.importorskip("mujoco_warp_pbr._src.traverse")
     trace = pytest.importorskip("mujoco_warp_pbr._src.trace")
     types = (6, 7)     # boxes and meshes
@@ -76,7 +76,7 @@ def test_a_compact_build_calls_the_shadow_rays_geom_test_and_inlines_the_rest():
         return (closest.inline_hint, any_hit.inline_hint, pbr_kernel._geom_test(shadow).inline_hint,
                 pbr_kernel._geom_test(camera).inline_hint)
 
-    assert hints("compact") == (None, None, "noinline", None)
+    assert hints("compact") == (None, None, "noinline", "noinline")
     assert hints("inlined") == (None, None, None, None)
     assert pbr_kernel._geom_test(traverse.make_ordered_cast(types, True)).inline_hint is None   # outside a build
     with pytest.raises(ValueError, match="'fast'"):

@@ -6,13 +6,13 @@ one function, so its time grows with every copy of the scene traversal inlined i
 each light's shadow ray (the light loop is unrolled), the headlight's shadow ray. On a fresh machine that
 compile was nearly all of the first frame (docs/performance.md, "Cold start"). Two builds:
 
-* ``compact`` (the default): the shadow-ray traversal's test of one geom (spheres, boxes, meshes, ...) is
-  compiled once as a called function, the traversal's loop around it stays inlined
-  (:data:`CALLED_TRAVERSALS`); lights are shaded in a loop; and every setting a graphsdg render context
-  holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight, tone mapper, ...) is compiled in as
-  a constant, so code for features a scene does not use is dropped before optimisation. Calling more (the
-  camera rays' test, or whole traversals) compiles little faster and draws slower (docs/performance.md,
-  "Cold start").
+* ``compact`` (the default): each traversal's test of one geom (spheres, boxes, meshes, ...: the camera
+  rays' closest hit and the shadow rays' any hit) is compiled once as a called function, the traversal
+  loops around them stay inlined (:data:`CALLED_TRAVERSALS`); lights are shaded in a loop; and every
+  setting a graphsdg render context holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight,
+  tone mapper, ...) is compiled in as a constant, so code for features a scene does not use is dropped
+  before optimisation. Calling whole traversals compiles faster still but draws twice as slow
+  (docs/performance.md, "Cold start").
 * ``inlined``: mujoco-warp-pbr's own build (its ``DEFAULT_BAKED`` settings): every traversal inlined,
   lights unrolled up to six. It compiles several times longer.
 
@@ -47,7 +47,7 @@ FIXED_GROUPS = frozenset({"any_rgb", "has_spot", "use_shadows", "shadow_samples"
                           "tone_mapper", "render_hdr"})
 #: what a ``compact`` build compiles as called functions: a whole traversal (``closest``: camera rays, ``any``:
 #: shadow rays) or a traversal's test of one geom (``closest-geom``, ``any-geom``), whose loop stays inlined
-CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom",)
+CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom", "closest-geom")
 _building = threading.local()
 _install_lock = threading.Lock()
 _installed = False
