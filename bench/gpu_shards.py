@@ -25,48 +25,32 @@ import sys
 import tempfile
 import time
 
-JOB = '''
-import graphsdg as rep
-rep.settings.set("/graphsdg/render/backend", "{backend}")
-rep.stage.new_stage()
-rep.functional.create.xform(name="World")
-rep.functional.create.dome_light(intensity=450, parent="/World", name="Sky")
-rep.functional.create.distant_light(intensity=900, parent="/World", name="Sun", rotation=(35, 20, 0))
-rep.functional.create.plane(parent="/World", name="Floor", scale=(8, 8, 1), semantics={{"class": "floor"}})
-for kind in ("cube", "sphere", "cylinder", "cone", "torus"):
-    getattr(rep.functional.create_batch, kind)(count=2, parent="/World", name=kind.capitalize(),
-                                               semantics={{"class": kind}})
-cam = rep.functional.create.camera(position=(4.5, -4.5, 3.5), look_at=(0, 0, 0.3), parent="/World")
-rp = rep.create.render_product(cam, ({size}, {size}))
-with rep.trigger.on_frame():
-    with rep.get.prims(semantics=[("class", k) for k in ("cube", "sphere", "cylinder", "cone", "torus")]):
-        rep.modify.pose(position=rep.distribution.uniform((-1.8, -1.8, 0.3), (1.8, 1.8, 0.3)),
-                        rotation=rep.distribution.uniform((0, 0, 0), (0, 0, 360)))
-        rep.randomizer.color(colors=rep.distribution.uniform((0, 0, 0), (1, 1, 1)))
-writer = rep.writers.get("BasicWriter")
-writer.initialize(output_dir="basic", rgb=True, semantic_segmentation=True, bounding_box_2d_tight=True,
-                  distance_to_image_plane=True)
-writer.attach(rp)
-rep.orchestrator.run()
-'''
+#: the job: graphsdg demo's scene as a graph script, given --size and --backend as its arguments
+JOB = os.path.join(os.path.dirname(os.path.abspath(__file__)), "demo_graph.py")
 
 
-def _shard_main(script: str, out: str, frames: int, index: int, count: int, resume: bool) -> None:
+def _job(script_args: tuple[str, ...], out: str, frames: int, resume: bool):
+    """The :class:`~graphsdg.jobs.job.JobSpec` every run of one check shares (its resume fingerprint too)."""
+    from graphsdg.jobs.job import JobSpec
+    return JobSpec(JOB, args=script_args, seed=7, out=out, frames=frames, resume=resume)
+
+
+def _shard_main(script_args: tuple[str, ...], out: str, frames: int, index: int, count: int, resume: bool) -> None:
     """Inside a shard process: run the job's frames of shard ``index``; print its summary as JSON."""
     from graphsdg import orchestrator
     from graphsdg.io.frame_plan import FramePlan
-    from graphsdg.jobs.job import JobSpec, run_job
-    job = JobSpec(script, seed=7, out=out, frames=frames, resume=resume)
+    from graphsdg.jobs.job import run_job
+    job = _job(script_args, out, frames, resume)
     summary = run_job(job, FramePlan(index, count, resume) if count > 1 else None)
     orchestrator.wait_until_complete()
     print("SHARD " + json.dumps(summary, default=str), flush=True)
 
 
-def _start(script, out, frames, index, count, resume, gpu):
+def _start(script_args, out, frames, index, count, resume, gpu):
     from graphsdg.render.gpu_assignment import process_environment
     env = {**os.environ, **process_environment(gpu)}
-    args = [sys.executable, __file__, "--shard", str(index), "--count", str(count), "--script", script, "--out", out,
-            "--frames", str(frames)] + (["--resume"] if resume else [])
+    args = [sys.executable, __file__, "--shard", str(index), "--count", str(count), "--out", out,
+            "--frames", str(frames), *script_args] + (["--resume"] if resume else [])
     return subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -77,14 +61,14 @@ def _summary(process) -> dict:
     return json.loads([line for line in out.splitlines() if line.startswith("SHARD ")][-1][6:])
 
 
-def _run(script, out, frames, gpus, resume=False, kill_after=None, per_gpu=1) -> tuple[list[dict], float]:
+def _run(script_args, out, frames, gpus, resume=False, kill_after=None, per_gpu=1) -> tuple[list[dict], float]:
     """Every shard at once, ``per_gpu`` a GPU (dealt in turn); shard 1 killed after ``kill_after`` s if given."""
     from graphsdg.dataset import merge
-    from graphsdg.jobs.job import JobSpec, check_job_file
-    check_job_file(JobSpec(script, seed=7, out=out, frames=frames, resume=resume))
+    from graphsdg.jobs.job import check_job_file
+    check_job_file(_job(script_args, out, frames, resume))
     count = len(gpus) * per_gpu
     start = time.perf_counter()
-    procs = [_start(script, out, frames, i, count, resume, gpus[i % len(gpus)]) for i in range(count)]
+    procs = [_start(script_args, out, frames, i, count, resume, gpus[i % len(gpus)]) for i in range(count)]
     if kill_after is not None:
         time.sleep(kill_after)
         procs[1].send_signal(signal.SIGKILL)
@@ -108,11 +92,11 @@ def _digest(root: str) -> dict[str, str]:
     return out
 
 
-def _sharded_checks(args, script: str, work: str, gpus, one: dict, one_s: float, mps) -> bool:
+def _sharded_checks(args, script_args: tuple[str, ...], work: str, gpus, one: dict, one_s: float, mps) -> bool:
     """The sharded run against the one-process files, then (``--kill-after``) a killed shard resumed; prints a
     row each and says whether every check held."""
     per_gpu = args.shards_per_gpu
-    results, many_s = _run(script, os.path.join(work, "many"), args.frames, gpus, per_gpu=per_gpu)
+    results, many_s = _run(script_args, os.path.join(work, "many"), args.frames, gpus, per_gpu=per_gpu)
     many = _digest(os.path.join(work, "many"))
     ok = one == many and len(one) > 0
     differ = sorted(k for k in one if one.get(k) != many.get(k))
@@ -123,15 +107,20 @@ def _sharded_checks(args, script: str, work: str, gpus, one: dict, one_s: float,
           f"{many_s:.1f} | {'byte-identical' if ok else f'DIFFERENT: {len(differ)} files, e.g. {differ[:3]}'} |")
     if args.kill_after is not None and len(gpus) * per_gpu > 1:
         out = os.path.join(work, "killed")
-        _run(script, out, args.frames, gpus, kill_after=args.kill_after, per_gpu=per_gpu)
+        _run(script_args, out, args.frames, gpus, kill_after=args.kill_after, per_gpu=per_gpu)
         partial = len(os.listdir(os.path.join(out, "basic"))) if os.path.isdir(os.path.join(out, "basic")) else 0
-        _, resume_s = _run(script, out, args.frames, gpus, resume=True, per_gpu=per_gpu)
+        _, resume_s = _run(script_args, out, args.frames, gpus, resume=True, per_gpu=per_gpu)
         resumed = _digest(out)
         same = resumed == one
         ok = ok and same
         print(f"| shard 1 killed after {args.kill_after:g} s ({partial} files), all resumed | {len(gpus)} | "
               f"{args.frames} | {len(resumed)} | {resume_s:.1f} | {'byte-identical' if same else 'DIFFERENT'} |")
     return ok
+
+
+def _script_args(args: argparse.Namespace) -> tuple[str, ...]:
+    """The job script's arguments: its product's size and the backend."""
+    return ("--size", str(args.size), "--backend", args.backend)
 
 
 def main() -> int:
@@ -145,24 +134,21 @@ def main() -> int:
     parser.add_argument("--mps", default="auto", choices=("auto", "on", "off"))
     parser.add_argument("--shard", type=int)
     parser.add_argument("--count", type=int)
-    parser.add_argument("--script")
     parser.add_argument("--out")
     parser.add_argument("--resume", action="store_true")
     args = parser.parse_args()
     if args.shard is not None:
-        _shard_main(args.script, args.out, args.frames, args.shard, args.count, args.resume)
+        _shard_main(_script_args(args), args.out, args.frames, args.shard, args.count, args.resume)
         return 0
     from graphsdg.render.gpu_assignment import choose_gpus
     gpus = choose_gpus(args.gpus)
     work = tempfile.mkdtemp(prefix="graphsdg-gpu-shards-", dir="/dev/shm" if os.path.isdir("/dev/shm") else None)
-    script = os.path.join(work, "job.py")
-    with open(script, "w") as f:
-        f.write(JOB.format(backend=args.backend, size=args.size))
-    _, one_s = _run(script, os.path.join(work, "one"), args.frames, gpus[:1])
+    script_args = _script_args(args)
+    _, one_s = _run(script_args, os.path.join(work, "one"), args.frames, gpus[:1])
     one = _digest(os.path.join(work, "one"))
     from graphsdg.render.cuda_mps import shared_gpus
     with shared_gpus(args.mps, args.shards_per_gpu) as mps:
-        ok = _sharded_checks(args, script, work, gpus, one, one_s, mps)
+        ok = _sharded_checks(args, script_args, work, gpus, one, one_s, mps)
     return 0 if ok else 1
 
 
