@@ -354,3 +354,33 @@ def test_a_deferred_pbr_render_gives_its_own_frames_pixels_when_read_after_the_n
     assert not np.array_equal(moved.geom_ids, now.geom_ids)
     for name in ("color", "depth", "id_codes", "code_boxes"):
         assert np.array_equal(deferred.get(name), now.get(name)), name
+
+
+def _pixel_body(kernel):
+    """The per-pixel function (mujoco-warp-pbr's ``render_pixel``) a megakernel calls."""
+    return next(cell.cell_contents for cell in kernel.func.__closure__
+                if str(getattr(cell.cell_contents, "key", "")).endswith("render_pixel"))
+
+
+def test_a_contexts_megakernel_compiles_on_a_thread_before_its_first_launch_finds_it(renderer, monkeypatch):
+    from mujoco_warp_pbr._src import render as pbr_render
+
+    from graphsdg.render import kernel_cache, pbr_kernel
+    cube, ball, cam = _scene()
+    scene = runtime().render_scene
+    view = camera_view(cam, W, H)
+    ctx = renderer._context(scene, [view], 1)
+    thread = pbr_kernel.start_compile(ctx.model, ctx.rc, ctx.key[-1], DEVICE)
+    thread.join()
+    kernel, compiled = ctx.rc._megakernel, kernel_cache.stats["compiled"]
+    assert kernel is not None
+    out = renderer.render(scene, view, {"color", "segmentation"})
+    assert ctx.rc._megakernel is kernel                       # the launch drew with the kernel built ahead
+    assert kernel_cache.stats["compiled"] == compiled         # and found it in the cache
+    assert (out.geom_ids >= 0).any()
+    # the light's shadow test is a called function only where the compact build's cuts name it
+    for cuts, hint in ((("any-geom", "closest-geom"), None), (("any-geom", "shadow-visibility"), "noinline")):
+        monkeypatch.setattr(pbr_kernel, "CALLED_TRAVERSALS", cuts)
+        with pbr_kernel.building("compact"):
+            pixel = _pixel_body(pbr_render._build_megakernel(ctx.model, ctx.rc))
+        assert pbr_kernel.nested_function(pixel, "light_visibility").inline_hint == hint

@@ -84,6 +84,30 @@ def test_a_compact_build_calls_each_traversals_geom_test_and_inlines_the_travers
             pass
 
 
+def _nested_functions():
+    @wp.func
+    def shadow_test(x: float) -> float:
+        return x * 2.0
+
+    @wp.func
+    def shade(x: float) -> float:
+        return shadow_test(x) + 1.0
+
+    @wp.func
+    def pixel(x: float) -> float:
+        return shade(x)
+
+    return pixel, shade, shadow_test
+
+
+def test_nested_function_finds_a_function_called_through_closures_and_only_those():
+    pixel, shade, shadow_test = _nested_functions()
+    assert pbr_kernel.nested_function(pixel, "shadow_test") is shadow_test
+    assert pbr_kernel.nested_function(pixel, "shade") is shade
+    assert pbr_kernel.nested_function(pixel, "pixel") is None          # the root is not its own callee
+    assert pbr_kernel.nested_function(shadow_test, "shade") is None    # callers are not searched
+
+
 def test_gathered_uploads_go_in_one_copy_and_keep_what_was_not_put():
     from graphsdg.render.pbr_uploads import PinnedUploads
     uploads = PinnedUploads("cpu")

@@ -46,8 +46,12 @@ FIXED_GROUPS = frozenset({"any_rgb", "has_spot", "use_shadows", "shadow_samples"
                           "headlight_active", "headlight", "env_background", "specular_aa", "vertex_normals",
                           "tone_mapper", "render_hdr"})
 #: what a ``compact`` build compiles as called functions: a whole traversal (``closest``: camera rays, ``any``:
-#: shadow rays) or a traversal's test of one geom (``closest-geom``, ``any-geom``), whose loop stays inlined
+#: shadow rays), a traversal's test of one geom (``closest-geom``, ``any-geom``), whose loop stays inlined, or
+#: a light's shadow test (``shadow-visibility``: mujoco-warp-pbr's ``light_visibility``, the shadow traversal
+#: inlined into it once)
 CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom", "closest-geom")
+#: the functions of mujoco-warp-pbr's per-pixel body (``render.make_render_pixel``) a cut names
+_PIXEL_FUNCTIONS = {"shadow-visibility": "light_visibility"}
 _building = threading.local()
 _install_lock = threading.Lock()
 _installed = False
@@ -103,14 +107,58 @@ def _geom_test(cast: Any) -> Any | None:
     return None
 
 
+def start_compile(m: Any, rc: Any, kind: str, device: str) -> threading.Thread | None:
+    """Build the megakernel of render context ``rc`` (mujoco-warp ``Model`` ``m``) as ``kind`` now and compile
+    it into the kernel cache on a thread; return the thread, or None where the context draws with another
+    kernel (the path tier, OptiX). The context's first ``mujoco_warp_pbr.render`` finds the same kernel
+    (mujoco-warp-pbr keeps it on the context under the key of what it is specialised on) and loads it once
+    the thread is done: the compile overlaps what the first frame does before its launch. A context changed
+    in between so that its key differs only builds another kernel at the launch, as it would anyway."""
+    import warp as wp
+    from mujoco_warp_pbr._src import kernel_inputs, launch, render, types
+    from warp._src.context import _resolve_launch_block_dim
+
+    from graphsdg.render import kernel_cache
+    if rc.tier != types.Tier.REALTIME or getattr(rc, "traversal", None) == "optix":
+        return None
+    with building(kind):
+        kernel = launch.cached_kernel(m, rc, kernel_inputs.settings_values(rc), render._build_megakernel)
+    # the block size mujoco_warp_pbr.render launches with, as Warp resolves it for the device
+    block_dim = _resolve_launch_block_dim(wp.get_device(device), rc.block_dim or m.block_dim.render)
+    return kernel_cache.compile_module_in_background(kernel.module, block_dim, device)
+
+
+def nested_function(root: Any, name: str) -> Any | None:
+    """The ``warp.Function`` named ``name`` that ``root`` (a ``warp.Function``) calls through its closure,
+    directly or through other such functions; None where it calls none of that name."""
+    pending, seen = [root], set()
+    while pending:
+        function = pending.pop()
+        body = getattr(function, "func", None)
+        if body is None or id(function) in seen:
+            continue
+        seen.add(id(function))
+        if body.__name__ == name and function is not root:
+            return function
+        for cell in body.__closure__ or ():
+            try:
+                value = cell.cell_contents
+            except ValueError:          # a free variable not bound yet
+                continue
+            if hasattr(value, "func") and hasattr(value, "inline_hint"):
+                pending.append(value)
+    return None
+
+
 def _install() -> None:
     """Wrap mujoco-warp-pbr's ``trace.make_trace`` (which both tiers' kernel builders call for their two
-    traversal functions) and ``traverse.make_ordered_cast`` (the traversal they wrap), once per process
-    (:func:`building` runs every frame: after the first, this returns at once)."""
+    traversal functions), ``traverse.make_ordered_cast`` (the traversal they wrap) and
+    ``render.make_render_pixel`` (the real-time tier's per-pixel body), once per process (:func:`building`
+    runs every frame: after the first, this returns at once)."""
     global _installed
     if _installed:
         return
-    from mujoco_warp_pbr._src import trace, traverse
+    from mujoco_warp_pbr._src import render, trace, traverse
     with _install_lock:
         original: Callable = trace.make_trace
         if getattr(original, "graphsdg_kernel_build", False):
@@ -136,7 +184,23 @@ def _install() -> None:
                     _not_inlined(test)
             return cast
 
+        original_pixel: Callable = render.make_render_pixel
+
+        def make_render_pixel(*args, **kwargs):
+            pixel = original_pixel(*args, **kwargs)
+            if getattr(_building, "kind", None) == "compact":
+                for cut, name in _PIXEL_FUNCTIONS.items():
+                    if cut not in CALLED_TRAVERSALS:
+                        continue
+                    function = nested_function(pixel, name)
+                    if function is None:
+                        log.warning("mujoco-warp-pbr's pixel body has no %s to call; it stays inlined", name)
+                    else:
+                        _not_inlined(function)
+            return pixel
+
         make_trace.graphsdg_kernel_build = True
         trace.make_trace = make_trace
         traverse.make_ordered_cast = make_ordered_cast
+        render.make_render_pixel = make_render_pixel
         _installed = True
