@@ -8,11 +8,12 @@ the seconds and the CUBIN's size. docs/performance.md ("Cold start, round 18") q
 Variants: ``inlined`` (mujoco-warp-pbr's own build), ``baked`` (every setting a graphsdg context holds fixed
 baked in, lights unrolled), ``looped`` (lights in a loop, mujoco-warp-pbr's baked settings), ``looped-baked``
 (both), and ``looped-baked+CUT`` with CUT one or more of ``closest``, ``any`` (a whole traversal called, not
-inlined), ``closest-geom``, ``any-geom`` (a traversal's per-geom test called), joined by commas:
-``looped-baked+any-geom,closest-geom`` is ``graphsdg.render.pbr_kernel``'s ``compact``.
+inlined), ``closest-geom``, ``any-geom`` (a traversal's per-geom test called), ``shadow-visibility`` (a light's
+shadow test called), joined by commas: ``looped-baked+any-geom,closest-geom,shadow-visibility`` is
+``graphsdg.render.pbr_kernel``'s ``compact``.
 
 Usage (Python >= 3.12 with graphsdg[gpu]):
-    MUJOCO_GL=egl python3.12 bench/megakernel_compile.py --variant looped-baked+any-geom,closest-geom
+    MUJOCO_GL=egl python3.12 bench/megakernel_compile.py --variant looped-baked+any-geom,closest-geom,shadow-visibility
 """
 from __future__ import annotations
 

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-import os
 
 import pytest
 
@@ -215,33 +214,3 @@ def test_the_hand_written_loop_draws_the_frames_graphsdg_draws(tmp_path):
         # host `auto` renders graphsdg's frames with the pbr backend, whose depths are exact (measured on an H200:
         # up to 1.5 cm apart); a shape drawn at another size differs by far more, and in what is hit
         assert np.mean(np.abs(ours[both] - loop[both]) < 0.0025 * loop[both]) > 0.99
-
-
-def test_pool_environment_sizes_blas_and_openmp_and_keeps_what_the_user_set():
-    from graphsdg.base.cpu_share import pool_environment
-    assert pool_environment(3, environ={}) == {"OPENBLAS_NUM_THREADS": "3", "OMP_NUM_THREADS": "3"}
-    assert pool_environment(1, environ={"OMP_NUM_THREADS": "8"}) == {"OPENBLAS_NUM_THREADS": "1"}
-    for bad in (0, -1, 1.5, True):
-        with pytest.raises(ValueError, match="positive integer"):
-            pool_environment(bad, environ={})
-
-
-def test_bench_processes_start_with_their_share_of_blas_threads_beside_their_own_environment(monkeypatch):
-    from graphsdg.benchmark import process_launch
-    from graphsdg.benchmark.throughput import BenchConfig, launch_processes
-    seen = {}
-
-    def fake_run(target, args, environments):   # starting them: test_gpu_assignment.py runs real ones
-        seen["environments"] = environments
-        return [{} for _ in args]
-
-    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
-        monkeypatch.delenv(name, raising=False)
-    monkeypatch.setattr(process_launch, "run_in_processes", fake_run)
-    monkeypatch.setattr(os, "cpu_count", lambda: 16)
-    launch_processes(BenchConfig(frames=1), 4, [{"CUDA_VISIBLE_DEVICES": str(i)} for i in range(4)])
-    assert seen["environments"] == [{"OPENBLAS_NUM_THREADS": "4", "OMP_NUM_THREADS": "4", "CUDA_VISIBLE_DEVICES": str(i)}
-                                    for i in range(4)]
-    monkeypatch.setenv("OMP_NUM_THREADS", "2")      # the user's setting reaches the children as it is
-    launch_processes(BenchConfig(frames=1), 2)
-    assert seen["environments"] == [{"OPENBLAS_NUM_THREADS": "8"}] * 2

@@ -232,7 +232,7 @@ def test_bench_processes_each_start_on_their_own_gpu(monkeypatch):
 
 @pytest.mark.parametrize("name", ["graphsdg.render.gpu_assignment", "graphsdg.render.egl_device",
                                   "graphsdg.benchmark.multi_gpu", "graphsdg.benchmark.gpu_sampler",
-                                  "graphsdg.jobs.scaleout", "graphsdg.base.cpu_share"])
+                                  "graphsdg.jobs.scaleout"])
 def test_the_docstring_examples_run(name):
     result = doctest.testmod(importlib.import_module(name))
     assert result.attempted > 0 and result.failed == 0

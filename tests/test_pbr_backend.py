@@ -362,25 +362,17 @@ def _pixel_body(kernel):
                 if str(getattr(cell.cell_contents, "key", "")).endswith("render_pixel"))
 
 
-def test_a_contexts_megakernel_compiles_on_a_thread_before_its_first_launch_finds_it(renderer, monkeypatch):
+def test_a_compact_build_calls_the_lights_shadow_test_where_its_cuts_name_it(renderer, monkeypatch):
     from mujoco_warp_pbr._src import render as pbr_render
 
-    from graphsdg.render import kernel_cache, pbr_kernel
+    from graphsdg.render import pbr_kernel
     cube, ball, cam = _scene()
-    scene = runtime().render_scene
-    view = camera_view(cam, W, H)
-    ctx = renderer._context(scene, [view], 1)
-    thread = pbr_kernel.start_compile(ctx.model, ctx.rc, ctx.key[-1], DEVICE)
-    thread.join()
-    kernel, compiled = ctx.rc._megakernel, kernel_cache.stats["compiled"]
-    assert kernel is not None
-    out = renderer.render(scene, view, {"color", "segmentation"})
-    assert ctx.rc._megakernel is kernel                       # the launch drew with the kernel built ahead
-    assert kernel_cache.stats["compiled"] == compiled         # and found it in the cache
-    assert (out.geom_ids >= 0).any()
-    # the light's shadow test is a called function only where the compact build's cuts name it
+    ctx = renderer._context(runtime().render_scene, [camera_view(cam, W, H)], 1)
     for cuts, hint in ((("any-geom", "closest-geom"), None), (("any-geom", "shadow-visibility"), "noinline")):
         monkeypatch.setattr(pbr_kernel, "CALLED_TRAVERSALS", cuts)
         with pbr_kernel.building("compact"):
             pixel = _pixel_body(pbr_render._build_megakernel(ctx.model, ctx.rc))
         assert pbr_kernel.nested_function(pixel, "light_visibility").inline_hint == hint
+    with pbr_kernel.building("inlined"):
+        pixel = _pixel_body(pbr_render._build_megakernel(ctx.model, ctx.rc))
+    assert pbr_kernel.nested_function(pixel, "light_visibility").inline_hint is None

@@ -5,24 +5,15 @@ per core, whose idle threads spin briefly before sleeping. Many processes with
 such pools on one host spend CPU waking and parking them, for no speed: one
 512x512 image operation is too small to split (docs/performance.md, "OpenCV's
 thread pools"). Processes that share a host (``graphsdg bench --processes K``,
-local Ray shards) give OpenCV their share of the cores instead, and so NumPy's
-BLAS and OpenMP pools, which a process sizes from its environment when it starts
-(:func:`pool_environment`; Ray sizes its workers' OpenMP pools itself).
+local Ray shards) give OpenCV their share of the cores instead.
 
 Example:
     >>> cores_per_process(16, cores=16), cores_per_process(3, cores=16), cores_per_process(4, cores=2)
     (1, 5, 1)
-    >>> pool_environment(2, environ={})
-    {'OPENBLAS_NUM_THREADS': '2', 'OMP_NUM_THREADS': '2'}
 """
 from __future__ import annotations
 
 import os
-from typing import Mapping
-
-#: the variables NumPy's BLAS (OpenBLAS, which reads OMP_NUM_THREADS where its own is unset) and OpenMP
-#: runtimes size their pools from when a process starts
-POOL_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
 
 
 def cores_per_process(processes: int, cores: int | None = None) -> int:
@@ -39,11 +30,3 @@ def limit_image_threads(threads: int) -> None:
         raise ValueError(f"image threads must be a positive integer, got {threads!r}")
     import cv2
     cv2.setNumThreads(threads)
-
-
-def pool_environment(threads: int, environ: Mapping[str, str] = os.environ) -> dict[str, str]:
-    """Environment variables giving a process started with them ``threads`` BLAS and OpenMP threads; a
-    variable already set in ``environ`` (the user's choice) is left out, so the child inherits it."""
-    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
-        raise ValueError(f"pool threads must be a positive integer, got {threads!r}")
-    return {name: str(threads) for name in POOL_VARIABLES if name not in environ}

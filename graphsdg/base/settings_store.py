@@ -83,9 +83,9 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                  "each; bench/pbr_products.py measured where it pays); 0: one "
                                                  "launch per product"),
     "/graphsdg/render/pbrKernel": ("compact", "how the pbr backend's render kernel is built: compact (the "
-                                              "traversals' per-geom tests called, not inlined: compiles about "
-                                              "three times faster) or inlined (mujoco-warp-pbr's own build); "
-                                              "graphsdg.render.pbr_kernel"),
+                                              "traversals' per-geom tests and the lights' shadow test called, "
+                                              "not inlined: compiles about four times faster) or inlined "
+                                              "(mujoco-warp-pbr's own build); graphsdg.render.pbr_kernel"),
     "/rtx/pathtracing/totalSpp": (1, "in PathTracing mode, the least number of jittered subframes each capture "
                                      "accumulates"),
     "/app/player/playSimulations": (True, "physics steps with the timeline's ticks; False: ticks advance time and "

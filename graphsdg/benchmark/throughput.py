@@ -572,19 +572,17 @@ def launch_processes(config: BenchConfig, processes: int,
                      environments: list[dict[str, str]] | None = None) -> tuple[list[dict], float, BenchConfig]:
     """Run ``processes`` benchmark processes (process i with seed + i, and ``environments[i]`` added to its
     environment: its GPU, say); return their :func:`_worker` results, the seconds it all took, and the
-    config they ran (the writer and OpenCV threads set to each one's share of the cores, and NumPy's BLAS
-    and OpenMP pools where the environment does not size them already)."""
+    config they ran (the writer and OpenCV threads set to each one's share of the cores)."""
     from graphsdg.benchmark.process_launch import run_in_processes
-    from graphsdg.base.cpu_share import cores_per_process, pool_environment
+    from graphsdg.base.cpu_share import cores_per_process
     from graphsdg.io.write_queue import threads_per_process
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(processes))
     if config.image_threads is None:
         config = dataclasses.replace(config, image_threads=cores_per_process(processes))
     configs = [(dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)),) for i in range(processes)]
-    pools = pool_environment(config.image_threads)     # NumPy's pools too: set before the child imports it
     start = time.perf_counter()
-    results = run_in_processes(_worker, configs, [{**pools, **env} for env in environments or [{}] * processes])
+    results = run_in_processes(_worker, configs, environments or [{}] * processes)
     return results, time.perf_counter() - start, config
 
 

@@ -339,7 +339,7 @@ EPILOG = ("exit codes: 0 success, 1 error (one line and a hint; --debug shows th
 def _add_pbr_kernel(command: argparse.ArgumentParser) -> None:
     """``--pbr-kernel``: the setting /graphsdg/render/pbrKernel for this command (graphsdg.render.pbr_kernel)."""
     command.add_argument("--pbr-kernel", choices=("compact", "inlined"),
-                         help="how the pbr backend's render kernel is built: compact (compiles about three times "
+                         help="how the pbr backend's render kernel is built: compact (compiles about four times "
                               "faster) or inlined (mujoco-warp-pbr's own build); a kernel cache warmed with one "
                               "holds nothing for the other (default: the setting /graphsdg/render/pbrKernel, "
                               "compact)")

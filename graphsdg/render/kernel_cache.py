@@ -17,8 +17,7 @@ once a node:
   (:func:`compile_ahead`), and every process on one GPU model runs the same binary.
 * **Side by side.** :func:`compile_in_background` compiles a list of modules into the cache in threads
   (NVRTC runs outside the interpreter lock), so the pbr renderer's first frame finds its scene-independent
-  modules compiled while it builds its scene; :func:`compile_module_in_background` does one module (the
-  scene's megakernel, from the moment its render context exists, while the first frame is set up).
+  modules compiled while it builds its scene.
 * **Compiled ahead.** ``graphsdg warmup`` (:mod:`graphsdg.jobs.warmup`) renders its scenes one frame each
   so their kernels land in the cache; with ``--arch`` it also compiles every module those frames launched
   for that GPU architecture, which needs no GPU (NVRTC runs on the CPU): a CPU build machine can bake the
@@ -191,31 +190,18 @@ def compile_in_background(module_names: tuple[str, ...], device: str) -> list[th
     import warp as wp
     configure_warp()
     target = wp.get_device(device)
-    threads = []
-    for name in module_names:
-        if name in sys.modules:
+
+    def compile_one(name: str) -> None:
+        try:
             module = wp.get_module(name)
             # the block size a launch that names none runs at: the module's on a GPU, one on the CPU
-            threads.append(compile_module_in_background(
-                module, 1 if target.is_cpu else int(module.options["block_dim"]), device))
-    return threads
-
-
-def compile_module_in_background(module: Any, block_dim: int, device: str) -> threading.Thread:
-    """Start compiling one Warp module (a ``warp.Module``, the variant launched with ``block_dim`` threads a
-    block) for ``device`` into the cache on a thread of its own, and return the thread: the module's first
-    launch then loads what the thread wrote, waiting for it where it is not done (the module's file lock).
-    A failure is logged and left to that launch, which compiles the module again and raises."""
-    import warp as wp
-    configure_warp()
-    target = wp.get_device(device)
-
-    def compile_one() -> None:
-        try:
+            block_dim = 1 if target.is_cpu else int(module.options["block_dim"])
             _compile_variant(module, block_dim, target)
         except Exception as exc:  # noqa: BLE001 - the launch that needs the module reports its own error
-            log.warning("compiling Warp module %s ahead failed: %s", module.name, exc)
+            log.warning("compiling Warp module %s ahead failed: %s", name, exc)
 
-    thread = threading.Thread(target=compile_one, name=f"graphsdg-compile-{module.name[:40]}", daemon=True)
-    thread.start()
-    return thread
+    threads = [threading.Thread(target=compile_one, args=(name,), name=f"graphsdg-compile-{name}", daemon=True)
+               for name in module_names if name in sys.modules]
+    for thread in threads:
+        thread.start()
+    return threads

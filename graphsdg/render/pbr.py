@@ -222,8 +222,6 @@ class PbrRenderer:
                 tier=mjpbr.Tier.PATH if path else mjpbr.Tier.REALTIME, path_samples=request.path_samples,
                 denoise=path and request.denoise, camera_rays=[pbr_scene.camera_rays(v) for v in views])
             rc.baked = pbr_kernel.baked_groups(key[-1], rc.baked)
-            if wp.get_device(self._device).is_cuda:     # NVRTC compiles while the first frame is set up
-                pbr_kernel.start_compile(m, rc, key[-1], self._device)
         layouts = [self._layout(v, model.ngeom) for v in views]
         return _Context(key=key, model=m, data=d, rc=rc, cameras=cameras, env_yaw=yaw, layouts=layouts,
                         rays_keys=[_rays_key(v) for v in views], meshes=self._mesh_state(scene, rc),

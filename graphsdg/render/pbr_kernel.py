@@ -7,12 +7,12 @@ each light's shadow ray (the light loop is unrolled), the headlight's shadow ray
 compile was nearly all of the first frame (docs/performance.md, "Cold start"). Two builds:
 
 * ``compact`` (the default): each traversal's test of one geom (spheres, boxes, meshes, ...: the camera
-  rays' closest hit and the shadow rays' any hit) is compiled once as a called function, the traversal
-  loops around them stay inlined (:data:`CALLED_TRAVERSALS`); lights are shaded in a loop; and every
-  setting a graphsdg render context holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight,
-  tone mapper, ...) is compiled in as a constant, so code for features a scene does not use is dropped
-  before optimisation. Calling whole traversals compiles faster still but draws twice as slow
-  (docs/performance.md, "Cold start").
+  rays' closest hit and the shadow rays' any hit) and a light's shadow test (the shadow traversal inlined
+  into it once) are compiled once as called functions, the camera traversal's loop stays inlined
+  (:data:`CALLED_TRAVERSALS`); lights are shaded in a loop; and every setting a graphsdg render context
+  holds fixed for its life (:data:`FIXED_GROUPS`: shadows, headlight, tone mapper, ...) is compiled in as
+  a constant, so code for features a scene does not use is dropped before optimisation. Calling whole
+  traversals compiles faster still but draws twice as slow (docs/performance.md, "Cold start").
 * ``inlined``: mujoco-warp-pbr's own build (its ``DEFAULT_BAKED`` settings): every traversal inlined,
   lights unrolled up to six. It compiles several times longer.
 
@@ -49,7 +49,7 @@ FIXED_GROUPS = frozenset({"any_rgb", "has_spot", "use_shadows", "shadow_samples"
 #: shadow rays), a traversal's test of one geom (``closest-geom``, ``any-geom``), whose loop stays inlined, or
 #: a light's shadow test (``shadow-visibility``: mujoco-warp-pbr's ``light_visibility``, the shadow traversal
 #: inlined into it once)
-CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom", "closest-geom")
+CALLED_TRAVERSALS: tuple[str, ...] = ("any-geom", "closest-geom", "shadow-visibility")
 #: the functions of mujoco-warp-pbr's per-pixel body (``render.make_render_pixel``) a cut names
 _PIXEL_FUNCTIONS = {"shadow-visibility": "light_visibility"}
 _building = threading.local()
@@ -105,27 +105,6 @@ def _geom_test(cast: Any) -> Any | None:
         if name == "intersect":
             return cell.cell_contents
     return None
-
-
-def start_compile(m: Any, rc: Any, kind: str, device: str) -> threading.Thread | None:
-    """Build the megakernel of render context ``rc`` (mujoco-warp ``Model`` ``m``) as ``kind`` now and compile
-    it into the kernel cache on a thread; return the thread, or None where the context draws with another
-    kernel (the path tier, OptiX). The context's first ``mujoco_warp_pbr.render`` finds the same kernel
-    (mujoco-warp-pbr keeps it on the context under the key of what it is specialised on) and loads it once
-    the thread is done: the compile overlaps what the first frame does before its launch. A context changed
-    in between so that its key differs only builds another kernel at the launch, as it would anyway."""
-    import warp as wp
-    from mujoco_warp_pbr._src import kernel_inputs, launch, render, types
-    from warp._src.context import _resolve_launch_block_dim
-
-    from graphsdg.render import kernel_cache
-    if rc.tier != types.Tier.REALTIME or getattr(rc, "traversal", None) == "optix":
-        return None
-    with building(kind):
-        kernel = launch.cached_kernel(m, rc, kernel_inputs.settings_values(rc), render._build_megakernel)
-    # the block size mujoco_warp_pbr.render launches with, as Warp resolves it for the device
-    block_dim = _resolve_launch_block_dim(wp.get_device(device), rc.block_dim or m.block_dim.render)
-    return kernel_cache.compile_module_in_background(kernel.module, block_dim, device)
 
 
 def nested_function(root: Any, name: str) -> Any | None:
