@@ -27,6 +27,7 @@ def test_a_processes_row_counts_images_of_every_camera_and_the_cores_kept_busy()
     a, b = _process(0.0, 0.1, 100), _process(2.0, 0.05, 100)
     a["cpu"], b["cpu"] = 40.0, 30.0
     a["system"], b["system"] = 4.0, 6.0
+    a["main_thread"], b["main_thread"] = 20.0, 16.0
     a["page_faults"], b["page_faults"] = 1000, 3000
     row = summarize_processes([a, b], BenchConfig(num_cameras=2, write_threads=1, write_processes=0), 12.0)
     assert row["processes"] == 2
@@ -35,6 +36,7 @@ def test_a_processes_row_counts_images_of_every_camera_and_the_cores_kept_busy()
     assert math.isclose(row["cores busy (CPU s / window s)"], 7.0)                        # 70 CPU s in 10 s
     assert math.isclose(row["CPU ms per frame (all threads)"], 350.0)
     assert math.isclose(row["of which system (kernel) ms"], 50.0)                         # 10 system s, 200 frames
+    assert math.isclose(row["of which main threads ms"], 180.0)                           # 36 s of main threads
     assert row["minor page faults per frame"] == 20
     assert math.isclose(row["sum of per-process frames/s"], 30.0) and row["slowest process frames/s"] == 10.0
     assert row["writer processes per process"] == 0 and row["wall s (incl. start-up)"] == 12.0

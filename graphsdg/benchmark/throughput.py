@@ -106,6 +106,7 @@ class BenchResult:
     started_at: float = 0.0               # wall clock (time.time()) when the timed frames began
     cpu_seconds: float = 0.0              # process CPU time (all threads) over the timed frames and the drain
     system_seconds: float = 0.0           # the part of cpu_seconds spent in the kernel (system calls, faults)
+    main_thread_seconds: float = 0.0      # the part of cpu_seconds the thread that steps the frames spent
     page_faults: int = 0                  # minor page faults over the same span (fresh pages the kernel mapped)
     peak_rss_mb: float = 0.0
     profile: dict[str, float] = field(default_factory=dict)
@@ -130,6 +131,8 @@ class BenchResult:
                 "mean ms": round(float(ft.mean()), 2), "max ms": round(float(ft.max()), 2),
                 "CPU ms/frame": round(1000 * self.cpu_seconds / self.frames, 1) if self.frames else 0.0,
                 "of which system ms": round(1000 * self.system_seconds / self.frames, 1) if self.frames else 0.0,
+                "of which main thread ms": round(1000 * self.main_thread_seconds / self.frames, 1) if self.frames
+                else 0.0,
                 "page faults/frame": round(self.page_faults / self.frames) if self.frames else 0,
                 "peak RSS MB": round(self.peak_rss_mb, 1)}
 
@@ -293,7 +296,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
         before_timing()
     rep.orchestrator.reset_profile()
     result.started_at = time.time()
-    cpu_start = _cpu_counters()
+    cpu_start, main_start = _cpu_counters(), time.thread_time()
     start = last = time.perf_counter()
     for _ in range(frames):
         t = time.perf_counter()
@@ -309,6 +312,7 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
     result.drain_seconds = time.perf_counter() - t
     result.cpu_seconds, result.system_seconds, result.page_faults = _cpu_counters() - cpu_start   # before the
     # queue's processes stop
+    result.main_thread_seconds = time.thread_time() - main_start
     result.profile = rep.orchestrator.get_profile()
     result.peak_rss_mb = _peak_rss_mb()
     if writer is not None:
@@ -461,7 +465,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     result = BenchResult(label="hand-written MuJoCo loop", frames=frames, cameras=config.num_cameras)
     pending.clear()
     profiling.reset()
-    cpu_start = _cpu_counters()
+    cpu_start, main_start = _cpu_counters(), time.thread_time()
     start = last = time.perf_counter()
     for i in range(frames):
         frame(draws.draw(), i)
@@ -476,6 +480,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
         f.result()
     result.drain_seconds = time.perf_counter() - t
     result.cpu_seconds, result.system_seconds, result.page_faults = _cpu_counters() - cpu_start
+    result.main_thread_seconds = time.thread_time() - main_start
     result.peak_rss_mb = _peak_rss_mb()
     result.profile = profiling.snapshot()
     pool.shutdown()
@@ -537,7 +542,7 @@ def _worker(config_dict: dict, before_timing=None) -> dict:
     config = BenchConfig(**config_dict)
     r = run_graphsdg(config, before_timing=before_timing)
     return {"frames": r.frames, "wall": r.wall_seconds, "start": r.started_at, "cpu": r.cpu_seconds,
-            "system": r.system_seconds, "page_faults": r.page_faults,
+            "system": r.system_seconds, "main_thread": r.main_thread_seconds, "page_faults": r.page_faults,
             "frame_ends": (r.started_at + np.cumsum(r.frame_times)).tolist(),
             "gpu": int(os.environ["GRAPHSDG_GPU"]) if os.environ.get("GRAPHSDG_GPU", "").isdigit() else None,
             "cuda_visible_devices": os.environ.get("CUDA_VISIBLE_DEVICES"),
@@ -599,6 +604,7 @@ def summarize_processes(results: list[dict], config: BenchConfig, elapsed: float
     aggregate = sum(r["frames"] for r in results) / window
     cpu = sum(r["cpu"] for r in results)
     system = sum(r.get("system", 0.0) for r in results)
+    main_thread = sum(r.get("main_thread", 0.0) for r in results)
     faults = sum(r.get("page_faults", 0) for r in results)
     frames = sum(r["frames"] for r in results)
     return {"processes": len(results),
@@ -609,6 +615,7 @@ def summarize_processes(results: list[dict], config: BenchConfig, elapsed: float
             "slowest process frames/s": round(min(per_process), 1),
             "CPU ms per frame (all threads)": round(1000 * cpu / frames, 1),
             "of which system (kernel) ms": round(1000 * system / frames, 1),
+            "of which main threads ms": round(1000 * main_thread / frames, 1),
             "minor page faults per frame": round(faults / frames),
             "cores busy (CPU s / window s)": round(cpu / window, 1),
             "wall s (incl. start-up)": round(elapsed, 1),
