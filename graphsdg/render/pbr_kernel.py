@@ -100,11 +100,7 @@ def _not_inlined(function: Any) -> Any:
 
 def _geom_test(cast: Any) -> Any | None:
     """The per-geom ray test (``intersect``) that mujoco-warp-pbr's ordered traversal ``cast`` calls, or None."""
-    code, cells = cast.func.__code__, cast.func.__closure__ or ()
-    for name, cell in zip(code.co_freevars, cells):
-        if name == "intersect":
-            return cell.cell_contents
-    return None
+    return nested_function(cast, "intersect")
 
 
 def nested_function(root: Any, name: str) -> Any | None:
