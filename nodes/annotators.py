@@ -94,8 +94,11 @@ def hdr_color(frame: FrameView, params: dict) -> dict:
 
 
 def distance_to_image_plane(frame: FrameView, params: dict) -> dict:
-    """float32 (H, W) depth along the optical axis in stage units; inf where nothing was hit."""
-    return {"data": frame.require("depth").astype(np.float32, copy=True)}
+    """float32 (H, W) depth along the optical axis in stage units; inf where nothing was hit.
+
+    The frame's own depth array, as ``rgb`` hands out the frame's colour: each render's passes are arrays of
+    that frame alone, and the frame's other annotators have read them before a writer or script gets them."""
+    return {"data": np.asarray(frame.require("depth"), dtype=np.float32)}
 
 
 def _distance_to_camera(frame: FrameView) -> np.ndarray:

@@ -139,3 +139,33 @@ def test_gathered_uploads_go_in_one_copy_and_keep_what_was_not_put():
         uploads.put("poses", moved["poses"], [1, 2, 3])
     with pytest.raises(RuntimeError, match="already"):
         uploads.gather({"ids": ids})
+
+
+def _layout_frame(layout: po.ClassicLayout, value: int) -> po.HostFrame:
+    """Fill ``layout``'s device outputs with ``value`` and read them back as a host frame."""
+    layout.rgba.fill_(value)
+    layout.depth.fill_(float(value))
+    layout.codes.fill_(value % 5)
+    layout.queue_boxes()                   # as convert(..., boxes=True) queues them after the conversion
+    layout.queue_read(colour=True, depth=True, ids=True)
+    return layout.take()
+
+
+def test_host_frames_are_lent_views_that_no_later_read_overwrites():
+    h, w = 3, 5
+    layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4)
+    kept = [_layout_frame(layout, v) for v in range(po.HOST_BUFFERS + 3)]   # more than the buffers: copies too
+    for v, frame in enumerate(kept):
+        assert np.all(frame.rgba.view(np.uint32) == v) and np.all(frame.depth == v)
+        assert np.all(frame.codes == v % 5) and frame.codes.shape == (h, w)
+        assert frame.code_boxes[v % 5].tolist() == [0, 0, w - 1, h - 1]
+        assert np.all(np.delete(frame.code_boxes, v % 5, axis=0) == -1)
+    assert layout.host.lent() == po.HOST_BUFFERS
+    lent = kept[0].rgba
+    assert not lent.flags.owndata and kept[-1].rgba.base is not None
+    del kept, frame
+    assert layout.host.lent() == 1                     # only the first frame's rgba still holds its buffer
+    for v in range(20):                                # the freed buffers are read into again, no new ones
+        frame = _layout_frame(layout, 100 + v)
+        assert np.all(frame.depth == 100 + v)
+    assert np.all(lent.view(np.uint32) == 0) and len(layout.host._buffers) == po.HOST_BUFFERS

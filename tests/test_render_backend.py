@@ -180,3 +180,15 @@ def test_models_compiled_for_pbr_carry_a_camera_per_render_product(monkeypatch):
     runtime().render_scene.require_pbr_cameras(5)
     assert sim.stats["compiles"] == compiles + 1 and pbr_camera_name(4) in names(sim.model)
     assert sim.data.time == 1.25
+
+
+def test_finish_finishes_copied_passes_and_leaves_derived_ones_until_asked():
+    calls = []
+    out = backend.RenderOutputs()
+    out.put("id_codes", lambda: calls.append("codes") or np.array([[2, 0]], dtype=np.uint8))
+    out.id_lut = np.array([-1, 0, 1], dtype=np.int32)
+    out.derive("geom_ids", lambda done: calls.append("ids") or done.id_lut[done.id_codes])
+    out.finish()
+    assert calls == ["codes"]                    # the copy is taken, the lookup nobody asked for is not made
+    assert out.geom_ids.tolist() == [[1, -1]]
+    assert calls == ["codes", "ids"]

@@ -108,12 +108,14 @@ class RenderOutputs:
       ``(geom ids, crop) -> int32 ids of the crop``
 
     A pass whose pixels are still being copied off the GPU (a deferred render)
-    is finished on first access.
+    is finished on first access; a pass derived from others on the CPU (``geom_ids``
+    from the id codes) is computed on first access only.
     """
 
     def __init__(self) -> None:
         self._values: dict[str, np.ndarray | None] = {}
         self._pending: dict[str, Callable[[], np.ndarray]] = {}
+        self._derived: dict[str, Callable[[RenderOutputs], np.ndarray]] = {}
         self.id_lut: np.ndarray | None = None
         self.render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
 
@@ -124,14 +126,24 @@ class RenderOutputs:
         else:
             self._values[name] = value
 
+    def derive(self, name: str, compute: Callable[["RenderOutputs"], np.ndarray]) -> None:
+        """Make pass ``name`` from other passes on first access: ``compute(self)``. :meth:`finish` leaves it
+        alone (nothing of the renderer's is held), and ``compute`` takes the outputs as its argument so that it
+        need not refer to them (a reference cycle would keep every pass alive until the garbage collector ran)."""
+        self._derived[name] = compute
+
     def get(self, name: str) -> np.ndarray | None:
-        """A pass's pixels (finished first if still copying); None if it was not rendered."""
+        """A pass's pixels (finished first if still copying, made first if derived); None if it was not
+        rendered."""
         if name in self._pending:
             self._values[name] = self._pending.pop(name)()
+        elif name in self._derived:
+            self._values[name] = self._derived.pop(name)(self)
         return self._values.get(name)
 
     def finish(self) -> None:
-        """Finish every pending pass (the GL context must still exist)."""
+        """Finish every pending pass, which holds a renderer's buffer (the GL context must still exist);
+        derived passes are made only when asked for."""
         for name in list(self._pending):
             self.get(name)
 

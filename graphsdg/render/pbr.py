@@ -102,6 +102,7 @@ class _Context:
     uploaded: dict = field(default_factory=dict)   # field name -> host copy last uploaded
     tree: Any = None    # pbr_scene_bvh.SceneTree: the scene BVH and the boxes it was last built from
     rgb: dict = field(default_factory=dict)        # camera index -> wp.array (1, H, W) vec3 (colour accumulation)
+    conversions: dict = field(default_factory=dict)   # (ids per camera, layouts) -> LaunchGraph of the conversion
 
 
 @dataclass
@@ -139,6 +140,7 @@ class PbrRenderer:
     docstring)."""
 
     MAX_CONTEXTS = 4    # live render contexts (device memory): a step's batch, plus products drawn alone
+    MAX_CONVERSIONS = 4     # conversion graphs kept a context (passes asked for, layouts)
     #: the mujoco-warp Data and Model arrays a frame uploads (PbrRenderer._upload_state), sent in one copy
     FRAME_DATA = ("geom_xpos", "geom_xmat", "light_xpos", "light_xdir", "cam_xpos", "cam_xmat")
     FRAME_MODEL = ("geom_rgba", "geom_matid", "geom_size", "mat_rgba", "light_diffuse")
@@ -158,13 +160,13 @@ class PbrRenderer:
         import mujoco_warp_pbr as mjpbr
         import warp as wp
 
-        from graphsdg.render import backend, pbr_meshes, pbr_outputs, pbr_scene_bvh, pbr_uploads
+        from graphsdg.render import backend, launch_graph, pbr_meshes, pbr_outputs, pbr_scene_bvh, pbr_uploads
         if wp.get_device(device or "cuda:0").is_cuda:
             kernel_cache.compile_in_background(self.FIRST_FRAME_MODULES, device or "cuda:0")
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads
-        self._scene_bvh = pbr_scene_bvh
+        self._scene_bvh, self._launch_graph = pbr_scene_bvh, launch_graph
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
         self._isolated = None                    # classic rasteriser for render_isolated footprints
@@ -338,12 +340,12 @@ class PbrRenderer:
                         acc = self._colour(ctx) if acc is None else acc + self._colour(ctx)
                 if acc is not None and first.motion is None:
                     acc = acc / launches
-                for index, layout in enumerate(ctx.layouts):
-                    layout.convert(ctx.rc.base, index)
+                ids = tuple(bool({"segmentation", "depth"} & r.passes) for r in requests)
+                self._conversion(ctx, ids).run()
             with profiling.timed("readback:pbr"):
                 queued = self._outputs.queue_reads([
-                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes,
-                     bool({"segmentation", "depth"} & r.passes)) for layout, r in zip(ctx.layouts, requests)])
+                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes, read_ids)
+                    for layout, r, read_ids in zip(ctx.layouts, requests, ids)])
                 if all(r.defer for r in requests):   # pipelined: the copies finish while the script goes on
                     self._queued.append(queued)
                 else:
@@ -351,6 +353,22 @@ class PbrRenderer:
         self.stats["products"] += len(requests)
         return [self._outputs_of(scene, r, _host_of(queued, i), layout.table, acc)
                 for i, (r, layout) in enumerate(zip(requests, ctx.layouts))]
+
+    def _conversion(self, ctx: _Context, ids: tuple[bool, ...]):
+        """The :class:`~graphsdg.render.launch_graph.LaunchGraph` converting each camera's pixels of ``ctx``
+        to the classic layout, with their codes' pixel bounds where ``ids`` asks (one per camera)."""
+        key = (ids, tuple(id(layout) for layout in ctx.layouts))
+        graph = ctx.conversions.get(key)
+        if graph is None:
+            if len(ctx.conversions) >= self.MAX_CONVERSIONS:   # new intrinsics every frame make new layouts
+                ctx.conversions.clear()
+            base, layouts = ctx.rc.base, list(ctx.layouts)
+
+            def launches() -> None:
+                for index, (layout, boxes) in enumerate(zip(layouts, ids)):
+                    layout.convert(base, index, boxes=boxes)
+            graph = ctx.conversions[key] = self._launch_graph.LaunchGraph(self._device, launches)
+        return graph
 
     def _take_queued(self) -> None:
         """Take every deferred render's pixels still in page-locked buffers, before a render reuses them."""
@@ -390,7 +408,7 @@ class PbrRenderer:
             out.put("id_codes", lambda: host().codes)
             out.put("code_boxes", lambda: host().code_boxes)
             out.id_lut = table
-            out.put("geom_ids", lambda: lookup(table, out.id_codes))
+            out.derive("geom_ids", lambda done: lookup(table, done.id_codes))
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(scene, view, geoms, crop)
         return out
 

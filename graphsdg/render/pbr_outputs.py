@@ -11,7 +11,9 @@ tight boxes' and drawn-geom lists' input, :class:`HostFrame`). One kernel conver
 where the pixels already are (one launch per camera of a batched render); a camera's outputs
 share one device allocation, so its asked-for arrays come back in one copy into page-locked
 host memory, all cameras' copies behind one event, waited for when the pixels are first used
-(a pipelined step's go on copying while the script randomizes the next frame): about a quarter
+(a pipelined step's go on copying while the script randomizes the next frame). The host arrays
+are views of that page-locked buffer, not copies of it: a layout keeps a few buffers and reads
+into one that no array of an earlier frame still uses (:class:`HostBuffers`). About a quarter
 of the bytes the renderer's own float
 ``get_rgb`` readback moves, and no per-pixel numpy work on the CPU (scenes under 255
 geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host).
@@ -20,8 +22,10 @@ Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on constru
 """
 from __future__ import annotations
 
+import ctypes
+import weakref
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import warp as wp
@@ -57,6 +61,10 @@ def _clear_boxes(boxes: wp.array2d[wp.int32]):
     boxes[i, 2] = -1
     boxes[i, 3] = -1
 
+
+#: page-locked buffers a layout lends out as frames' arrays before it copies them instead (HostBuffers): a
+#: pipelined step holds one frame's, its writer threads the few frames they have not written yet
+HOST_BUFFERS = 6
 
 #: pixels of a row one thread of :func:`_code_boxes` walks: a row a thread left 512 threads for a 512x512 frame,
 #: each walking 512 pixels one after another
@@ -114,6 +122,69 @@ def code_table(ngeom: int) -> np.ndarray:
 
 _WARP_CODE_TYPES = {np.uint8: wp.uint8, np.uint16: wp.uint16, np.uint32: wp.uint32}
 _ALIGN = 256           # bytes: each output's start in the layout's one allocation
+_QUEUED = lambda: True   # noqa: E731  a buffer's lease while a read into it is queued and not yet taken
+
+
+class HostBuffers:
+    """Page-locked host buffers of ``nbytes`` for one layout's reads, lent out as the frames' arrays.
+
+    A frame's arrays are views of the buffer its pixels were copied into, kept alive by one lease object
+    (their common base); the buffer is read into again only once every array of that frame is gone. So a
+    frame costs no host copy while annotators and writers let go of its arrays within ``count`` frames,
+    and one copy a frame (into arrays of its own, from one more buffer kept for that) while they do not.
+
+    Example (Warp's CPU device)::
+
+        buffers = HostBuffers(16, "cpu", count=2)
+        index = buffers.acquire()           # a free buffer, or None: read into buffers.spare and copy
+        arrays = buffers.lend(index)        # a uint8 view of it; the buffer is free once views are gone
+    """
+
+    def __init__(self, nbytes: int, device: str, count: int) -> None:
+        self.nbytes, self.device, self.count = nbytes, device, count
+        self._pinned = wp.get_device(device).is_cuda
+        self._buffers: list[Any] = []                 # Warp host arrays
+        self._leases: list[Callable[[], Any]] = []    # per buffer: its lease (a weak reference) or _QUEUED
+        self._spare: Any = None
+
+    @property
+    def spare(self) -> Any:
+        """The buffer read into when none is free (its contents are copied out by the taker)."""
+        if self._spare is None:
+            self._spare = self._allocate()
+        return self._spare
+
+    def buffer(self, index: int) -> Any:
+        """Buffer ``index`` (a Warp host array of uint8)."""
+        return self._buffers[index]
+
+    def acquire(self) -> int | None:
+        """A buffer no frame's arrays use (made while fewer than ``count`` exist), marked queued; None if none."""
+        for index, lease in enumerate(self._leases):
+            if lease() is None:
+                self._leases[index] = _QUEUED
+                return index
+        if len(self._buffers) < self.count:
+            self._buffers.append(self._allocate())
+            self._leases.append(_QUEUED)
+            return len(self._buffers) - 1
+        return None
+
+    def lend(self, index: int) -> np.ndarray:
+        """Buffer ``index`` as a uint8 array whose base is a fresh lease: the buffer is free again once that
+        array and every view of it are gone."""
+        buffer = self._buffers[index]
+        lease = (ctypes.c_uint8 * self.nbytes).from_address(buffer.ptr)
+        lease.buffer = buffer          # the page-locked memory outlives the arrays, whatever becomes of the layout
+        self._leases[index] = weakref.ref(lease)
+        return np.frombuffer(lease, dtype=np.uint8)
+
+    def lent(self) -> int:
+        """Buffers whose arrays are still in use or whose read is queued."""
+        return sum(lease() is not None for lease in self._leases)
+
+    def _allocate(self) -> Any:
+        return wp.empty(self.nbytes, dtype=wp.uint8, device="cpu", pinned=self._pinned)
 
 
 @dataclass
@@ -154,21 +225,24 @@ class ClassicLayout:
             end = start + int(np.prod(shape)) * wp.types.type_size_in_bytes(dtype)
             self._spans[name] = (start, end, np.dtype(wp.dtype_to_numpy(dtype)), shape)
         self._device_bytes = wp.empty(end, dtype=wp.uint8, device=device)
-        self._host_bytes = wp.empty(end, dtype=wp.uint8, device="cpu", pinned=wp.get_device(device).is_cuda)
-        self._host_view = self._host_bytes.numpy()
+        self.host = HostBuffers(end, device, HOST_BUFFERS)
+        self._reading: int | None = None       # the host buffer of the read last queued (None: the spare)
         for name, dtype, shape in parts:    # typed views of the allocation, which the layout keeps alive
             setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
                                          shape=shape, device=device))
         self._adrs: dict[tuple, int] = {}
         self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
 
-    def convert(self, base, camera: int) -> None:
-        """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0)."""
+    def convert(self, base, camera: int, boxes: bool = False) -> None:
+        """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0), and with
+        ``boxes`` their codes' pixel bounds (:meth:`queue_boxes`; a read of the ids needs them)."""
         wp.launch(_classic_layout, dim=self.shape[0] * self.shape[1],
                   inputs=[base.rgb_data, base.depth_data, base.seg_data, self._adr(base, "rgb", camera),
                           self._adr(base, "depth", camera), self._adr(base, "seg", camera), self.cosines, self.near,
                           self.far],
                   outputs=[self.rgba, self.depth, self.codes], device=self.device)
+        if boxes:
+            self.queue_boxes()
 
     def _adr(self, base, kind: str, camera: int) -> int:
         """The camera's first pixel in one of ``base``'s buffers (read from the device once)."""
@@ -189,23 +263,32 @@ class ClassicLayout:
         return [name for name, want in (("rgba", colour), ("depth", depth), ("codes", ids), ("boxes", ids)) if want]
 
     def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
-        """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds)
-        into the page-locked host buffer."""
+        """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds:
+        converted with ``boxes``) into a page-locked host buffer."""
         self._wanted = (colour, depth, ids)
-        if ids:
-            self.queue_boxes()
         parts = self._parts()
         if parts:
+            self._reading = self.host.acquire()
+            target = self.host.spare if self._reading is None else self.host.buffer(self._reading)
             lo, hi = self._spans[parts[0]][0], self._spans[parts[-1]][1]
-            wp.copy(self._host_bytes, self._device_bytes, dest_offset=lo, src_offset=lo, count=hi - lo)
+            wp.copy(target, self._device_bytes, dest_offset=lo, src_offset=lo, count=hi - lo)
 
     def take(self) -> HostFrame:
-        """The queued copies (done) as arrays of their own: annotators and writer threads keep them past the
-        next render (each its own copy, so keeping one keeps no other alive)."""
+        """The queued copies (done) as arrays: views of the page-locked buffer they were read into, lent until
+        every one of them is gone (:class:`HostBuffers`), or copies of their own when no buffer was free.
+        Annotators and writer threads may keep them past later renders."""
+        parts = self._parts()
+        if not parts:
+            return HostFrame(rgba=None, depth=None, codes=None)
+        if self._reading is None:
+            whole, lent = self.host.spare.numpy(), False
+        else:
+            whole, lent = self.host.lend(self._reading), True
         own = {}
-        for name in self._parts():
+        for name in parts:
             start, end, dtype, shape = self._spans[name]
-            own[name] = np.array(self._host_view[start:end]).view(dtype).reshape(shape)
+            piece = whole[start:end] if lent else np.array(whole[start:end])   # copies keep no other part alive
+            own[name] = piece.view(dtype).reshape(shape)
         h, w = self.shape
         rgba, boxes = own.get("rgba"), own.get("boxes")
         if boxes is not None:
@@ -242,4 +325,4 @@ def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> QueuedRe
     return QueuedReads([layout for layout, *_ in reads], wp.record_event() if cuda else None)
 
 
-__all__ = ["ClassicLayout", "HostFrame", "QueuedReads", "code_format", "code_table", "queue_reads"]
+__all__ = ["ClassicLayout", "HostBuffers", "HostFrame", "QueuedReads", "code_format", "code_table", "queue_reads"]

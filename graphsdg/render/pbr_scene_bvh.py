@@ -23,6 +23,8 @@ from typing import Any
 import numpy as np
 import warp as wp
 
+from graphsdg.render.launch_graph import LaunchGraph
+
 
 @wp.kernel(enable_backward=False)
 def _group_roots(bvh: wp.uint64, roots: wp.array[int]):
@@ -45,11 +47,13 @@ def rebuild_scene_bvh(mjw: Any, m: Any, d: Any, context: Any) -> None:
 class SceneTree:
     """A render context's scene BVH: rebuilt from a frame's boxes unless they are made of what the last
     rebuild's were (geom positions, the frames the tracer uses, sizes, mesh bounds), so its tree is always
-    that of the frame's own boxes."""
+    that of the frame's own boxes. The rebuild's launches are replayed as one graph
+    (:class:`~graphsdg.render.launch_graph.LaunchGraph`)."""
 
     def __init__(self) -> None:
         self._built_from: tuple[np.ndarray, ...] | None = None    # None: still the tree of the compiled poses
         self.rebuilds = 0
+        self._rebuild: tuple[tuple[int, ...], LaunchGraph] | None = None   # (ids of mjw, m, d, context), graph
 
     def update(self, mjw: Any, m: Any, d: Any, context: Any, inputs: tuple[Any, ...], always: bool = False) -> bool:
         """Rebuild ``context``'s tree (:func:`rebuild_scene_bvh`) unless ``inputs``, the host arrays the
@@ -59,10 +63,19 @@ class SceneTree:
         if not always and self._built_from is not None and len(inputs) == len(self._built_from) and all(
                 a.shape == b.shape and np.array_equal(a, b) for a, b in zip(inputs, self._built_from)):
             return False
-        rebuild_scene_bvh(mjw, m, d, context)
+        self._rebuild_graph(mjw, m, d, context).run()
         self._built_from = tuple(np.array(a, copy=True) for a in inputs)
         self.rebuilds += 1
         return True
+
+    def _rebuild_graph(self, mjw: Any, m: Any, d: Any, context: Any) -> LaunchGraph:
+        """The graph of :func:`rebuild_scene_bvh` on these arrays (made again if another model or context
+        comes)."""
+        key = (id(mjw), id(m), id(d), id(context))
+        if self._rebuild is None or self._rebuild[0] != key:
+            device = str(context.group_root.device)
+            self._rebuild = (key, LaunchGraph(device, lambda: rebuild_scene_bvh(mjw, m, d, context)))
+        return self._rebuild[1]
 
 
 __all__ = ["SceneTree", "rebuild_scene_bvh"]

@@ -330,7 +330,7 @@ class Rasterizer:
             if "segmentation" in passes:
                 out.put("id_codes", codes)
                 out.id_lut = lut
-                out.put("geom_ids", lambda: lookup(lut, out.id_codes))
+                out.derive("geom_ids", lambda done: lookup(lut, done.id_codes))
             out.put("depth", depth)
         if not defer:
             out.finish()
