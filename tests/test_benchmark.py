@@ -216,3 +216,12 @@ def test_the_hand_written_loop_draws_the_frames_graphsdg_draws(tmp_path):
         # host `auto` renders graphsdg's frames with the pbr backend, whose depths are exact (measured on an H200:
         # up to 1.5 cm apart); a shape drawn at another size differs by far more, and in what is hit
         assert np.mean(np.abs(ours[both] - loop[both]) < 0.0025 * loop[both]) > 0.99
+
+
+def test_processes_started_together_stop_together_at_the_deadline():
+    from graphsdg.benchmark.throughput import BenchConfig, run_graphsdg
+    waited = []
+    config = BenchConfig(frames=100000, seconds=0.6, warmup=1, asset_count=1, resolution=(64, 48), skip_write=True)
+    r = run_graphsdg(config, before_timing=lambda: waited.append(True))
+    assert waited == [True] and 0 < r.frames < 100000 and len(r.frame_times) == r.frames
+    assert 0.6 <= r.wall_seconds <= 0.6 + max(r.frame_times) + 0.05   # the frame under way at the deadline ends it

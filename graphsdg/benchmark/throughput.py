@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import dataclasses
+import math
 import os
 import resource
 import tempfile
@@ -73,7 +74,8 @@ class BenchConfig:
     path_spp: int | None = None          # /rtx/pathtracing/spp of the path tier; None: the setting as it is
     pbr_batch_pixels: int | None = None  # /graphsdg/render/pbrBatchPixels (0: a launch per product); None: as set
     pbr_kernel: str | None = None        # /graphsdg/render/pbrKernel (compact, inlined); None: as set
-    seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow
+    seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow (with
+    #                                      a before_timing barrier, processes started together: until this deadline)
     write_processes: int | str | None = None   # /graphsdg/io/writeProcesses (a count, 0, auto); None: as set
     temp_dir: str | None = None          # where each run makes (and then removes) its output folder; None: the
     #                                      system's temporary folder. It picks the file system the frames go to.
@@ -290,21 +292,26 @@ def run_graphsdg(config: BenchConfig, before_timing=None) -> BenchResult:
         rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
         warmup_times.append(time.perf_counter() - t)
     rep.orchestrator.wait_until_complete()
-    frames = timed_frames(config, warmup_times)
-    result = BenchResult(label="graphsdg", frames=frames, cameras=config.num_cameras)
+    # processes started together stop together: at the deadline (a frame count from each one's warm-up rate left
+    # the processes whose warm-up ran while others still compiled straggling at the end of the window)
+    together = before_timing is not None and config.seconds is not None
+    frames = config.frames if together else timed_frames(config, warmup_times)
     if before_timing is not None:
         before_timing()
     rep.orchestrator.reset_profile()
+    result = BenchResult(label="graphsdg", frames=0, cameras=config.num_cameras)
     result.started_at = time.time()
     cpu_start, main_start = _cpu_counters(), time.thread_time()
     start = last = time.perf_counter()
-    for _ in range(frames):
+    deadline = start + config.seconds if together else math.inf
+    while result.frames < frames and last < deadline:
         t = time.perf_counter()
         _apply(draws.draw(), assets, cams)
         profiling.add("randomize", time.perf_counter() - t)
         rep.orchestrator.step(rt_subframes=config.rt_subframes, wait_for_render=config.wait_for_render)
         now = time.perf_counter()
         result.frame_times.append(now - last)
+        result.frames += 1
         last = now
     result.wall_seconds = time.perf_counter() - start
     t = time.perf_counter()
@@ -565,7 +572,8 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     """``processes`` independent graphsdg benchmark processes at once (seeds differ); aggregate frames/s.
 
     Every process builds its scene and warms up, then all start their timed
-    frames together (a barrier). The aggregate is all frames over the window
+    frames together (a barrier) and, with ``config.seconds``, stop together at
+    that deadline. The aggregate is all frames over the window
     from the first start to the last finish, so a straggler counts against it;
     the steady rate counts only the frames finished while every process ran.
     """

@@ -373,7 +373,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="timed frames of each run, after the warm-up (default: 600)")
     bench.add_argument("--seconds", type=_positive_float,
                        help="time each run for about this many seconds: fewer than --num-frames frames when the "
-                            "warm-up's rate says so, at least 20 (default: always --num-frames)")
+                            "warm-up's rate says so, at least 20; with --processes every process stops at the same "
+                            "deadline, this many seconds after they start together (default: always --num-frames)")
     bench.add_argument("--warmup", type=_non_negative, default=10,
                        help="untimed frames captured first, so compiling and first uploads are not timed "
                             "(default: 10)")
