@@ -25,13 +25,13 @@ log = logging.getLogger(__name__)
 
 
 class LaunchGraph:
-    """``launches()`` (a function queuing Warp launches on ``device``'s current stream), replayed as a graph
-    from its third run on.
+    """``launches()`` (a function queuing Warp launches on ``device``'s current stream), recorded as a graph on
+    its second run and replayed from then on.
 
     Example (Warp's CPU device)::
 
         data = wp.zeros(4, dtype=wp.float32, device="cpu")
-        step = LaunchGraph("cpu", lambda: wp.launch(add_one, dim=4, inputs=[data], device="cpu"))
+        step = LaunchGraph("cpu", lambda: wp.launch(add_one, dim=4, inputs=[data], device="cpu"))  # a @wp.kernel
         for _ in range(3):
             step.run()       # plain, recorded and replayed, replayed: data is 3.0 everywhere
     """
