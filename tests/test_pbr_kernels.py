@@ -169,3 +169,12 @@ def test_host_frames_are_lent_views_that_no_later_read_overwrites():
         frame = _layout_frame(layout, 100 + v)
         assert np.all(frame.depth == 100 + v)
     assert np.all(lent.view(np.uint32) == 0) and len(layout.host._buffers) == po.HOST_BUFFERS
+
+
+def test_large_frames_lend_fewer_buffers():
+    counts = {}
+    for side in (2048, 3000, 4096):       # ~36, ~81 and ~144 MiB a frame (colour, depth, one-byte codes)
+        layout = po.ClassicLayout(side, side, np.ones((side, side)), 0.0, 100.0, "cpu", ngeom=4)
+        counts[side] = layout.host.count
+        assert counts[side] * layout.host.nbytes <= po.HOST_BUFFER_BYTES or counts[side] == 1
+    assert counts == {2048: po.HOST_BUFFERS, 3000: 3, 4096: 1}

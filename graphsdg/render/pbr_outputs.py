@@ -63,8 +63,10 @@ def _clear_boxes(boxes: wp.array2d[wp.int32]):
 
 
 #: page-locked buffers a layout lends out as frames' arrays before it copies them instead (HostBuffers): a
-#: pipelined step holds one frame's, its writer threads the few frames they have not written yet
+#: pipelined step holds one frame's, its writer threads the few frames they have not written yet; fewer where
+#: that many would lock more than HOST_BUFFER_BYTES of host memory (large frames), but at least one
 HOST_BUFFERS = 6
+HOST_BUFFER_BYTES = 256 << 20
 
 #: pixels of a row one thread of :func:`_code_boxes` walks: a row a thread left 512 threads for a 512x512 frame,
 #: each walking 512 pixels one after another
@@ -225,7 +227,7 @@ class ClassicLayout:
             end = start + int(np.prod(shape)) * wp.types.type_size_in_bytes(dtype)
             self._spans[name] = (start, end, np.dtype(wp.dtype_to_numpy(dtype)), shape)
         self._device_bytes = wp.empty(end, dtype=wp.uint8, device=device)
-        self.host = HostBuffers(end, device, HOST_BUFFERS)
+        self.host = HostBuffers(end, device, max(1, min(HOST_BUFFERS, HOST_BUFFER_BYTES // end)))
         self._reading: int | None = None       # the host buffer of the read last queued (None: the spare)
         for name, dtype, shape in parts:    # typed views of the allocation, which the layout keeps alive
             setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
