@@ -143,8 +143,9 @@ class HostBuffers:
     """
 
     def __init__(self, nbytes: int, device: str, count: int) -> None:
-        self.nbytes, self.device, self.count = nbytes, device, count
+        self.nbytes, self.count = nbytes, count
         self._pinned = wp.get_device(device).is_cuda
+        self._lease_type = ctypes.c_uint8 * nbytes    # a lease: the buffer's bytes as an object of their own
         self._buffers: list[Any] = []                 # Warp host arrays
         self._leases: list[Callable[[], Any]] = []    # per buffer: its lease (a weak reference) or _QUEUED
         self._spare: Any = None
@@ -176,7 +177,7 @@ class HostBuffers:
         """Buffer ``index`` as a uint8 array whose base is a fresh lease: the buffer is free again once that
         array and every view of it are gone."""
         buffer = self._buffers[index]
-        lease = (ctypes.c_uint8 * self.nbytes).from_address(buffer.ptr)
+        lease = self._lease_type.from_address(buffer.ptr)
         lease.buffer = buffer          # the page-locked memory outlives the arrays, whatever becomes of the layout
         self._leases[index] = weakref.ref(lease)
         return np.frombuffer(lease, dtype=np.uint8)
