@@ -376,3 +376,54 @@ def test_a_compact_build_calls_the_lights_shadow_test_where_its_cuts_name_it(ren
     with pbr_kernel.building("inlined"):
         pixel = _pixel_body(pbr_render._build_megakernel(ctx.model, ctx.rc))
     assert pbr_kernel.nested_function(pixel, "light_visibility").inline_hint is None
+
+
+def test_the_megakernels_replays_render_what_the_librarys_launches_render(renderer):
+    """A replayed megakernel launch (only the seed set) gives the library's pixels for that seed and the arrays'
+    current contents; a field replaced by another array goes through the library again and is recorded anew."""
+    import mujoco_warp_pbr as mjpbr
+    import warp as wp
+
+    from graphsdg.render.megakernel_launch import MegakernelLaunch
+
+    rep.functional.create.dome_light(intensity=100)
+    rep.functional.create.cube(position=(0, 0, 0.5), name="Cube")
+    rep.functional.create.plane(scale=5, name="Floor")   # a bulb's soft shadows on a floor: the seed shows
+    rep.functional.create.sphere_light(intensity=3000, radius=0.6, position=(0.5, -1.5, 2.0))
+    cam = rep.functional.create.camera(position=(3, -4, 2.5), look_at=(0.3, 0, 0.4))
+    scene, view = runtime().render_scene, camera_view(cam, W, H)
+    renderer.render(scene, view, {"color", "depth", "segmentation"})
+    ctx = next(c for c in renderer._contexts.values() if c.layouts[0].shape == (H, W))
+    m, d, rc = ctx.model, ctx.data, ctx.rc
+    samples = rc.shadow_samples
+    rc.shadow_samples = 8
+
+    def pixels(launch) -> tuple[np.ndarray, ...]:
+        launch()
+        wp.synchronize_device(rc.base.rgb_data.device)
+        return rc.base.rgb_data.numpy().copy(), rc.base.depth_data.numpy().copy(), rc.base.seg_data.numpy().copy()
+
+    draw = MegakernelLaunch()
+    seen = set()
+    for step, seed in enumerate((3, 4, 4, 11)):
+        if step == 2:    # new contents of an array the recording points at: a cube moved on the device
+            xpos = d.geom_xpos.numpy()
+            xpos[0, :, 0] += 0.4
+            d.geom_xpos.assign(xpos)
+        replayed = pixels(lambda: draw(m, d, rc, seed))
+        library = pixels(lambda: mjpbr.render(m, d, rc, seed=seed))
+        assert all(np.array_equal(a, b) for a, b in zip(replayed, library))
+        seen.add(replayed[0].tobytes())
+    assert draw.replays == 3 and len(seen) == 3          # seeds 3, 4 and the move change the colour
+
+    rough = rc.geom_roughness
+    try:
+        rc.geom_roughness = wp.clone(rough)              # another object: the library launches and is recorded
+        rc.geom_roughness.fill_(0.05)
+        replayed = pixels(lambda: draw(m, d, rc, 5))
+        library = pixels(lambda: mjpbr.render(m, d, rc, seed=5))
+        assert draw.replays == 3 and all(np.array_equal(a, b) for a, b in zip(replayed, library))
+        assert all(np.array_equal(a, b) for a, b in zip(pixels(lambda: draw(m, d, rc, 5)), library))
+        assert draw.replays == 4
+    finally:
+        rc.geom_roughness, rc.shadow_samples = rough, samples

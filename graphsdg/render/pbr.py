@@ -103,6 +103,7 @@ class _Context:
     tree: Any = None    # pbr_scene_bvh.SceneTree: the scene BVH and the boxes it was last built from
     rgb: dict = field(default_factory=dict)        # camera index -> wp.array (1, H, W) vec3 (colour accumulation)
     conversions: dict = field(default_factory=dict)   # (ids per camera, layouts) -> LaunchGraph of the conversion
+    draw: Any = None    # megakernel_launch.MegakernelLaunch: the megakernel's launch, replayed with each seed
 
 
 @dataclass
@@ -160,13 +161,14 @@ class PbrRenderer:
         import mujoco_warp_pbr as mjpbr
         import warp as wp
 
-        from graphsdg.render import backend, launch_graph, pbr_meshes, pbr_outputs, pbr_scene_bvh, pbr_uploads
+        from graphsdg.render import (backend, launch_graph, megakernel_launch, pbr_meshes, pbr_outputs, pbr_scene_bvh,
+                                     pbr_uploads)
         if wp.get_device(device or "cuda:0").is_cuda:
             kernel_cache.compile_in_background(self.FIRST_FRAME_MODULES, device or "cuda:0")
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads
-        self._scene_bvh, self._launch_graph = pbr_scene_bvh, launch_graph
+        self._scene_bvh, self._launch_graph, self._megakernel = pbr_scene_bvh, launch_graph, megakernel_launch
         self._device = device or "cuda:0"
         self._contexts: dict[tuple, _Context] = {}
         self._isolated = None                    # classic rasteriser for render_isolated footprints
@@ -378,8 +380,10 @@ class PbrRenderer:
 
     def _launch(self, ctx: _Context, seeds: _LaunchSeeds) -> None:
         """One launch of every camera of ``ctx``, with the frame's next seed for these products."""
+        if ctx.draw is None:
+            ctx.draw = self._megakernel.MegakernelLaunch()
         with pbr_kernel.building(ctx.key[-1]):     # builds the megakernel on a context's first launch
-            self._mjpbr.render(ctx.model, ctx.data, ctx.rc, seed=seeds.next())
+            ctx.draw(ctx.model, ctx.data, ctx.rc, seeds.next())
         self.stats["color"] += 1
 
     def _outputs_of(self, scene: RenderScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,
