@@ -63,6 +63,35 @@ def test_processes_sharing_the_cores_get_their_share_of_image_threads(processes,
     assert cores_per_process(processes, cores) == share
 
 
+def _sized_pools() -> dict[str, int]:
+    """What a process sizes from its cores, in a spawned process given one core (the test's own stays as it is)."""
+    import os
+    from graphsdg.base.cpu_share import usable_cores
+    from graphsdg.io.write_queue import default_threads, processes_wanted
+    from graphsdg.render.gpu_assignment import default_processes_per_gpu
+    threads = default_threads()
+    return {"usable": usable_cores(), "machine": os.cpu_count(), "writer threads": threads,
+            "writer processes": processes_wanted("auto", threads), "share of 2": cores_per_process(2),
+            "processes a GPU": default_processes_per_gpu(1)}
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "sched_setaffinity"), reason="no CPU affinity on this OS")
+def test_a_process_sizes_its_pools_by_the_cores_its_affinity_allows_not_the_machines():
+    import concurrent.futures
+    import multiprocessing
+    import os
+    ours = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {min(ours)})       # a spawned child inherits it (taskset, a container's cpuset)
+    try:
+        with concurrent.futures.ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+            child = pool.submit(_sized_pools).result(timeout=120)
+    finally:
+        os.sched_setaffinity(0, ours)
+    assert child == {"usable": 1, "machine": os.cpu_count(), "writer threads": 1, "writer processes": 0,
+                     "share of 2": 1, "processes a GPU": 1}
+    assert _sized_pools()["usable"] == len(ours)
+
+
 @pytest.mark.parametrize("bad", [0, -1, 2.0, False])
 def test_image_threads_need_positive_counts(bad):
     with pytest.raises(ValueError, match="positive integer"):

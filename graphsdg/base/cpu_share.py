@@ -7,6 +7,11 @@ such pools on one host spend CPU waking and parking them, for no speed: one
 thread pools"). Processes that share a host (``graphsdg bench --processes K``,
 local Ray shards) give OpenCV their share of the cores instead.
 
+The cores a process counts are those it may run on (:func:`usable_cores`: its CPU affinity, which
+``taskset``, a container's cpuset or a batch scheduler narrow), not every core of the machine: a process
+given 16 of a host's 64 cores that sized its pools for 64 started four writer threads and four writer
+processes where one thread was its share (docs/performance.md, "Round 22").
+
 Example:
     >>> cores_per_process(16, cores=16), cores_per_process(3, cores=16), cores_per_process(4, cores=2)
     (1, 5, 1)
@@ -16,11 +21,24 @@ from __future__ import annotations
 import os
 
 
+def usable_cores() -> int:
+    """The logical CPUs this process may run on: its affinity mask where the OS has one, else the machine's.
+
+    Example:
+        >>> 1 <= usable_cores() <= (os.cpu_count() or 1)
+        True
+    """
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):     # no affinity masks on this OS (macOS, Windows)
+        return os.cpu_count() or 1
+
+
 def cores_per_process(processes: int, cores: int | None = None) -> int:
-    """Each of ``processes`` processes' share of ``cores`` (default: this machine's), at least 1."""
+    """Each of ``processes`` processes' share of ``cores`` (default: :func:`usable_cores`), at least 1."""
     if isinstance(processes, bool) or not isinstance(processes, int) or processes < 1:
         raise ValueError(f"processes must be a positive integer, got {processes!r}")
-    cores = cores if cores is not None else (os.cpu_count() or 1)
+    cores = cores if cores is not None else usable_cores()
     return max(1, cores // processes)
 
 

@@ -33,6 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from graphsdg.base import cpu_share
+
 SHAPES = ("cube", "cone", "cylinder", "sphere", "torus")
 # benchmark_sdg.py annotator names -> BasicWriter flags
 ANNOTATOR_FLAGS = {
@@ -627,7 +629,7 @@ def summarize_processes(results: list[dict], config: BenchConfig, elapsed: float
             "minor page faults per frame": round(faults / frames),
             "cores busy (CPU s / window s)": round(cpu / window, 1),
             "wall s (incl. start-up)": round(elapsed, 1),
-            "cpu count": os.cpu_count() or 0, "writer threads per process": config.write_threads,
+            "cpu count": cpu_share.usable_cores(), "writer threads per process": config.write_threads,
             "writer processes per process": processes_wanted(
                 "auto" if config.write_processes is None else config.write_processes, config.write_threads),
             "OpenCV threads per process": config.image_threads}

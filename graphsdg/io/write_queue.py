@@ -44,7 +44,7 @@ import numpy as np
 
 from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
-from graphsdg.base.cpu_share import cores_per_process
+from graphsdg.base.cpu_share import cores_per_process, usable_cores
 from graphsdg.errors import WriterError
 from graphsdg.io.write_processes import FileWrite, WriteProcesses
 from graphsdg.io.written_totals import count_written
@@ -574,7 +574,7 @@ class WriteQueue:
 
 
 def threads_per_process(processes: int, cores: int | None = None) -> int:
-    """Writer threads for each of ``processes`` processes sharing ``cores`` (default: this machine's).
+    """Writer threads for each of ``processes`` processes sharing ``cores`` (default: the cores this one may run on).
 
     The default of 4, or the processes' share of the cores when that is smaller,
     at least 1: 16 processes on 16 cores each get one writer thread. More would
@@ -589,7 +589,7 @@ def threads_per_process(processes: int, cores: int | None = None) -> int:
 
 
 def default_threads(cores: int | None = None) -> int:
-    """Writer threads for one process alone on ``cores`` cores (default: this machine's): the default of 4
+    """Writer threads for one process alone on ``cores`` cores (default: the cores it may run on): the default of 4
     with 16 cores or more, a quarter of the cores below, at least 1.
 
     Writers share the cores with the thread that renders and the GL driver's threads; more writers than
@@ -601,7 +601,7 @@ def default_threads(cores: int | None = None) -> int:
         >>> default_threads(16), default_threads(8), default_threads(2)
         (4, 2, 1)
     """
-    cores = cores if cores is not None else (os.cpu_count() or 1)
+    cores = cores if cores is not None else usable_cores()
     return min(DEFAULT_THREADS, max(1, cores // 4))
 
 
@@ -619,7 +619,7 @@ def processes_wanted(value: Any, threads: int, cores: int | None = None) -> int:
         (4, 0, 2)
     """
     if value == "auto":
-        cores = cores if cores is not None else (os.cpu_count() or 1)
+        cores = cores if cores is not None else usable_cores()
         return threads if cores >= MIN_CORES_FOR_PROCESSES and threads >= 2 else 0
     settings.VALIDATORS[PROCESSES_KEY](PROCESSES_KEY, value)   # a default edited by hand lands here unchecked
     return int(value)

@@ -58,7 +58,7 @@ def run_bench(args: argparse.Namespace) -> None:
     settings_line = (f"{length}, {args.num_cameras} camera(s), {args.resolution[0]}x{args.resolution[1]}{quality}, "
                      f"{args.asset_count * 5} assets, annotators {', '.join(annotators)}, "
                      f"{'skip-write' if args.skip_write else 'written to ' + _written_where(args.temp_dir)}")
-    machine = f"{platform.node()} ({os.cpu_count()} cores), GL: {_gl_renderer()}, render backend: " \
+    machine = f"{platform.node()} ({_cores_line()}), GL: {_gl_renderer()}, render backend: " \
               f"{_render_backend(args.backend)}"
     if args.gpus:
         table = _bench_on_gpus(args, config)
@@ -167,6 +167,13 @@ def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
     where = f"stopped at orchestrator.{stopped_at}()" if stopped_at else "the script ended without capturing"
     print(f"\n{where}; wrote {dot_path}, {json_path}, {png_path}", file=sys.stderr)
     return 0
+
+
+def _cores_line() -> str:
+    """``64 cores``, or ``64 cores, 16 of them usable`` where this process's affinity allows fewer."""
+    from graphsdg.base.cpu_share import usable_cores
+    machine, usable = os.cpu_count() or 1, usable_cores()
+    return f"{machine} cores" + (f", {usable} of them usable" if usable < machine else "")
 
 
 def _gl_renderer() -> str:

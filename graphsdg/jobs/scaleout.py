@@ -33,7 +33,7 @@ import tempfile
 import time
 from dataclasses import replace
 
-from graphsdg.base.cpu_share import cores_per_process
+from graphsdg.base.cpu_share import cores_per_process, usable_cores
 from graphsdg.render.cuda_mps import MpsSession, check_mode, shared_gpus
 from graphsdg.render.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
 from graphsdg.io import object_store
@@ -155,7 +155,7 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
             # this machine's GPUs, checked before Ray starts: the local cluster gets them (or the first --gpus)
             local_gpus = len(choose_gpus(gpus)) if gpus is not None else _visible_gpu_count()
             # address="local": a new cluster of this process's own, never one another run left on the machine
-            cores = num_cpus or os.cpu_count() or 1
+            cores = num_cpus or usable_cores()
             wanted = default_workers(local_gpus, cores) if workers == "auto" else workers
             # before Ray starts, so its workers (children of this process) find the daemon's pipe
             mps_session = daemon.enter_context(
@@ -185,8 +185,8 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
         actor = ray.remote(num_cpus=1, num_gpus=per_worker, scheduling_strategy="SPREAD")(ShardWorker)
         actors = [actor.remote() for _ in range(workers)]
         # shards of a local cluster share this machine's cores: a writer pool each of their share of them
-        threads = None if address else threads_per_process(workers, num_cpus or os.cpu_count())
-        image_threads = None if address else cores_per_process(workers, num_cpus or os.cpu_count())
+        threads = None if address else threads_per_process(workers, num_cpus or usable_cores())
+        image_threads = None if address else cores_per_process(workers, num_cpus or usable_cores())
         pending = {a.run.remote(job, i, workers, threads, image_threads): i for i, a in enumerate(actors)}
         results: list[dict] = []
         try:

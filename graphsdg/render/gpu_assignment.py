@@ -32,6 +32,7 @@ import subprocess
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
+from graphsdg.base.cpu_share import usable_cores
 from graphsdg.render.egl_device import BIND_ENV   # at import a process given BIND_ENV renders on that GPU
 
 #: the most processes a default run puts on one GPU; bench/multi_gpu.sh measures 4, 8 and 16 a GPU (issue 37)
@@ -203,7 +204,7 @@ def default_processes_per_gpu(gpus: int, cores: int | None = None) -> int:
         >>> default_processes_per_gpu(1, 16), default_processes_per_gpu(4, 64), default_processes_per_gpu(4, 2)
         (8, 8, 1)
     """
-    cores = cores if cores is not None else (os.cpu_count() or 1)
+    cores = cores if cores is not None else usable_cores()
     return max(1, min(MAX_DEFAULT_PROCESSES_PER_GPU, cores // max(1, gpus)))
 
 

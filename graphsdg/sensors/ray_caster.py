@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 
 from graphsdg.base import settings_store as settings
+from graphsdg.base.cpu_share import usable_cores
 from graphsdg.sensors.scene_motion import GeomMotion
 from graphsdg.sim.visual import UNDRAWN_GROUPS
 
@@ -84,7 +85,7 @@ class CpuRayCaster:
 
     def __init__(self, threads: int | None = None) -> None:
         wanted = threads if threads is not None else int(settings.get(THREADS_SETTING, 0) or 0)
-        self.threads = max(1, wanted or os.cpu_count() or 1)
+        self.threads = max(1, wanted or usable_cores())
         self._pool: ThreadPoolExecutor | None = None
         self._scratch: list[mujoco.MjData] = []
         self._scratch_model: mujoco.MjModel | None = None
