@@ -18,6 +18,8 @@ from graphsdg.render.gpu_assignment import (GpuCountError, GpuInfo, check_egl_se
                                           default_processes_per_gpu, gpu_of_process, gpu_share, parse_nvidia_smi,
                                           process_environment, visible_gpus)
 from graphsdg.render.egl_device import EglDeviceError, bind_visible_gpu, egl_index_of
+from graphsdg.render.gpu_cores import gpu_cores, local_cores, parse_cpu_list
+from graphsdg.base.cpu_share import bound_to, cpu_list
 
 SMI = """0, GPU-0a1b2c3d-0000-0000-0000-000000000000, 00000000:18:00.0, NVIDIA H100 80GB HBM3
 1, GPU-1a1b2c3d-0000-0000-0000-000000000000, 00000000:2A:00.0, NVIDIA H100 80GB HBM3
@@ -230,9 +232,64 @@ def test_bench_processes_each_start_on_their_own_gpu(monkeypatch):
         run_on_gpus(config, 1, gpus)
 
 
+def test_cpu_lists_read_as_linux_writes_them():
+    assert parse_cpu_list("0-3,8,10-11\n") == {0, 1, 2, 3, 8, 10, 11} and parse_cpu_list("5") == {5}
+    for bad in ("0-x", "3-1", "-2", "a"):
+        with pytest.raises(ValueError, match=f"{bad!r} is not a CPU list"):
+            parse_cpu_list(bad)
+    assert cpu_list({8, 0, 1, 2, 3, 10}) == "0-3,8,10"
+
+
+def test_a_gpus_local_cores_come_from_its_pci_device_in_sysfs(tmp_path):
+    for address, cores in (("0000:18:00.0", "0-31"), ("0000:3a:00.0", "32-63\n")):
+        (tmp_path / address).mkdir()
+        (tmp_path / address / "local_cpulist").write_text(cores)
+    assert local_cores(HOST[0], root=str(tmp_path)) == set(range(32))            # 00000000:18:00.0
+    assert local_cores(HOST[2], root=str(tmp_path)) == set(range(32, 64))        # 00000000:3A:00.0
+    assert local_cores(HOST[1], root=str(tmp_path)) is None                      # no such device here
+    assert local_cores(GpuInfo(0), root=str(tmp_path)) is None                   # no PCI address known
+
+
+def test_each_gpu_gets_an_equal_run_of_the_cores_near_it():
+    shares = gpu_cores(HOST, range(64), local=lambda gpu: None)                 # one node (a VM): split in order
+    assert [shares[i] for i in range(4)] == [list(range(16 * i, 16 * i + 16)) for i in range(4)]
+    near = {0: set(range(32)), 1: set(range(32)), 2: set(range(32, 64)), 3: set(range(32, 64))}
+    shares = gpu_cores(HOST, range(64), local=lambda gpu: near[gpu.index])      # two sockets, two GPUs each
+    assert [(min(shares[i]), max(shares[i])) for i in range(4)] == [(0, 15), (16, 31), (32, 47), (48, 63)]
+    shares = gpu_cores(HOST, range(40), local=lambda gpu: near[gpu.index])      # cores 40-63 not ours
+    assert shares[2] == list(range(32, 36)) and shares[3] == list(range(36, 40))
+    shares = gpu_cores(HOST, [0, 1], local=lambda gpu: None)                    # more GPUs than cores
+    assert [shares[i] for i in range(4)] == [[0], [1], [0], [1]]
+    with pytest.raises(ValueError, match="no usable CPU cores"):
+        gpu_cores(HOST, [], local=lambda gpu: None)
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2,
+                    reason="needs two cores this process may run on")
+def test_bench_processes_bound_to_cores_run_there_and_the_parent_keeps_its_own():
+    from graphsdg.benchmark.throughput import BenchConfig, launch_processes
+    ours = os.sched_getaffinity(0)
+    first, second = sorted(ours)[:2]
+    config = BenchConfig(frames=2, warmup=1, resolution=(32, 24), asset_count=1, skip_write=True,
+                         render_backend="classic")
+    results, _, ran = launch_processes(config, 3, [{}] * 3, cores=[[first], [second], [first]])
+    assert [r["cores"] for r in results] == [[first], [second], [first]]
+    assert ran.write_threads == 1 and ran.image_threads == 1       # two processes share one core
+    assert os.sched_getaffinity(0) == ours
+    with pytest.raises(ValueError, match="cannot bind processes to cores"):
+        with bound_to([10 ** 6]):
+            pass
+
+
+def test_bind_cores_needs_gpus(capsys):
+    assert main(["bench", "--bind-cores", "--num-frames", "1"]) == 1
+    assert "--bind-cores needs --gpus" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("name", ["graphsdg.render.gpu_assignment", "graphsdg.render.egl_device",
                                   "graphsdg.benchmark.multi_gpu", "graphsdg.benchmark.gpu_sampler",
-                                  "graphsdg.jobs.scaleout"])
+                                  "graphsdg.jobs.scaleout", "graphsdg.render.gpu_cores",
+                                  "graphsdg.base.cpu_share"])
 def test_the_docstring_examples_run(name):
     result = doctest.testmod(importlib.import_module(name))
     assert result.attempted > 0 and result.failed == 0

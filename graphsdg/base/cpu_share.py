@@ -18,7 +18,9 @@ Example:
 """
 from __future__ import annotations
 
+import contextlib
 import os
+from typing import Iterable, Iterator
 
 
 def usable_cores() -> int:
@@ -40,6 +42,52 @@ def cores_per_process(processes: int, cores: int | None = None) -> int:
         raise ValueError(f"processes must be a positive integer, got {processes!r}")
     cores = cores if cores is not None else usable_cores()
     return max(1, cores // processes)
+
+
+@contextlib.contextmanager
+def bound_to(cores: Iterable[int] | None) -> Iterator[None]:
+    """This process's CPU affinity narrowed to ``cores`` for a block (None: left as it is), then restored; a
+    process started inside the block keeps ``cores`` (a child inherits its parent's affinity).
+
+    Example:
+        >>> with bound_to(None):
+        ...     pass
+
+    Raises:
+        ValueError: ``cores`` names no core this process may run on, or the OS has no affinity masks.
+    """
+    if cores is None:
+        yield
+        return
+    wanted = set(cores)
+    try:
+        saved = os.sched_getaffinity(0)
+    except AttributeError:
+        raise ValueError(f"cannot bind processes to cores {sorted(wanted)}: this OS has no CPU affinity") from None
+    if not wanted or not wanted <= saved:
+        raise ValueError(f"cannot bind processes to cores {sorted(wanted)}: this process may run on "
+                         f"{len(saved)} core(s), {cpu_list(saved)}")
+    os.sched_setaffinity(0, wanted)
+    try:
+        yield
+    finally:
+        os.sched_setaffinity(0, saved)
+
+
+def cpu_list(cores: Iterable[int]) -> str:
+    """The Linux CPU list of ``cores`` (as ``taskset -c`` takes it).
+
+    Example:
+        >>> cpu_list([8, 0, 1, 2, 3])
+        '0-3,8'
+    """
+    runs: list[list[int]] = []
+    for core in sorted(cores):
+        if runs and core == runs[-1][1] + 1:
+            runs[-1][1] = core
+        else:
+            runs.append([core, core])
+    return ",".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
 
 
 def limit_image_threads(threads: int) -> None:

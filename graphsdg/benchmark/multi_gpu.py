@@ -23,6 +23,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+from graphsdg.base.cpu_share import cpu_list
 from graphsdg.benchmark.gpu_sampler import GpuSampler, summarize
 from graphsdg.benchmark.throughput import BenchConfig, _steady_rate, launch_processes, summarize_processes
 from graphsdg.render.gpu_assignment import GpuInfo, gpu_of_process, process_environment
@@ -39,9 +40,10 @@ class GpuRun:
     per_gpu: list[dict] = field(default_factory=list)
 
 
-def run_on_gpus(config: BenchConfig, processes: int, gpus: list[GpuInfo]) -> GpuRun:
-    """``processes`` benchmark processes dealt out to ``gpus`` in turn (:func:`gpu_of_process`); the total and
-    per-GPU rows.
+def run_on_gpus(config: BenchConfig, processes: int, gpus: list[GpuInfo],
+                cores: dict[int, list[int]] | None = None) -> GpuRun:
+    """``processes`` benchmark processes dealt out to ``gpus`` in turn (:func:`gpu_of_process`), each bound to
+    its GPU's ``cores`` where given (:func:`graphsdg.render.gpu_cores.gpu_cores`); the total and per-GPU rows.
 
     Raises:
         ValueError: fewer processes than GPUs (a GPU would stay idle).
@@ -49,21 +51,25 @@ def run_on_gpus(config: BenchConfig, processes: int, gpus: list[GpuInfo]) -> Gpu
     if processes < len(gpus):
         raise ValueError(f"--processes {processes} cannot keep --gpus {len(gpus)} busy: give each GPU at least "
                          f"one process (--processes {len(gpus)} or more)")
-    environments = [process_environment(gpus[gpu_of_process(i, len(gpus))]) for i in range(processes)]
+    placed = [gpus[gpu_of_process(i, len(gpus))] for i in range(processes)]
+    environments = [process_environment(gpu) for gpu in placed]
+    bound = [cores[gpu.index] for gpu in placed] if cores is not None else None
     started = time.time()
     with GpuSampler() as sampler:
-        results, elapsed, config = launch_processes(config, processes, environments)
+        results, elapsed, config = launch_processes(config, processes, environments, bound)
     total = summarize_processes(results, config, elapsed)
     total = {"GPUs": len(gpus), **total}
     lo = max((r["start"] for r in results), default=started)
     hi = min((r["start"] + r["wall"] for r in results), default=time.time())
     busy = summarize(sampler.samples, lo, hi)
-    return GpuRun(gpus=list(gpus), total=total, per_gpu=per_gpu_rows(results, gpus, busy))
+    return GpuRun(gpus=list(gpus), total=total, per_gpu=per_gpu_rows(results, gpus, busy, cores))
 
 
-def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple[float, float]]) -> list[dict]:
+def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple[float, float]],
+                 cores: dict[int, list[int]] | None = None) -> list[dict]:
     """A row per GPU from the processes' results (each names its ``gpu`` index) and ``busy``
-    (:func:`graphsdg.benchmark.gpu_sampler.summarize`: index -> (busy %, memory MiB)).
+    (:func:`graphsdg.benchmark.gpu_sampler.summarize`: index -> (busy %, memory MiB)); with ``cores``, the cores
+    its processes were bound to.
 
     Example:
         >>> a = {"gpu": 0, "frames": 100, "start": 0.0, "wall": 10.0, "cpu": 5.0, "frame_ends": [10.0]}
@@ -86,6 +92,8 @@ def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple
                      "steady frames/s": round(steady, 1) if steady == steady else "-",
                      "CPU ms per frame": round(1000 * sum(r["cpu"] for r in mine) / frames, 1) if frames else 0.0,
                      "GPU busy %": percent, "GPU memory MiB": memory})
+        if cores is not None:
+            rows[-1]["cores"] = cpu_list(cores[gpu.index])
     return rows
 
 

@@ -17,8 +17,9 @@ from __future__ import annotations
 import multiprocessing
 import os
 import queue as queues
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Iterable, Sequence
 
+from graphsdg.base.cpu_share import bound_to
 from graphsdg.base.environment import patched_environment
 
 
@@ -41,9 +42,10 @@ def _run_task(target: Callable, args: tuple, barrier, results, index: int) -> No
 
 
 def run_in_processes(target: Callable, args: Sequence[tuple], environments: Sequence[dict[str, str]],
-                     poll_seconds: float = 1.0) -> list[Any]:
+                     poll_seconds: float = 1.0,
+                     cores: Sequence[Iterable[int] | None] | None = None) -> list[Any]:
     """``target(*args[i], before_timing=wait)`` in process i, started with ``environments[i]`` added to this
-    process's environment; their return values in order.
+    process's environment (and, where ``cores`` gives them, bound to ``cores[i]``); their return values in order.
 
     ``target`` must be importable by name (processes are spawned) and take a ``before_timing`` callable,
     the shared barrier's ``wait``.
@@ -53,6 +55,9 @@ def run_in_processes(target: Callable, args: Sequence[tuple], environments: Sequ
     """
     if len(args) != len(environments):
         raise ValueError(f"{len(args)} tasks but {len(environments)} environments")
+    cores = list(cores) if cores is not None else [None] * len(args)
+    if len(cores) != len(args):
+        raise ValueError(f"{len(args)} tasks but {len(cores)} core sets")
     ctx = multiprocessing.get_context("spawn")
     count = len(args)
     with ctx.Manager() as manager:
@@ -60,8 +65,8 @@ def run_in_processes(target: Callable, args: Sequence[tuple], environments: Sequ
         results = ctx.Queue()
         processes = []
         try:
-            for i, (task_args, env) in enumerate(zip(args, environments)):
-                with patched_environment(env):
+            for i, (task_args, env, bound) in enumerate(zip(args, environments, cores)):
+                with patched_environment(env), bound_to(bound):
                     process = ctx.Process(target=_run_task, args=(target, tuple(task_args), barrier, results, i),
                                           name=f"graphsdg-bench-{i}")
                     process.start()

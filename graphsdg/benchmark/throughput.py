@@ -547,7 +547,8 @@ def round_summaries(rounds: list[tuple[BenchResult, BenchResult | None]]) -> lis
 
 
 def _worker(config_dict: dict, before_timing=None) -> dict:
-    """One benchmark process of :func:`run_processes`: its timing, and the GPU it was given (None: any)."""
+    """One benchmark process of :func:`run_processes`: its timing, the GPU it was given (None: any) and the cores
+    it ran on."""
     config = BenchConfig(**config_dict)
     r = run_graphsdg(config, before_timing=before_timing)
     return {"frames": r.frames, "wall": r.wall_seconds, "start": r.started_at, "cpu": r.cpu_seconds,
@@ -555,7 +556,8 @@ def _worker(config_dict: dict, before_timing=None) -> dict:
             "frame_ends": (r.started_at + np.cumsum(r.frame_times)).tolist(),
             "gpu": int(os.environ["GRAPHSDG_GPU"]) if os.environ.get("GRAPHSDG_GPU", "").isdigit() else None,
             "cuda_visible_devices": os.environ.get("CUDA_VISIBLE_DEVICES"),
-            "egl_device": os.environ.get("MUJOCO_EGL_DEVICE_ID")}
+            "egl_device": os.environ.get("MUJOCO_EGL_DEVICE_ID"),
+            "cores": sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None}
 
 
 def _steady_rate(results: list[dict]) -> float:
@@ -583,21 +585,25 @@ def run_processes(config: BenchConfig, processes: int) -> dict[str, float]:
     return summarize_processes(results, config, elapsed)
 
 
-def launch_processes(config: BenchConfig, processes: int,
-                     environments: list[dict[str, str]] | None = None) -> tuple[list[dict], float, BenchConfig]:
-    """Run ``processes`` benchmark processes (process i with seed + i, and ``environments[i]`` added to its
-    environment: its GPU, say); return their :func:`_worker` results, the seconds it all took, and the
-    config they ran (the writer and OpenCV threads set to each one's share of the cores)."""
+def launch_processes(config: BenchConfig, processes: int, environments: list[dict[str, str]] | None = None,
+                     cores: list[list[int]] | None = None) -> tuple[list[dict], float, BenchConfig]:
+    """Run ``processes`` benchmark processes (process i with seed + i, ``environments[i]`` added to its
+    environment: its GPU, say, and bound to ``cores[i]`` where given); return their :func:`_worker` results,
+    the seconds it all took, and the config they ran (the writer and OpenCV threads set to each one's share of
+    the cores: of its bound cores among the processes bound to the same ones, else of this process's)."""
     from graphsdg.benchmark.process_launch import run_in_processes
-    from graphsdg.base.cpu_share import cores_per_process
     from graphsdg.io.write_queue import threads_per_process
+    sharing, share_of = processes, None
+    if cores is not None:      # the tightest share: the fewest cores a process of a bound set gets
+        sets = [tuple(sorted(c)) for c in cores]
+        sharing, share_of = min(((sets.count(c), len(c)) for c in set(sets)), key=lambda s: s[1] // s[0])
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
-        config = dataclasses.replace(config, write_threads=threads_per_process(processes))
+        config = dataclasses.replace(config, write_threads=threads_per_process(sharing, share_of))
     if config.image_threads is None:
-        config = dataclasses.replace(config, image_threads=cores_per_process(processes))
+        config = dataclasses.replace(config, image_threads=cpu_share.cores_per_process(sharing, share_of))
     configs = [(dataclasses.asdict(dataclasses.replace(config, seed=config.seed + i)),) for i in range(processes)]
     start = time.perf_counter()
-    results = run_in_processes(_worker, configs, environments or [{}] * processes)
+    results = run_in_processes(_worker, configs, environments or [{}] * processes, cores=cores)
     return results, time.perf_counter() - start, config
 
 

@@ -27,6 +27,8 @@ def run_bench(args: argparse.Namespace) -> None:
     if args.processes_per_gpu and not args.gpus:
         raise ValueError(f"--processes-per-gpu {args.processes_per_gpu} needs --gpus: it is each GPU's share of the "
                          f"processes")
+    if args.bind_cores and not args.gpus:
+        raise ValueError("--bind-cores needs --gpus: it binds each GPU's processes to that GPU's share of the cores")
     if args.gpus and args.rounds > 1:
         raise ValueError(f"--rounds {args.rounds} alternates the one-process comparison with the hand-written loop; "
                          f"with --gpus there is none: run the command again instead")
@@ -133,17 +135,30 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
     if os.environ.get("MUJOCO_GL", "egl").lower() == "egl":
         from graphsdg.render.egl_device import egl_cuda_devices
         check_egl_sees(chosen[max(chosen)], egl_cuda_devices())
+    cores = _gpu_core_shares() if args.bind_cores else None
     runs, parts = [], []
     for count, gpus in chosen.items():
-        processes = args.processes or count * (args.processes_per_gpu or default_processes_per_gpu(count))
+        per_gpu = args.processes_per_gpu or default_processes_per_gpu(
+            count, cores=len(cores[gpus[0].index]) * count if cores else None)
+        processes = args.processes or count * per_gpu
         with shared_gpus(args.mps, math.ceil(processes / count)) as mps:
-            run = multi_gpu.run_on_gpus(config, processes, gpus)
+            run = multi_gpu.run_on_gpus(config, processes, gpus, cores)
         runs.append(run)
-        parts.append(f"#### {count} GPU(s), {processes} processes\n\n{format_table([run.total])}\n\n"
+        bound = f", each GPU's on its {len(cores[gpus[0].index])} cores" if cores else ""
+        parts.append(f"#### {count} GPU(s), {processes} processes{bound}\n\n{format_table([run.total])}\n\n"
                      f"{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}\n\n{mps.describe()}")
     if len(runs) > 1:
         parts.append("#### Scaling\n\n" + format_table(multi_gpu.scaling_rows(runs)))
     return "\n\n".join(parts)
+
+
+def _gpu_core_shares() -> dict[int, list[int]]:
+    """``--bind-cores``: each GPU this process sees, with its share of the cores this process may run on."""
+    from graphsdg.render.gpu_assignment import host_gpus, visible_gpus
+    from graphsdg.render.gpu_cores import gpu_cores
+    seen = visible_gpus(host_gpus(), os.environ.get("CUDA_VISIBLE_DEVICES"))
+    usable = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else range(os.cpu_count() or 1)
+    return gpu_cores(seen, usable)
 
 
 def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
@@ -447,6 +462,11 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--processes-per-gpu", type=_positive, metavar="N",
                        help="with --gpus: N processes on each GPU (default: --processes spread over the GPUs, or "
                             "the cores' share of each GPU, at most 8)")
+    bench.add_argument("--bind-cores", action="store_true",
+                       help="with --gpus: bind each GPU's processes to that GPU's share of the cores (its NUMA-local "
+                            "cores where the host lists them, split evenly among the GPUs near them), the same share "
+                            "whatever the GPU count, so --gpus 1 2 4 scales GPUs and cores together (default: every "
+                            "process may run on every core)")
     bench.add_argument("--mps", choices=MPS_MODES, default="auto",
                        help="with --processes or --gpus: CUDA MPS for the processes that share a GPU, so their "
                             "kernels run side by side (auto: when a GPU has several processes and the host has "

@@ -1,0 +1,98 @@
+"""The CPU cores each GPU's processes run on: the GPU's own share of the host's cores, near it where the host says.
+
+On a multi-GPU server a capture process does most of its work on the CPU (randomizing, annotating, encoding)
+and the rest through its GPU: processes of one GPU kept on cores of the GPU's own NUMA node read the
+page-locked frames the GPU wrote into that node's memory, and processes of different GPUs do not move
+between each other's cores. :func:`gpu_cores` gives each GPU of the host an equal share of the cores this
+process may run on: the GPUs whose PCI device lists the same local cores (``local_cpulist`` in sysfs; a
+host that tells nothing, or a virtual machine with one node, lists every core) split those cores into
+contiguous runs in GPU order.
+
+The share is a GPU's whatever the number of GPUs a run uses, so ``graphsdg bench --gpus 1 2 4 --bind-cores``
+compares runs that each give a GPU the same cores: the scaling of the whole host, GPU by GPU, rather than one
+GPU with every core against all of them sharing the cores.
+
+Example:
+    >>> from graphsdg.render.gpu_assignment import GpuInfo
+    >>> host = [GpuInfo(i) for i in range(4)]
+    >>> shares = gpu_cores(host, range(64), local=lambda gpu: None)
+    >>> [(min(shares[g]), max(shares[g])) for g in range(4)]
+    [(0, 15), (16, 31), (32, 47), (48, 63)]
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable, Iterable, Sequence
+
+from graphsdg.render.gpu_assignment import GpuInfo
+
+SYSFS_PCI = "/sys/bus/pci/devices"
+
+
+def parse_cpu_list(text: str) -> set[int]:
+    """The cores of a Linux CPU list (``0-15,32-47``, as ``local_cpulist`` and ``taskset -c`` write them).
+
+    Example:
+        >>> sorted(parse_cpu_list("0-2,8,10-11\\n"))
+        [0, 1, 2, 8, 10, 11]
+
+    Raises:
+        ValueError: text that is not a CPU list (the message quotes it).
+    """
+    cores: set[int] = set()
+    for part in text.strip().split(","):
+        if not part:
+            continue
+        low, _, high = part.partition("-")
+        try:
+            first, last = int(low), int(high or low)
+        except ValueError:
+            raise ValueError(f"{text.strip()!r} is not a CPU list such as '0-15,32-47'") from None
+        if first < 0 or last < first:
+            raise ValueError(f"{text.strip()!r} is not a CPU list such as '0-15,32-47'")
+        cores.update(range(first, last + 1))
+    return cores
+
+
+def local_cores(gpu: GpuInfo, root: str = SYSFS_PCI) -> set[int] | None:
+    """The cores sysfs lists as local to ``gpu``'s PCI device, or None where it lists none (no PCI address,
+    no sysfs, an unreadable file)."""
+    if not gpu.pci_bus_id:
+        return None
+    domain, _, rest = gpu.pci_bus_id.lower().partition(":")
+    address = f"{domain[-4:]:0>4}:{rest}"        # nvidia-smi's 8-digit PCI domain, sysfs's 4
+    try:
+        with open(os.path.join(root, address, "local_cpulist")) as f:
+            return parse_cpu_list(f.read()) or None
+    except (OSError, ValueError):
+        return None
+
+
+def gpu_cores(host: Sequence[GpuInfo], usable: Iterable[int],
+              local: Callable[[GpuInfo], set[int] | None] = local_cores) -> dict[int, list[int]]:
+    """Each host GPU's cores (by ``nvidia-smi`` index): the ``usable`` cores local to it (all of them where
+    ``local`` says none, or none of its local cores is usable), split evenly among the GPUs with the same
+    local cores, in GPU order; a share is never empty (GPUs outnumbering their cores share them round-robin).
+
+    Raises:
+        ValueError: no usable cores.
+    """
+    usable = sorted(set(usable))
+    if not usable:
+        raise ValueError("no usable CPU cores to share among the GPUs")
+    groups: dict[tuple[int, ...], list[GpuInfo]] = {}
+    for gpu in sorted(host, key=lambda g: g.index):
+        near = sorted((local(gpu) or set()) & set(usable)) or usable
+        groups.setdefault(tuple(near), []).append(gpu)
+    shares: dict[int, list[int]] = {}
+    for cores, gpus in groups.items():
+        for position, gpu in enumerate(gpus):
+            if len(cores) >= len(gpus):
+                lo, hi = position * len(cores) // len(gpus), (position + 1) * len(cores) // len(gpus)
+                shares[gpu.index] = list(cores[lo:hi])
+            else:
+                shares[gpu.index] = [cores[position % len(cores)]]
+    return shares
+
+
+__all__ = ["SYSFS_PCI", "gpu_cores", "local_cores", "parse_cpu_list"]
