@@ -18,8 +18,8 @@ from graphsdg.render.gpu_assignment import (GpuCountError, GpuInfo, check_egl_se
                                           default_processes_per_gpu, gpu_of_process, gpu_share, parse_nvidia_smi,
                                           process_environment, visible_gpus)
 from graphsdg.render.egl_device import EglDeviceError, bind_visible_gpu, egl_index_of
-from graphsdg.render.gpu_cores import gpu_cores, local_cores, parse_cpu_list
-from graphsdg.base.cpu_share import bound_to, cpu_list
+from graphsdg.render.gpu_cores import gpu_cores, local_cores
+from graphsdg.base.cpu_share import bound_to, cpu_list, parse_cpu_list
 
 SMI = """0, GPU-0a1b2c3d-0000-0000-0000-000000000000, 00000000:18:00.0, NVIDIA H100 80GB HBM3
 1, GPU-1a1b2c3d-0000-0000-0000-000000000000, 00000000:2A:00.0, NVIDIA H100 80GB HBM3

@@ -90,6 +90,31 @@ def cpu_list(cores: Iterable[int]) -> str:
     return ",".join(str(a) if a == b else f"{a}-{b}" for a, b in runs)
 
 
+def parse_cpu_list(text: str) -> set[int]:
+    """The cores of a Linux CPU list (``0-15,32-47``, as ``local_cpulist`` and ``taskset -c`` write them).
+
+    Example:
+        >>> sorted(parse_cpu_list("0-2,8,10-11\\n"))
+        [0, 1, 2, 8, 10, 11]
+
+    Raises:
+        ValueError: text that is not a CPU list (the message quotes it).
+    """
+    cores: set[int] = set()
+    for part in text.strip().split(","):
+        if not part:
+            continue
+        low, _, high = part.partition("-")
+        try:
+            first, last = int(low), int(high or low)
+        except ValueError:
+            raise ValueError(f"{text.strip()!r} is not a CPU list such as '0-15,32-47'") from None
+        if first < 0 or last < first:
+            raise ValueError(f"{text.strip()!r} is not a CPU list such as '0-15,32-47'")
+        cores.update(range(first, last + 1))
+    return cores
+
+
 def limit_image_threads(threads: int) -> None:
     """Give OpenCV's thread pool in this process ``threads`` threads (1: no pool, work on the caller)."""
     if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:

@@ -4,7 +4,8 @@
 its own GPU, which only its environment can say before CUDA or EGL start in it (``CUDA_VISIBLE_DEVICES``,
 :mod:`graphsdg.render.gpu_assignment`). A pool's workers all inherit the parent's environment, so
 :func:`run_in_processes` starts one spawned process per task with the parent's environment patched for
-that task while it starts. Every task gets the same barrier (``before_timing``): they build and warm up
+that task while it starts (and, for ``--bind-cores``, bound to the task's cores: a child inherits the affinity
+of the thread that starts it). Every task gets the same barrier (``before_timing``): they build and warm up
 apart, then time together. A task that fails aborts the barrier, so the others stop waiting, and the
 first failure is raised here naming the process.
 

@@ -144,7 +144,7 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
         with shared_gpus(args.mps, math.ceil(processes / count)) as mps:
             run = multi_gpu.run_on_gpus(config, processes, gpus, cores)
         runs.append(run)
-        bound = f", each GPU's on its {len(cores[gpus[0].index])} cores" if cores else ""
+        bound = f", each GPU's processes on its {len(cores[gpus[0].index])} cores" if cores else ""
         parts.append(f"#### {count} GPU(s), {processes} processes{bound}\n\n{format_table([run.total])}\n\n"
                      f"{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}\n\n{mps.describe()}")
     if len(runs) > 1:

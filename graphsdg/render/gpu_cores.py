@@ -24,34 +24,10 @@ from __future__ import annotations
 import os
 from typing import Callable, Iterable, Sequence
 
+from graphsdg.base.cpu_share import parse_cpu_list
 from graphsdg.render.gpu_assignment import GpuInfo
 
 SYSFS_PCI = "/sys/bus/pci/devices"
-
-
-def parse_cpu_list(text: str) -> set[int]:
-    """The cores of a Linux CPU list (``0-15,32-47``, as ``local_cpulist`` and ``taskset -c`` write them).
-
-    Example:
-        >>> sorted(parse_cpu_list("0-2,8,10-11\\n"))
-        [0, 1, 2, 8, 10, 11]
-
-    Raises:
-        ValueError: text that is not a CPU list (the message quotes it).
-    """
-    cores: set[int] = set()
-    for part in text.strip().split(","):
-        if not part:
-            continue
-        low, _, high = part.partition("-")
-        try:
-            first, last = int(low), int(high or low)
-        except ValueError:
-            raise ValueError(f"{text.strip()!r} is not a CPU list such as '0-15,32-47'") from None
-        if first < 0 or last < first:
-            raise ValueError(f"{text.strip()!r} is not a CPU list such as '0-15,32-47'")
-        cores.update(range(first, last + 1))
-    return cores
 
 
 def local_cores(gpu: GpuInfo, root: str = SYSFS_PCI) -> set[int] | None:
@@ -95,4 +71,4 @@ def gpu_cores(host: Sequence[GpuInfo], usable: Iterable[int],
     return shares
 
 
-__all__ = ["SYSFS_PCI", "gpu_cores", "local_cores", "parse_cpu_list"]
+__all__ = ["SYSFS_PCI", "gpu_cores", "local_cores"]
