@@ -1,4 +1,4 @@
-"""The CPU cores each GPU's processes run on: the GPU's own share of the host's cores, near it where the host says.
+"""The CPU cores each GPU's processes run on: its own share of the host's cores, near it where known.
 
 On a multi-GPU server a capture process does most of its work on the CPU (randomizing, annotating, encoding)
 and the rest through its GPU: processes of one GPU kept on cores of the GPU's own NUMA node read the
