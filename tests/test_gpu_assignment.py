@@ -293,3 +293,17 @@ def test_bind_cores_needs_gpus(capsys):
 def test_the_docstring_examples_run(name):
     result = doctest.testmod(importlib.import_module(name))
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_gpu_rounds_take_each_counts_median_run_and_give_each_rounds_ratio():
+    from graphsdg.benchmark.multi_gpu import AGGREGATE, GpuRun, median_runs, round_rows, scaling_rows
+
+    def run(gpus: int, rate: float) -> GpuRun:
+        return GpuRun(gpus=HOST[:gpus], total={AGGREGATE: rate, "processes": 16 * gpus,
+                                               "CPU ms per frame (all threads)": 9.0})
+    rounds = [[run(1, 2000.0), run(4, 6000.0)], [run(1, 2500.0), run(4, 4200.0)], [run(1, 1900.0), run(4, 6700.0)]]
+    assert [r["x 1 GPU(s) with 4"] for r in round_rows(rounds)] == [3.0, 1.68, 3.53]
+    medians = median_runs(rounds)
+    assert [(len(r.gpus), r.total[AGGREGATE]) for r in medians] == [(1, 2000.0), (4, 6000.0)]
+    assert [row["x 1 GPU(s)"] for row in scaling_rows(medians)] == [1.0, 3.0]
+    assert [r.total[AGGREGATE] for r in median_runs(rounds[:2])] == [2000.0, 4200.0]   # even: the lower middle

@@ -7,7 +7,10 @@ The table has the run's total row (:func:`graphsdg.benchmark.throughput.summariz
 GPU: its processes, their frames/s over their common window and while all of them ran, the CPU time a
 frame, and how busy the GPU was (``nvidia-smi``, :mod:`graphsdg.benchmark.gpu_sampler`). Several counts
 (``--gpus 1 2 4``) run one after the other and end with a scaling table: frames/s, frames/s a GPU, and the
-scaling efficiency, each count's rate a GPU over the smallest count's.
+scaling efficiency, each count's rate a GPU over the smallest count's. With ``--rounds K`` the counts run K
+times in turn (1, 2, 4, 1, 2, 4, ...): runs of one configuration on a shared host vary by tens of percent, so
+:func:`round_rows` gives each round's rates and its own ratios, and the scaling table is made of each count's
+median run (:func:`median_runs`).
 
 Example:
     >>> one = GpuRun(gpus=[GpuInfo(0)], total={"processes": 8, "aggregate frames/s (all frames / common window)":
@@ -94,6 +97,51 @@ def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple
                      "GPU busy %": percent, "GPU memory MiB": memory})
         if cores is not None:
             rows[-1]["cores"] = cpu_list(cores[gpu.index])
+    return rows
+
+
+def median_runs(rounds: list[list[GpuRun]]) -> list[GpuRun]:
+    """Each GPU count's run of median frames/s over the rounds (the lower middle one of an even number).
+
+    Example:
+        >>> def run(gpus, rate):
+        ...     return GpuRun(gpus=[GpuInfo(i) for i in range(gpus)], total={AGGREGATE: rate})
+        >>> [r.total[AGGREGATE] for r in median_runs([[run(1, 10.0), run(4, 30.0)], [run(1, 12.0), run(4, 20.0)],
+        ...                                           [run(1, 11.0), run(4, 40.0)]])]
+        [11.0, 30.0]
+    """
+    by_count: dict[int, list[GpuRun]] = {}
+    for one_round in rounds:
+        for run in one_round:
+            by_count.setdefault(len(run.gpus), []).append(run)
+    medians = []
+    for count in sorted(by_count):
+        ranked = sorted(by_count[count], key=lambda r: r.total[AGGREGATE])
+        medians.append(ranked[(len(ranked) - 1) // 2])
+    return medians
+
+
+def round_rows(rounds: list[list[GpuRun]]) -> list[dict]:
+    """A row per round: each GPU count's frames/s, and each count's ratio to the fewest GPUs of that round.
+
+    Example:
+        >>> def run(gpus, rate):
+        ...     return GpuRun(gpus=[GpuInfo(i) for i in range(gpus)], total={AGGREGATE: rate})
+        >>> rows = round_rows([[run(1, 10.0), run(4, 30.0)], [run(1, 12.0), run(4, 42.0)]])
+        >>> [(r["round"], r["4 GPU(s) frames/s"], r["x 1 GPU(s) with 4"]) for r in rows]
+        [(1, 30.0, 3.0), (2, 42.0, 3.5)]
+    """
+    rows = []
+    for number, one_round in enumerate(rounds, 1):
+        ordered = sorted(one_round, key=lambda r: len(r.gpus))
+        base = ordered[0]
+        row: dict = {"round": number}
+        for run in ordered:
+            row[f"{len(run.gpus)} GPU(s) frames/s"] = round(run.total[AGGREGATE], 1)
+        for run in ordered[1:]:
+            ratio = run.total[AGGREGATE] / base.total[AGGREGATE] if base.total[AGGREGATE] else 0.0
+            row[f"x {len(base.gpus)} GPU(s) with {len(run.gpus)}"] = round(ratio, 2)
+        rows.append(row)
     return rows
 
 

@@ -21,17 +21,15 @@ def run_bench(args: argparse.Namespace) -> None:
     from graphsdg.benchmark import throughput
 
     annotators = tuple(throughput.ANNOTATOR_FLAGS) if args.annotators == ["all"] else tuple(args.annotators)
-    if args.rounds > 1 and args.processes:
+    if args.rounds > 1 and args.processes and not args.gpus:
         raise ValueError(f"--rounds {args.rounds} alternates the one-process comparison with the hand-written loop; "
-                         f"with --processes {args.processes} there is none: run the command again instead")
+                         f"with --processes {args.processes} there is none (with --gpus the GPU counts take turns): "
+                         f"run the command again instead")
     if args.processes_per_gpu and not args.gpus:
         raise ValueError(f"--processes-per-gpu {args.processes_per_gpu} needs --gpus: it is each GPU's share of the "
                          f"processes")
     if args.bind_cores and not args.gpus:
         raise ValueError("--bind-cores needs --gpus: it binds each GPU's processes to that GPU's share of the cores")
-    if args.gpus and args.rounds > 1:
-        raise ValueError(f"--rounds {args.rounds} alternates the one-process comparison with the hand-written loop; "
-                         f"with --gpus there is none: run the command again instead")
     unknown = [a for a in annotators if a not in throughput.ANNOTATOR_FLAGS]
     if unknown:
         raise ValueError(f"unknown benchmark annotator(s) {unknown}; known: {sorted(throughput.ANNOTATOR_FLAGS)}")
@@ -136,19 +134,27 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
         from graphsdg.render.egl_device import egl_cuda_devices
         check_egl_sees(chosen[max(chosen)], egl_cuda_devices())
     cores = _gpu_core_shares() if args.bind_cores else None
-    runs, parts = [], []
-    for count, gpus in chosen.items():
-        per_gpu = args.processes_per_gpu or default_processes_per_gpu(
-            count, cores=len(cores[gpus[0].index]) * count if cores else None)
-        processes = args.processes or count * per_gpu
-        with shared_gpus(args.mps, math.ceil(processes / count)) as mps:
-            run = multi_gpu.run_on_gpus(config, processes, gpus, cores)
-        runs.append(run)
-        bound = f", each GPU's processes on its {len(cores[gpus[0].index])} cores" if cores else ""
-        parts.append(f"#### {count} GPU(s), {processes} processes{bound}\n\n{format_table([run.total])}\n\n"
-                     f"{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}\n\n{mps.describe()}")
-    if len(runs) > 1:
-        parts.append("#### Scaling\n\n" + format_table(multi_gpu.scaling_rows(runs)))
+    rounds, parts = [], []
+    for number in range(1, args.rounds + 1):     # with --rounds K the counts take turns: 1, 2, 4, 1, 2, 4, ...
+        runs = []
+        for count, gpus in chosen.items():
+            per_gpu = args.processes_per_gpu or default_processes_per_gpu(
+                count, cores=len(cores[gpus[0].index]) * count if cores else None)
+            processes = args.processes or count * per_gpu
+            with shared_gpus(args.mps, math.ceil(processes / count)) as mps:
+                run = multi_gpu.run_on_gpus(config, processes, gpus, cores)
+            runs.append(run)
+            bound = f", each GPU's processes on its {len(cores[gpus[0].index])} cores" if cores else ""
+            which = f", round {number}" if args.rounds > 1 else ""
+            parts.append(f"#### {count} GPU(s), {processes} processes{bound}{which}\n\n{format_table([run.total])}"
+                         f"\n\n{format_table(run.per_gpu) if run.per_gpu else '(no per-GPU rows)'}\n\n"
+                         f"{mps.describe()}")
+        rounds.append(runs)
+    if args.rounds > 1:
+        parts.append("#### Rounds\n\n" + format_table(multi_gpu.round_rows(rounds)))
+    if len(chosen) > 1:
+        title = "#### Scaling (each count's median round)" if args.rounds > 1 else "#### Scaling"
+        parts.append(f"{title}\n\n" + format_table(multi_gpu.scaling_rows(multi_gpu.median_runs(rounds))))
     return "\n\n".join(parts)
 
 
@@ -475,7 +481,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--rounds", type=_positive, default=1,
                        help="run graphsdg and the hand-written loop this many times each, alternately, in one "
                             "process; the table adds the medians, the ratio being the median of the rounds' "
-                            "ratios, so a machine whose speed drifts between runs weighs on both (default: 1)")
+                            "ratios, so a machine whose speed drifts between runs weighs on both; with --gpus, the "
+                            "GPU counts take turns this many times and the scaling table takes each count's median "
+                            "run (default: 1)")
     bench.add_argument("--profile", action="store_true",
                        help="also print milliseconds per frame of each phase (randomize, render passes, "
                             "annotators, writing) for both runs")
