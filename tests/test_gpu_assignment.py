@@ -307,3 +307,19 @@ def test_gpu_rounds_take_each_counts_median_run_and_give_each_rounds_ratio():
     assert [(len(r.gpus), r.total[AGGREGATE]) for r in medians] == [(1, 2000.0), (4, 6000.0)]
     assert [row["x 1 GPU(s)"] for row in scaling_rows(medians)] == [1.0, 3.0]
     assert [r.total[AGGREGATE] for r in median_runs(rounds[:2])] == [2000.0, 4200.0]   # even: the lower middle
+
+
+def test_bench_gpu_counts_take_turns_over_rounds_and_scale_their_medians(monkeypatch, capsys):
+    monkeypatch.setattr("graphsdg.render.gpu_assignment._query_nvidia_smi", lambda: SMI)
+    monkeypatch.setattr("graphsdg.render.gpu_assignment.check_egl_sees", lambda *args, **kwargs: None)
+    monkeypatch.setattr("graphsdg.render.egl_device.egl_cuda_devices", lambda: [])
+    monkeypatch.delenv("CUDA_VISIBLE_DEVICES", raising=False)
+    assert main(["bench", "--gpus", "1", "2", "--rounds", "2", "--processes-per-gpu", "1", "--num-frames", "2",
+                 "--resolution", "32", "24", "--asset-count", "1", "--skip-write", "--backend", "classic",
+                 "--mps", "off", "--no-baseline"]) == 0     # no NVIDIA GPU here: each process renders with Mesa
+    out = capsys.readouterr().out
+    for count, processes in ((1, 1), (2, 2)):
+        for number in (1, 2):
+            assert f"#### {count} GPU(s), {processes} processes, round {number}" in out
+    assert "#### Rounds" in out and "x 1 GPU(s) with 2" in out
+    assert "#### Scaling (each count's median round)" in out
