@@ -3,8 +3,8 @@
 ``mujoco_warp_pbr.render`` rebuilds nothing between frames when nothing changed, but it still checks that
 every frame: it lists the fields of the model, data and render context to compare them with the last
 launch's, works out the key of the kernel's specialisation from the context's settings, and packs the
-kernel's seven arguments for Warp's launch. On the thread that steps the frames that is a third of a
-millisecond a frame on an H100 host (docs/performance.md, "Round 22").
+kernel's seven arguments for Warp's launch, all on the thread that steps the frames (docs/performance.md,
+"Round 22").
 
 :class:`MegakernelLaunch` lets the library launch whenever any field of the model, data, context or the
 context's base is another object than at the last launch (the library's own test for rebuilding its inputs),
