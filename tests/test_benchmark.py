@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import os
 
 import pytest
 
@@ -65,7 +66,6 @@ def test_processes_sharing_the_cores_get_their_share_of_image_threads(processes,
 
 def _sized_pools() -> dict[str, int]:
     """What a process sizes from its cores, in a spawned process given one core (the test's own stays as it is)."""
-    import os
     from graphsdg.base.cpu_share import usable_cores
     from graphsdg.io.write_queue import default_threads, processes_wanted
     from graphsdg.render.gpu_assignment import default_processes_per_gpu
@@ -75,11 +75,10 @@ def _sized_pools() -> dict[str, int]:
             "processes a GPU": default_processes_per_gpu(1)}
 
 
-@pytest.mark.skipif(not hasattr(__import__("os"), "sched_setaffinity"), reason="no CPU affinity on this OS")
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="no CPU affinity on this OS")
 def test_a_process_sizes_its_pools_by_the_cores_its_affinity_allows_not_the_machines():
     import concurrent.futures
     import multiprocessing
-    import os
     ours = os.sched_getaffinity(0)
     os.sched_setaffinity(0, {min(ours)})       # a spawned child inherits it (taskset, a container's cpuset)
     try:
