@@ -23,17 +23,22 @@ import os
 from typing import Iterable, Iterator
 
 
-def usable_cores() -> int:
+def usable_core_set() -> set[int]:
     """The logical CPUs this process may run on: its affinity mask where the OS has one, else the machine's.
 
     Example:
-        >>> 1 <= usable_cores() <= (os.cpu_count() or 1)
+        >>> 1 <= len(usable_core_set()) <= (os.cpu_count() or 1)
         True
     """
     try:
-        return max(1, len(os.sched_getaffinity(0)))
+        return set(os.sched_getaffinity(0)) or set(range(os.cpu_count() or 1))
     except (AttributeError, OSError):     # no affinity masks on this OS (macOS, Windows)
-        return os.cpu_count() or 1
+        return set(range(os.cpu_count() or 1))
+
+
+def usable_cores() -> int:
+    """How many logical CPUs this process may run on (:func:`usable_core_set`)."""
+    return len(usable_core_set())
 
 
 def cores_per_process(processes: int, cores: int | None = None) -> int:

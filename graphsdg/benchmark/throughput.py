@@ -22,6 +22,7 @@ Example:
 """
 from __future__ import annotations
 
+import collections
 import concurrent.futures
 import dataclasses
 import math
@@ -557,7 +558,7 @@ def _worker(config_dict: dict, before_timing=None) -> dict:
             "gpu": int(os.environ["GRAPHSDG_GPU"]) if os.environ.get("GRAPHSDG_GPU", "").isdigit() else None,
             "cuda_visible_devices": os.environ.get("CUDA_VISIBLE_DEVICES"),
             "egl_device": os.environ.get("MUJOCO_EGL_DEVICE_ID"),
-            "cores": sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None}
+            "cores": sorted(cpu_share.usable_core_set())}
 
 
 def _steady_rate(results: list[dict]) -> float:
@@ -595,8 +596,8 @@ def launch_processes(config: BenchConfig, processes: int, environments: list[dic
     from graphsdg.io.write_queue import threads_per_process
     sharing, share_of = processes, None
     if cores is not None:      # the tightest share: the fewest cores a process of a bound set gets
-        sets = [tuple(sorted(c)) for c in cores]
-        sharing, share_of = min(((sets.count(c), len(c)) for c in set(sets)), key=lambda s: s[1] // s[0])
+        bound = collections.Counter(frozenset(c) for c in cores)    # core set -> processes bound to it
+        share_of, sharing = min(((len(c), n) for c, n in bound.items()), key=lambda s: s[0] // s[1])
     if config.write_threads is None:   # as the CLI's scale-out does: the processes share the cores
         config = dataclasses.replace(config, write_threads=threads_per_process(sharing, share_of))
     if config.image_threads is None:

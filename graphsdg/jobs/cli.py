@@ -162,9 +162,9 @@ def _gpu_core_shares() -> dict[int, list[int]]:
     """``--bind-cores``: each GPU this process sees, with its share of the cores this process may run on."""
     from graphsdg.render.gpu_assignment import host_gpus, visible_gpus
     from graphsdg.render.gpu_cores import gpu_cores
+    from graphsdg.base.cpu_share import usable_core_set
     seen = visible_gpus(host_gpus(), os.environ.get("CUDA_VISIBLE_DEVICES"))
-    usable = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else range(os.cpu_count() or 1)
-    return gpu_cores(seen, usable)
+    return gpu_cores(seen, usable_core_set())
 
 
 def run_graph(args: argparse.Namespace, script_args: list[str]) -> int:
