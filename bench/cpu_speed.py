@@ -7,14 +7,22 @@ host), so printed before and after each host run (``bench/host_rounds.sh``) it t
 frame that got more expensive. Also prints the host's steal time (a VM's vCPUs waiting for a physical core)
 since the previous call of this script (on this machine).
 
+``--load N [N ...]`` asks how the cores hold up as more of them work: for each N, N processes run the unit
+together, then copy 64 MiB arrays together (memory bandwidth), and a table gives each count's median unit time,
+each process's and all processes' copy rate, and the steal time over each phase. On a host whose frames cost
+more CPU as more GPUs run (docs/performance.md, "Every GPU of the host"), it tells slower cores from costlier
+frames.
+
 Usage:
     python bench/cpu_speed.py [--processes 16] [--seconds 1.0]
+    python bench/cpu_speed.py --load 1 16 32 64 [--seconds 2.0]
 """
 from __future__ import annotations
 
 import argparse
 import concurrent.futures
 import json
+import multiprocessing
 import os
 import tempfile
 import time
@@ -52,6 +60,68 @@ def unit_ms(seconds: float) -> float:
     return 1000 * float(np.median(times))
 
 
+def copy_gbs(seconds: float, mib: int = 64) -> float:
+    """Gigabytes a second one process moves copying a ``mib`` MiB array into another (bytes read plus written),
+    over about ``seconds`` of repeats: past the caches, so it measures the memory bus this process gets."""
+    source = np.ones(mib << 18, dtype=np.float32)
+    target = np.empty_like(source)
+    np.copyto(target, source)                    # both touched once: no page faults inside the timing
+    copies, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        np.copyto(target, source)
+        copies += 1
+    return 2 * copies * source.nbytes / (time.perf_counter() - start) / 1e9
+
+
+def _loaded_worker(seconds: float, start: multiprocessing.Barrier, results: multiprocessing.Queue) -> None:
+    start.wait()
+    unit = unit_ms(seconds)
+    start.wait()
+    results.put((unit, copy_gbs(seconds)))
+
+
+def under_load(processes: int, seconds: float) -> dict[str, float]:
+    """``processes`` processes timing the unit together, then copying memory together: the median unit ms,
+    the median and summed copy GB/s, and the steal percent of the CPU time over each phase."""
+    context = multiprocessing.get_context("fork")
+    start, results = context.Barrier(processes + 1), context.Queue()
+    workers = [context.Process(target=_loaded_worker, args=(seconds, start, results)) for _ in range(processes)]
+    for worker in workers:
+        worker.start()
+    start.wait()
+    before = _steal()
+    start.wait()                                 # every worker has finished the unit phase
+    middle = _steal()
+    got = [results.get() for _ in workers]
+    after = _steal()
+    for worker in workers:
+        worker.join()
+    copies = [gbs for _, gbs in got]
+    return {"unit ms": float(np.median([unit for unit, _ in got])), "copy GB/s": float(np.median(copies)),
+            "copy GB/s, all": float(np.sum(copies)), "steal % (unit)": _steal_percent(before, middle),
+            "steal % (copy)": _steal_percent(middle, after)}
+
+
+def _steal_percent(before: tuple[float, float] | None, after: tuple[float, float] | None) -> float:
+    if before is None or after is None or after[1] <= before[1]:
+        return float("nan")
+    return 100 * (after[0] - before[0]) / (after[1] - before[1])
+
+
+def load_table(counts: list[int], seconds: float) -> str:
+    """The markdown table of :func:`under_load` for each process count, with each count's unit time and copy
+    rate against one process's."""
+    rows = {n: under_load(n, seconds) for n in counts}
+    first = rows[counts[0]]
+    lines = [f"| processes | unit ms (x {counts[0]}) | copy GB/s a process (x {counts[0]}) | copy GB/s, all | "
+             "steal % (unit) | steal % (copy) |", "|---|---|---|---|---|---|"]
+    for n, row in rows.items():
+        lines.append(f"| {n} | {row['unit ms']:.3f} ({row['unit ms'] / first['unit ms']:.2f}) | "
+                     f"{row['copy GB/s']:.1f} ({row['copy GB/s'] / first['copy GB/s']:.2f}) | "
+                     f"{row['copy GB/s, all']:.0f} | {row['steal % (unit)']:.1f} | {row['steal % (copy)']:.1f} |")
+    return "\n".join(lines)
+
+
 def _steal() -> tuple[float, float] | None:
     """(steal jiffies, all jiffies) from /proc/stat's cpu line; None where there is none."""
     try:
@@ -83,7 +153,14 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=os.cpu_count() or 1,
                         help="processes timing the work at once for the all-core figure (default: every core)")
     parser.add_argument("--seconds", type=float, default=1.0, help="seconds each timing repeats the work")
+    parser.add_argument("--load", type=int, nargs="+", metavar="N",
+                        help="instead: a table of the unit and memory copies with N processes at once, each N")
     args = parser.parse_args()
+    if args.load:
+        if min(args.load) < 1:
+            parser.error(f"--load takes process counts of 1 or more, got {args.load}")
+        print(load_table(args.load, args.seconds))
+        return
     one = unit_ms(args.seconds)
     with concurrent.futures.ProcessPoolExecutor(args.processes) as pool:
         every = list(pool.map(unit_ms, [args.seconds] * args.processes))

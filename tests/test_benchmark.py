@@ -253,3 +253,37 @@ def test_processes_started_together_stop_together_at_the_deadline():
     r = run_graphsdg(config, before_timing=lambda: waited.append(True))
     assert waited == [True] and 0 < r.frames < 100000 and len(r.frame_times) == r.frames
     assert 0.6 <= r.wall_seconds <= 0.6 + max(r.frame_times) + 0.05   # the frame under way at the deadline ends it
+
+
+def _bench_script(name: str):
+    import importlib.util
+    import sys
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench", f"{name}.py")
+    spec = importlib.util.spec_from_file_location(f"graphsdg_bench_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_cpu_speed_under_load_gives_a_row_a_process_count():
+    """bench/cpu_speed.py --load: each count's processes time the unit and copy memory together; the table has
+    a row a count with the unit's time, positive copy rates (all processes' the sum of theirs) and steal."""
+    cpu_speed = _bench_script("cpu_speed")
+    one, two = cpu_speed.under_load(1, 0.05), cpu_speed.under_load(2, 0.05)
+    for row in (one, two):
+        assert row["unit ms"] > 0 and row["copy GB/s"] > 0
+        assert math.isnan(row["steal % (unit)"]) or 0 <= row["steal % (unit)"] <= 100
+    assert one["copy GB/s, all"] == pytest.approx(one["copy GB/s"])
+    assert two["copy GB/s, all"] >= two["copy GB/s"]                  # the sum of two, the median of two
+    table = cpu_speed.load_table([1, 2], 0.05).splitlines()
+    assert table[0].startswith("| processes |") and [r.split("|")[1].strip() for r in table[2:]] == ["1", "2"]
+    assert table[2].split("|")[2].strip().endswith("(1.00)")          # the first count against itself
+
+
+def test_cpu_speed_refuses_a_load_of_no_processes():
+    import subprocess
+    import sys
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench", "cpu_speed.py")
+    done = subprocess.run([sys.executable, path, "--load", "2", "0"], capture_output=True, text=True)
+    assert done.returncode == 2 and "--load takes process counts of 1 or more, got [2, 0]" in done.stderr

@@ -54,6 +54,38 @@ def test_chunks_are_well_formed_and_bytes_deterministic():
     assert (width, height, data[24], data[25]) == (53, 37, 8, 6)   # 8 bits, RGBA
 
 
+def _idat_rows(data: bytes) -> bytes:
+    """The inflated IDAT stream of a PNG that has one IDAT chunk."""
+    start = data.index(b"IDAT")
+    return zlib.decompress(data[start + 4:start + 4 + int.from_bytes(data[start - 4:start], "big")])
+
+
+@pytest.mark.parametrize("stripe_bytes", [1, 1000, 1 << 18])
+def test_rows_deflated_stripe_by_stripe_decode_exactly(monkeypatch, stripe_bytes):
+    """Rows filtered and deflated a stripe at a time (one row a stripe, a few rows, the default) make one zlib
+    stream of every row: filter byte 1 (Sub), then each byte minus the one a pixel to its left."""
+    import graphsdg.io.png as png
+    monkeypatch.setattr(png, "STRIPE_BYTES", stripe_bytes)
+    smooth = np.linspace(0, 255, 108 * 90 * 4).astype(np.uint8).reshape(108, 90, 4)
+    image = np.concatenate([RNG.integers(0, 256, (150, 90, 4), dtype=np.uint8), smooth])   # noise, then runs
+    data = png.encode_png(image)
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), image)
+    rows = np.frombuffer(_idat_rows(data), np.uint8).reshape(image.shape[0], 90 * 4 + 1)
+    assert (rows[:, 0] == 1).all()
+    flat = image.reshape(image.shape[0], -1)
+    assert np.array_equal(rows[:, 5:], flat[:, 4:] - flat[:, :-4]) and np.array_equal(rows[:, 1:5], flat[:, :4])
+
+
+def test_threads_encoding_at_once_each_get_their_own_pixels():
+    import concurrent.futures
+    images = [RNG.integers(0, 256, (300 + 7 * i, 200, 4), dtype=np.uint8) for i in range(6)]
+
+    def check(image):
+        return all(np.array_equal(np.asarray(Image.open(io.BytesIO(encode_png(image)))), image) for _ in range(5))
+    with concurrent.futures.ThreadPoolExecutor(3) as pool:
+        assert all(pool.map(check, images))
+
+
 def test_encode_image_writes_pngs_through_it():
     image = RNG.integers(0, 256, (8, 8, 4), dtype=np.uint8)
     assert encode_image(image, ".png") == encode_png(image)
@@ -82,3 +114,38 @@ def test_npy_bytes_are_numpys_own(array) -> None:
     np.save(reference, array, allow_pickle=False)
     assert encode_npy(array) == reference.getvalue()
     assert np.array_equal(np.load(io.BytesIO(encode_npy(array))), array)
+
+
+@pytest.mark.parametrize("array", [
+    np.linspace(0, 1, 512 * 512, dtype=np.float32).reshape(512, 512), np.zeros((0, 4), np.uint8), np.array(3.5),
+    np.asfortranarray(np.arange(12.0).reshape(3, 4)),
+    np.array([(1, -2, 0.5)], dtype=[("semanticId", "<u4"), ("x_min", "<i4"), ("occlusionRatio", "<f4")])])
+def test_npy_files_are_written_from_the_arrays_pieces(tmp_path, array) -> None:
+    """write_np writes np.save's bytes from the header and the array's memory (no joined copy), to a path and
+    through a folder backend, and the written totals count every byte."""
+    from graphsdg.io import io_functions
+    from graphsdg.io.backends import DiskBackend
+    from graphsdg.io.encode import npy_parts
+    from graphsdg.io.written_totals import bytes_written
+    reference = io.BytesIO()
+    np.save(reference, array, allow_pickle=False)
+    parts = npy_parts(array)
+    if array.flags.c_contiguous and array.dtype.names is None:
+        assert len(parts) == 2 and isinstance(parts[1], memoryview) and parts[1].obj is not None
+        assert np.shares_memory(np.frombuffer(parts[1], np.uint8), array) or array.size == 0
+    before = bytes_written()
+    io_functions.write_np(array, str(tmp_path / "a.npy"))
+    io_functions.write_np(array, "b.npy", backend_instance=DiskBackend(str(tmp_path / "backend")))
+    assert bytes_written() - before == 2 * len(reference.getvalue())
+    for path in (tmp_path / "a.npy", tmp_path / "backend" / "b.npy"):
+        assert path.read_bytes() == reference.getvalue()
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a.npy", "b.npy", "backend"]   # no temporaries left
+
+
+def test_atomic_writes_take_a_list_of_pieces(tmp_path) -> None:
+    from graphsdg.io.atomic_files import byte_count, write_atomic
+    big = np.arange(300_000, dtype=np.uint32)
+    pieces = [b"head", memoryview(b""), memoryview(big.view(np.uint8)), bytearray(b"tail")]
+    write_atomic(str(tmp_path / "f.bin"), pieces)
+    assert (tmp_path / "f.bin").read_bytes() == b"head" + big.tobytes() + b"tail"
+    assert byte_count(pieces) == 8 + big.nbytes and byte_count(b"abc") == 3

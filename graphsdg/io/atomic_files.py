@@ -17,6 +17,7 @@ import itertools
 import os
 import re
 import uuid
+from typing import Sequence
 
 _folders_made: set[str] = set()
 _temp_serial = itertools.count()
@@ -76,14 +77,31 @@ def _fsync_dir(directory: str) -> None:
 _CREATE_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_CLOEXEC", 0)
 
 
-def _write_all(fd: int, data: bytes) -> None:
-    view = memoryview(data)
-    while view:
-        view = view[os.write(fd, view):]
+def byte_count(data: bytes | Sequence[bytes | memoryview]) -> int:
+    """How many bytes :func:`write_atomic` writes for ``data`` (one buffer, or a list of pieces)."""
+    if isinstance(data, (list, tuple)):
+        return sum(memoryview(piece).nbytes for piece in data)
+    return memoryview(data).nbytes
 
 
-def write_atomic(full_path: str, data: bytes, durable: bool = False) -> None:
-    """Write ``data`` to ``full_path`` so that the file appears whole or not at all.
+def _write_all(fd: int, data: bytes | Sequence[bytes | memoryview]) -> None:
+    if not isinstance(data, (list, tuple)):
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+        return
+    views = [memoryview(piece).cast("B") for piece in data if memoryview(piece).nbytes]
+    while views:                       # one system call for every piece (a short write resumes mid-piece)
+        written = os.writev(fd, views)
+        while views and written >= views[0].nbytes:
+            written -= views.pop(0).nbytes
+        if views:
+            views[0] = views[0][written:]
+
+
+def write_atomic(full_path: str, data: bytes | Sequence[bytes | memoryview], durable: bool = False) -> None:
+    """Write ``data`` (bytes, or a list of pieces written one after the other) to ``full_path`` so that the file
+    appears whole or not at all.
 
     The bytes go to a temporary name in the same folder, which is then renamed over ``full_path``
     (atomic on POSIX). A process that dies at any point leaves either the old file or the new one,

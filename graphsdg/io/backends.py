@@ -12,7 +12,7 @@ import inspect
 import os
 import threading
 import uuid
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 
 from graphsdg.base import settings_store as settings
@@ -274,8 +274,9 @@ def _check_writable(path: str) -> None:
         raise PermissionError(f"output_dir {path!r} is not writable: {exc.strerror or exc}") from exc
 
 
-def write_file_atomic(full_path: str, data: bytes) -> None:
-    """Write ``data`` to ``full_path`` so that the file appears whole or not at all.
+def write_file_atomic(full_path: str, data: bytes | Sequence[bytes | memoryview]) -> None:
+    """Write ``data`` (bytes, or a list of pieces written one after the other) to ``full_path`` so that the
+    file appears whole or not at all.
 
     The bytes go to a temporary name in the same folder, which is then renamed
     over ``full_path`` (atomic on POSIX; :func:`graphsdg.io.atomic_files.write_atomic`).
@@ -286,13 +287,13 @@ def write_file_atomic(full_path: str, data: bytes) -> None:
     _write_atomic(full_path, data, count=True)
 
 
-def _write_atomic(full_path: str, data: bytes, count: bool) -> None:
+def _write_atomic(full_path: str, data: bytes | Sequence[bytes | memoryview], count: bool) -> None:
     """:func:`write_file_atomic`; ``count=False`` leaves the totals alone (bookkeeping files: the run state)."""
     if writes_discarded():
         return
     atomic_files.write_atomic(full_path, data, durable_writes())
     if count:     # bookkeeping files (the run state) are not part of the dataset's totals
-        count_written(len(data))
+        count_written(atomic_files.byte_count(data))
 
 
 class BackendGroup(BaseBackend):

@@ -44,17 +44,33 @@ def encode_image(data: Any, ext: str = ".png") -> bytes:
 
 
 def encode_npy(data: Any) -> bytes:
-    """The bytes ``np.save`` writes for ``data`` (a .npy file), made with one copy of a C-ordered array.
+    """The bytes ``np.save`` writes for ``data`` (a .npy file): :func:`npy_parts` joined.
 
     ``np.save`` into a buffer copies a frame's megabyte of depth four times (an iterator's chunks, their bytes,
-    the buffer, its value); here the header (NumPy's own writer, format 1.0) and the array's memory are joined
-    once. Other arrays (object, Fortran-ordered or strided, a header too long for format 1.0) go through
-    ``np.save``.
+    the buffer, its value); this copies it once.
 
     Example:
         >>> import io
         >>> a = np.arange(6, dtype=np.float32).reshape(2, 3)
         >>> b = io.BytesIO(); np.save(b, a); encode_npy(a) == b.getvalue()
+        True
+    """
+    parts = npy_parts(data)
+    return parts[0] if len(parts) == 1 else b"".join(parts)
+
+
+def npy_parts(data: Any) -> list[bytes | memoryview]:
+    """The bytes of ``data``'s .npy file as pieces to write one after the other, without joining them: the
+    header (NumPy's own writer, format 1.0) and a view of the array's own memory, for a C-ordered array of a
+    plain dtype; the whole file as one piece from ``np.save`` for any other (object, Fortran-ordered or strided,
+    a header too long for format 1.0).
+
+    Writing the pieces (:func:`graphsdg.io.atomic_files.write_atomic` takes a list) keeps a frame's depth from
+    being copied into a joined buffer only to be copied again into the file.
+
+    Example:
+        >>> a = np.arange(6, dtype=np.float32).reshape(2, 3)
+        >>> header, body = npy_parts(a); bytes(body) == a.tobytes()
         True
     """
     arr = np.asarray(data)
@@ -65,10 +81,10 @@ def encode_npy(data: Any) -> bytes:
         except ValueError:   # a header longer than format 1.0 holds: np.save picks the version
             pass
         else:
-            return b"".join([header.getvalue(), arr.reshape(-1).view(np.uint8)])
+            return [header.getvalue(), memoryview(arr.reshape(-1).view(np.uint8))]
     bio = io.BytesIO()
     np.save(bio, arr, allow_pickle=False)
-    return bio.getvalue()
+    return [bio.getvalue()]
 
 
 def to_jsonable(value: Any) -> Any:

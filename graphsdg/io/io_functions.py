@@ -28,8 +28,12 @@ def write_image(data: Any = None, path: str = "", backend_instance: BaseBackend 
 
 
 def write_np(data: Any = None, path: str = "", backend_instance: BaseBackend | None = None) -> None:
-    """Write ``data`` as a ``.npy`` file."""
-    _write(path, encode.encode_npy(data), backend_instance)
+    """Write ``data`` as a ``.npy`` file (to a local file straight from the array's memory, unjoined)."""
+    resolve = os.path.abspath if backend_instance is None else backend_instance.local_resolver()
+    if resolve is None:        # a bucket or a backend of its own: it gets the file's bytes
+        backend_instance.write_blob(path, encode.encode_npy(data))
+    else:
+        write_file_atomic(resolve(path), encode.npy_parts(data))
 
 
 def write_json(data: Any = None, path: str = "", backend_instance: BaseBackend | None = None,

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from graphsdg.io import encode
-from graphsdg.io.atomic_files import write_atomic
+from graphsdg.io.atomic_files import byte_count, write_atomic
 
 # argv: package folder, request fd, reply fd, arena fd, arena bytes
 BOOT = ("import sys, types; package = types.ModuleType('graphsdg'); package.__path__ = [sys.argv[1]]; "
@@ -39,12 +39,13 @@ BOOT = ("import sys, types; package = types.ModuleType('graphsdg'); package.__pa
         "main(*map(int, sys.argv[2:]))")
 
 
-def encoded(kind: str, path: str, data: Any, indent: int | None) -> bytes:
-    """The file bytes of one write: the encoders :mod:`graphsdg.io.io_functions` uses in a writer thread."""
+def encoded(kind: str, path: str, data: Any, indent: int | None) -> bytes | list[bytes | memoryview]:
+    """The file bytes of one write (an array's .npy as its unjoined pieces): the encoders
+    :mod:`graphsdg.io.io_functions` uses in a writer thread."""
     if kind == "image":
         return encode.encode_image(data, os.path.splitext(path)[1] or ".png")
     if kind == "npy":
-        return encode.encode_npy(data)
+        return encode.npy_parts(data)
     if kind == "json":
         return encode.encode_json(data, indent=indent)
     if kind == "blob":
@@ -79,7 +80,7 @@ def _write_one(arena: mmap.mmap, task: tuple) -> tuple[tuple | None, int]:
     try:
         data = encoded(kind, path, _payload(arena, payload), indent)
         write_atomic(path, data, durable)
-        return None, len(data)
+        return None, byte_count(data)
     except OSError as exc:     # sent as (errno, text) so the parent rebuilds it as str() shows it here
         text = exc.strerror or str(exc)
         return (type(exc).__name__, exc.errno, text if exc.filename is None else f"{text}: {exc.filename!r}"), 0
