@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
 import pytest
 
 from graphsdg.benchmark.throughput import BenchConfig, _steady_rate, summarize_processes
@@ -287,3 +288,32 @@ def test_cpu_speed_refuses_a_load_of_no_processes():
     path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench", "cpu_speed.py")
     done = subprocess.run([sys.executable, path, "--load", "2", "0"], capture_output=True, text=True)
     assert done.returncode == 2 and "--load takes process counts of 1 or more, got [2, 0]" in done.stderr
+
+
+@pytest.mark.parametrize("shape", [(70, 53, 4), (37, 29, 3), (5, 1, 1), (300, 2, 1)])
+def test_gpu_png_prototype_encodes_exact_pngs_on_warps_cpu(shape):
+    """bench/gpu_png.py's fixed-code deflate (run on Warp's CPU device): Pillow and OpenCV decode the pixels
+    encoded, zlib checks the Adler-32 combined from the rows' sums, and each row is a block of its own that
+    ends byte-aligned (an empty stored block: 00 00 FF FF)."""
+    pytest.importorskip("warp")
+    import io
+    import zlib
+    import cv2
+    from PIL import Image
+    gpu_png = _bench_script("gpu_png")
+    rng = np.random.default_rng(sum(shape))
+    image = rng.integers(0, 256, shape, dtype=np.uint8)
+    image[shape[0] // 2:] = 7                                   # flat rows below: matches
+    data = gpu_png.FixedCodeEncoder(*shape, device="cpu").png(image)
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))).reshape(shape), image)
+    decoded = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED).reshape(shape)
+    if shape[2] >= 3:
+        decoded = decoded[..., [2, 1, 0, 3][:shape[2]]]
+    assert np.array_equal(decoded, image)
+    start = data.index(b"IDAT")
+    stream = data[start + 4:start + 4 + int.from_bytes(data[start - 4:start], "big")]
+    rows = np.frombuffer(zlib.decompress(stream), np.uint8).reshape(shape[0], shape[1] * shape[2] + 1)
+    assert (rows[:, 0] == 1).all()                                # every row Sub-filtered
+    assert stream.count(b"\x00\x00\xff\xff") >= shape[0]
+    flat = gpu_png.FixedCodeEncoder(64, 64, 4, device="cpu").png(np.full((64, 64, 4), 200, np.uint8))
+    assert len(flat) < 64 * 16 < 64 * 257                           # runs become matches: a few bytes a row
