@@ -2,10 +2,10 @@
 
 The writer threads' colour and class-mask PNGs are most of what holds four GPUs of one host back
 (docs/performance.md, round 23). A GPU encoder keeps to what runs in parallel: each image row is its own
-deflate block with the fixed Huffman codes (RFC 1951, 3.2.6), its matches limited to three distances (the byte
-before, the pixel before, the row above), and ends byte-aligned with an empty stored block, so every row is
-encoded by one thread into a slot of its own and the slots are joined by a prefix sum of their lengths. The
-zlib checksum is summed a row at a time on the device and combined on the host.
+deflate block with the fixed Huffman codes (RFC 1951, 3.2.6), its matches limited to five distances (the byte,
+the pixel and two pixels before, the row above and its pixel before), and ends byte-aligned with an empty stored
+block, so every row is encoded by one thread into a slot of its own and the slots are joined by a prefix sum of
+their lengths. The zlib checksum is summed a row at a time on the device and combined on the host.
 
 This script measures that design: the bytes it makes of a frame against ISA-L level 1's (graphsdg's PNG writer),
 and the device time of encoding it (the kernel, the prefix sum, the gathering copy and the read back). It is a
@@ -93,7 +93,7 @@ def _encode_rows(rows: wp.array2d(dtype=wp.uint8), bpp: int, length_base: wp.arr
     while i < line:
         best = int(0)
         distance = int(0)
-        for c in range(5):         # the byte before, the pixel before, two pixels before, the row above, its pixel before
+        for c in range(5):         # the distances: byte, pixel, two pixels, row, row and pixel back
             d = int(1)
             if c == 1:
                 d = bpp
@@ -103,7 +103,7 @@ def _encode_rows(rows: wp.array2d(dtype=wp.uint8), bpp: int, length_base: wp.arr
                 d = line
             elif c == 4:
                 d = line + bpp
-            if (c > 0 and c < 3 and d == 1) or d > 32768 or i - d < -line or (r == 0 and i - d < 0):
+            if (c == 1 and d == 1) or d > 32768 or i - d < -line or (r == 0 and i - d < 0):
                 continue
             n = _match(rows, r, i, d, bpp)
             if n > best:
