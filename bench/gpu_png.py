@@ -1,6 +1,6 @@
 """What a PNG encoder on the GPU would cost: fixed-code deflate of Sub-filtered rows in a Warp kernel, timed.
 
-The writer threads' colour and class-mask PNGs are most of what holds four GPUs of one host back
+The colour and class-mask PNGs are the largest part of the writing that holds four GPUs of one host back
 (docs/performance.md, round 23). A GPU encoder keeps to what runs in parallel: each image row is its own
 deflate block with the fixed Huffman codes (RFC 1951, 3.2.6), its matches limited to five distances (the byte,
 the pixel and two pixels before, the row above and its pixel before), and ends byte-aligned with an empty stored
