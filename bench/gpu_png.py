@@ -19,10 +19,11 @@ from __future__ import annotations
 import argparse
 import struct
 import time
-import zlib
 
 import numpy as np
 import warp as wp
+
+from graphsdg.io.png import encode_png, png_file
 
 ADLER = wp.constant(65521)
 MAX_MATCH = wp.constant(258)
@@ -183,7 +184,7 @@ class FixedCodeEncoder:
         self.offsets = wp.empty(height, dtype=wp.int32, device=device)
         self.sums = wp.empty((height, 2), dtype=wp.int64, device=device)
         self.stream = wp.empty(height * slot_bytes, dtype=wp.uint8, device=device)
-        self.header = struct.pack(">IIBBBBB", width, height, 8, {1: 0, 2: 4, 3: 2, 4: 6}[channels], 0, 0, 0)
+        self.size = (width, height, channels)
 
     def encode_device(self, rows: wp.array2d) -> tuple[np.ndarray, np.ndarray]:
         """The joined deflate blocks of ``rows`` (uint8 device rows) and each line's checksum sums, on the host."""
@@ -201,8 +202,8 @@ class FixedCodeEncoder:
         blocks, sums = self.encode_device(rows)
         idat = b"".join([b"\x78\x01", blocks.tobytes(), b"\x03\x00",
                          struct.pack(">I", _adler(sums, self.shape[1] + 1))])
-        return b"".join([b"\x89PNG\r\n\x1a\n", _chunk(b"IHDR", self.header), _chunk(b"IDAT", idat),
-                         _chunk(b"IEND", b"")])
+        width, height, channels = self.size
+        return png_file(width, height, 8, channels, idat)
 
 
 def _adler(sums: np.ndarray, line: int) -> int:
@@ -212,10 +213,6 @@ def _adler(sums: np.ndarray, line: int) -> int:
         b = (b + line * a + s2) % ADLER
         a = (a + s1) % ADLER
     return (b << 16) | a
-
-
-def _chunk(kind: bytes, data: bytes) -> bytes:
-    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(data, zlib.crc32(kind)))
 
 
 def _frame(path: str | None) -> np.ndarray:
@@ -239,7 +236,6 @@ def main() -> None:
     parser.add_argument("--device", default="cuda:0" if wp.get_cuda_device_count() else "cpu")
     parser.add_argument("--frames", type=int, default=200, help="encodes timed")
     args = parser.parse_args()
-    from graphsdg.io.png import encode_png
     image = _frame(args.image)
     encoder = FixedCodeEncoder(*image.shape, device=args.device)
     data = encoder.png(image)

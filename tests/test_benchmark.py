@@ -256,11 +256,14 @@ def test_processes_started_together_stop_together_at_the_deadline():
     assert 0.6 <= r.wall_seconds <= 0.6 + max(r.frame_times) + 0.05   # the frame under way at the deadline ends it
 
 
+def _bench_path(name: str) -> str:
+    return os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench", f"{name}.py")
+
+
 def _bench_script(name: str):
     import importlib.util
     import sys
-    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench", f"{name}.py")
-    spec = importlib.util.spec_from_file_location(f"graphsdg_bench_{name}", path)
+    spec = importlib.util.spec_from_file_location(f"graphsdg_bench_{name}", _bench_path(name))
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     spec.loader.exec_module(module)
@@ -285,8 +288,8 @@ def test_cpu_speed_under_load_gives_a_row_a_process_count():
 def test_cpu_speed_refuses_a_load_of_no_processes():
     import subprocess
     import sys
-    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "bench", "cpu_speed.py")
-    done = subprocess.run([sys.executable, path, "--load", "2", "0"], capture_output=True, text=True)
+    done = subprocess.run([sys.executable, _bench_path("cpu_speed"), "--load", "2", "0"], capture_output=True,
+                          text=True)
     assert done.returncode == 2 and "--load takes process counts of 1 or more, got [2, 0]" in done.stderr
 
 

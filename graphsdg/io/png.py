@@ -54,9 +54,14 @@ def encode_png(image: np.ndarray) -> bytes:
     rows = np.ascontiguousarray(arr.astype(">u2", copy=False) if depth == 16 else arr).view(np.uint8)
     rows = rows.reshape(h, w * c * arr.dtype.itemsize)
     step = c * arr.dtype.itemsize                     # bytes per pixel: Sub subtracts the pixel to the left
-    header = struct.pack(">IIBBBBB", w, h, depth, COLOR_TYPES[c], 0, 0, 0)
-    return b"".join([SIGNATURE, _chunk(b"IHDR", header), _chunk(b"IDAT", _deflated_rows(rows, step)),
-                     _chunk(b"IEND", b"")])
+    return png_file(w, h, depth, c, _deflated_rows(rows, step))
+
+
+def png_file(width: int, height: int, bit_depth: int, channels: int, zlib_stream: bytes) -> bytes:
+    """A PNG file around ``zlib_stream``, the compressed filtered rows of a ``width`` x ``height`` image of
+    ``channels`` channels (1-4) and ``bit_depth`` bits a channel: signature, ``IHDR``, one ``IDAT``, ``IEND``."""
+    header = struct.pack(">IIBBBBB", width, height, bit_depth, COLOR_TYPES[channels], 0, 0, 0)
+    return b"".join([SIGNATURE, _chunk(b"IHDR", header), _chunk(b"IDAT", zlib_stream), _chunk(b"IEND", b"")])
 
 
 def _deflated_rows(rows: np.ndarray, step: int) -> bytes:
