@@ -6,9 +6,9 @@ was the largest CPU cost of a written frame; ISA-L level 1 takes a fraction of
 OpenCV's libpng + zlib time for a slightly smaller file (docs/performance.md,
 "PNG encoding with ISA-L"), and it releases the GIL, so writer threads run in parallel. Every row
 uses the ``Sub`` filter (each byte minus the byte one pixel to the left, mod 256),
-which is what OpenCV picks for rendered images too. Rows are filtered and deflated a stripe of
-:data:`STRIPE_BYTES` at a time through one buffer a thread keeps, so the filtered image is never
-written out to memory whole and read back (docs/performance.md, "PNG stripes").
+which is what OpenCV picks for rendered images too. The filtered rows are deflated in one call
+(ISA-L's stateless deflate): a stream fed in pieces gave other bytes from run to run on the CI
+machine (docs/performance.md, "PNG stripes").
 
 Files decode to the same pixels with any PNG reader (tests compare OpenCV's and
 Pillow's decodes); the compressed bytes are deterministic for a given ``isal``
@@ -24,7 +24,6 @@ Example:
 from __future__ import annotations
 
 import struct
-import threading
 import zlib
 
 import numpy as np
@@ -34,9 +33,6 @@ SIGNATURE = b"\x89PNG\r\n\x1a\n"
 COLOR_TYPES = {1: 0, 2: 4, 3: 2, 4: 6}   # channels -> PNG colour type (grey, grey+alpha, RGB, RGBA)
 SUB_FILTER = 1
 LEVEL = 1                                # ISA-L level 1: fastest of the levels that compress well
-STRIPE_BYTES = 1 << 18                   # filtered bytes deflated at a time: well inside a core's L2 cache
-
-_stripe_buffers = threading.local()      # each thread's filter buffer, reused image after image
 
 
 def encode_png(image: np.ndarray) -> bytes:
@@ -66,29 +62,13 @@ def png_file(width: int, height: int, bit_depth: int, channels: int, zlib_stream
 
 def _deflated_rows(rows: np.ndarray, step: int) -> bytes:
     """The zlib stream of ``rows`` (uint8, one image row a row), each row ``Sub``-filtered with ``step`` bytes a
-    pixel behind its filter-type byte, made a stripe of rows at a time."""
+    pixel behind its filter-type byte."""
     height, width = rows.shape
-    stripe_rows = max(1, STRIPE_BYTES // (width + 1))
-    buffer = _stripe_buffer(min(stripe_rows, height) * (width + 1))
-    compressor = isal_zlib.compressobj(LEVEL)
-    pieces = []
-    for top in range(0, height, stripe_rows):
-        source = rows[top:top + stripe_rows]
-        filtered = buffer[:source.shape[0] * (width + 1)].reshape(source.shape[0], width + 1)
-        filtered[:, 0] = SUB_FILTER
-        filtered[:, 1:step + 1] = source[:, :step]
-        np.subtract(source[:, step:], source[:, :-step], out=filtered[:, step + 1:])  # uint8 wraps mod 256
-        pieces.append(compressor.compress(filtered))
-    pieces.append(compressor.flush())
-    return b"".join(pieces)
-
-
-def _stripe_buffer(nbytes: int) -> np.ndarray:
-    """This thread's filter buffer, at least ``nbytes`` long."""
-    buffer = getattr(_stripe_buffers, "buffer", None)
-    if buffer is None or buffer.size < nbytes:
-        buffer = _stripe_buffers.buffer = np.empty(max(nbytes, STRIPE_BYTES), dtype=np.uint8)
-    return buffer
+    filtered = np.empty((height, width + 1), dtype=np.uint8)
+    filtered[:, 0] = SUB_FILTER
+    filtered[:, 1:step + 1] = rows[:, :step]
+    np.subtract(rows[:, step:], rows[:, :-step], out=filtered[:, step + 1:])   # uint8 arithmetic wraps mod 256
+    return isal_zlib.compress(filtered, LEVEL)
 
 
 def _chunk(kind: bytes, data: bytes) -> bytes:
