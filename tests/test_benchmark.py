@@ -320,3 +320,72 @@ def test_gpu_png_prototype_encodes_exact_pngs_on_warps_cpu(shape):
     assert stream.count(b"\x00\x00\xff\xff") >= shape[0]
     flat = gpu_png.FixedCodeEncoder(64, 64, 4, device="cpu").png(np.full((64, 64, 4), 200, np.uint8))
     assert len(flat) < 64 * 16 < 64 * 257                           # runs become matches: a few bytes a row
+
+
+def test_png_codes_parse_rebuilds_the_filtered_lines_and_counts_its_bits():
+    """bench/png_codes.py: the segment-by-segment parse a GPU would make replays to the exact filtered lines (no
+    match past its segment's end), a flat image is nearly all matches, and the bits counted with the fixed codes
+    are the lengths of the codes RFC 1951 gives each symbol."""
+    from graphsdg.io.png import filtered_lines
+    png_codes = _bench_script("png_codes")
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 256, (24, 20, 4), dtype=np.uint8)
+    image[12:] = (9, 90, 200, 255)                                   # flat rows below: long matches
+    stream = filtered_lines(image).reshape(-1)
+    for segment in (7, 64, stream.size):
+        best, distance = png_codes.best_matches(stream, png_codes.distance_set("9", 4, 81), segment)
+        ends = np.arange(stream.size) + best
+        assert (best <= 258).all() and ((ends - 1) // segment <= np.arange(stream.size) // segment).all()
+        symbols = png_codes.greedy_parse(stream, best, distance)
+        assert png_codes.replayed(symbols) == stream.tobytes()
+    flat = filtered_lines(np.full((16, 16, 4), 77, np.uint8)).reshape(-1)
+    symbols = png_codes.greedy_parse(flat, *png_codes.best_matches(flat, [1, 4, 65], flat.size))
+    assert png_codes.replayed(symbols) == flat.tobytes() and len(symbols) < 20
+    lit_len, dist, extra = png_codes.histograms([(0, 0), (200, 0), (3, 1), (258, 65)])
+    assert lit_len[[0, 200, 256, 257, 285]].tolist() == [1, 1, 1, 1, 1] and dist[[0, 12]].tolist() == [1, 1]
+    assert extra == 5                                                 # distance 65: 5 extra bits; lengths 3, 258: 0
+    assert png_codes.fixed_bits(lit_len, dist, extra) == 3 + 8 + 9 + 7 + 7 + 8 + 5 + 5 + 5
+
+
+@pytest.mark.parametrize("counts", [[5, 1], [1, 1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192,
+                                              16384, 32768, 65536], [3, 0, 0, 7, 7, 1]])
+def test_png_codes_lengths_are_complete_prefix_codes_within_the_limit(counts):
+    """Package-merge: lengths at most the limit (the skewed counts would want 17 bits unlimited), a complete
+    prefix code (Kraft sum 1), unused symbols left out, and no worse than a plain Huffman code would be where
+    the limit does not bind."""
+    png_codes = _bench_script("png_codes")
+    counts = np.array(counts)
+    lengths = png_codes.limited_code_lengths(counts, limit=15)
+    used = counts > 0
+    assert (lengths[~used] == 0).all() and lengths[used].min() >= 1 and lengths.max() <= 15
+    assert sum(2.0 ** -int(n) for n in lengths[used]) == 1.0
+    if counts.size < 10:
+        import heapq
+        heap = [int(c) for c in counts if c]
+        heapq.heapify(heap)
+        huffman_cost = 0
+        while len(heap) > 1:
+            merged = heapq.heappop(heap) + heapq.heappop(heap)
+            huffman_cost += merged
+            heapq.heappush(heap, merged)
+        assert int(counts @ lengths) == huffman_cost
+
+
+def test_png_codes_table_sizes_an_image_against_isal(tmp_path):
+    """The script's table: a row a (distance set, segment) with ISA-L's size and both estimates."""
+    import subprocess
+    import sys
+    import cv2
+    image = np.zeros((40, 30, 4), np.uint8)
+    image[:, :, 3] = 255
+    image[10:30, 5:20, :3] = (200, 40, 10)
+    path = str(tmp_path / "mask.png")
+    cv2.imwrite(path, image)
+    done = subprocess.run([sys.executable, _bench_path("png_codes"), path, "--distances", "5", "--segments", "64",
+                           "256"], capture_output=True, text=True, check=True)
+    rows = [line.split("|") for line in done.stdout.splitlines()[2:]]
+    assert [(r[2].strip(), r[3].strip()) for r in rows] == [("5", "64"), ("5", "256")]
+    assert all(int(r[4].replace(",", "")) > 0 for r in rows)
+    bad = subprocess.run([sys.executable, _bench_path("png_codes"), path, "--segments", "0"], capture_output=True,
+                         text=True)
+    assert bad.returncode == 2 and "--segments takes lengths of 1 byte or more, got [0]" in bad.stderr

@@ -37,20 +37,42 @@ LEVEL = 1                                # ISA-L level 1: fastest of the levels 
 
 def encode_png(image: np.ndarray) -> bytes:
     """PNG bytes of a uint8 or uint16 image: (H, W) grey, or (H, W, C) with C = 2 (grey+alpha), 3 (RGB), 4 (RGBA)."""
+    arr = _checked(image)
+    h, w, c = arr.shape
+    return png_file(w, h, 8 * arr.dtype.itemsize, c, isal_zlib.compress(filtered_lines(arr), LEVEL))
+
+
+def filtered_lines(image: np.ndarray) -> np.ndarray:
+    """The lines a PNG of ``image`` (as :func:`encode_png` takes it) deflates, uint8 (H, 1 + row bytes): each
+    row's filter-type byte (1, ``Sub``), then each byte minus the byte one pixel to its left, mod 256.
+
+    Example:
+        >>> filtered_lines(np.array([[[10, 20], [13, 19]]], np.uint8)).tolist()
+        [[1, 10, 20, 3, 255]]
+    """
+    arr = _checked(image)
+    h, w, c = arr.shape
+    rows = np.ascontiguousarray(arr.astype(">u2", copy=False) if arr.dtype == np.uint16 else arr).view(np.uint8)
+    rows = rows.reshape(h, w * c * arr.dtype.itemsize)
+    step = c * arr.dtype.itemsize                     # bytes per pixel: Sub subtracts the pixel to the left
+    lines = np.empty((h, rows.shape[1] + 1), dtype=np.uint8)
+    lines[:, 0] = SUB_FILTER
+    lines[:, 1:step + 1] = rows[:, :step]
+    np.subtract(rows[:, step:], rows[:, :-step], out=lines[:, step + 1:])   # uint8 arithmetic wraps mod 256
+    return lines
+
+
+def _checked(image: np.ndarray) -> np.ndarray:
+    """``image`` as an (H, W, C) array a PNG can hold, or a ValueError naming its shape and dtype."""
     arr = np.asarray(image)
     if arr.ndim == 2:
         arr = arr[:, :, None]
     if arr.ndim != 3 or arr.shape[2] not in COLOR_TYPES or arr.dtype not in (np.uint8, np.uint16):
         raise ValueError(f"cannot write a PNG of shape {arr.shape} and dtype {arr.dtype}; expected uint8 or "
                          f"uint16 (H, W) or (H, W, 1-4)")
-    h, w, c = arr.shape
-    if h == 0 or w == 0:
+    if arr.shape[0] == 0 or arr.shape[1] == 0:
         raise ValueError(f"cannot write a PNG of shape {arr.shape}: it has no pixels")
-    depth = 8 * arr.dtype.itemsize
-    rows = np.ascontiguousarray(arr.astype(">u2", copy=False) if depth == 16 else arr).view(np.uint8)
-    rows = rows.reshape(h, w * c * arr.dtype.itemsize)
-    step = c * arr.dtype.itemsize                     # bytes per pixel: Sub subtracts the pixel to the left
-    return png_file(w, h, depth, c, _deflated_rows(rows, step))
+    return arr
 
 
 def png_file(width: int, height: int, bit_depth: int, channels: int, zlib_stream: bytes) -> bytes:
@@ -58,17 +80,6 @@ def png_file(width: int, height: int, bit_depth: int, channels: int, zlib_stream
     ``channels`` channels (1-4) and ``bit_depth`` bits a channel: signature, ``IHDR``, one ``IDAT``, ``IEND``."""
     header = struct.pack(">IIBBBBB", width, height, bit_depth, COLOR_TYPES[channels], 0, 0, 0)
     return b"".join([SIGNATURE, _chunk(b"IHDR", header), _chunk(b"IDAT", zlib_stream), _chunk(b"IEND", b"")])
-
-
-def _deflated_rows(rows: np.ndarray, step: int) -> bytes:
-    """The zlib stream of ``rows`` (uint8, one image row a row), each row ``Sub``-filtered with ``step`` bytes a
-    pixel behind its filter-type byte."""
-    height, width = rows.shape
-    filtered = np.empty((height, width + 1), dtype=np.uint8)
-    filtered[:, 0] = SUB_FILTER
-    filtered[:, 1:step + 1] = rows[:, :step]
-    np.subtract(rows[:, step:], rows[:, :-step], out=filtered[:, step + 1:])   # uint8 arithmetic wraps mod 256
-    return isal_zlib.compress(filtered, LEVEL)
 
 
 def _chunk(kind: bytes, data: bytes) -> bytes:
