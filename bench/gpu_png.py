@@ -1,258 +1,279 @@
-"""What a PNG encoder on the GPU would cost: fixed-code deflate of Sub-filtered rows in a Warp kernel, timed.
+"""What a PNG encoder on the GPU would cost: deflate of Sub-filtered rows in Warp kernels, a segment a thread, timed.
 
 The colour and class-mask PNGs are the largest part of the writing that holds four GPUs of one host back
-(docs/performance.md, round 23). A GPU encoder keeps to what runs in parallel: each image row is its own
-deflate block with the fixed Huffman codes (RFC 1951, 3.2.6), its matches limited to five distances (the byte,
-the pixel and two pixels before, the row above and its pixel before), and ends byte-aligned with an empty stored
-block, so every row is encoded by one thread into a slot of its own and the slots are joined by a prefix sum of
-their lengths. The zlib checksum is summed a row at a time on the device and combined on the host.
+(docs/performance.md, round 23). This encoder keeps to what runs in parallel: the filtered lines are cut into
+segments of a fixed length, and one thread parses each (at every byte the longest match among a few fixed
+distances back, never past its segment's end; ``bench/png_codes.py`` sizes these parses on the CPU). A first
+pass counts each segment's bits (and, for codes built for the image, the symbols), a prefix sum of the counts
+places every segment in one deflate block, and a second pass writes the bits there (the words two segments
+share are or-ed atomically). The block uses the fixed codes, codes built for this image from the first pass's
+counts (a copy back and a wait between the passes), or codes built from another frame. The Adler-32 is summed a
+segment at a time and combined on the device.
 
-This script measures that design: the bytes it makes of a frame against ISA-L level 1's (graphsdg's PNG writer),
-and the device time of encoding it (the kernel, the prefix sum, the gathering copy and the read back). It is a
-prototype for deciding whether to build it into the pbr path, not part of graphsdg.
+The bytes equal ``png_codes.zlib_stream`` of the same parse (the tests check it), so the sizes are those of
+``bench/png_codes.py``; this script adds the device time, against ISA-L level 1 on one core.
 
 Usage:
-    python bench/gpu_png.py [--image PNG] [--device cuda:0] [--frames 200]
+    python bench/gpu_png.py FRAME.png [--device cuda:0] [--frames 200] [--segment 256] [--distances 9]
+        [--codes fixed|own|OTHER.png]
 """
 from __future__ import annotations
 
 import argparse
-import struct
+import os
+import sys
 import time
 
 import numpy as np
 import warp as wp
 
-from graphsdg.io.png import encode_png, png_file
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import png_codes  # noqa: E402  (a bench script beside this one)
+
+from graphsdg.io.png import encode_png, filtered_lines, png_file  # noqa: E402
 
 ADLER = wp.constant(65521)
 MAX_MATCH = wp.constant(258)
-# fixed-code length symbols 257..285: base length and extra bits (RFC 1951, 3.2.5)
-LENGTH_BASE = np.array([3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 15, 17, 19, 23, 27, 31, 35, 43, 51, 59, 67, 83, 99, 115,
-                        131, 163, 195, 227, 258], dtype=np.int32)
-LENGTH_EXTRA = np.array([0] * 8 + [1] * 4 + [2] * 4 + [3] * 4 + [4] * 4 + [5] * 4 + [0], dtype=np.int32)
-DISTANCE_BASE = np.array([1, 2, 3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65, 97, 129, 193, 257, 385, 513, 769, 1025,
-                          1537, 2049, 3073, 4097, 6145, 8193, 12289, 16385, 24577], dtype=np.int32)
-DISTANCE_EXTRA = np.array([0, 0, 0, 0] + [k for k in range(1, 14) for _ in range(2)], dtype=np.int32)
+
+
+@wp.kernel(enable_backward=False)
+def _filter(rows: wp.array2d(dtype=wp.uint8), bpp: int, lines: wp.array(dtype=wp.uint8)):
+    """Line byte ``i`` of row ``r``: the filter type (1, Sub), then each byte minus the one a pixel to its left."""
+    r, i = wp.tid()
+    line = rows.shape[1] + 1
+    value = int(1)
+    if i > 0:
+        j = i - 1
+        value = int(rows[r, j])
+        if j >= bpp:
+            value = (value - int(rows[r, j - bpp])) & 255
+    lines[r * line + i] = wp.uint8(value)
 
 
 @wp.func
-def _reversed(code: int, bits: int) -> int:
-    out = int(0)
-    for k in range(bits):
-        out = (out << 1) | ((code >> k) & 1)
-    return out
-
-
-@wp.func
-def _filtered(rows: wp.array2d(dtype=wp.uint8), r: int, i: int, bpp: int) -> int:
-    """Byte ``i`` of row ``r``'s filtered line: the filter type (1, Sub) and then each byte minus the one a pixel
-    to its left; ``i`` < 0 reaches into the row above."""
-    width = rows.shape[1]
-    if i < 0:
-        r = r - 1
-        i = i + width + 1
-    if i == 0:
-        return 1
-    j = i - 1
-    if j < bpp:
-        return int(rows[r, j])
-    return (int(rows[r, j]) - int(rows[r, j - bpp])) & 255
-
-
-@wp.func
-def _match(rows: wp.array2d(dtype=wp.uint8), r: int, i: int, distance: int, bpp: int) -> int:
-    """How many bytes from line position ``i`` repeat those ``distance`` bytes back (at most the line's rest)."""
-    width = rows.shape[1]
-    limit = wp.min(MAX_MATCH, width + 1 - i)
+def _match(lines: wp.array(dtype=wp.uint8), p: int, distance: int, room: int) -> int:
     n = int(0)
-    while n < limit and _filtered(rows, r, i + n, bpp) == _filtered(rows, r, i + n - distance, bpp):
+    while n < room and lines[p + n] == lines[p + n - distance]:
         n += 1
     return n
 
 
-@wp.kernel
-def _encode_rows(rows: wp.array2d(dtype=wp.uint8), bpp: int, length_base: wp.array(dtype=wp.int32),
-                 length_extra: wp.array(dtype=wp.int32), distance_base: wp.array(dtype=wp.int32),
-                 distance_extra: wp.array(dtype=wp.int32), slots: wp.array2d(dtype=wp.uint8),
-                 lengths: wp.array(dtype=wp.int32), sums: wp.array2d(dtype=wp.int64)):
-    r = wp.tid()
-    width = rows.shape[1]
-    line = width + 1
-    acc = wp.uint64(2)             # block header: BFINAL 0, BTYPE 01 (fixed codes)
-    nbits = int(3)
-    pos = int(0)
-    s1 = wp.int64(0)
-    s2 = wp.int64(0)
-    for k in range(line):          # the checksum's sums of this line (combined on the host)
-        byte = wp.int64(_filtered(rows, r, k, bpp))
-        s1 += byte
-        s2 += wp.int64(line - k) * byte
-    sums[r, 0] = s1 % wp.int64(ADLER)
-    sums[r, 1] = s2 % wp.int64(ADLER)
-    i = int(0)
-    while i < line:
+@wp.func
+def _put(words: wp.array(dtype=wp.uint32), bit: int, value: int, count: int):
+    """Or ``count`` bits of ``value`` (fewer than 32) into the stream at bit ``bit``, least significant first."""
+    if count > 0:
+        shifted = wp.uint64(value) << wp.uint64(bit & 31)
+        wp.atomic_or(words, bit >> 5, wp.uint32(shifted & wp.uint64(0xFFFFFFFF)))
+        if (bit & 31) + count > 32:
+            wp.atomic_or(words, (bit >> 5) + 1, wp.uint32(shifted >> wp.uint64(32)))
+
+
+@wp.kernel(enable_backward=False)
+def _parse(lines: wp.array(dtype=wp.uint8), segment: int, distances: wp.array(dtype=wp.int32),
+           lengths: wp.array(dtype=wp.int32), codes: wp.array(dtype=wp.int32),
+           length_slot: wp.array(dtype=wp.int32), length_base: wp.array(dtype=wp.int32),
+           length_extra: wp.array(dtype=wp.int32), distance_base: wp.array(dtype=wp.int32),
+           distance_extra: wp.array(dtype=wp.int32), write: int, count_symbols: int, header_bits: int,
+           offsets: wp.array(dtype=wp.int32), segment_bits: wp.array(dtype=wp.int32),
+           symbol_counts: wp.array(dtype=wp.int32), adler: wp.array(dtype=wp.int64),
+           words: wp.array(dtype=wp.uint32)):
+    """One segment's parse: its bits counted (``write`` 0) or written at its offset (``write`` 1).
+
+    ``lengths`` and ``codes`` hold the 286 literal/length codes, then the 30 distance codes (as sent)."""
+    s = wp.tid()
+    n = lines.shape[0]
+    start = s * segment
+    end = wp.min(start + segment, n)
+    bit = header_bits
+    if write == 1:
+        bit = header_bits + offsets[s]
+    total = int(0)
+    p = start
+    while p < end:
         best = int(0)
         distance = int(0)
-        for c in range(5):         # the distances: byte, pixel, two pixels, row, row and pixel back
-            d = int(1)
-            if c == 1:
-                d = bpp
-            elif c == 2:
-                d = 2 * bpp
-            elif c == 3:
-                d = line
-            elif c == 4:
-                d = line + bpp
-            if (c == 1 and d == 1) or d > 32768 or i - d < -line or (r == 0 and i - d < 0):
-                continue
-            n = _match(rows, r, i, d, bpp)
-            if n > best:
-                best = n
-                distance = d
-        code = int(0)
-        bits = int(0)
+        for c in range(distances.shape[0]):
+            d = distances[c]
+            if d <= p:
+                length = _match(lines, p, d, wp.min(MAX_MATCH, end - p))
+                if length > best:
+                    best = length
+                    distance = d
         if best >= 3:
-            slot = int(28)
-            while length_base[slot] > best:
-                slot -= 1
-            symbol = 257 + slot
-            if symbol < 280:
-                code = _reversed(symbol - 256, 7)
-                bits = 7
-            else:
-                code = _reversed(0xC0 + symbol - 280, 8)
-                bits = 8
-            code = code | ((best - length_base[slot]) << bits)
-            bits += length_extra[slot]
+            slot = length_slot[best]
             dslot = int(29)
             while distance_base[dslot] > distance:
                 dslot -= 1
-            code = code | (_reversed(dslot, 5) << bits)
-            bits += 5
-            code = code | ((distance - distance_base[dslot]) << bits)
-            bits += distance_extra[dslot]
-            i += best
+            symbol = 257 + slot
+            bits = lengths[symbol] + length_extra[slot] + lengths[286 + dslot] + distance_extra[dslot]
+            if write == 1:
+                _put(words, bit, codes[symbol], lengths[symbol])
+                _put(words, bit + lengths[symbol], best - length_base[slot], length_extra[slot])
+                at = bit + lengths[symbol] + length_extra[slot]
+                _put(words, at, codes[286 + dslot], lengths[286 + dslot])
+                _put(words, at + lengths[286 + dslot], distance - distance_base[dslot], distance_extra[dslot])
+            elif count_symbols == 1:
+                wp.atomic_add(symbol_counts, symbol, 1)
+                wp.atomic_add(symbol_counts, 286 + dslot, 1)
+            bit += bits
+            total += bits
+            p += best
         else:
-            value = _filtered(rows, r, i, bpp)
-            if value < 144:
-                code = _reversed(0x30 + value, 8)
-                bits = 8
-            else:
-                code = _reversed(0x190 + value - 144, 9)
-                bits = 9
-            i += 1
-        acc = acc | (wp.uint64(code) << wp.uint64(nbits))
-        nbits += bits
-        while nbits >= 8:
-            slots[r, pos] = wp.uint8(acc & wp.uint64(255))
-            acc = acc >> wp.uint64(8)
-            nbits -= 8
-            pos += 1
-    nbits += 7 + 3                 # end of block (code 0, 7 bits), then an empty stored block's header (3 zero bits)
-    while nbits > 0:               # ... padded to the byte
-        slots[r, pos] = wp.uint8(acc & wp.uint64(255))
-        acc = acc >> wp.uint64(8)
-        nbits -= 8
-        pos += 1
-    slots[r, pos] = wp.uint8(0)    # the stored block's LEN 0 and NLEN 0xFFFF
-    slots[r, pos + 1] = wp.uint8(0)
-    slots[r, pos + 2] = wp.uint8(255)
-    slots[r, pos + 3] = wp.uint8(255)
-    lengths[r] = pos + 4
+            value = int(lines[p])
+            if write == 1:
+                _put(words, bit, codes[value], lengths[value])
+            elif count_symbols == 1:
+                wp.atomic_add(symbol_counts, value, 1)
+            bit += lengths[value]
+            total += lengths[value]
+            p += 1
+    if write == 0:
+        segment_bits[s] = total
+        s1 = wp.int64(0)
+        s2 = wp.int64(0)
+        for k in range(start, end):          # this segment's share of the Adler-32 (RFC 1950, 9)
+            s1 += wp.int64(lines[k])
+            s2 += wp.int64(end - k) * wp.int64(lines[k])
+        wp.atomic_add(adler, 0, s1)
+        wp.atomic_add(adler, 1, (s2 + wp.int64(n - end) * s1) % wp.int64(ADLER))
+    elif s == (n + segment - 1) // segment - 1:
+        _put(words, bit, codes[256], lengths[256])          # the end of the block after the last segment
 
 
-@wp.kernel
-def _gather(slots: wp.array2d(dtype=wp.uint8), lengths: wp.array(dtype=wp.int32),
-            offsets: wp.array(dtype=wp.int32), stream: wp.array(dtype=wp.uint8)):
-    r, k = wp.tid()
-    if k < lengths[r]:
-        stream[offsets[r] + k] = slots[r, k]
+class SegmentDeflate:
+    """Deflates the filtered lines of uint8 images of one shape on a Warp device, a segment a thread."""
 
+    def __init__(self, height: int, width: int, channels: int, device: str, segment: int = 256,
+                 distances: str = "9") -> None:
+        if segment < 1:
+            raise ValueError(f"segment must be 1 byte or more, got {segment}")
+        self.size, self.device, self.segment = (width, height, channels), device, segment
+        self.line = width * channels + 1
+        total = height * self.line
+        self.count = (total + segment - 1) // segment
+        chosen = png_codes.distance_set(distances, channels, self.line)
+        slot = np.searchsorted(png_codes.LENGTH_BASE, np.arange(259), side="right") - 1
 
-class FixedCodeEncoder:
-    """Encodes images of one size and channel count on a Warp device into PNG bytes (fixed-code deflate)."""
+        def device_array(values, dtype=wp.int32):
+            return wp.array(np.asarray(values), dtype=dtype, device=device)
+        self.tables = [device_array(t) for t in (np.maximum(slot, 0), png_codes.LENGTH_BASE,
+                                                 png_codes.LENGTH_EXTRA, png_codes.DISTANCE_BASE,
+                                                 png_codes.DISTANCE_EXTRA)]
+        self.distances = device_array(chosen)
+        self.lines = wp.empty(total, dtype=wp.uint8, device=device)
+        self.offsets = wp.empty(self.count, dtype=wp.int32, device=device)
+        self.segment_bits = wp.empty(self.count, dtype=wp.int32, device=device)
+        self.symbol_counts = wp.zeros(316, dtype=wp.int32, device=device)
+        self.adler = wp.zeros(2, dtype=wp.int64, device=device)
+        self.words = wp.zeros(total * 15 // 32 + 2 + 80, dtype=wp.uint32, device=device)   # 15 bits a byte at most
+        self._codes: dict[tuple, tuple] = {}
 
-    def __init__(self, height: int, width: int, channels: int, device: str) -> None:
-        self.shape, self.device = (height, width * channels), device
-        self.bpp = channels
-        slot_bytes = (width * channels + 1) * 9 // 8 + 16        # every byte a 9-bit literal, plus block ends
-        self.tables = [wp.array(t, dtype=wp.int32, device=device)
-                       for t in (LENGTH_BASE, LENGTH_EXTRA, DISTANCE_BASE, DISTANCE_EXTRA)]
-        self.slots = wp.empty((height, slot_bytes), dtype=wp.uint8, device=device)
-        self.lengths = wp.empty(height, dtype=wp.int32, device=device)
-        self.offsets = wp.empty(height, dtype=wp.int32, device=device)
-        self.sums = wp.empty((height, 2), dtype=wp.int64, device=device)
-        self.stream = wp.empty(height * slot_bytes, dtype=wp.uint8, device=device)
-        self.size = (width, height, channels)
-
-    def encode_device(self, rows: wp.array2d) -> tuple[np.ndarray, np.ndarray]:
-        """The joined deflate blocks of ``rows`` (uint8 device rows) and each line's checksum sums, on the host."""
-        wp.launch(_encode_rows, dim=self.shape[0], inputs=[rows, self.bpp, *self.tables, self.slots, self.lengths,
-                                                            self.sums], device=self.device)
-        wp.utils.array_scan(self.lengths, self.offsets, inclusive=False)
-        wp.launch(_gather, dim=self.slots.shape, inputs=[self.slots, self.lengths, self.offsets, self.stream],
+    def encode(self, rows: wp.array2d, codes: str | tuple[np.ndarray, np.ndarray] = "own") -> bytes:
+        """The zlib stream of ``rows`` (uint8 device rows of ``width * channels`` bytes): ``codes`` is "fixed",
+        "own" (built for these rows from a first count) or (literal/length, distance) code lengths."""
+        wp.launch(_filter, dim=(rows.shape[0], self.line), inputs=[rows, self.size[2], self.lines],
                   device=self.device)
-        total = int(self.lengths.numpy().sum())
-        return self.stream[:total].numpy(), self.sums.numpy()
+        if isinstance(codes, str) and codes == "own":
+            self.symbol_counts.zero_()
+            self._pass(0, 1, self._tables("fixed"))
+            counts = self.symbol_counts.numpy()
+            codes = png_codes.block_code_lengths(counts[:286] + np.eye(286, dtype=np.int64)[256], counts[286:])
+        chosen = self._tables(codes)
+        self.adler.zero_()
+        self._pass(0, 0, chosen)
+        wp.utils.array_scan(self.segment_bits, self.offsets, inclusive=False)
+        self.words.zero_()
+        header, header_bits = chosen[2], chosen[3]
+        self.words[:header.size].assign(wp.array(header, dtype=wp.uint32, device=self.device))
+        self._pass(1, 0, chosen)
+        last = np.concatenate([self.offsets[self.count - 1:].numpy(), self.segment_bits[self.count - 1:].numpy()])
+        bits = header_bits + int(last.sum()) + int(chosen[4])
+        body = self.words.numpy().view(np.uint8)[:(bits + 7) // 8]
+        a, b = (int(v) % 65521 for v in self.adler.numpy())
+        b = (b + self.lines.shape[0]) % 65521                        # Adler's A starts at 1: n more in B
+        a = (a + 1) % 65521
+        return b"\x78\x01" + body.tobytes() + ((b << 16) | a).to_bytes(4, "big")
 
-    def png(self, image: np.ndarray) -> bytes:
-        """PNG bytes of a uint8 (H, W, C) image."""
-        rows = wp.array(np.ascontiguousarray(image).reshape(self.shape), dtype=wp.uint8, device=self.device)
-        blocks, sums = self.encode_device(rows)
-        idat = b"".join([b"\x78\x01", blocks.tobytes(), b"\x03\x00",
-                         struct.pack(">I", _adler(sums, self.shape[1] + 1))])
+    def png(self, image: np.ndarray, codes: str | tuple[np.ndarray, np.ndarray] = "own") -> bytes:
+        """PNG bytes of a uint8 (H, W, C) image, encoded on the device."""
         width, height, channels = self.size
-        return png_file(width, height, 8, channels, idat)
+        rows = wp.array(np.ascontiguousarray(image).reshape(height, width * channels), dtype=wp.uint8,
+                        device=self.device)
+        return png_file(width, height, 8, channels, self.encode(rows, codes))
+
+    def _pass(self, write: int, count_symbols: int, chosen: tuple) -> None:
+        lengths, sent, _, header_bits, _ = chosen
+        wp.launch(_parse, dim=self.count, inputs=[self.lines, self.segment, self.distances, lengths, sent,
+                                                  *self.tables, write, count_symbols, header_bits, self.offsets,
+                                                  self.segment_bits, self.symbol_counts, self.adler, self.words],
+                  device=self.device)
+
+    def _tables(self, codes) -> tuple:
+        """Device code lengths and sent codes, the header as words, its bits and the end-of-block code's bits."""
+        key = codes if isinstance(codes, str) else tuple(np.concatenate(codes).tolist())
+        if key not in self._codes:
+            if isinstance(codes, str):
+                lengths, distance_lengths = png_codes.FIXED_LENGTHS, np.full(30, 5)
+                header, header_bits = 0b011, 3                   # BFINAL 1, BTYPE 01: the fixed codes
+            else:
+                lengths, distance_lengths = (np.asarray(c, np.int64) for c in codes)
+                header, header_bits = png_codes.dynamic_header(lengths, distance_lengths)
+            # the codes come from every length given (the fixed code's 288), the device takes the 286 used
+            both = np.concatenate([lengths[:286], distance_lengths])
+            sent = np.concatenate([png_codes.sent_codes(lengths)[:286], png_codes.sent_codes(distance_lengths)])
+            words = np.frombuffer(header.to_bytes((header_bits + 31) // 32 * 4, "little"), np.uint32)
+            self._codes[key] = (wp.array(both, dtype=wp.int32, device=self.device),
+                                wp.array(sent, dtype=wp.int32, device=self.device), words, header_bits,
+                                int(lengths[256]))
+        return self._codes[key]
 
 
-def _adler(sums: np.ndarray, line: int) -> int:
-    """Adler-32 of the lines from each line's byte sum and weighted sum (RFC 1950, 9)."""
-    a, b = 1, 0
-    for s1, s2 in sums.tolist():
-        b = (b + line * a + s2) % ADLER
-        a = (a + s1) % ADLER
-    return (b << 16) | a
-
-
-def _frame(path: str | None) -> np.ndarray:
-    if path:
-        import cv2
-        image = cv2.imread(path, cv2.IMREAD_UNCHANGED)
-        return cv2.cvtColor(image, cv2.COLOR_BGRA2RGBA if image.shape[2] == 4 else cv2.COLOR_BGR2RGB)
-    y, x = np.mgrid[0:512, 0:512]
-    image = np.zeros((512, 512, 4), np.uint8)        # a sky gradient, a flat floor and a noisy box
-    image[..., 2] = 128 + y // 4
-    image[..., 3] = 255
-    image[300:, :, :3] = 90
-    rng = np.random.default_rng(0)
-    image[150:280, 180:330, :3] = rng.integers(100, 140, (130, 150, 3), dtype=np.uint8)
-    return image
+def codes_of_frame(path: str, segment: int, distances: str) -> tuple[np.ndarray, np.ndarray]:
+    """Code lengths built from another frame's parse, every symbol given a code (counts plus one)."""
+    import cv2
+    image = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    lines = filtered_lines(image)
+    stream = lines.reshape(-1)
+    chosen = png_codes.distance_set(distances, image.shape[2] if image.ndim == 3 else 1, lines.shape[1])
+    symbols = png_codes.greedy_parse(stream, *png_codes.best_matches(stream, chosen, segment))
+    lit_len, distance, _ = png_codes.histograms(symbols)
+    return png_codes.block_code_lengths(lit_len + 1, distance + 1)
 
 
 def main() -> None:
+    import cv2
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--image", help="a PNG to encode (default: a made-up 512x512 RGBA frame)")
+    parser.add_argument("image", help="a PNG to encode (a frame's rgb or class mask)")
     parser.add_argument("--device", default="cuda:0" if wp.get_cuda_device_count() else "cpu")
     parser.add_argument("--frames", type=int, default=200, help="encodes timed")
+    parser.add_argument("--segment", type=int, default=256, help="bytes a thread parses")
+    parser.add_argument("--distances", default="9", help="distance set of bench/png_codes.py: 5, 9 or 12")
+    parser.add_argument("--codes", default="own", help="fixed, own (built for each image), or a PNG to build "
+                                                      "them from")
     args = parser.parse_args()
-    image = _frame(args.image)
-    encoder = FixedCodeEncoder(*image.shape, device=args.device)
-    data = encoder.png(image)
-    rows = wp.array(image.reshape(encoder.shape), dtype=wp.uint8, device=args.device)
-    encoder.encode_device(rows)                       # compiled and warm
+    image = cv2.imread(args.image, cv2.IMREAD_UNCHANGED)
+    if image is None:
+        parser.error(f"cannot read {args.image!r} as an image")
+    image = image[..., None] if image.ndim == 2 else image
+    codes = args.codes if args.codes in ("fixed", "own") else codes_of_frame(args.codes, args.segment,
+                                                                              args.distances)
+    encoder = SegmentDeflate(*image.shape, device=args.device, segment=args.segment, distances=args.distances)
+    data = encoder.png(image, codes)
+    rows = wp.array(image.reshape(image.shape[0], -1), dtype=wp.uint8, device=args.device)
+    encoder.encode(rows, codes)                                   # compiled and warm
     wp.synchronize_device(args.device)
     start = time.perf_counter()
     for _ in range(args.frames):
-        encoder.encode_device(rows)
+        encoder.encode(rows, codes)
     seconds = (time.perf_counter() - start) / args.frames
     start = time.perf_counter()
     for _ in range(args.frames):
         reference = encode_png(image)
     cpu_seconds = (time.perf_counter() - start) / args.frames
-    print(f"{image.shape[1]}x{image.shape[0]}x{image.shape[2]} on {args.device}: fixed-code deflate {len(data):,} "
-          f"bytes, {1000 * seconds:.3f} ms a frame (launches, prefix sum, gather, read back); ISA-L level 1 "
-          f"{len(reference):,} bytes, {1000 * cpu_seconds:.3f} ms of one core")
+    print(f"{image.shape[1]}x{image.shape[0]}x{image.shape[2]} on {args.device}, segments of {args.segment} "
+          f"bytes, distances {args.distances}, codes {args.codes}: {len(data):,} bytes, {1000 * seconds:.3f} ms "
+          f"a frame (filter, two passes, prefix sum, read back); ISA-L level 1 {len(reference):,} bytes, "
+          f"{1000 * cpu_seconds:.3f} ms of one core")
 
 
 if __name__ == "__main__":

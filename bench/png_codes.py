@@ -4,9 +4,9 @@ A GPU encoder finds each byte's longest match among a few fixed distances back (
 segments of the filtered lines on their own (one thread a segment: no match runs past its segment's end) and
 joins the segments' bits into one deflate block. This script makes exactly that parse on the CPU for a few
 distance sets and segment lengths and counts its bits with the fixed Huffman codes (RFC 1951, 3.2.6) and with
-codes built for the image (a dynamic block's, lengths at most 15 bits by package-merge; its header is counted
-at its largest, every code length sent as a 7-bit code-length code). The files would be the zlib stream's
-bytes plus the PNG's 57 bytes of chunks, as ISA-L's are.
+codes built for the image (a dynamic block's, lengths at most 15 bits by package-merge, with the header
+:func:`dynamic_header` writes). The files would be the zlib stream's bytes plus the PNG's 57 bytes of chunks,
+as ISA-L's are. ``bench/gpu_png.py`` encodes with these codes on a Warp device.
 
 Usage:
     python bench/png_codes.py FRAME.png [FRAME.png ...] [--segments 64 256] [--distances 5 9 12]
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import heapq
+import zlib
 
 import numpy as np
 from isal import isal_zlib
@@ -29,9 +30,10 @@ LENGTH_EXTRA = np.array([0] * 8 + [1] * 4 + [2] * 4 + [3] * 4 + [4] * 4 + [5] * 
 DISTANCE_BASE = np.array([1, 2, 3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65, 97, 129, 193, 257, 385, 513, 769, 1025,
                           1537, 2049, 3073, 4097, 6145, 8193, 12289, 16385, 24577])
 DISTANCE_EXTRA = np.array([0, 0, 0, 0] + [k for k in range(1, 14) for _ in range(2)])
-# the largest dynamic-block header: BFINAL and BTYPE, HLIT/HDIST/HCLEN, 19 3-bit code-length-code lengths,
-# then each of 286 + 30 code lengths as a code-length code of at most 7 bits
-DYNAMIC_HEADER_BITS = 3 + 14 + 19 * 3 + (286 + 30) * 7
+# the order a dynamic block sends its code-length code's lengths in (RFC 1951, 3.2.7)
+CODE_LENGTH_ORDER = [16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15]
+# the fixed literal/length code's lengths (RFC 1951, 3.2.6): all 288, as its canonical codes count 286 and 287
+FIXED_LENGTHS = np.concatenate([np.full(144, 8), np.full(112, 9), np.full(24, 7), np.full(8, 8)])
 ZLIB_WRAPPER = 2 + 4          # the zlib header and the Adler-32
 
 
@@ -111,15 +113,134 @@ def histograms(symbols: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray, 
 
 def fixed_bits(lit_len: np.ndarray, distance: np.ndarray, extra: int) -> int:
     """Bits of one fixed-code block of these symbols, its 3-bit header included."""
-    code_length = np.concatenate([np.full(144, 8), np.full(112, 9), np.full(24, 7), np.full(6, 8)])
-    return 3 + int(lit_len @ code_length) + 5 * int(distance.sum()) + extra
+    return 3 + int(lit_len @ FIXED_LENGTHS[:286]) + 5 * int(distance.sum()) + extra
 
 
 def dynamic_bits(lit_len: np.ndarray, distance: np.ndarray, extra: int) -> int:
-    """Bits of one dynamic block of these symbols with codes built for them, its header counted at its
-    largest (:data:`DYNAMIC_HEADER_BITS`)."""
-    return (DYNAMIC_HEADER_BITS + int(lit_len @ limited_code_lengths(lit_len))
-            + int(distance @ limited_code_lengths(distance)) + extra)
+    """Bits of one dynamic block of these symbols with codes built for them (:func:`block_code_lengths`), its
+    header included."""
+    lengths, distance_lengths = block_code_lengths(lit_len, distance)
+    return dynamic_header(lengths, distance_lengths)[1] + int(lit_len @ lengths) + int(distance @ distance_lengths) \
+        + extra
+
+
+def block_code_lengths(lit_len: np.ndarray, distance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Code lengths for a dynamic block of these counts that every inflater takes: two distance codes at
+    least (a lone code or none is an incomplete code, which zlib refuses for some alphabets)."""
+    distance = np.asarray(distance).copy()
+    for symbol in (0, 1):
+        if np.count_nonzero(distance) < 2 and distance[symbol] == 0:
+            distance[symbol] = 1
+    return limited_code_lengths(np.asarray(lit_len)), limited_code_lengths(distance)
+
+
+def canonical_codes(lengths: np.ndarray) -> np.ndarray:
+    """The Huffman code of each symbol for these code lengths (RFC 1951, 3.2.2), most significant bit first."""
+    lengths = np.asarray(lengths, np.int64)
+    count = np.bincount(lengths, minlength=16)
+    count[0] = 0
+    next_code = np.zeros(16, np.int64)
+    code = 0
+    for bits in range(1, 16):
+        code = (code + count[bits - 1]) << 1
+        next_code[bits] = code
+    codes = np.zeros(lengths.size, np.int64)
+    for symbol, bits in enumerate(lengths.tolist()):
+        if bits:
+            codes[symbol] = next_code[bits]
+            next_code[bits] += 1
+    return codes
+
+
+def sent_codes(lengths: np.ndarray) -> np.ndarray:
+    """The codes as a deflate stream sends them: bit-reversed, since the stream packs bits from the least
+    significant up and a Huffman code goes first bit first."""
+    codes = canonical_codes(lengths)
+    return np.array([int(format(code, f"0{bits}b")[::-1], 2) if bits else 0
+                     for code, bits in zip(codes.tolist(), np.asarray(lengths).tolist())], np.int64)
+
+
+def zlib_stream(symbols: list[tuple[int, int]], data: bytes, lengths: np.ndarray | None = None,
+                distance_lengths: np.ndarray | None = None) -> bytes:
+    """The zlib stream of ``data`` parsed as ``symbols`` (:func:`greedy_parse`), one final block: with the fixed
+    codes when no lengths are given, else a dynamic block with these code lengths (the reference a device
+    encoder's bytes are checked against)."""
+    fixed = lengths is None
+    if fixed:
+        lengths, distance_lengths = FIXED_LENGTHS, np.full(30, 5)
+        value, count = 0b011, 3                                       # BFINAL 1, BTYPE 01
+    else:
+        value, count = dynamic_header(lengths, distance_lengths)
+    codes, distance_codes = sent_codes(lengths), sent_codes(distance_lengths)
+    fields = []
+    for first, distance in symbols:
+        if distance == 0:
+            fields.append((int(codes[first]), int(lengths[first])))
+            continue
+        slot = int(np.searchsorted(LENGTH_BASE, first, side="right")) - 1
+        dslot = int(np.searchsorted(DISTANCE_BASE, distance, side="right")) - 1
+        fields += [(int(codes[257 + slot]), int(lengths[257 + slot])),
+                   (first - int(LENGTH_BASE[slot]), int(LENGTH_EXTRA[slot])),
+                   (int(distance_codes[dslot]), int(distance_lengths[dslot])),
+                   (distance - int(DISTANCE_BASE[dslot]), int(DISTANCE_EXTRA[dslot]))]
+    fields.append((int(codes[256]), int(lengths[256])))
+    for field, bits in fields:
+        value |= field << count
+        count += bits
+    body = value.to_bytes((count + 7) // 8, "little")
+    return b"\x78\x01" + body + zlib.adler32(data).to_bytes(4, "big")
+
+
+def dynamic_header(lengths: np.ndarray, distance_lengths: np.ndarray) -> tuple[int, int]:
+    """The header of a final dynamic block (RFC 1951, 3.2.7) with these literal/length and distance code
+    lengths, as (bits, how many): the bits packed from the least significant up, as the stream sends them."""
+    hlit = max(257, int(np.flatnonzero(lengths)[-1]) + 1)
+    hdist = max(1, int(np.flatnonzero(distance_lengths)[-1]) + 1 if np.any(distance_lengths) else 1)
+    tokens = _run_length_tokens(np.concatenate([lengths[:hlit], distance_lengths[:hdist]]).tolist())
+    counts = np.bincount([symbol for symbol, _, _ in tokens], minlength=19)
+    if np.count_nonzero(counts) < 2:                 # a complete code needs two symbols
+        counts[0 if counts[0] == 0 else 1] += 1
+    cl_lengths = limited_code_lengths(counts, limit=7)
+    cl_codes = sent_codes(cl_lengths)
+    hclen = max(4, max(k for k, symbol in enumerate(CODE_LENGTH_ORDER) if cl_lengths[symbol]) + 1)
+    fields = [(1, 1), (2, 2), (hlit - 257, 5), (hdist - 1, 5), (hclen - 4, 4)]
+    fields += [(int(cl_lengths[symbol]), 3) for symbol in CODE_LENGTH_ORDER[:hclen]]
+    for symbol, extra, extra_bits in tokens:
+        fields += [(int(cl_codes[symbol]), int(cl_lengths[symbol])), (extra, extra_bits)]
+    value, count = 0, 0
+    for field, bits in fields:
+        value |= field << count
+        count += bits
+    return value, count
+
+
+def _run_length_tokens(lengths: list[int]) -> list[tuple[int, int, int]]:
+    """Code lengths as code-length-code tokens (symbol, extra value, extra bits): 0-15 as they are, 16 to
+    repeat the last 3-6 times, 17 and 18 for 3-10 and 11-138 zeros."""
+    tokens, i = [], 0
+    while i < len(lengths):
+        run = 1
+        while i + run < len(lengths) and lengths[i + run] == lengths[i]:
+            run += 1
+        value, left = lengths[i], run
+        if value == 0:
+            while left >= 11:
+                take = min(left, 138)
+                tokens.append((18, take - 11, 7))
+                left -= take
+            if left >= 3:
+                tokens.append((17, left - 3, 3))
+                left = 0
+        else:
+            tokens.append((value, 0, 0))
+            left -= 1
+            while left >= 3:
+                take = min(left, 6)
+                tokens.append((16, take - 3, 2))
+                left -= take
+        tokens += [(value, 0, 0)] * left
+        i += run
+    return tokens
 
 
 def limited_code_lengths(counts: np.ndarray, limit: int = 15) -> np.ndarray:

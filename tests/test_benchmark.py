@@ -295,31 +295,43 @@ def test_cpu_speed_refuses_a_load_of_no_processes():
 
 @pytest.mark.parametrize("shape", [(70, 53, 4), (37, 29, 3), (5, 1, 1), (300, 2, 1)])
 def test_gpu_png_prototype_encodes_exact_pngs_on_warps_cpu(shape):
-    """bench/gpu_png.py's fixed-code deflate (run on Warp's CPU device): Pillow and OpenCV decode the pixels
-    encoded, zlib checks the Adler-32 combined from the rows' sums, and each row is a block of its own that
-    ends byte-aligned (an empty stored block: 00 00 FF FF)."""
+    """bench/gpu_png.py (run on Warp's CPU device): for fixed codes, codes built for the image and codes built
+    from another image, and segments of a few bytes up to many lines, its zlib stream is byte for byte the one
+    bench/png_codes.py writes for the same parse, zlib checks its Adler-32, and Pillow and OpenCV decode the
+    pixels encoded."""
     pytest.importorskip("warp")
     import io
     import zlib
     import cv2
     from PIL import Image
-    gpu_png = _bench_script("gpu_png")
+    from graphsdg.io.png import filtered_lines
+    gpu_png, png_codes = _bench_script("gpu_png"), _bench_script("png_codes")
     rng = np.random.default_rng(sum(shape))
     image = rng.integers(0, 256, shape, dtype=np.uint8)
     image[shape[0] // 2:] = 7                                   # flat rows below: matches
-    data = gpu_png.FixedCodeEncoder(*shape, device="cpu").png(image)
-    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))).reshape(shape), image)
+    stream = filtered_lines(image).reshape(-1)
+    other = png_codes.histograms(png_codes.greedy_parse(stream[::-1].copy(), *png_codes.best_matches(
+        stream[::-1].copy(), [1, 2], 64)))
+    given = png_codes.block_code_lengths(other[0] + 1, other[1] + 1)
+    for segment in (5, 256, 4096):
+        encoder = gpu_png.SegmentDeflate(*shape, device="cpu", segment=segment)
+        distances = png_codes.distance_set("9", shape[2], stream.size // shape[0])
+        symbols = png_codes.greedy_parse(stream, *png_codes.best_matches(stream, distances, segment))
+        lit_len, distance, _ = png_codes.histograms(symbols)
+        for codes, lengths in (("fixed", ()), ("own", png_codes.block_code_lengths(lit_len, distance)),
+                               (given, given)):
+            data = encoder.png(image, codes)
+            start = data.index(b"IDAT")
+            idat = data[start + 4:start + 4 + int.from_bytes(data[start - 4:start], "big")]
+            assert idat == png_codes.zlib_stream(symbols, stream.tobytes(), *lengths)
+            assert zlib.decompress(idat) == stream.tobytes()
+            assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))).reshape(shape), image)
     decoded = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED).reshape(shape)
     if shape[2] >= 3:
         decoded = decoded[..., [2, 1, 0, 3][:shape[2]]]
     assert np.array_equal(decoded, image)
-    start = data.index(b"IDAT")
-    stream = data[start + 4:start + 4 + int.from_bytes(data[start - 4:start], "big")]
-    rows = np.frombuffer(zlib.decompress(stream), np.uint8).reshape(shape[0], shape[1] * shape[2] + 1)
-    assert (rows[:, 0] == 1).all()                                # every row Sub-filtered
-    assert stream.count(b"\x00\x00\xff\xff") >= shape[0]
-    flat = gpu_png.FixedCodeEncoder(64, 64, 4, device="cpu").png(np.full((64, 64, 4), 200, np.uint8))
-    assert len(flat) < 64 * 16 < 64 * 257                           # runs become matches: a few bytes a row
+    with pytest.raises(ValueError, match="segment must be 1 byte or more, got 0"):
+        gpu_png.SegmentDeflate(*shape, device="cpu", segment=0)
 
 
 def test_png_codes_parse_rebuilds_the_filtered_lines_and_counts_its_bits():
@@ -345,6 +357,13 @@ def test_png_codes_parse_rebuilds_the_filtered_lines_and_counts_its_bits():
     assert lit_len[[0, 200, 256, 257, 285]].tolist() == [1, 1, 1, 1, 1] and dist[[0, 12]].tolist() == [1, 1]
     assert extra == 5                                                 # distance 65: 5 extra bits; lengths 3, 258: 0
     assert png_codes.fixed_bits(lit_len, dist, extra) == 3 + 8 + 9 + 7 + 7 + 8 + 5 + 5 + 5
+    import zlib
+    symbols = png_codes.greedy_parse(stream, *png_codes.best_matches(stream, [1, 4, 81], 64))
+    counts = png_codes.histograms(symbols)
+    for lengths, bits in (((), png_codes.fixed_bits(*counts)),
+                          (png_codes.block_code_lengths(*counts[:2]), png_codes.dynamic_bits(*counts))):
+        written = png_codes.zlib_stream(symbols, stream.tobytes(), *lengths)   # the sizes are the streams' own
+        assert zlib.decompress(written) == stream.tobytes() and len(written) == (bits + 7) // 8 + 6
 
 
 @pytest.mark.parametrize("counts", [[5, 1], [1, 1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192,
