@@ -3,12 +3,14 @@
 The colour and class-mask PNGs are the largest part of the writing that holds four GPUs of one host back
 (docs/performance.md, round 23). This encoder keeps to what runs in parallel: the filtered lines are cut into
 segments of a fixed length, and one thread parses each (at every byte the longest match among a few fixed
-distances back, never past its segment's end; ``bench/png_codes.py`` sizes these parses on the CPU). A first
-pass counts each segment's bits (and, for codes built for the image, the symbols), a prefix sum of the counts
-places every segment in one deflate block, and a second pass writes the bits there (the words two segments
-share are or-ed atomically). The block uses the fixed codes, codes built for this image from the first pass's
-counts (a copy back and a wait between the passes), or codes built from another frame. The Adler-32 is summed a
-segment at a time and combined on the device.
+distances back, never past its segment's end; ``bench/png_codes.py`` sizes these parses on the CPU). A kernel
+of a thread a byte first compares each candidate's next 8 bytes, so a segment's thread reads one word where a
+match starts and compares further only for the candidates that matched all 8. A first pass counts each
+segment's bits (and, for codes built for the image, the symbols), a prefix sum of the counts places every
+segment in one deflate block, and a second pass writes the bits there (the words two segments share are or-ed
+atomically). The block uses the fixed codes, codes built for this image from the first pass's counts (a copy
+back and a wait between the passes), or codes built from another frame. The Adler-32 is summed a segment at a
+time and combined on the device.
 
 The bytes equal ``png_codes.zlib_stream`` of the same parse (the tests check it), so the sizes are those of
 ``bench/png_codes.py``; this script adds the device time, against ISA-L level 1 on one core.
@@ -34,6 +36,7 @@ from graphsdg.io.png import encode_png, filtered_lines, png_file  # noqa: E402
 
 ADLER = wp.constant(65521)
 MAX_MATCH = wp.constant(258)
+CAP = wp.constant(8)           # match bytes compared a byte a thread; the parse extends matches that reach it
 
 
 @wp.kernel(enable_backward=False)
@@ -58,6 +61,30 @@ def _match(lines: wp.array(dtype=wp.uint8), p: int, distance: int, room: int) ->
     return n
 
 
+@wp.kernel(enable_backward=False)
+def _matches(lines: wp.array(dtype=wp.uint8), segment: int, distances: wp.array(dtype=wp.int32),
+             packed: wp.array(dtype=wp.int32)):
+    """Byte ``p``'s matches, each cut at :data:`CAP` bytes: the longest's length and candidate (the first of
+    equals), and which candidates reached the cut (the parse extends those), packed in one word."""
+    p = wp.tid()
+    n = lines.shape[0]
+    room = wp.min(wp.min(MAX_MATCH, (p // segment + 1) * segment - p), n - p)
+    cut = wp.min(room, CAP)
+    best = int(0)
+    first = int(0)
+    capped = int(0)
+    for c in range(distances.shape[0]):
+        d = distances[c]
+        if d <= p:
+            length = _match(lines, p, d, cut)
+            if length > best:
+                best = length
+                first = c
+            if length == cut:
+                capped = capped | (1 << c)
+    packed[p] = (best << 20) | (first << 16) | capped
+
+
 @wp.func
 def _put(words: wp.array(dtype=wp.uint32), bit: int, value: int, count: int):
     """Or ``count`` bits of ``value`` (fewer than 32) into the stream at bit ``bit``, least significant first."""
@@ -69,8 +96,8 @@ def _put(words: wp.array(dtype=wp.uint32), bit: int, value: int, count: int):
 
 
 @wp.kernel(enable_backward=False)
-def _parse(lines: wp.array(dtype=wp.uint8), segment: int, distances: wp.array(dtype=wp.int32),
-           lengths: wp.array(dtype=wp.int32), codes: wp.array(dtype=wp.int32),
+def _parse(lines: wp.array(dtype=wp.uint8), packed: wp.array(dtype=wp.int32), segment: int,
+           distances: wp.array(dtype=wp.int32), lengths: wp.array(dtype=wp.int32), codes: wp.array(dtype=wp.int32),
            length_slot: wp.array(dtype=wp.int32), length_base: wp.array(dtype=wp.int32),
            length_extra: wp.array(dtype=wp.int32), distance_base: wp.array(dtype=wp.int32),
            distance_extra: wp.array(dtype=wp.int32), write: int, count_symbols: int, header_bits: int,
@@ -90,15 +117,19 @@ def _parse(lines: wp.array(dtype=wp.uint8), segment: int, distances: wp.array(dt
     total = int(0)
     p = start
     while p < end:
-        best = int(0)
-        distance = int(0)
-        for c in range(distances.shape[0]):
-            d = distances[c]
-            if d <= p:
-                length = _match(lines, p, d, wp.min(MAX_MATCH, end - p))
-                if length > best:
-                    best = length
-                    distance = d
+        word = packed[p]
+        best = int(word >> 20)
+        first = int((word >> 16) & 15)
+        room = wp.min(MAX_MATCH, end - p)
+        if best == CAP and CAP < room:     # cut short: the candidates that reached the cut, in order, in full
+            best = int(0)
+            for c in range(distances.shape[0]):
+                if (word >> c) & 1 == 1 and best < room:
+                    length = CAP + _match(lines, p + CAP, distances[c], room - CAP)
+                    if length > best:
+                        best = length
+                        first = c
+        distance = distances[first]
         if best >= 3:
             slot = length_slot[best]
             dslot = int(29)
@@ -161,6 +192,7 @@ class SegmentDeflate:
                                                  png_codes.DISTANCE_EXTRA)]
         self.distances = device_array(chosen)
         self.lines = wp.empty(total, dtype=wp.uint8, device=device)
+        self.packed = wp.empty(total, dtype=wp.int32, device=device)
         self.offsets = wp.empty(self.count, dtype=wp.int32, device=device)
         self.segment_bits = wp.empty(self.count, dtype=wp.int32, device=device)
         self.symbol_counts = wp.zeros(316, dtype=wp.int32, device=device)
@@ -172,6 +204,8 @@ class SegmentDeflate:
         """The zlib stream of ``rows`` (uint8 device rows of ``width * channels`` bytes): ``codes`` is "fixed",
         "own" (built for these rows from a first count) or (literal/length, distance) code lengths."""
         wp.launch(_filter, dim=(rows.shape[0], self.line), inputs=[rows, self.size[2], self.lines],
+                  device=self.device)
+        wp.launch(_matches, dim=self.lines.shape[0], inputs=[self.lines, self.segment, self.distances, self.packed],
                   device=self.device)
         if isinstance(codes, str) and codes == "own":
             self.symbol_counts.zero_()
@@ -203,7 +237,7 @@ class SegmentDeflate:
 
     def _pass(self, write: int, count_symbols: int, chosen: tuple) -> None:
         lengths, sent, _, header_bits, _ = chosen
-        wp.launch(_parse, dim=self.count, inputs=[self.lines, self.segment, self.distances, lengths, sent,
+        wp.launch(_parse, dim=self.count, inputs=[self.lines, self.packed, self.segment, self.distances, lengths, sent,
                                                   *self.tables, write, count_symbols, header_bits, self.offsets,
                                                   self.segment_bits, self.symbol_counts, self.adler, self.words],
                   device=self.device)
@@ -262,18 +296,19 @@ def main() -> None:
     rows = wp.array(image.reshape(image.shape[0], -1), dtype=wp.uint8, device=args.device)
     encoder.encode(rows, codes)                                   # compiled and warm
     wp.synchronize_device(args.device)
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     for _ in range(args.frames):
         encoder.encode(rows, codes)
     seconds = (time.perf_counter() - start) / args.frames
+    host_seconds = (time.process_time() - cpu_start) / args.frames
     start = time.perf_counter()
     for _ in range(args.frames):
         reference = encode_png(image)
     cpu_seconds = (time.perf_counter() - start) / args.frames
     print(f"{image.shape[1]}x{image.shape[0]}x{image.shape[2]} on {args.device}, segments of {args.segment} "
           f"bytes, distances {args.distances}, codes {args.codes}: {len(data):,} bytes, {1000 * seconds:.3f} ms "
-          f"a frame (filter, two passes, prefix sum, read back); ISA-L level 1 {len(reference):,} bytes, "
-          f"{1000 * cpu_seconds:.3f} ms of one core")
+          f"a frame (filter, matches, two passes, prefix sum, read back; {1000 * host_seconds:.3f} ms of this "
+          f"process's CPU); ISA-L level 1 {len(reference):,} bytes, {1000 * cpu_seconds:.3f} ms of one core")
 
 
 if __name__ == "__main__":
