@@ -218,11 +218,11 @@ class SegmentDeflate:
         wp.utils.array_scan(self.segment_bits, self.offsets, inclusive=False)
         self.words.zero_()
         header, header_bits = chosen[2], chosen[3]
-        self.words[:header.size].assign(wp.array(header, dtype=wp.uint32, device=self.device))
+        wp.copy(self.words, header, count=header.shape[0])
         self._pass(1, 0, chosen)
         last = np.concatenate([self.offsets[self.count - 1:].numpy(), self.segment_bits[self.count - 1:].numpy()])
         bits = header_bits + int(last.sum()) + int(chosen[4])
-        body = self.words.numpy().view(np.uint8)[:(bits + 7) // 8]
+        body = self.words[:(bits + 31) // 32].numpy().view(np.uint8)[:(bits + 7) // 8]   # the stream's words only
         a, b = (int(v) % 65521 for v in self.adler.numpy())
         b = (b + self.lines.shape[0]) % 65521                        # Adler's A starts at 1: n more in B
         a = (a + 1) % 65521
@@ -243,7 +243,8 @@ class SegmentDeflate:
                   device=self.device)
 
     def _tables(self, codes) -> tuple:
-        """Device code lengths and sent codes, the header as words, its bits and the end-of-block code's bits."""
+        """Device code lengths and sent codes, the header as device words, its bits and the end-of-block code's
+        bits, made once for each choice of codes."""
         key = codes if isinstance(codes, str) else tuple(np.concatenate(codes).tolist())
         if key not in self._codes:
             if isinstance(codes, str):
@@ -257,7 +258,8 @@ class SegmentDeflate:
             sent = np.concatenate([png_codes.sent_codes(lengths)[:286], png_codes.sent_codes(distance_lengths)])
             words = np.frombuffer(header.to_bytes((header_bits + 31) // 32 * 4, "little"), np.uint32)
             self._codes[key] = (wp.array(both, dtype=wp.int32, device=self.device),
-                                wp.array(sent, dtype=wp.int32, device=self.device), words, header_bits,
+                                wp.array(sent, dtype=wp.int32, device=self.device),
+                                wp.array(words, dtype=wp.uint32, device=self.device), header_bits,
                                 int(lengths[256]))
         return self._codes[key]
 
