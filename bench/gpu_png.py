@@ -223,9 +223,9 @@ class SegmentDeflate:
         last = np.concatenate([self.offsets[self.count - 1:].numpy(), self.segment_bits[self.count - 1:].numpy()])
         bits = header_bits + int(last.sum()) + int(chosen[4])
         body = self.words[:(bits + 31) // 32].numpy().view(np.uint8)[:(bits + 7) // 8]   # the stream's words only
-        a, b = (int(v) % 65521 for v in self.adler.numpy())
-        b = (b + self.lines.shape[0]) % 65521                        # Adler's A starts at 1: n more in B
-        a = (a + 1) % 65521
+        a, b = (int(v) % ADLER for v in self.adler.numpy())
+        b = (b + self.lines.shape[0]) % ADLER                        # Adler's A starts at 1: n more in B
+        a = (a + 1) % ADLER
         return b"\x78\x01" + body.tobytes() + ((b << 16) | a).to_bytes(4, "big")
 
     def png(self, image: np.ndarray, codes: str | tuple[np.ndarray, np.ndarray] = "own") -> bytes:

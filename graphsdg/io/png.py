@@ -39,7 +39,7 @@ def encode_png(image: np.ndarray) -> bytes:
     """PNG bytes of a uint8 or uint16 image: (H, W) grey, or (H, W, C) with C = 2 (grey+alpha), 3 (RGB), 4 (RGBA)."""
     arr = _checked(image)
     h, w, c = arr.shape
-    return png_file(w, h, 8 * arr.dtype.itemsize, c, isal_zlib.compress(filtered_lines(arr), LEVEL))
+    return png_file(w, h, 8 * arr.dtype.itemsize, c, isal_zlib.compress(_lines(arr), LEVEL))
 
 
 def filtered_lines(image: np.ndarray) -> np.ndarray:
@@ -50,7 +50,11 @@ def filtered_lines(image: np.ndarray) -> np.ndarray:
         >>> filtered_lines(np.array([[[10, 20], [13, 19]]], np.uint8)).tolist()
         [[1, 10, 20, 3, 255]]
     """
-    arr = _checked(image)
+    return _lines(_checked(image))
+
+
+def _lines(arr: np.ndarray) -> np.ndarray:
+    """:func:`filtered_lines` of an image :func:`_checked` has passed."""
     h, w, c = arr.shape
     rows = np.ascontiguousarray(arr.astype(">u2", copy=False) if arr.dtype == np.uint16 else arr).view(np.uint8)
     rows = rows.reshape(h, w * c * arr.dtype.itemsize)
