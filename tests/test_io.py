@@ -291,3 +291,31 @@ def test_writer_threads_start_as_the_backlog_needs_them():
     q.wait_until_done()
     assert len(q._threads) == 2
     q.shutdown()
+
+
+def test_waiting_for_progress_returns_once_a_write_let_go_of_its_data():
+    """``wait_for_progress``: False at once with nothing queued; else back after a task finished, by when the
+    task's arguments are released (what lent frame buffers wait on)."""
+    import threading
+    import weakref
+
+    from graphsdg.io.write_queue import WriteQueue
+
+    class Frame:
+        pass
+
+    q = WriteQueue(num_threads=1, max_size=10)
+    assert q.wait_for_progress() is False
+    gate = threading.Event()
+    frame = Frame()
+    alive = weakref.ref(frame)
+    q.schedule(lambda held: gate.wait(), frame)
+    del frame
+    threading.Timer(0.05, gate.set).start()
+    assert q.wait_for_progress() is True
+    assert alive() is None                      # the worker let go of the frame before the write counted as done
+    assert q.wait_for_progress() is False and q.completed == 1
+    with q.batch():                             # a task deferred by this thread's batch is woken, not waited on forever
+        q.schedule(lambda: None)
+        assert q.wait_for_progress() is True
+    q.shutdown()

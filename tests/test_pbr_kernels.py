@@ -178,3 +178,29 @@ def test_large_frames_lend_fewer_buffers():
         counts[side] = layout.host.count
         assert counts[side] * layout.host.nbytes <= po.HOST_BUFFER_BYTES or counts[side] == 1
     assert counts == {2048: po.HOST_BUFFERS, 3000: 3, 4096: 1}
+
+
+def test_a_read_with_every_buffer_lent_waits_for_their_release_instead_of_copying():
+    """With ``wait_for_release``, a read finding every host buffer lent waits while it says a holder may let go
+    (the write queue), reads into the freed buffer, and copies only once nothing more will be released."""
+    import threading
+
+    from graphsdg.io.write_queue import WriteQueue
+
+    h, w = 3, 5
+    queue = WriteQueue(num_threads=1, max_size=100)
+    layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4,
+                              wait_for_release=queue.wait_for_progress)
+    gate = threading.Event()
+    for v in range(po.HOST_BUFFERS):          # every buffer's frame held by a write that has not run yet
+        queue.schedule(lambda frame: gate.wait(), _layout_frame(layout, v))
+    assert layout.host.lent() == po.HOST_BUFFERS
+    threading.Timer(0.05, gate.set).start()
+    frame = _layout_frame(layout, 50)
+    assert layout._reading is not None                      # read into a freed buffer, not the spare
+    assert np.all(frame.rgba.view(np.uint32) == 50) and queue.completed >= 1
+    queue.wait_until_done()
+    kept = [frame] + [_layout_frame(layout, v) for v in range(po.HOST_BUFFERS)]   # held here: nothing to wait for
+    assert layout._reading is None                          # the last one read into the spare and copied
+    assert [int(f.depth[0, 0]) for f in kept] == [50] + list(range(po.HOST_BUFFERS))
+    queue.shutdown()

@@ -18,6 +18,7 @@ from graphsdg.annotate.frame import SceneLabels
 from graphsdg.annotate.ids import IdTables
 from graphsdg.engine.frame_provider import NO_GRAPH, FrameProvider
 from graphsdg.engine.session import session
+from graphsdg.io.write_queue import current_write_queue
 from graphsdg.render import render_product
 from graphsdg.render.attachments import OrderedSet, attachments
 from graphsdg.render.backend import RenderBackend, pbr_draws, resolve_backend
@@ -76,7 +77,7 @@ class Runtime:
         if self._pbr is None:
             from graphsdg.render.backend import pbr_device
             from graphsdg.render.pbr import PbrRenderer   # imports Warp: only where pbr was chosen
-            self._pbr = PbrRenderer(pbr_device())
+            self._pbr = PbrRenderer(pbr_device(), wait_for_release=_wait_for_a_write)
         return self._pbr
 
     @property
@@ -123,3 +124,10 @@ def runtime() -> Runtime:
     if rt is None:
         rt = session.adopt("runtime", Runtime())
     return rt
+
+
+def _wait_for_a_write() -> bool:
+    """Wait until a queued write finishes (False at once when none is queued): a frame read while every
+    page-locked host buffer is still lent waits on this for the writes holding them instead of being copied."""
+    queue = current_write_queue()
+    return queue is not None and queue.wait_for_progress()

@@ -222,6 +222,7 @@ class WriteQueue:
         self._has_work = threading.Condition(lock)
         self._items: collections.deque = collections.deque()
         self._unfinished = 0              # waiting + running
+        self._settled = 0                 # tasks finished, failed ones too
         self._bytes = 0                   # held by waiting + running tasks
         self._errors: list[tuple[BaseException, str]] = []
         self._threads: list[threading.Thread] = []
@@ -278,12 +279,14 @@ class WriteQueue:
                     return
                 if not self._items:        # closing and drained
                     return
-                item = self._items.popleft()
+                run = [self._items.popleft()]
                 self._cond.notify_all()    # a throttled producer may go on (no-op when none waits)
-            self._run(item)
+            self._run(run)
 
-    def _run(self, item: tuple) -> None:
-        fn, args, kwargs, nbytes, group = item
+    def _run(self, run: list[tuple]) -> None:
+        """Run the task ``run`` holds, taking it out first: the task's arguments are let go before it counts
+        as done, so what waits for a write to free memory (:meth:`wait_for_progress`) finds it free."""
+        fn, args, kwargs, nbytes, group = run.pop()
         error = None
         start = time.perf_counter()
         try:
@@ -291,7 +294,9 @@ class WriteQueue:
         except BaseException as exc:  # noqa: BLE001 - every failure must reach the script
             error = exc
         profiling.add("encode+write", time.perf_counter() - start)
-        self._settle(nbytes, group, error, _describe(fn, kwargs) if error is not None else "")
+        what = _describe(fn, kwargs) if error is not None else ""
+        del fn, args, kwargs
+        self._settle(nbytes, group, error, what)
 
     def _settle(self, nbytes: int, group: TaskGroup | None, error: BaseException | None, what: str) -> None:
         """Account for one finished write on a thread (``error``: how it failed, ``what``: which write that was)."""
@@ -308,6 +313,7 @@ class WriteQueue:
         with self._cond:
             self._errors += failed
             self._unfinished -= len(finished)
+            self._settled += len(finished)
             self._in_processes -= in_processes
             self.completed += len(finished) - len(failed)
             for nbytes, group, error, _ in finished:
@@ -359,7 +365,8 @@ class WriteQueue:
                 else:
                     self._has_work.notify()    # one idle worker takes it
         if inline:
-            self._run(item)
+            self._run([item])
+            del item
 
     def schedule_many(self, calls: list[tuple[Callable[..., Any], dict[str, Any]]]) -> None:
         """:meth:`schedule` ``fn(**kwargs)`` of each ``(fn, kwargs)``, in order: a frame's files in one call.
@@ -523,6 +530,31 @@ class WriteQueue:
     def is_done(self) -> bool:
         self._collect()
         return self._unfinished == 0
+
+    def wait_for_progress(self) -> bool:
+        """Wait until one more scheduled task has finished: False at once when none is pending, else True.
+
+        For a producer that would otherwise copy what queued writes still hold (a renderer's page-locked
+        frame buffers): each finished write may have let go of one, and once nothing is pending, waiting
+        longer frees nothing.
+
+        Example:
+            >>> q = WriteQueue(num_threads=1)
+            >>> q.wait_for_progress()
+            False
+            >>> q.schedule(time.sleep, 0.01); q.wait_for_progress()
+            True
+            >>> q.shutdown()
+        """
+        self._wake_deferred()              # tasks deferred by this thread's batch() would never run otherwise
+        with self._cond:
+            self._collect()
+            if not self._unfinished:
+                return False
+            settled = self._settled
+            while self._settled == settled:
+                self._wait_for_progress()
+            return True
 
     def wait_until_done(self) -> None:
         """Block until every scheduled task ran, then raise the first failure if any."""

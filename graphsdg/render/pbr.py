@@ -151,7 +151,10 @@ class PbrRenderer:
                            "mujoco_warp_pbr._src.ibl", "mujoco_warp_pbr._src.rays", "graphsdg.render.pbr_scene_bvh",
                            "graphsdg.render.pbr_outputs")
 
-    def __init__(self, device: str | None = None) -> None:
+    def __init__(self, device: str | None = None, wait_for_release: Callable[[], bool] | None = None) -> None:
+        """``device``: the Warp device drawn on (default ``cuda:0``); ``wait_for_release``: what a frame's read
+        waits on while every page-locked host buffer is still lent (:class:`~graphsdg.render.pbr_outputs.HostBuffers`:
+        the write queue's progress, so a frame waits for the writes behind it instead of being copied)."""
         lacks = pbr_missing()
         if lacks and device != "cpu":
             raise PbrUnavailableError("the pbr backend needs " + "; and ".join(lacks))
@@ -170,6 +173,7 @@ class PbrRenderer:
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads
         self._scene_bvh, self._launch_graph, self._megakernel = pbr_scene_bvh, launch_graph, megakernel_launch
         self._device = device or "cuda:0"
+        self._wait_for_release = wait_for_release
         self._contexts: dict[tuple, _Context] = {}
         self._isolated = None                    # classic rasteriser for render_isolated footprints
         self.stats: dict[str, int] = {"color": 0, "contexts": 0, "products": 0, "scene_trees": 0}
@@ -243,7 +247,7 @@ class PbrRenderer:
 
     def _layout(self, view: CameraView, ngeom: int):
         return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
-                                           view.far, self._device, ngeom)
+                                           view.far, self._device, ngeom, self._wait_for_release)
 
     def _mesh_state(self, scene: RenderScene, rc) -> _MeshState:
         """The context was built from the model's current vertices: every mesh's BVH is up to date."""

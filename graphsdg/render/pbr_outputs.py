@@ -134,6 +134,9 @@ class HostBuffers:
     (their common base); the buffer is read into again only once every array of that frame is gone. So a
     frame costs no host copy while annotators and writers let go of its arrays within ``count`` frames,
     and one copy a frame (into arrays of its own, from one more buffer kept for that) while they do not.
+    ``wait_for_release`` (optional) is called while every buffer is lent, before settling for the copy: it
+    waits for something that may let go of a frame (a queued write finishing) and says whether it did, so
+    frames held only by writes that are still running cost a wait instead of a copy.
 
     Example (Warp's CPU device)::
 
@@ -142,8 +145,9 @@ class HostBuffers:
         arrays = buffers.lend(index)        # a uint8 view of it; the buffer is free once views are gone
     """
 
-    def __init__(self, nbytes: int, device: str, count: int) -> None:
-        self.nbytes, self.count = nbytes, count
+    def __init__(self, nbytes: int, device: str, count: int,
+                 wait_for_release: Callable[[], bool] | None = None) -> None:
+        self.nbytes, self.count, self.wait_for_release = nbytes, count, wait_for_release
         self._pinned = wp.get_device(device).is_cuda
         self._lease_type = ctypes.c_uint8 * nbytes    # a lease: the buffer's bytes as an object of their own
         self._buffers: list[Any] = []                 # Warp host arrays
@@ -162,7 +166,14 @@ class HostBuffers:
         return self._buffers[index]
 
     def acquire(self) -> int | None:
-        """A buffer no frame's arrays use (made while fewer than ``count`` exist), marked queued; None if none."""
+        """A buffer no frame's arrays use (made while fewer than ``count`` exist), marked queued; None if none
+        is free and ``wait_for_release`` has nothing more to wait for."""
+        index = self._free()
+        while index is None and self.wait_for_release is not None and self.wait_for_release():
+            index = self._free()
+        return index
+
+    def _free(self) -> int | None:
         for index, lease in enumerate(self._leases):
             if lease() is None:
                 self._leases[index] = _QUEUED
@@ -205,11 +216,12 @@ class ClassicLayout:
     """Device buffers and page-locked host buffers of one camera's outputs at one resolution, for a model of
     ``ngeom`` geoms (the id codes' type, :func:`code_format`).
 
-    ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos).
+    ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos);
+    ``wait_for_release``: :class:`HostBuffers`'.
     """
 
     def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str,
-                 ngeom: int) -> None:
+                 ngeom: int, wait_for_release: Callable[[], bool] | None = None) -> None:
         n = width * height
         self.shape, self.near, self.far, self.device = (height, width), float(near), float(far), device
         self.ngeom = int(ngeom)
@@ -228,7 +240,7 @@ class ClassicLayout:
             end = start + int(np.prod(shape)) * wp.types.type_size_in_bytes(dtype)
             self._spans[name] = (start, end, np.dtype(wp.dtype_to_numpy(dtype)), shape)
         self._device_bytes = wp.empty(end, dtype=wp.uint8, device=device)
-        self.host = HostBuffers(end, device, max(1, min(HOST_BUFFERS, HOST_BUFFER_BYTES // end)))
+        self.host = HostBuffers(end, device, max(1, min(HOST_BUFFERS, HOST_BUFFER_BYTES // end)), wait_for_release)
         self._reading: int | None = None       # the host buffer of the read last queued (None: the spare)
         for name, dtype, shape in parts:    # typed views of the allocation, which the layout keeps alive
             setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
