@@ -303,6 +303,12 @@ def main() -> None:
         encoder.encode(rows, codes)
     seconds = (time.perf_counter() - start) / args.frames
     host_seconds = (time.process_time() - cpu_start) / args.frames
+    wp.timing_begin(cuda_filter=wp.TIMING_KERNEL | wp.TIMING_MEMCPY | wp.TIMING_MEMSET)
+    for _ in range(args.frames):
+        encoder.encode(rows, codes)
+    device_ms: dict[str, float] = {}
+    for result in wp.timing_end():
+        device_ms[result.name] = device_ms.get(result.name, 0.0) + result.elapsed / args.frames
     start = time.perf_counter()
     for _ in range(args.frames):
         reference = encode_png(image)
@@ -311,6 +317,9 @@ def main() -> None:
           f"bytes, distances {args.distances}, codes {args.codes}: {len(data):,} bytes, {1000 * seconds:.3f} ms "
           f"a frame (filter, matches, two passes, prefix sum, read back; {1000 * host_seconds:.3f} ms of this "
           f"process's CPU); ISA-L level 1 {len(reference):,} bytes, {1000 * cpu_seconds:.3f} ms of one core")
+    if device_ms:
+        print(f"  device time a frame {1000 * sum(device_ms.values()):.1f} us: " + ", ".join(
+            f"{name} {1000 * ms:.1f}" for name, ms in sorted(device_ms.items(), key=lambda kv: -kv[1])))
 
 
 if __name__ == "__main__":

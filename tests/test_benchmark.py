@@ -334,6 +334,38 @@ def test_gpu_png_prototype_encodes_exact_pngs_on_warps_cpu(shape):
         gpu_png.SegmentDeflate(*shape, device="cpu", segment=0)
 
 
+@pytest.mark.parametrize("shape", [(70, 53), (9, 1), (1, 300), (40, 2000)])
+def test_pixel_run_deflate_encodes_exact_pngs_on_warps_cpu(shape):
+    """bench/gpu_png_runs.py (Warp's CPU device): its zlib stream is byte for byte png_codes.zlib_stream of
+    png_codes.pixel_run_parse with the same codes (built from another image), zlib checks its Adler-32, Pillow
+    decodes the pixels, and the parse replays to the filtered lines with runs of one distance as matches of at
+    most 64 pixels (a flat line of 2,000 pixels: a literal pixel, then 31 matches)."""
+    pytest.importorskip("warp")
+    import io
+    import zlib
+    from PIL import Image
+    from graphsdg.io.png import filtered_lines
+    runs, png_codes = _bench_script("gpu_png_runs"), _bench_script("png_codes")
+    rng = np.random.default_rng(sum(shape))
+    image = rng.integers(0, 256, (*shape, 4), dtype=np.uint8)
+    image[shape[0] // 2:, : shape[1] // 2] = (9, 8, 7, 255)           # a flat block: runs at the pixel before
+    image[shape[0] // 3:, shape[1] // 2:] = image[shape[0] // 3, shape[1] // 2:]   # repeated lines: runs above
+    lines = filtered_lines(image)
+    symbols = png_codes.pixel_run_parse(lines, runs.candidate_distances(shape[1]))
+    assert png_codes.replayed(symbols) == lines.tobytes()
+    lengths = runs.codes_of_frames([rng.integers(0, 256, (5, 7, 4), dtype=np.uint8)])
+    data = runs.PixelRunDeflate(*shape, *lengths, device="cpu").png(image)
+    start = data.index(b"IDAT")
+    idat = data[start + 4:start + 4 + int.from_bytes(data[start - 4:start], "big")]
+    assert idat == png_codes.zlib_stream(symbols, lines.tobytes(), *lengths)
+    assert zlib.decompress(idat) == lines.tobytes()
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), image)
+    if shape == (40, 2000):
+        flat = png_codes.pixel_run_parse(filtered_lines(np.zeros((1, 2000, 4), np.uint8)), [4])
+        assert flat[:5] == [(1, 0), (0, 0), (0, 0), (0, 0), (0, 0)]
+        assert flat[5:] == [(256, 4)] * 31 + [(4 * (1999 - 31 * 64), 4)]
+
+
 def test_png_codes_parse_rebuilds_the_filtered_lines_and_counts_its_bits():
     """bench/png_codes.py: the segment-by-segment parse a GPU would make replays to the exact filtered lines (no
     match past its segment's end), a flat image is nearly all matches, and the bits counted with the fixed codes
