@@ -86,44 +86,46 @@ def greedy_parse(stream: np.ndarray, best: np.ndarray, best_distance: np.ndarray
     return symbols
 
 
-def pixel_run_parse(lines: np.ndarray, distances: list[int], piece: int = 64) -> list[tuple[int, int]]:
-    """The parse of ``bench/gpu_png_runs.py``, made without a sequential scan: whole 4-byte pixels only.
+def pixel_run_parse(lines: np.ndarray, piece: int = 64) -> list[tuple[int, int]]:
+    """The parse of :mod:`graphsdg.render.device_png`, made here one pixel after another: its reference.
 
-    ``lines``: the filtered lines of an RGBA image, (H, 1 + 4 W) bytes. Each line's filter byte is a literal;
-    each pixel takes the first of ``distances`` at which the 4 bytes that far back in the stream equal its
-    own, or none (4 literals). A run of pixels of one line taking the same distance is matches of ``piece``
-    pixels (4 ``piece`` bytes, 258 at most) and the rest, from the run's first pixel on.
+    ``lines``: the Sub-filtered lines of an RGBA image, (H, 1 + 4 W) bytes. Each line's filter byte is a literal.
+    Each pixel takes the first of its neighbours left, above, above-left, above-right and two to the left
+    (:data:`~graphsdg.render.device_png.NEIGHBOURS`, those in the image and at most 32,768 bytes back) whose
+    filtered bytes equal its own, or none: 4 literals. A match starts at each pixel that takes a neighbour
+    where its left pixel takes another (or none) and at each pixel whose x is a multiple of ``piece``, and
+    covers the pixels after it that take the same neighbour, up to the next such start.
     """
     height, line = lines.shape
     width = (line - 1) // 4
-    if line != 1 + 4 * width or 4 * piece > MAX_MATCH or piece < 1:
+    if line != 1 + 4 * width or not 1 <= piece <= MAX_MATCH // 4:
         raise ValueError(f"lines of {line} bytes and pieces of {piece} pixels: expected 1 + 4 W bytes and 1-64 pixels")
-    stream = lines.reshape(-1)
-    padded = np.concatenate([stream, np.zeros(3, np.uint8)]).astype(np.uint32)
-    words = padded[:-3] | padded[1:-2] << 8 | padded[2:-1] << 16 | padded[3:] << 24   # the 4 bytes at each byte
-    starts = (np.arange(height)[:, None] * line + 1 + 4 * np.arange(width)[None, :]).ravel()
-    mode = np.full(starts.size, -1)
-    for k in reversed(range(len(distances))):                # the first distance that matches wins
-        back = starts - distances[k]
-        inside = back >= 0
-        same = np.zeros(starts.size, bool)
-        same[inside] = words[starts[inside]] == words[back[inside]]
+    pixels = lines[:, 1:].reshape(height, width, 4).view(np.uint32)[..., 0]
+    neighbours = [(dy, dx) for dy, dx in ((0, -1), (-1, 0), (-1, -1), (-1, 1), (0, -2))
+                  if -dy * line - 4 * dx <= 32768]
+    mode = np.full((height, width), -1)
+    for k in reversed(range(len(neighbours))):               # the first neighbour that matches wins
+        dy, dx = neighbours[k]
+        same = np.zeros((height, width), bool)
+        ys, xs = slice(max(0, -dy), height), slice(max(0, -dx), min(width, width - dx))
+        same[ys, xs] = pixels[ys, xs] == pixels[max(0, -dy) + dy:height + dy, xs.start + dx:xs.stop + dx]
         mode[same] = k
-    grid = mode.reshape(height, width)
-    changed = np.ones((height, width + 1), bool)
-    changed[:, 1:-1] = grid[:, 1:] != grid[:, :-1]
-    first = np.flatnonzero((grid >= 0) & changed[:, :-1])     # each run's first and last pixel
-    last = np.flatnonzero((grid >= 0) & changed[:, 1:])
-    run = np.cumsum((grid >= 0) & changed[:, :-1]) - 1
-    values, symbols = stream.tolist(), []
+    values, symbols = lines.tolist(), []
     for y in range(height):
-        symbols.append((values[y * line], 0))
-        for p in range(y * width, (y + 1) * width):
-            b = int(starts[p])
-            if mode[p] < 0:
-                symbols += [(values[b + i], 0) for i in range(4)]
-            elif (p - first[run[p]]) % piece == 0:
-                symbols.append((4 * int(min(piece, last[run[p]] - p + 1)), distances[mode[p]]))
+        symbols.append((values[y][0], 0))
+        x = 0
+        while x < width:
+            k = mode[y, x]
+            if k < 0:
+                symbols += [(v, 0) for v in values[y][1 + 4 * x:5 + 4 * x]]
+                x += 1
+                continue
+            end = x + 1
+            while end < width and end % piece and mode[y, end] == k:
+                end += 1
+            dy, dx = neighbours[k]
+            symbols.append((4 * (end - x), -dy * line - 4 * dx))
+            x = end
     return symbols
 
 

@@ -334,36 +334,23 @@ def test_gpu_png_prototype_encodes_exact_pngs_on_warps_cpu(shape):
         gpu_png.SegmentDeflate(*shape, device="cpu", segment=0)
 
 
-@pytest.mark.parametrize("shape", [(70, 53), (9, 1), (1, 300), (40, 2000)])
-def test_pixel_run_deflate_encodes_exact_pngs_on_warps_cpu(shape):
-    """bench/gpu_png_runs.py (Warp's CPU device): its zlib stream is byte for byte png_codes.zlib_stream of
-    png_codes.pixel_run_parse with the same codes (built from another image), zlib checks its Adler-32, Pillow
-    decodes the pixels, and the parse replays to the filtered lines with runs of one distance as matches of at
-    most 64 pixels (a flat line of 2,000 pixels: a literal pixel, then 31 matches)."""
+def test_png_on_device_reports_the_streams_size_against_isal(tmp_path):
+    """bench/png_on_device.py on Warp's CPU device: the stream it times is checked by zlib, and it prints its
+    size against ISA-L's and the host CPU of an encode."""
     pytest.importorskip("warp")
-    import io
-    import zlib
-    from PIL import Image
-    from graphsdg.io.png import filtered_lines
-    runs, png_codes = _bench_script("gpu_png_runs"), _bench_script("png_codes")
-    rng = np.random.default_rng(sum(shape))
-    image = rng.integers(0, 256, (*shape, 4), dtype=np.uint8)
-    image[shape[0] // 2:, : shape[1] // 2] = (9, 8, 7, 255)           # a flat block: runs at the pixel before
-    image[shape[0] // 3:, shape[1] // 2:] = image[shape[0] // 3, shape[1] // 2:]   # repeated lines: runs above
-    lines = filtered_lines(image)
-    symbols = png_codes.pixel_run_parse(lines, runs.candidate_distances(shape[1]))
-    assert png_codes.replayed(symbols) == lines.tobytes()
-    lengths = runs.codes_of_frames([rng.integers(0, 256, (5, 7, 4), dtype=np.uint8)])
-    data = runs.PixelRunDeflate(*shape, *lengths, device="cpu").png(image)
-    start = data.index(b"IDAT")
-    idat = data[start + 4:start + 4 + int.from_bytes(data[start - 4:start], "big")]
-    assert idat == png_codes.zlib_stream(symbols, lines.tobytes(), *lengths)
-    assert zlib.decompress(idat) == lines.tobytes()
-    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), image)
-    if shape == (40, 2000):
-        flat = png_codes.pixel_run_parse(filtered_lines(np.zeros((1, 2000, 4), np.uint8)), [4])
-        assert flat[:5] == [(1, 0), (0, 0), (0, 0), (0, 0), (0, 0)]
-        assert flat[5:] == [(256, 4)] * 31 + [(4 * (1999 - 31 * 64), 4)]
+    import subprocess
+    import sys
+    import cv2
+    image = np.zeros((24, 40, 4), np.uint8)
+    image[:, :, 3] = 255
+    image[8:16, 10:30, :3] = (200, 40, 10)
+    cv2.imwrite(str(tmp_path / "rgb.png"), image)
+    done = subprocess.run([sys.executable, _bench_path("png_on_device"), str(tmp_path / "rgb.png"), "--device", "cpu",
+                           "--frames", "2"], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    lines = [line for line in done.stdout.splitlines() if not line.startswith(("Warp", "Module", "   "))]
+    assert lines[0].startswith("40x24 on cpu: ") and "bytes of stream against ISA-L level 1's" in lines[0]
+    assert lines[1].startswith("host CPU a frame, plain launches: ") and lines[-1].startswith("ISA-L (encode_png)")
 
 
 def test_png_codes_parse_rebuilds_the_filtered_lines_and_counts_its_bits():

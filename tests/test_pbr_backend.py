@@ -427,3 +427,50 @@ def test_the_megakernels_replays_render_what_the_librarys_launches_render(render
         assert draw.replays == 4
     finally:
         rc.geom_roughness, rc.shadow_samples = rough, samples
+
+
+def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(tmp_path):
+    """With /graphsdg/render/pbrPngOnDevice, the rgb annotator's image carries the stream compressed where it was
+    rendered, and BasicWriter's rgb file is that stream wrapped (not ISA-L's bytes), decoding to the pixels; the
+    same frame without the setting is compressed on the CPU."""
+    import io
+    import zlib
+
+    from PIL import Image
+
+    import warp as wp
+
+    from graphsdg import settings
+    from graphsdg.io.png import PrecompressedImage, encode_png, filtered_lines
+    from graphsdg.render import device_png
+
+    def capture(on_device: bool, out: str):
+        rep.stage.new_stage()
+        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
+                           "/graphsdg/render/pbrPngOnDevice": on_device}.items():
+            settings.set(key, value)
+        _, _, cam = _scene()
+        rp = rep.create.render_product(cam, (W, H))
+        rgb = rep.annotators.get("rgb")
+        rgb.attach(rp)
+        writer = rep.writers.get("BasicWriter", init_params={"output_dir": out, "rgb": True}, render_products=rp)
+        rep.orchestrator.step(delta_time=0)
+        rep.orchestrator.wait_until_complete()
+        writer.detach()
+        with open(os.path.join(out, "rgb_0000.png"), "rb") as f:
+            return rgb.get_data(), f.read()
+
+    pixels, written = capture(True, str(tmp_path / "device"))
+    assert isinstance(pixels, PrecompressedImage)         # a view of the frame's image: the stream stays with it
+    start = written.index(b"IDAT")
+    idat = written[start + 4:start + 4 + int.from_bytes(written[start - 4:start], "big")]
+    room = wp.zeros(W * H * 3, dtype=wp.uint32, device=DEVICE)
+    meta = wp.zeros(2, dtype=wp.int64, device=DEVICE)
+    device_png.DevicePng(W, H, DEVICE, room, meta).queue(
+        wp.array(np.ascontiguousarray(pixels).view(np.uint32).reshape(-1), dtype=wp.uint32, device=DEVICE))
+    assert idat == device_png.zlib_stream(meta.numpy(), room.numpy())
+    assert zlib.decompress(idat) == filtered_lines(pixels).tobytes()
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(written))), pixels)
+    cpu_pixels, cpu_written = capture(False, str(tmp_path / "cpu"))
+    assert type(cpu_pixels) is np.ndarray and np.array_equal(cpu_pixels, pixels)
+    assert cpu_written == encode_png(np.asarray(pixels)) != written

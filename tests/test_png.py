@@ -151,3 +151,31 @@ def test_atomic_writes_take_a_list_of_pieces(tmp_path) -> None:
     write_atomic(str(tmp_path / "f.bin"), pieces)
     assert (tmp_path / "f.bin").read_bytes() == b"head" + big.tobytes() + b"tail"
     assert byte_count(pieces) == 8 + big.nbytes and byte_count(b"abc") == 3
+
+
+def test_a_precompressed_image_wraps_its_stream_and_its_views_do_not():
+    """encode_png / encode_image of a PrecompressedImage wrap its stream (here zlib's level 9, other bytes than
+    ISA-L's); views, copies and np.asarray of it are plain arrays, compressed again; the image is read-only; a
+    writer process is sent the PNG's bytes."""
+    import zlib
+
+    from graphsdg.io.encode import encode_image
+    from graphsdg.io.png import PrecompressedImage, encode_png, filtered_lines, png_file, precompressed
+    from graphsdg.io.write_queue import file_write
+    from graphsdg.io import io_functions
+
+    image = np.arange(5 * 6 * 4, dtype=np.uint8).reshape(5, 6, 4)
+    stream = zlib.compress(filtered_lines(image).tobytes(), 9)
+    ready = precompressed(image, stream)
+    assert isinstance(ready, PrecompressedImage) and ready.zlib_stream == stream and not ready.flags.writeable
+    wrapped = png_file(6, 5, 8, 4, stream)
+    assert encode_png(ready) == encode_image(ready, ".png") == wrapped != encode_png(image)
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(wrapped))), image)
+    assert encode_png(ready[1:]) == encode_png(image[1:]) and encode_png(ready.copy()) == encode_png(image)
+    assert encode_image(np.asarray(ready), ".png") == encode_png(image)
+    assert encode_image(ready, ".jpg")[:3] == b"\xff\xd8\xff"          # other formats compress the pixels
+    with pytest.raises(ValueError, match="read-only"):
+        ready[0, 0, 0] = 1
+    write = file_write(io_functions.write_image, (), {"data": ready, "path": "/tmp/a/rgb_0000.png"})
+    assert (write.kind, write.data) == ("blob", wrapped)
+    assert file_write(io_functions.write_image, (), {"data": ready, "path": "/tmp/a/rgb_0000.jpg"}).kind == "image"

@@ -82,6 +82,9 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
                                                  "while their pixels add up to at most this many (one camera "
                                                  "each; bench/pbr_products.py measured where it pays); 0: one "
                                                  "launch per product"),
+    "/graphsdg/render/pbrPngOnDevice": (False, "the pbr backend compresses each frame's colour PNG on its device "
+                                               "(graphsdg.render.device_png): less CPU a written frame, files "
+                                               "about a tenth larger"),
     "/graphsdg/render/pbrKernel": ("compact", "how the pbr backend's render kernel is built: compact (the "
                                               "traversals' per-geom tests and the lights' shadow test called, "
                                               "not inlined: compiles about four times faster) or inlined "
@@ -197,6 +200,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/graphsdg/render/pbrDevice": _warp_device,
     "/graphsdg/render/pbrBatchPixels": _integer(0),
     "/graphsdg/render/pbrKernel": _choice("compact", "inlined"),
+    "/graphsdg/render/pbrPngOnDevice": _boolean,
     "/rtx/pathtracing/spp": _integer(1),
     "/rtx/pathtracing/optixDenoiser/enabled": _boolean,
     "/omni/replicator/captureMotionBlur": _boolean,

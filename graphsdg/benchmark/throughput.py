@@ -77,6 +77,7 @@ class BenchConfig:
     path_spp: int | None = None          # /rtx/pathtracing/spp of the path tier; None: the setting as it is
     pbr_batch_pixels: int | None = None  # /graphsdg/render/pbrBatchPixels (0: a launch per product); None: as set
     pbr_kernel: str | None = None        # /graphsdg/render/pbrKernel (compact, inlined); None: as set
+    png_on_device: bool | None = None    # /graphsdg/render/pbrPngOnDevice; None: as set
     seconds: float | None = None         # time about this long: fewer than ``frames`` when the warm-up is slow (with
     #                                      a before_timing barrier, processes started together: until this deadline)
     write_processes: int | str | None = None   # /graphsdg/io/writeProcesses (a count, 0, auto); None: as set
@@ -232,6 +233,8 @@ def build_scene(config: BenchConfig):
         rep.settings.set("/graphsdg/render/pbrBatchPixels", int(config.pbr_batch_pixels))
     if config.pbr_kernel is not None:
         rep.settings.set("/graphsdg/render/pbrKernel", config.pbr_kernel)
+    if config.png_on_device is not None:
+        rep.settings.set("/graphsdg/render/pbrPngOnDevice", config.png_on_device)
     rep.stage.new_stage()
     rep.set_global_seed(config.seed)
     rep.orchestrator.set_capture_on_play(False)

@@ -8,19 +8,22 @@ from typing import Any
 import cv2
 import numpy as np
 
-from graphsdg.io.png import encode_png
+from graphsdg.io.png import PrecompressedImage, encode_png
 
 
 def encode_image(data: Any, ext: str = ".png") -> bytes:
-    """Encode an RGB(A) uint8 array, a grey uint8/uint16 array, or a PIL image.
+    """Encode an RGB(A) uint8 array, a grey uint8/uint16 array, or a PIL image (as a PNG, a
+    :class:`~graphsdg.io.png.PrecompressedImage` is its own stream wrapped).
 
     uint32 id images are stored as 16-bit PNG when their ids fit, as Replicator's
     viewers expect a standard image; larger ids are refused (save them as .npy).
     """
     if hasattr(data, "convert") and hasattr(data, "size"):   # PIL.Image
         data = np.asarray(data)
-    arr = np.asarray(data)
     ext = ext.lower()
+    if ext == ".png" and isinstance(data, PrecompressedImage) and data.zlib_stream is not None:
+        return encode_png(data)
+    arr = np.asarray(data)
     if arr.dtype == np.uint32 or arr.dtype == np.int32 or arr.dtype == np.int64:
         if arr.size and (arr.min() < 0 or arr.max() > 65535):
             raise ValueError(f"id image values span {arr.min()}..{arr.max()}; a PNG holds 0..65535")

@@ -46,6 +46,7 @@ from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
 from graphsdg.base.cpu_share import cores_per_process, usable_cores
 from graphsdg.errors import WriterError
+from graphsdg.io.png import PrecompressedImage, encode_png
 from graphsdg.io.write_processes import FileWrite, WriteProcesses
 from graphsdg.io.written_totals import count_written
 
@@ -186,7 +187,11 @@ def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict,
         full = resolve(path) if resolve is not None else None
     if full is None:
         return None
-    return FileWrite(kind, full, kwargs.get("data"), kwargs.get("indent"))
+    data = kwargs.get("data")
+    if kind == "image" and isinstance(data, PrecompressedImage) and data.zlib_stream is not None \
+            and os.path.splitext(full)[1].lower() in ("", ".png"):
+        return FileWrite("blob", full, encode_png(data), None)   # the PNG is made already: its bytes cross
+    return FileWrite(kind, full, data, kwargs.get("indent"))
 
 
 def _resolver(backend: Any) -> Callable[[str], str | None] | None:

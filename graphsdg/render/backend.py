@@ -27,6 +27,8 @@ The choice comes from settings (:func:`requested_backend`):
   samples per pixel per launch and ``/rtx/pathtracing/optixDenoiser/enabled`` as the denoiser.
 * ``/graphsdg/render/pbrBatchPixels``: the pbr backend draws a step's render products in one
   launch while their pixels add up to at most this many (:func:`launch_groups`).
+* ``/graphsdg/render/pbrPngOnDevice``: the pbr backend compresses each frame's colour PNG on its
+  device (:mod:`graphsdg.render.device_png`; read when a camera's buffers are made).
 """
 from __future__ import annotations
 
@@ -51,6 +53,9 @@ BACKEND_KEY = "/graphsdg/render/backend"
 #: the Warp device the pbr backend renders on: ``cuda:N`` (default ``cuda:0``) or ``cpu`` (Warp's CPU device:
 #: no GPU needed, slow; for checking a script or the mapping on a machine without one)
 DEVICE_KEY = "/graphsdg/render/pbrDevice"
+#: whether the pbr backend compresses each frame's colour PNG on its device (graphsdg.render.device_png): the
+#: writer wraps the stream read back instead of compressing on the CPU; files about a tenth larger
+PNG_ON_DEVICE_KEY = "/graphsdg/render/pbrPngOnDevice"
 BACKENDS = ("classic", "pbr", "auto")
 DENOISER_KEY = "/rtx/pathtracing/optixDenoiser/enabled"
 #: its default (the settings store's) is eight 512x512 products: the most pixels bench/pbr_products.py measured one
@@ -340,5 +345,5 @@ def resolve_backend(request: BackendRequest | None = None,
     return chosen
 
 
-__all__ = ["BACKENDS", "BackendRequest", "PbrUnavailableError", "RenderBackend", "RenderRequest", "launch_groups",
+__all__ = ["BACKENDS", "PNG_ON_DEVICE_KEY", "BackendRequest", "PbrUnavailableError", "RenderBackend", "RenderRequest", "launch_groups",
            "pbr_device", "pbr_missing", "requested_backend", "resolve_backend"]

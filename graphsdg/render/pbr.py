@@ -55,8 +55,8 @@ from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
 from graphsdg.imaging import environment_map
 from graphsdg.render import mesh_folds, pbr_kernel, pbr_scene
-from graphsdg.render.backend import (BackendRequest, PbrUnavailableError, RenderOutputs, RenderRequest, launch_groups,
-                                     pbr_missing, requested_backend)
+from graphsdg.render.backend import (PNG_ON_DEVICE_KEY, BackendRequest, PbrUnavailableError, RenderOutputs,
+                                     RenderRequest, launch_groups, pbr_missing, requested_backend)
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
 from graphsdg.maths.rotations import decompose
@@ -247,7 +247,8 @@ class PbrRenderer:
 
     def _layout(self, view: CameraView, ngeom: int):
         return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
-                                           view.far, self._device, ngeom, self._wait_for_release)
+                                           view.far, self._device, ngeom, self._wait_for_release,
+                                           png=bool(settings.get(PNG_ON_DEVICE_KEY, False)))
 
     def _mesh_state(self, scene: RenderScene, rc) -> _MeshState:
         """The context was built from the model's current vertices: every mesh's BVH is up to date."""

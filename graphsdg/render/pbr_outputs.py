@@ -30,6 +30,8 @@ from typing import Any, Callable
 import numpy as np
 import warp as wp
 
+from graphsdg.io.png import precompressed
+from graphsdg.render import device_png
 from graphsdg.render.polling import wait_until
 
 GEOM_TYPE = 5          # mujoco.mjtObj.mjOBJ_GEOM, as the renderer writes it into segmentation pairs
@@ -217,11 +219,13 @@ class ClassicLayout:
     ``ngeom`` geoms (the id codes' type, :func:`code_format`).
 
     ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos);
-    ``wait_for_release``: :class:`HostBuffers`'.
+    ``wait_for_release``: :class:`HostBuffers`'; ``png``: also compress the colour's PNG rows on the device
+    (:mod:`graphsdg.render.device_png`), read back with the colour, so the frame's colour array is a
+    :class:`~graphsdg.io.png.PrecompressedImage` (where the image fits :func:`device_png.fits`).
     """
 
     def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str,
-                 ngeom: int, wait_for_release: Callable[[], bool] | None = None) -> None:
+                 ngeom: int, wait_for_release: Callable[[], bool] | None = None, png: bool = False) -> None:
         n = width * height
         self.shape, self.near, self.far, self.device = (height, width), float(near), float(far), device
         self.ngeom = int(ngeom)
@@ -231,7 +235,10 @@ class ClassicLayout:
                                 device=device)
         # The outputs lie in one device allocation, mirrored by one page-locked host buffer, so a frame's reads
         # are one copy of the span they cover, not one per array (each copy is a driver call of its own).
-        parts = [("rgba", wp.uint32, (n,)), ("depth", wp.float32, (n,)),
+        png = png and device_png.fits(width, height)
+        # the stream right after the colour: a read of the colour alone is one span without the other passes
+        stream = [("png_meta", wp.int64, (2,)), ("png_words", wp.uint32, (device_png.stream_words(width, height),))]
+        parts = [("rgba", wp.uint32, (n,)), *(stream if png else []), ("depth", wp.float32, (n,)),
                  ("codes", _WARP_CODE_TYPES[code_type], (n,)), ("boxes", wp.int32, (self.ngeom + 1, 4))]
         self._spans: dict[str, tuple[int, int, np.dtype, tuple]] = {}
         end = 0
@@ -245,6 +252,7 @@ class ClassicLayout:
         for name, dtype, shape in parts:    # typed views of the allocation, which the layout keeps alive
             setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
                                          shape=shape, device=device))
+        self.png = device_png.DevicePng(width, height, device, self.png_words, self.png_meta) if png else None
         self._adrs: dict[tuple, int] = {}
         self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
 
@@ -256,6 +264,8 @@ class ClassicLayout:
                           self._adr(base, "depth", camera), self._adr(base, "seg", camera), self.cosines, self.near,
                           self.far],
                   outputs=[self.rgba, self.depth, self.codes], device=self.device)
+        if self.png is not None:
+            self.png.queue(self.rgba)
         if boxes:
             self.queue_boxes()
 
@@ -275,7 +285,9 @@ class ClassicLayout:
 
     def _parts(self) -> list[str]:
         colour, depth, ids = self._wanted
-        return [name for name, want in (("rgba", colour), ("depth", depth), ("codes", ids), ("boxes", ids)) if want]
+        stream = colour and self.png is not None
+        return [name for name, want in (("rgba", colour), ("png_meta", stream), ("png_words", stream),
+                                        ("depth", depth), ("codes", ids), ("boxes", ids)) if want]
 
     def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
         """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds:
@@ -308,7 +320,12 @@ class ClassicLayout:
         rgba, boxes = own.get("rgba"), own.get("boxes")
         if boxes is not None:
             boxes[boxes[:, 2] < 0] = -1          # codes no pixel has: -1 rows, as the classic path's boxes
-        return HostFrame(rgba=None if rgba is None else rgba.view(np.uint8).reshape(h, w, 4),
+        if rgba is not None:
+            rgba = rgba.view(np.uint8).reshape(h, w, 4)
+            stream = device_png.zlib_stream(own["png_meta"], own["png_words"]) if "png_meta" in own else None
+            if stream is not None:               # else too long for the room read back: the CPU compresses it
+                rgba = precompressed(rgba, stream)
+        return HostFrame(rgba=rgba,
                          depth=own["depth"].reshape(h, w) if "depth" in own else None,
                          codes=own["codes"].reshape(h, w) if "codes" in own else None, code_boxes=boxes)
 

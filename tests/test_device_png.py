@@ -1,0 +1,118 @@
+"""PNG rows compressed on a Warp device (graphsdg.render.device_png), on Warp's CPU device: the stream is byte for
+byte the CPU reference parse's (bench/png_codes.py) with the module's fixed codes, zlib checks it, and a frame's
+colour read back with it is an image whose PNG wraps it."""
+from __future__ import annotations
+
+import importlib.util
+import io
+import os
+import zlib
+
+import numpy as np
+import pytest
+
+wp = pytest.importorskip("warp")
+
+from graphsdg.io.png import PrecompressedImage, encode_png, filtered_lines, png_file  # noqa: E402
+from graphsdg.render import device_png  # noqa: E402
+from graphsdg.render import pbr_outputs as po  # noqa: E402
+
+
+def _png_codes():
+    path = os.path.join(os.path.dirname(__file__), "..", "bench", "png_codes.py")
+    spec = importlib.util.spec_from_file_location("png_codes", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _image(height: int, width: int, seed: int) -> np.ndarray:
+    """Noise with a flat block (runs on the left) and repeated lines (runs above) in it."""
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (height, width, 4), dtype=np.uint8)
+    image[height // 2:, :width // 2] = (9, 8, 7, 255)
+    image[height // 3:, width // 2:] = image[height // 3, width // 2:]
+    return image
+
+
+def _compress(image: np.ndarray, words: int | None = None) -> bytes | None:
+    height, width, _ = image.shape
+    room = (device_png.HEADER_BITS + 75 * width * height) // 32 + 2      # the longest a stream can be
+    out = wp.zeros(words or room, dtype=wp.uint32, device="cpu")
+    meta = wp.zeros(2, dtype=wp.int64, device="cpu")
+    png = device_png.DevicePng(width, height, "cpu", out, meta)
+    png.queue(wp.array(image.view(np.uint32).reshape(-1), dtype=wp.uint32, device="cpu"))
+    return device_png.zlib_stream(meta.numpy(), out.numpy())
+
+
+@pytest.mark.parametrize("shape", [(70, 53), (9, 1), (1, 300), (40, 130), (3, 8200)])
+def test_the_stream_is_the_reference_parse_with_the_fixed_codes(shape):
+    """Widths of one pixel, of several match pieces (130 > 2 x 64) and past deflate's window for the line above
+    (8,200 pixels: only the left neighbours are tried)."""
+    png_codes = _png_codes()
+    image = _image(*shape, seed=sum(shape))
+    lines = filtered_lines(image)
+    stream = _compress(image)
+    symbols = png_codes.pixel_run_parse(lines)
+    assert png_codes.replayed(symbols) == lines.tobytes()
+    assert stream == png_codes.zlib_stream(symbols, lines.tobytes(), device_png.LENGTHS, device_png.DISTANCE_LENGTHS)
+    assert zlib.decompress(stream) == lines.tobytes()                 # zlib checks the Adler-32 too
+    if shape == (3, 8200):
+        assert {d for _, d in symbols if d} <= {4, 8}
+
+
+def test_runs_are_cut_where_their_neighbour_changes_and_every_64_pixels():
+    png_codes = _png_codes()
+    flat = png_codes.pixel_run_parse(filtered_lines(np.zeros((1, 200, 4), np.uint8)))
+    assert flat == [(1, 0)] + [(0, 0)] * 4 + [(4 * 63, 4), (4 * 64, 4), (4 * 64, 4), (4 * 8, 4)]
+    image = np.zeros((2, 4, 4), np.uint8)
+    image[:, 2] = 5                                                   # Sub: a step, then back: +5, -5
+    # line 0: a literal pixel, its right neighbour repeats it (4 back), then two literal pixels; line 1: the
+    # first pixel repeats the one above (17 back), the second its left one, the last two the ones above
+    assert png_codes.pixel_run_parse(filtered_lines(image)) == [(1, 0)] + [(0, 0)] * 4 + [(4, 4)] + [(5, 0)] * 4 \
+        + [(251, 0)] * 4 + [(1, 0), (4, 17), (4, 4), (8, 17)]
+
+
+def test_the_fixed_header_and_codes_are_those_of_the_code_lengths():
+    png_codes = _png_codes()
+    assert png_codes.dynamic_header(device_png.LENGTHS, device_png.DISTANCE_LENGTHS) == \
+        (device_png.HEADER, device_png.HEADER_BITS)
+    assert device_png.sent_codes(device_png.LENGTHS).tolist() == png_codes.sent_codes(device_png.LENGTHS).tolist()
+    assert len(device_png.LENGTHS) == 286 and len(device_png.DISTANCE_LENGTHS) == 30
+
+
+def test_a_stream_longer_than_its_room_is_reported_as_none():
+    image = _image(16, 16, seed=3)
+    assert _compress(image, words=64) is None
+    assert _compress(image) is not None
+
+
+def test_an_image_too_large_for_32_bit_offsets_is_refused():
+    assert not device_png.fits(30000, 20000) and device_png.fits(4096, 4096)
+    with pytest.raises(ValueError, match="cannot compress a 30000x20000 image on the device; expected fewer than"):
+        device_png.DevicePng(30000, 20000, "cpu", None, None)
+
+
+def test_a_layout_reads_the_stream_with_the_colour_and_lends_a_precompressed_image():
+    """ClassicLayout(png=True): a read of the colour brings its stream along; the frame's colour is a read-only
+    PrecompressedImage whose PNG decodes to the pixels; a read without the colour reads no stream."""
+    from PIL import Image
+    h, w = 12, 20
+    layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4, png=True)
+    image = _image(h, w, seed=5)
+    image[:h // 2] = 40                           # flat enough for the room a layout reads back
+    layout.rgba.assign(wp.array(image.view(np.uint32).reshape(-1), dtype=wp.uint32, device="cpu"))
+    layout.png.queue(layout.rgba)                 # what convert() queues after the conversion
+    layout.queue_read(colour=True, depth=False, ids=False)
+    frame = layout.take()
+    assert isinstance(frame.rgba, PrecompressedImage) and not frame.rgba.flags.writeable
+    assert np.array_equal(frame.rgba, image)
+    data = encode_png(frame.rgba)
+    assert data == png_file(w, h, 8, 4, _compress(image)) and data != encode_png(np.array(frame.rgba))
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), image)
+    layout.queue_read(colour=False, depth=True, ids=False)
+    assert layout._parts() == ["depth"]
+    plain = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4)
+    plain.rgba.assign(layout.rgba)
+    plain.queue_read(colour=True, depth=False, ids=False)
+    assert type(plain.take().rgba) is np.ndarray
