@@ -40,8 +40,8 @@ class PrecompressedImage(np.ndarray):
     made (the pbr renderer's colour with ``/graphsdg/render/pbrPngOnDevice``): :func:`encode_png` of this very
     array wraps the stream in a PNG instead of compressing the rows again.
 
-    It is read-only, so the stream cannot go stale; its views, slices and copies, and ``np.asarray`` of it, are
-    plain arrays without the stream.
+    It is read-only, so the stream cannot go stale. Its views, slices and copies carry no stream, and
+    ``np.asarray`` of it is a plain array: each of them is compressed anew.
     """
 
     zlib_stream: bytes | None = None

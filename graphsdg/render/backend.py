@@ -345,5 +345,5 @@ def resolve_backend(request: BackendRequest | None = None,
     return chosen
 
 
-__all__ = ["BACKENDS", "PNG_ON_DEVICE_KEY", "BackendRequest", "PbrUnavailableError", "RenderBackend", "RenderRequest", "launch_groups",
-           "pbr_device", "pbr_missing", "requested_backend", "resolve_backend"]
+__all__ = ["BACKENDS", "PNG_ON_DEVICE_KEY", "BackendRequest", "PbrUnavailableError", "RenderBackend", "RenderRequest",
+           "launch_groups", "pbr_device", "pbr_missing", "requested_backend", "resolve_backend"]

@@ -410,7 +410,7 @@ class PbrRenderer:
             if "color" in passes:
                 out.put("color", lambda: host().rgba)
             if "hdr" in passes:
-                out.put("hdr", lambda: host().rgba[..., :3].astype(np.float32) / 255.0)
+                out.put("hdr", lambda: np.asarray(host().rgba)[..., :3].astype(np.float32) / 255.0)
         if "depth" in passes:
             out.put("depth", lambda: host().depth)
         if "segmentation" in passes:

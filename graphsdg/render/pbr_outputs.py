@@ -219,7 +219,7 @@ class ClassicLayout:
     ``ngeom`` geoms (the id codes' type, :func:`code_format`).
 
     ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos);
-    ``wait_for_release``: :class:`HostBuffers`'; ``png``: also compress the colour's PNG rows on the device
+    ``wait_for_release``: as :class:`HostBuffers` takes it; ``png``: also compress the colour's PNG rows on the device
     (:mod:`graphsdg.render.device_png`), read back with the colour, so the frame's colour array is a
     :class:`~graphsdg.io.png.PrecompressedImage` (where the image fits :func:`device_png.fits`).
     """
