@@ -13,7 +13,8 @@ import pytest
 
 wp = pytest.importorskip("warp")
 
-from graphsdg.io.png import PrecompressedImage, encode_png, filtered_lines, png_file  # noqa: E402
+from graphsdg.imaging.precompressed import PrecompressedImage  # noqa: E402
+from graphsdg.io.png import encode_png, filtered_lines, png_file  # noqa: E402
 from graphsdg.render import device_png  # noqa: E402
 from graphsdg.render import pbr_outputs as po  # noqa: E402
 
@@ -94,8 +95,9 @@ def test_an_image_too_large_for_32_bit_offsets_is_refused():
 
 
 def test_a_layout_reads_the_stream_with_the_colour_and_lends_a_precompressed_image():
-    """ClassicLayout(png=True): a read of the colour brings its stream along; the frame's colour is a read-only
-    PrecompressedImage whose PNG decodes to the pixels; a read without the colour reads no stream."""
+    """ClassicLayout(png=True): a read of the colour with its stream brings it along; the frame's colour is a
+    read-only PrecompressedImage whose PNG decodes to the pixels; a read without the colour, or of the colour
+    without the stream, reads none, and a layout that does not compress has none to read."""
     from PIL import Image
     h, w = 12, 20
     layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4, png=True)
@@ -103,16 +105,18 @@ def test_a_layout_reads_the_stream_with_the_colour_and_lends_a_precompressed_ima
     image[:h // 2] = 40                           # flat enough for the room a layout reads back
     layout.rgba.assign(wp.array(image.view(np.uint32).reshape(-1), dtype=wp.uint32, device="cpu"))
     layout.png.queue(layout.rgba)                 # what convert() queues after the conversion
-    layout.queue_read(colour=True, depth=False, ids=False)
+    layout.queue_read(colour=True, depth=False, ids=False, stream=True)
     frame = layout.take()
     assert isinstance(frame.rgba, PrecompressedImage) and not frame.rgba.flags.writeable
     assert np.array_equal(frame.rgba, image)
     data = encode_png(frame.rgba)
     assert data == png_file(w, h, 8, 4, _compress(image)) and data != encode_png(np.array(frame.rgba))
     assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), image)
-    layout.queue_read(colour=False, depth=True, ids=False)
+    layout.queue_read(colour=False, depth=True, ids=False, stream=True)
     assert layout._parts() == ["depth"]
+    layout.queue_read(colour=True, depth=False, ids=False)             # the colour without its stream (hdr alone)
+    assert layout._parts() == ["rgba"] and type(layout.take().rgba) is np.ndarray
     plain = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4)
     plain.rgba.assign(layout.rgba)
-    plain.queue_read(colour=True, depth=False, ids=False)
+    plain.queue_read(colour=True, depth=False, ids=False, stream=True)
     assert type(plain.take().rgba) is np.ndarray

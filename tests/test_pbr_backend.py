@@ -441,7 +441,8 @@ def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(
     import warp as wp
 
     from graphsdg import settings
-    from graphsdg.io.png import PrecompressedImage, encode_png, filtered_lines
+    from graphsdg.imaging.precompressed import PrecompressedImage
+    from graphsdg.io.png import encode_png, filtered_lines
     from graphsdg.render import device_png
 
     def capture(on_device: bool, out: str):

@@ -160,7 +160,8 @@ def test_a_precompressed_image_wraps_its_stream_and_its_views_do_not():
     import zlib
 
     from graphsdg.io.encode import encode_image
-    from graphsdg.io.png import PrecompressedImage, encode_png, filtered_lines, png_file, precompressed
+    from graphsdg.imaging.precompressed import PrecompressedImage, precompressed
+    from graphsdg.io.png import encode_png, filtered_lines, png_file
     from graphsdg.io.write_queue import file_write
     from graphsdg.io import io_functions
 

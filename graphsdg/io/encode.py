@@ -8,12 +8,13 @@ from typing import Any
 import cv2
 import numpy as np
 
-from graphsdg.io.png import PrecompressedImage, encode_png
+from graphsdg.imaging.precompressed import PrecompressedImage
+from graphsdg.io.png import encode_png
 
 
 def encode_image(data: Any, ext: str = ".png") -> bytes:
     """Encode an RGB(A) uint8 array, a grey uint8/uint16 array, or a PIL image (as a PNG, a
-    :class:`~graphsdg.io.png.PrecompressedImage` is its own stream wrapped).
+    :class:`~graphsdg.imaging.precompressed.PrecompressedImage` is its own stream wrapped).
 
     uint32 id images are stored as 16-bit PNG when their ids fit, as Replicator's
     viewers expect a standard image; larger ids are refused (save them as .npy).

@@ -29,47 +29,26 @@ import zlib
 import numpy as np
 from isal import isal_zlib
 
+from graphsdg.imaging.precompressed import PrecompressedImage
+
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 COLOR_TYPES = {1: 0, 2: 4, 3: 2, 4: 6}   # channels -> PNG colour type (grey, grey+alpha, RGB, RGBA)
 SUB_FILTER = 1
 LEVEL = 1                                # ISA-L level 1: fastest of the levels that compress well
 
 
-class PrecompressedImage(np.ndarray):
-    """An image array that carries the zlib stream of its PNG's filtered rows, compressed where the pixels were
-    made (the pbr renderer's colour with ``/graphsdg/render/pbrPngOnDevice``): :func:`encode_png` of this very
-    array wraps the stream in a PNG instead of compressing the rows again.
-
-    It is read-only, so the stream cannot go stale. Its views, slices and copies carry no stream, and
-    ``np.asarray`` of it is a plain array: each of them is compressed anew.
-    """
-
-    zlib_stream: bytes | None = None
-
-    def __array_finalize__(self, obj: object) -> None:
-        self.zlib_stream = None
-
-
-def precompressed(image: np.ndarray, zlib_stream: bytes) -> PrecompressedImage:
-    """``image`` (a uint8 (H, W, C) array, not copied) as a read-only :class:`PrecompressedImage` carrying
-    ``zlib_stream``, the zlib stream of its filtered rows (any PNG filter types, one byte a row before them).
+def encode_png(image: np.ndarray) -> bytes:
+    """PNG bytes of a uint8 or uint16 image: (H, W) grey, or (H, W, C) with C = 2 (grey+alpha), 3 (RGB), 4 (RGBA).
+    A :class:`~graphsdg.imaging.precompressed.PrecompressedImage` gets its own stream wrapped.
 
     Example:
         >>> import zlib
+        >>> from graphsdg.imaging.precompressed import precompressed
         >>> img = np.arange(24, dtype=np.uint8).reshape(2, 3, 4)
         >>> ready = precompressed(img, zlib.compress(filtered_lines(img).tobytes()))
         >>> encode_png(ready) == png_file(3, 2, 8, 4, ready.zlib_stream)
         True
     """
-    out = image.view(PrecompressedImage)
-    out.zlib_stream = zlib_stream
-    out.flags.writeable = False
-    return out
-
-
-def encode_png(image: np.ndarray) -> bytes:
-    """PNG bytes of a uint8 or uint16 image: (H, W) grey, or (H, W, C) with C = 2 (grey+alpha), 3 (RGB), 4 (RGBA).
-    A :class:`PrecompressedImage` gets its own stream wrapped."""
     stream = getattr(image, "zlib_stream", None)
     if stream is not None and isinstance(image, PrecompressedImage):
         h, w, c = _checked(image).shape

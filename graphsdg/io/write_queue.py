@@ -46,7 +46,8 @@ from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
 from graphsdg.base.cpu_share import cores_per_process, usable_cores
 from graphsdg.errors import WriterError
-from graphsdg.io.png import PrecompressedImage, encode_png
+from graphsdg.imaging.precompressed import PrecompressedImage
+from graphsdg.io.png import encode_png
 from graphsdg.io.write_processes import FileWrite, WriteProcesses
 from graphsdg.io.written_totals import count_written
 

@@ -348,11 +348,12 @@ class PbrRenderer:
                 if acc is not None and first.motion is None:
                     acc = acc / launches
                 ids = tuple(bool({"segmentation", "depth"} & r.passes) for r in requests)
-                self._conversion(ctx, ids).run()
+                pngs = tuple(acc is None and "color" in r.passes for r in requests)
+                self._conversion(ctx, ids, pngs).run()
             with profiling.timed("readback:pbr"):
                 queued = self._outputs.queue_reads([
-                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes, read_ids)
-                    for layout, r, read_ids in zip(ctx.layouts, requests, ids)])
+                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes, read_ids, png)
+                    for layout, r, read_ids, png in zip(ctx.layouts, requests, ids, pngs)])
                 if all(r.defer for r in requests):   # pipelined: the copies finish while the script goes on
                     self._queued.append(queued)
                 else:
@@ -361,10 +362,11 @@ class PbrRenderer:
         return [self._outputs_of(scene, r, _host_of(queued, i), layout.table, acc)
                 for i, (r, layout) in enumerate(zip(requests, ctx.layouts))]
 
-    def _conversion(self, ctx: _Context, ids: tuple[bool, ...]):
+    def _conversion(self, ctx: _Context, ids: tuple[bool, ...], pngs: tuple[bool, ...]):
         """The :class:`~graphsdg.render.launch_graph.LaunchGraph` converting each camera's pixels of ``ctx``
-        to the classic layout, with their codes' pixel bounds where ``ids`` asks (one per camera)."""
-        key = (ids, tuple(id(layout) for layout in ctx.layouts))
+        to the classic layout, with their codes' pixel bounds where ``ids`` asks and their colour's PNG rows
+        compressed where ``pngs`` asks and the layout does that (one flag of each per camera)."""
+        key = (ids, pngs, tuple(id(layout) for layout in ctx.layouts))
         graph = ctx.conversions.get(key)
         if graph is None:
             if len(ctx.conversions) >= self.MAX_CONVERSIONS:   # new intrinsics every frame make new layouts
@@ -372,8 +374,8 @@ class PbrRenderer:
             base, layouts = ctx.rc.base, list(ctx.layouts)
 
             def launches() -> None:
-                for index, (layout, boxes) in enumerate(zip(layouts, ids)):
-                    layout.convert(base, index, boxes=boxes)
+                for index, (layout, boxes, png) in enumerate(zip(layouts, ids, pngs)):
+                    layout.convert(base, index, boxes=boxes, png=png)
             graph = ctx.conversions[key] = self._launch_graph.LaunchGraph(self._device, launches)
         return graph
 

@@ -30,7 +30,7 @@ from typing import Any, Callable
 import numpy as np
 import warp as wp
 
-from graphsdg.io.png import precompressed
+from graphsdg.imaging.precompressed import precompressed
 from graphsdg.render import device_png
 from graphsdg.render.polling import wait_until
 
@@ -221,7 +221,7 @@ class ClassicLayout:
     ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos);
     ``wait_for_release``: as :class:`HostBuffers` takes it; ``png``: also compress the colour's PNG rows on the device
     (:mod:`graphsdg.render.device_png`), read back with the colour, so the frame's colour array is a
-    :class:`~graphsdg.io.png.PrecompressedImage` (where the image fits :func:`device_png.fits`).
+    :class:`~graphsdg.imaging.precompressed.PrecompressedImage` (where the image fits :func:`device_png.fits`).
     """
 
     def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str,
@@ -254,17 +254,18 @@ class ClassicLayout:
                                          shape=shape, device=device))
         self.png = device_png.DevicePng(width, height, device, self.png_words, self.png_meta) if png else None
         self._adrs: dict[tuple, int] = {}
-        self._wanted = (False, False, False)    # (colour, depth, ids) of the read last queued
+        self._wanted = (False, False, False, False)    # (colour, depth, ids, stream) of the read last queued
 
-    def convert(self, base, camera: int, boxes: bool = False) -> None:
-        """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0), and with
-        ``boxes`` their codes' pixel bounds (:meth:`queue_boxes`; a read of the ids needs them)."""
+    def convert(self, base, camera: int, boxes: bool = False, png: bool = True) -> None:
+        """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0), with
+        ``boxes`` their codes' pixel bounds (:meth:`queue_boxes`; a read of the ids needs them), and with ``png``
+        their colour's PNG stream where this layout compresses it (a read of the colour needs it)."""
         wp.launch(_classic_layout, dim=self.shape[0] * self.shape[1],
                   inputs=[base.rgb_data, base.depth_data, base.seg_data, self._adr(base, "rgb", camera),
                           self._adr(base, "depth", camera), self._adr(base, "seg", camera), self.cosines, self.near,
                           self.far],
                   outputs=[self.rgba, self.depth, self.codes], device=self.device)
-        if self.png is not None:
+        if png and self.png is not None:
             self.png.queue(self.rgba)
         if boxes:
             self.queue_boxes()
@@ -284,15 +285,16 @@ class ClassicLayout:
         wp.launch(_code_boxes, dim=(h, -(-w // BOX_SPAN)), inputs=[self.codes, w, self.boxes], device=self.device)
 
     def _parts(self) -> list[str]:
-        colour, depth, ids = self._wanted
-        stream = colour and self.png is not None
+        colour, depth, ids, stream = self._wanted
+        stream = stream and self.png is not None
         return [name for name, want in (("rgba", colour), ("png_meta", stream), ("png_words", stream),
                                         ("depth", depth), ("codes", ids), ("boxes", ids)) if want]
 
-    def queue_read(self, colour: bool, depth: bool, ids: bool) -> None:
+    def queue_read(self, colour: bool, depth: bool, ids: bool, stream: bool = False) -> None:
         """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds:
-        converted with ``boxes``) into a page-locked host buffer."""
-        self._wanted = (colour, depth, ids)
+        converted with ``boxes``; with ``stream``, the colour's PNG stream: converted with ``png``) into a
+        page-locked host buffer."""
+        self._wanted = (colour, depth, ids, colour and stream)
         parts = self._parts()
         if parts:
             self._reading = self.host.acquire()
@@ -349,10 +351,10 @@ class QueuedReads:
         return self._hosts
 
 
-def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool]]) -> QueuedReads:
-    """Queue each ``(layout, colour, depth, ids)``'s asked-for copies, all behind one event."""
-    for layout, colour, depth, ids in reads:
-        layout.queue_read(colour, depth, ids)
+def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool, bool]]) -> QueuedReads:
+    """Queue each ``(layout, colour, depth, ids, stream)``'s asked-for copies, all behind one event."""
+    for layout, colour, depth, ids, stream in reads:
+        layout.queue_read(colour, depth, ids, stream)
     cuda = bool(reads) and wp.get_device(reads[0][0].device).is_cuda   # CPU copies are done when queued
     return QueuedReads([layout for layout, *_ in reads], wp.record_event() if cuda else None)
 
