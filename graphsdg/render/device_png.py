@@ -85,11 +85,12 @@ def sent_codes(lengths: np.ndarray) -> np.ndarray:
     return sent
 
 
-def neighbour_distances(width: int) -> list[int]:
-    """Bytes back to each of :data:`NEIGHBOURS` in the filtered lines of an RGBA image ``width`` pixels wide, the
-    ones deflate reaches."""
+def reachable_neighbours(width: int) -> list[tuple[tuple[int, int], int]]:
+    """The :data:`NEIGHBOURS` deflate reaches in the filtered lines of an RGBA image ``width`` pixels wide, each
+    as ``((dy, dx), bytes back)``, in the order tried."""
     line = 4 * width + 1
-    return [d for d in (-dy * line - 4 * dx for dy, dx in NEIGHBOURS) if d <= _WINDOW]
+    back = [((dy, dx), -dy * line - 4 * dx) for dy, dx in NEIGHBOURS]
+    return [(neighbour, d) for neighbour, d in back if d <= _WINDOW]
 
 
 def stream_words(width: int, height: int) -> int:
@@ -267,7 +268,7 @@ def _match_tables(width: int) -> tuple[np.ndarray, ...]:
         match_codes[n] = int(codes[257 + slot]) | (4 * n - LENGTH_BASE[slot]) << int(LENGTHS[257 + slot])
         match_bits[n] = int(LENGTHS[257 + slot]) + LENGTH_EXTRA[slot]
     d_codes, d_bits = [], []
-    for d in neighbour_distances(width):
+    for _, d in reachable_neighbours(width):
         slot = int(np.searchsorted(DISTANCE_BASE, d, side="right")) - 1
         d_codes.append(int(distance_codes[slot]) | (d - DISTANCE_BASE[slot]) << int(DISTANCE_LENGTHS[slot]))
         d_bits.append(int(DISTANCE_LENGTHS[slot]) + DISTANCE_EXTRA[slot])
@@ -300,8 +301,7 @@ class DevicePng:
         self.width, self.height, self.device = width, height, device
         self.words, self.meta = words, meta
         n = width * height
-        neighbours = [nb for nb, d in zip(NEIGHBOURS, (-dy * (4 * width + 1) - 4 * dx for dy, dx in NEIGHBOURS))
-                      if d <= _WINDOW]
+        neighbours = [neighbour for neighbour, _ in reachable_neighbours(width)]
 
         def device_array(values, dtype=wp.int32):
             return wp.array(np.asarray(values), dtype=dtype, device=device)
@@ -349,4 +349,4 @@ def zlib_stream(meta: np.ndarray, words: np.ndarray) -> bytes | None:
 
 
 __all__ = ["DISTANCE_LENGTHS", "DevicePng", "HEADER", "HEADER_BITS", "LENGTHS", "NEIGHBOURS", "PIECE", "fits",
-           "neighbour_distances", "sent_codes", "stream_words", "zlib_stream"]
+           "reachable_neighbours", "sent_codes", "stream_words", "zlib_stream"]
