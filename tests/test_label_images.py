@@ -57,9 +57,10 @@ def png_bytes(rows: np.ndarray, colour_type: int, filters: list[int], interlace:
 
 @pytest.mark.parametrize("shape,seed", [((48, 64), 0), ((1, 1), 1), ((1, 37), 2), ((29, 1), 3), ((64, 48), 4)])
 @pytest.mark.parametrize("values,missing", [(None, -1), ([0, 0, 1, 2, 3, 4, 5], 0), ([0, 7, 300, 2, 3, 4, 9], 0)])
-def test_runs_of_graphsdgs_pngs_give_each_pixel_its_colours_value(shape, seed, values, missing):
+@pytest.mark.parametrize("unfiltered", [True, False])
+def test_runs_of_graphsdgs_pngs_give_each_pixel_its_colours_value(shape, seed, values, missing, unfiltered):
     img = mask_image(*shape, seed)
-    data = encode_png(img)
+    data = encode_png(img, unfiltered=unfiltered)     # class masks unfiltered, and Sub rows as written before
     truth = naive_ids(img, PALETTE, values, missing)
     fast = png_colour_ids(data, PALETTE, values, missing)
     general = colour_ids(decode_image(data), PALETTE, values=values, missing=missing)
@@ -71,15 +72,22 @@ def test_runs_of_graphsdgs_pngs_give_each_pixel_its_colours_value(shape, seed, v
 
 def test_a_whole_mask_of_one_colour_and_of_unlisted_colours():
     flat = np.zeros((16, 16, 4), np.uint8)
-    assert np.array_equal(png_colour_ids(encode_png(flat), PALETTE), np.zeros((16, 16)))
     noise = np.random.default_rng(5).integers(0, 256, (16, 16, 4), dtype=np.uint8)   # almost every pixel a run
-    assert np.array_equal(png_colour_ids(encode_png(noise), PALETTE, missing=-1), naive_ids(noise, PALETTE))
+    for unfiltered in (True, False):
+        assert np.array_equal(png_colour_ids(encode_png(flat, unfiltered=unfiltered), PALETTE), np.zeros((16, 16)))
+        assert np.array_equal(png_colour_ids(encode_png(noise, unfiltered=unfiltered), PALETTE, missing=-1),
+                              naive_ids(noise, PALETTE))
 
 
 def test_other_pngs_are_declined_and_read_the_general_way():
     img = mask_image(20, 30, 6)
     rows = img.reshape(20, -1)
-    assert png_colour_ids(png_bytes(rows, 6, [0] * 20), PALETTE) is None                 # filter None
+    assert np.array_equal(png_colour_ids(png_bytes(rows, 6, [0] * 20), PALETTE),
+                          naive_ids(img, PALETTE))                                         # all None: read
+    up = rows.copy()
+    up[1:] = rows[1:] - rows[:-1]
+    assert np.array_equal(decode_image(png_bytes(up, 6, [0] + [2] * 19)), img)
+    assert png_colour_ids(png_bytes(up, 6, [0] + [2] * 19), PALETTE) is None              # filter Up
     sub = rows.copy()
     sub[:, 4:] = rows[:, 4:] - rows[:, :-4]                                                # uint8: mod 256
     sub[5] = rows[5]

@@ -180,3 +180,60 @@ def test_a_precompressed_image_wraps_its_stream_and_its_views_do_not():
     write = file_write(io_functions.write_image, (), {"data": ready, "path": "/tmp/a/rgb_0000.png"})
     assert (write.kind, write.data) == ("blob", wrapped)
     assert file_write(io_functions.write_image, (), {"data": ready, "path": "/tmp/a/rgb_0000.jpg"}).kind == "image"
+
+
+def _filter_types(png: bytes, row_bytes: int) -> set[int]:
+    """The filter-type bytes of a PNG's lines (one IDAT, as encode_png writes)."""
+    start = png.index(b"IDAT") + 4
+    length = int.from_bytes(png[start - 8:start - 4], "big")
+    lines = zlib.decompress(png[start:start + length])
+    return set(lines[::row_bytes + 1])
+
+
+def _class_mask(size: int = 96) -> np.ndarray:
+    """A class mask of three labels: two discs and the background, as a renderer's ids coloured."""
+    y, x = np.mgrid[:size, :size]
+    mask = np.zeros((size, size, 4), np.uint8)
+    mask[(x - 30) ** 2 + (y - 40) ** 2 < 400] = (140, 25, 255, 255)
+    mask[(x - 60) ** 2 + (y - 55) ** 2 < 600] = (25, 255, 140, 255)
+    return mask
+
+
+def test_label_images_are_stored_unfiltered_and_decode_to_their_pixels():
+    """A LabelImage's rows (a class mask; uint32 ids written through encode_image) are stored with filter type
+    None, every other image's with Sub; each decodes to its pixels; the class mask is smaller unfiltered."""
+    from graphsdg.imaging.label_image import label_image
+
+    mask = _class_mask()
+    labelled = encode_png(label_image(mask))
+    assert _filter_types(labelled, 96 * 4) == {0} and _filter_types(encode_png(mask), 96 * 4) == {1}
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(labelled))), mask)
+    assert len(labelled) < len(encode_png(mask))
+    assert encode_png(mask, unfiltered=True) == labelled == encode_image(label_image(mask), ".png")
+    assert encode_png(label_image(mask)[10:50]) == encode_png(mask[10:50], unfiltered=True)   # crops stay labels
+    ids = (mask[..., 0].astype(np.uint32) * 3)                                                  # ids as uint32
+    as_png = encode_image(ids, ".png")
+    assert _filter_types(as_png, 96 * 2) == {0}
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(as_png))), ids.astype(np.uint16))
+
+
+def test_arithmetic_and_reductions_on_a_label_image_are_plain_arrays():
+    from graphsdg.imaging.label_image import LabelImage, label_image
+
+    mask = label_image(_class_mask(8))
+    assert isinstance(mask[2:], LabelImage) and isinstance(mask.copy(), LabelImage)
+    assert type(mask // 2) is np.ndarray and type(np.asarray(mask)) is np.ndarray
+    assert type(mask.sum()) is not LabelImage and int(mask.sum()) == int(np.asarray(mask).sum())
+
+
+def test_a_label_image_goes_to_a_writer_process_as_a_label_image_write():
+    from graphsdg.imaging.label_image import label_image
+    from graphsdg.io import io_functions
+    from graphsdg.io.write_process import encoded
+    from graphsdg.io.write_queue import file_write
+
+    mask = _class_mask()
+    write = file_write(io_functions.write_image, (), {"data": label_image(mask), "path": "/tmp/a/m_0000.png"})
+    assert write.kind == "label_image"
+    assert encoded(write.kind, write.path, np.asarray(write.data), None) == encode_png(mask, unfiltered=True)
+    assert file_write(io_functions.write_image, (), {"data": mask, "path": "/tmp/a/m_0000.png"}).kind == "image"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import zlib
 
 import numpy as np
 import pytest
@@ -62,6 +63,12 @@ def test_processes_write_the_same_bytes_as_threads(tmp_path):
     assert depth.shape == (64, 96) and depth.dtype == np.float32 and np.isfinite(depth).any()
     rgb = np.asarray(Image.open(tmp_path / "processes" / "rgb_0001.png"))
     assert rgb.shape == (64, 96, 4) and rgb[..., :3].std() > 0   # a real render, decoded by another reader
+    # the class mask's rows went unfiltered on both paths (a label image), the colour's Sub-filtered
+    for name, filter_type in (("semantic_segmentation_0001.png", 0), ("rgb_0001.png", 1)):
+        png = processes[name]
+        start = png.index(b"IDAT") + 4
+        lines = zlib.decompress(png[start:start + int.from_bytes(png[start - 8:start - 4], "big")])
+        assert set(lines[::96 * 4 + 1]) == {filter_type}, name
     state = json.load(open(tmp_path / "processes" / run_state.FILE_NAME)) \
         if os.path.exists(tmp_path / "processes" / run_state.FILE_NAME) else None
     assert state is None or state["writers"]["BasicWriter"]["complete"] == [[0, 2]]

@@ -24,6 +24,7 @@ from pxr import Usd
 from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, IdTables, color_of, labels_key, sorted_unique
 from graphsdg.annotate.motion import PoseSnapshot, history
 from graphsdg.annotate.semantic_filter import ALL_LABELS, SemanticFilter
+from graphsdg.imaging.label_image import label_image
 from graphsdg.render.camera import CameraView
 from graphsdg.render.lookup import lookup
 from graphsdg.render.backend import RenderOutputs
@@ -258,7 +259,7 @@ class FrameView:
     def colorized_id_image(self, kind: str, semantic_filter: SemanticFilter) -> np.ndarray:
         """uint8 (H, W, 4): the ``"semantic"``/``"instance"`` id image already coloured with
         :func:`graphsdg.annotate.ids.color_of`, in one lookup per pixel (geom -> packed RGBA) instead of ids
-        then colours."""
+        then colours; a :class:`~graphsdg.imaging.label_image.LabelImage` (its PNG's rows stored unfiltered)."""
         imap = self.instance_map(semantic_filter)
 
         def palette():   # packed RGBA per geom index (and the background's last)
@@ -269,7 +270,7 @@ class FrameView:
             rgba = np.array([color_of(int(v)) for v in distinct.tolist()], dtype=np.uint8).reshape(-1, 4)[slot]
             return np.ascontiguousarray(rgba).view(np.uint32)[:, 0]
         packed = self.ids_through(imap.derived(("palette", kind), palette))
-        return packed.view(np.uint8).reshape(*packed.shape, 4)
+        return label_image(packed.view(np.uint8).reshape(*packed.shape, 4))
 
     def _id_image(self, semantic_filter: SemanticFilter, kind: str) -> np.ndarray:
         return self.ids_through(self.instance_map(semantic_filter).id_lut(kind))   # one lookup per pixel

@@ -10,10 +10,11 @@ with one hash-table lookup per pixel, then checks each pixel's colour against
 the one its index names, so a colour outside the mapping reads as ``-1``.
 
 :func:`png_colour_ids` does both steps at once for the PNGs graphsdg writes
-(8-bit RGBA, every row ``Sub``-filtered: each byte minus the byte one pixel to
-the left): a filtered pixel is zero wherever the pixel repeats its left
-neighbour, so only the first pixel of each run of one colour is reconstructed
-and looked up, and the runs are expanded to ids in one pass. It skips libpng's
+(8-bit RGBA, every row unfiltered, as graphsdg stores class masks, or every row
+``Sub``-filtered: each byte minus the byte one pixel to the left, where a
+filtered pixel is zero wherever the pixel repeats its left neighbour): only the
+first pixel of each run of one colour is reconstructed and looked up, and the
+runs are expanded to ids in one pass. It skips libpng's
 row reconstruction, its channel reordering and the per-pixel lookup, and
 inflates with ISA-L (timings: ``docs/performance.md``, "Class masks read run by
 run"). Any other PNG goes the general way.
@@ -38,7 +39,7 @@ from PIL import Image
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _PALETTE = 3   # PNG colour type of palette images (IHDR byte 25 of the file)
 _RGBA = 6      # PNG colour type of RGBA images
-_SUB = 1       # PNG row filter: each byte minus the byte one pixel to the left
+_NONE, _SUB = 0, 1   # PNG row filters: the bytes themselves; each byte minus the byte one pixel to the left
 # odd multipliers tried in turn for a collision-free multiplicative hash of the mapping's colours
 _MULTIPLIERS = (0x9E3779B1, 0x85EBCA77, 0xC2B2AE3D, 0x27D4EB2F, 0x165667B1, 0xD3A2646C | 1, 0xFD7046C5, 0xB55A4F09)
 
@@ -158,10 +159,36 @@ def _png_rgba_stream(data: bytes) -> tuple[int, int, bytes] | None:
     return width, height, b"".join(stream)
 
 
+def _sub_runs(steps: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """(flat start, packed RGBA colour) of each run of one colour in ``Sub``-filtered rows ``steps`` (each pixel
+    minus its left neighbour, bytewise mod 256, as little-endian words)."""
+    starts_run = steps != 0                     # a run of one colour starts where a pixel differs ...
+    starts_run[:, 0] = True                     # ... and at every row's first pixel
+    starts = np.flatnonzero(starts_run)
+    row, col = np.divmod(starts, width)
+    # a run's colour: the bytewise sum (mod 256) of its row's steps up to it, the left of a row being 0
+    sums = np.cumsum(steps[row, col].view(np.uint8).reshape(-1, 4), axis=0, dtype=np.uint8)
+    row_first = np.flatnonzero(col == 0)
+    before = np.zeros_like(sums)
+    before[row_first[1:]] = sums[row_first[1:] - 1]
+    run_colour = np.subtract(sums, np.repeat(before[row_first], np.diff(row_first, append=len(starts)), axis=0))
+    return starts, np.ascontiguousarray(run_colour).view("<u4")[:, 0]
+
+
+def _plain_runs(pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(flat start, packed RGBA colour) of each run of one colour in unfiltered rows ``pixels`` (words)."""
+    starts_run = np.empty(pixels.shape, dtype=bool)
+    starts_run[:, 0] = True
+    np.not_equal(pixels[:, 1:], pixels[:, :-1], out=starts_run[:, 1:])
+    starts = np.flatnonzero(starts_run)
+    return starts, pixels.reshape(-1)[starts]
+
+
 def png_colour_ids(data: bytes, colours: Sequence[Sequence[int]], values: Sequence[int] | None = None,
                    missing: int = -1) -> np.ndarray | None:
     """:func:`colour_ids` of PNG bytes (``colours`` RGBA), read run by run; None where the file is not an 8-bit
-    RGBA PNG with every row ``Sub``-filtered (decode it and call :func:`colour_ids` then).
+    RGBA PNG with every row ``Sub``-filtered or every row unfiltered (decode it and call :func:`colour_ids`
+    then).
 
     The result equals ``colour_ids(decode_image(data), colours, values=values, missing=missing)``.
     """
@@ -176,22 +203,14 @@ def png_colour_ids(data: bytes, colours: Sequence[Sequence[int]], values: Sequen
     if len(raw) != height * (4 * width + 1):
         return None
     rows = np.frombuffer(raw, np.uint8).reshape(height, 4 * width + 1)
-    if not (rows[:, 0] == _SUB).all():
+    if (rows[:, 0] == _SUB).all():
+        starts, found = _sub_runs(rows[:, 1:].view("<u4"), width)
+    elif (rows[:, 0] == _NONE).all():
+        starts, found = _plain_runs(rows[:, 1:].view("<u4"))
+    else:
         return None
     values, dtype = _values_and_type(len(colours), values, missing)
     keys = _distinct_keys(colours)
-    steps = rows[:, 1:].view("<u4")             # each pixel minus its left neighbour, bytewise mod 256
-    starts_run = steps != 0                     # a run of one colour starts where a pixel differs ...
-    starts_run[:, 0] = True                     # ... and at every row's first pixel
-    starts = np.flatnonzero(starts_run)
-    row, col = np.divmod(starts, width)
-    # a run's colour: the bytewise sum (mod 256) of its row's steps up to it, the left of a row being 0
-    sums = np.cumsum(steps[row, col].view(np.uint8).reshape(-1, 4), axis=0, dtype=np.uint8)
-    row_first = np.flatnonzero(col == 0)
-    before = np.zeros_like(sums)
-    before[row_first[1:]] = sums[row_first[1:] - 1]
-    run_colour = np.subtract(sums, np.repeat(before[row_first], np.diff(row_first, append=len(starts)), axis=0))
-    found = np.ascontiguousarray(run_colour).view("<u4")[:, 0]
     order = np.argsort(keys)
     at = np.minimum(np.searchsorted(keys[order], found), len(keys) - 1)
     run_values = np.where(keys[order][at] == found, values[order][at], missing).astype(dtype)

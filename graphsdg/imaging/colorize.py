@@ -21,6 +21,8 @@ from typing import Any
 import numpy as np
 from PIL import Image, ImageDraw
 
+from graphsdg.imaging.label_image import label_image
+
 GOLDEN_RATIO_INV = 2.0 / (1.0 + 5.0 ** 0.5)   # hues i / golden ratio apart are spread as evenly as any sequence
 MASK32 = 0xFFFFFFFF
 
@@ -113,7 +115,7 @@ def _label_key(labels: dict, segment_id: Any) -> Any:
 
 
 def colorize_segmentation(data: Any, labels: dict, mapping: dict | None = None) -> Any:
-    """A segmentation id image as uint8 RGBA.
+    """A segmentation id image as uint8 RGBA (a :class:`~graphsdg.imaging.label_image.LabelImage`).
 
     With ``mapping`` (label, lower case -> colour) each id takes the colour of its first label (unknown:
     transparent black) and the image is returned. Without, ids take distinct colours (the smallest id,
@@ -129,7 +131,7 @@ def colorize_segmentation(data: Any, labels: dict, mapping: dict | None = None) 
             entry = labels.get(_label_key(labels, segment_id), {})
             first = next(iter(entry.values()), "") if isinstance(entry, dict) else ""
             colours.append(mapping.get(str(first).lower(), [0, 0, 0, 0]))
-        return np.asarray(colours, dtype=np.uint8)[index]
+        return label_image(np.asarray(colours, dtype=np.uint8)[index])
     colours = random_colours(len(unique), enable_random=False)
     colours[0] = (0, 0, 0, 0)
     palette: dict[tuple, Any] = {}
@@ -138,7 +140,7 @@ def colorize_segmentation(data: Any, labels: dict, mapping: dict | None = None) 
         key = _label_key(labels, segment_id)
         palette[tuple(int(c) for c in colour)] = labels.get(key, "UNLABELLED")
         colour_to_id[tuple(int(c) for c in colour)] = key
-    return colours[index], palette, colour_to_id
+    return label_image(colours[index]), palette, colour_to_id
 
 
 def colorize_normals(data: Any) -> np.ndarray:

@@ -8,6 +8,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from graphsdg.imaging.label_image import LabelImage
 from graphsdg.imaging.precompressed import PrecompressedImage
 from graphsdg.io.png import encode_png
 
@@ -17,18 +18,20 @@ def encode_image(data: Any, ext: str = ".png") -> bytes:
     :class:`~graphsdg.imaging.precompressed.PrecompressedImage` is its own stream wrapped).
 
     uint32 id images are stored as 16-bit PNG when their ids fit, as Replicator's
-    viewers expect a standard image; larger ids are refused (save them as .npy).
+    viewers expect a standard image; larger ids are refused (save them as .npy). A PNG of ids, or of a
+    :class:`~graphsdg.imaging.label_image.LabelImage`, is stored with unfiltered rows (:mod:`graphsdg.io.png`).
     """
     if hasattr(data, "convert") and hasattr(data, "size"):   # PIL.Image
         data = np.asarray(data)
     ext = ext.lower()
     if ext == ".png" and isinstance(data, PrecompressedImage) and data.zlib_stream is not None:
         return encode_png(data)
+    labels = isinstance(data, LabelImage)
     arr = np.asarray(data)
     if arr.dtype == np.uint32 or arr.dtype == np.int32 or arr.dtype == np.int64:
         if arr.size and (arr.min() < 0 or arr.max() > 65535):
             raise ValueError(f"id image values span {arr.min()}..{arr.max()}; a PNG holds 0..65535")
-        arr = arr.astype(np.uint16)
+        arr, labels = arr.astype(np.uint16), True
     if arr.dtype == np.bool_:
         arr = arr.astype(np.uint8) * 255
     if arr.dtype not in (np.uint8, np.uint16):
@@ -36,7 +39,7 @@ def encode_image(data: Any, ext: str = ".png") -> bytes:
     if arr.ndim not in (2, 3) or (arr.ndim == 3 and arr.shape[2] not in (3, 4)):
         raise ValueError(f"cannot encode an image of shape {arr.shape}; expected (H, W), (H, W, 3) or (H, W, 4)")
     if ext == ".png":
-        return encode_png(arr)
+        return encode_png(arr, unfiltered=labels)
     if arr.ndim == 3:
         arr = cv2.cvtColor(arr, cv2.COLOR_RGB2BGR if arr.shape[2] == 3 else
                            cv2.COLOR_RGBA2BGR if ext in (".jpg", ".jpeg") else cv2.COLOR_RGBA2BGRA)

@@ -29,17 +29,20 @@ import zlib
 import numpy as np
 from isal import isal_zlib
 
+from graphsdg.imaging.label_image import LabelImage
 from graphsdg.imaging.precompressed import PrecompressedImage
 
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 COLOR_TYPES = {1: 0, 2: 4, 3: 2, 4: 6}   # channels -> PNG colour type (grey, grey+alpha, RGB, RGBA)
-SUB_FILTER = 1
+NONE_FILTER, SUB_FILTER = 0, 1         # PNG filter types: the byte itself; minus the byte one pixel left
 LEVEL = 1                                # ISA-L level 1: fastest of the levels that compress well
 
 
-def encode_png(image: np.ndarray) -> bytes:
+def encode_png(image: np.ndarray, unfiltered: bool | None = None) -> bytes:
     """PNG bytes of a uint8 or uint16 image: (H, W) grey, or (H, W, C) with C = 2 (grey+alpha), 3 (RGB), 4 (RGBA).
-    A :class:`~graphsdg.imaging.precompressed.PrecompressedImage` gets its own stream wrapped.
+    A :class:`~graphsdg.imaging.precompressed.PrecompressedImage` gets its own stream wrapped. The rows are
+    ``Sub``-filtered, or stored unfiltered with ``unfiltered`` (default: whether ``image`` is a
+    :class:`~graphsdg.imaging.label_image.LabelImage`).
 
     Example:
         >>> import zlib
@@ -53,29 +56,38 @@ def encode_png(image: np.ndarray) -> bytes:
     if stream is not None and isinstance(image, PrecompressedImage):
         h, w, c = _checked(image).shape
         return png_file(w, h, 8 * image.dtype.itemsize, c, stream)
+    if unfiltered is None:
+        unfiltered = isinstance(image, LabelImage)
     arr = _checked(image)
     h, w, c = arr.shape
-    return png_file(w, h, 8 * arr.dtype.itemsize, c, isal_zlib.compress(_lines(arr), LEVEL))
+    return png_file(w, h, 8 * arr.dtype.itemsize, c, isal_zlib.compress(_lines(arr, unfiltered), LEVEL))
 
 
-def filtered_lines(image: np.ndarray) -> np.ndarray:
-    """The lines a PNG of ``image`` (as :func:`encode_png` takes it) deflates, uint8 (H, 1 + row bytes): each
-    row's filter-type byte (1, ``Sub``), then each byte minus the byte one pixel to its left, mod 256.
+def filtered_lines(image: np.ndarray, unfiltered: bool | None = None) -> np.ndarray:
+    """The lines a PNG of ``image`` (as :func:`encode_png` takes it, ``unfiltered`` too) deflates, uint8
+    (H, 1 + row bytes): each row's filter-type byte (1, ``Sub``), then each byte minus the byte one pixel to its
+    left, mod 256; or, unfiltered, the filter-type byte 0 (``None``) and the row's bytes.
 
     Example:
         >>> filtered_lines(np.array([[[10, 20], [13, 19]]], np.uint8)).tolist()
         [[1, 10, 20, 3, 255]]
+        >>> filtered_lines(np.array([[[10, 20], [13, 19]]], np.uint8), unfiltered=True).tolist()
+        [[0, 10, 20, 13, 19]]
     """
-    return _lines(_checked(image))
+    return _lines(_checked(image), isinstance(image, LabelImage) if unfiltered is None else unfiltered)
 
 
-def _lines(arr: np.ndarray) -> np.ndarray:
+def _lines(arr: np.ndarray, unfiltered: bool = False) -> np.ndarray:
     """:func:`filtered_lines` of an image :func:`_checked` has passed."""
     h, w, c = arr.shape
     rows = np.ascontiguousarray(arr.astype(">u2", copy=False) if arr.dtype == np.uint16 else arr).view(np.uint8)
     rows = rows.reshape(h, w * c * arr.dtype.itemsize)
-    step = c * arr.dtype.itemsize                     # bytes per pixel: Sub subtracts the pixel to the left
     lines = np.empty((h, rows.shape[1] + 1), dtype=np.uint8)
+    if unfiltered:
+        lines[:, 0] = NONE_FILTER
+        lines[:, 1:] = rows
+        return lines
+    step = c * arr.dtype.itemsize                     # bytes per pixel: Sub subtracts the pixel to the left
     lines[:, 0] = SUB_FILTER
     lines[:, 1:step + 1] = rows[:, :step]
     np.subtract(rows[:, step:], rows[:, :-step], out=lines[:, step + 1:])   # uint8 arithmetic wraps mod 256

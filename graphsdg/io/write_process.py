@@ -1,7 +1,8 @@
 """One writer process: encodes the arrays it is sent and writes each file atomically.
 
 Started by :mod:`graphsdg.io.write_processes`, never imported by the rest of graphsdg. It imports only
-:mod:`graphsdg.io.encode` and :mod:`graphsdg.io.atomic_files` (NumPy, OpenCV, ISA-L), not the package
+:mod:`graphsdg.io.encode`, :mod:`graphsdg.io.atomic_files` and :mod:`graphsdg.imaging.label_image` (NumPy,
+OpenCV, ISA-L), not the package
 (USD, MuJoCo, GL): :data:`BOOT` stands a bare ``graphsdg`` package in for the real one, so a writer
 process starts quickly (docs/performance.md, "Writer processes and the interpreter lock").
 
@@ -30,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from graphsdg.imaging.label_image import label_image
 from graphsdg.io import encode
 from graphsdg.io.atomic_files import byte_count, write_atomic
 
@@ -44,13 +46,15 @@ def encoded(kind: str, path: str, data: Any, indent: int | None) -> bytes | list
     :mod:`graphsdg.io.io_functions` uses in a writer thread."""
     if kind == "image":
         return encode.encode_image(data, os.path.splitext(path)[1] or ".png")
+    if kind == "label_image":
+        return encode.encode_image(label_image(data), os.path.splitext(path)[1] or ".png")
     if kind == "npy":
         return encode.npy_parts(data)
     if kind == "json":
         return encode.encode_json(data, indent=indent)
     if kind == "blob":
         return bytes(data)
-    raise ValueError(f"unknown write kind {kind!r}; expected image, npy, json or blob")
+    raise ValueError(f"unknown write kind {kind!r}; expected image, label_image, npy, json or blob")
 
 
 _DTYPES: dict[str | bytes, np.dtype] = {}

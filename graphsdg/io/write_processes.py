@@ -58,12 +58,14 @@ INLINE_BYTES = 16 << 10     # arrays smaller than this travel in the message its
 BATCHES_PER_PROCESS = 2     # batches waiting on every started process before another one starts
 COLLECT_AFTER = 4           # batches a process holds before a send takes its replies (they wait in the pipe)
 _ALIGN = 64
+_ARRAY_KINDS = ("image", "label_image", "npy")   # writes whose arrays go through the arena
 REPLY_PIPE_BYTES = 1 << 20
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 class FileWrite(NamedTuple):
-    """One file to encode and write: ``kind`` is ``image``, ``npy``, ``json`` or ``blob``."""
+    """One file to encode and write: ``kind`` is ``image``, ``label_image`` (an image of label colours or ids,
+    :class:`~graphsdg.imaging.label_image.LabelImage`), ``npy``, ``json`` or ``blob``."""
 
     kind: str
     path: str
@@ -247,7 +249,7 @@ class WriteProcesses:
         arrays = []
         for i, (write, _) in enumerate(writes):
             data = write.data
-            if write.kind in ("image", "npy") and isinstance(data, np.ndarray) and not data.dtype.hasobject \
+            if write.kind in _ARRAY_KINDS and isinstance(data, np.ndarray) and not data.dtype.hasobject \
                     and data.nbytes >= INLINE_BYTES:
                 arrays.append((i, data, -(-data.nbytes // _ALIGN) * _ALIGN))
         return arrays

@@ -46,6 +46,7 @@ from graphsdg.base import settings_store as settings
 from graphsdg.base import profiling
 from graphsdg.base.cpu_share import cores_per_process, usable_cores
 from graphsdg.errors import WriterError
+from graphsdg.imaging.label_image import LabelImage
 from graphsdg.imaging.precompressed import PrecompressedImage
 from graphsdg.io.png import encode_png
 from graphsdg.io.write_processes import FileWrite, WriteProcesses
@@ -192,6 +193,8 @@ def file_write(fn: Callable[..., Any], args: tuple, kwargs: dict,
     if kind == "image" and isinstance(data, PrecompressedImage) and data.zlib_stream is not None \
             and os.path.splitext(full)[1].lower() in ("", ".png"):
         return FileWrite("blob", full, encode_png(data), None)   # the PNG is made already: its bytes cross
+    if kind == "image" and isinstance(data, LabelImage):
+        kind = "label_image"      # the arena carries no array's class: the kind says how its rows are stored
     return FileWrite(kind, full, data, kwargs.get("indent"))
 
 

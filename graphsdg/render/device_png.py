@@ -18,8 +18,8 @@ as none, and that frame's PNG is compressed on the CPU as before.
 
 Kernels, one launch each: the pixels' filtered words and neighbours (``_modes``), each pixel's match length
 and bits (``_bits``), a prefix sum of the bits, the bits written at their offsets (``_write``, words two pixels
-share or-ed atomically), the lines' sums for the Adler-32 (``_adler_lines``) and the block's end and checksum
-(``_finish``).
+share or-ed atomically), the Adler-32's sums of pieces of lines (``_adler_lines``) and the block's end and
+checksum (``_finish``).
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
 """
@@ -31,6 +31,8 @@ import warp as wp
 ADLER = 65521
 ADLER_CONST = wp.constant(ADLER)
 PIECE = wp.constant(64)          # pixels a match covers at most: 256 bytes (deflate's longest is 258)
+ADLER_PIECE = 32                 # pixels a thread sums for the Adler-32 (a thread a line left the GPU idle)
+ADLER_PIECE_CONST = wp.constant(ADLER_PIECE)
 #: the pixels a pixel may repeat, in the order tried, as (dy, dx): left, above, above-left, above-right, two left
 NEIGHBOURS = ((0, -1), (-1, 0), (-1, -1), (-1, 1), (0, -2))
 _WINDOW = 32768                  # deflate's distances reach this far back
@@ -184,13 +186,17 @@ def _bits(filtered: wp.array(dtype=wp.uint32), modes: wp.array(dtype=wp.int32), 
 
 @wp.kernel(enable_backward=False)
 def _adler_lines(filtered: wp.array(dtype=wp.uint32), width: int, totals: wp.array(dtype=wp.int64)):
-    # a thread a line: its bytes' sum and the sum of position x byte (RFC 1950's Adler-32 is made of the two),
-    # added to the image's
-    y = wp.tid()
+    # a thread a piece of a line (ADLER_PIECE pixels; the piece at x = 0 holds the line's filter byte too): its
+    # bytes' sum and the sum of position x byte (RFC 1950's Adler-32 is made of the two), added to the image's
+    y, piece = wp.tid()
     line = 4 * width + 1
-    total = wp.int64(1)                      # the filter byte, 1 (Sub), at the line's first byte
-    moment = wp.int64(y * line)
-    for x in range(width):
+    start = piece * ADLER_PIECE_CONST
+    total = wp.int64(0)
+    moment = wp.int64(0)
+    if start == 0:
+        total = wp.int64(1)                  # the filter byte, 1 (Sub), at the line's first byte
+        moment = wp.int64(y * line)
+    for x in range(start, wp.min(start + ADLER_PIECE_CONST, width)):
         word = filtered[y * width + x]
         b0, b1, b2, b3 = wp.int64(_byte(word, 0)), wp.int64(_byte(word, 8)), wp.int64(_byte(word, 16)), \
             wp.int64(_byte(word, 24))
@@ -333,7 +339,8 @@ class DevicePng:
                                           self._codes, self._match_codes, self._match_bits, self._distance_codes,
                                           self._distance_bits, self._offsets, self.words], device=d)
         self._totals.zero_()
-        wp.launch(_adler_lines, dim=self.height, inputs=[self._filtered, width, self._totals], device=d)
+        wp.launch(_adler_lines, dim=(self.height, -(-width // ADLER_PIECE)), inputs=[self._filtered, width,
+                                                                                     self._totals], device=d)
         wp.launch(_finish, dim=1, inputs=[self._offsets, self._bits, self._totals, self.height * (4 * width + 1),
                                            self._end_code, self._end_bits, self.words, self.meta], device=d)
 
