@@ -124,6 +124,11 @@ def semantic_segmentation(frame: FrameView, params: dict) -> dict:
                                    "idToLabelLists": {key: lists for key, _, lists in rows}}}
 
 
+def _semantic_colours(params: dict) -> tuple[str, SemanticFilter] | None:
+    """The class mask :func:`semantic_segmentation` colours from the ids (with ``colorize``), or None."""
+    return ("semantic", semantic_filter(params)) if params.get("colorize") else None
+
+
 def _semantic_rows(imap, colorize: bool) -> dict[int, tuple[str, dict, dict]]:
     """Semantic id -> (its key in the info tables, its joined labels, its label lists), the reserved ids
     included; kept with the instance map (the same every frame until the labels change)."""
@@ -346,10 +351,11 @@ def reference_time(frame: FrameView, params: dict) -> dict:
 
 # ---- registration -----------------------------------------------------------
 def _spec(name: str, passes: set[str], fn, defaults: dict | None = None, aliases=(), validate=None,
-          pixels_only: bool = False) -> None:
+          pixels_only: bool = False, id_colours=None) -> None:
     AnnotatorRegistry.register_spec(AnnotatorSpec(name=name, passes=frozenset(passes), compute=fn,
                                                   defaults=dict(defaults or {}), doc=fn.__doc__ or "",
-                                                  validate=validate, pixels_only=pixels_only), aliases=aliases)
+                                                  validate=validate, pixels_only=pixels_only,
+                                                  id_colours=id_colours), aliases=aliases)
 
 
 SEG = {"segmentation"}
@@ -358,7 +364,7 @@ _spec("HdrColor", {"hdr"}, hdr_color, aliases=("HdrColorSD",), pixels_only=True)
 _spec("distance_to_image_plane", {"depth"}, distance_to_image_plane, pixels_only=True)
 _spec("distance_to_camera", {"depth"}, distance_to_camera, pixels_only=True)
 _spec("semantic_segmentation", SEG, semantic_segmentation, {**SEMANTIC_DEFAULTS, "colorize": False},
-      validate=_validate_semantics, pixels_only=True)
+      validate=_validate_semantics, pixels_only=True, id_colours=_semantic_colours)
 _spec("instance_segmentation", SEG, instance_segmentation, {**SEMANTIC_DEFAULTS, "colorize": False},
       validate=_validate_semantics, pixels_only=True)
 _spec("instance_id_segmentation", SEG, instance_id_segmentation, {"colorize": False})

@@ -120,3 +120,40 @@ def test_a_layout_reads_the_stream_with_the_colour_and_lends_a_precompressed_ima
     plain.rgba.assign(layout.rgba)
     plain.queue_read(colour=True, depth=False, ids=False, stream=True)
     assert type(plain.take().rgba) is np.ndarray
+
+
+@pytest.mark.parametrize("png", [True, False])
+def test_class_masks_are_the_ids_coloured_with_each_palette_and_compressed_with_them(png):
+    """ClassicLayout(masks=2): each mask is its palette at every pixel's geom (code 0 and codes past the model:
+    the background's colour, the palette's last); read back with the ids as label images, whose PNG is the
+    device's stream where the layout compresses; palettes are sent again only when they change."""
+    from PIL import Image
+
+    from graphsdg.imaging.label_image import LabelImage
+    from graphsdg.imaging.precompressed import PrecompressedLabelImage
+    h, w, ngeom = 10, 24, 5
+    layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=ngeom, png=png, masks=2)
+    codes = np.zeros((h, w), np.uint8)
+    codes[2:8, 3:15], codes[5:, 10:20], codes[0, :4] = 1, 4, 5            # geoms 0, 3, 4; the rest background
+    layout.codes.assign(wp.array(codes.reshape(-1), dtype=wp.uint8, device="cpu"))
+    rng = np.random.default_rng(3)
+    palettes = [rng.integers(0, 2 ** 32, ngeom + 1, dtype=np.uint64).astype(np.uint32) for _ in range(2)]
+    layout.set_palettes(palettes)
+    sent = layout._sent_palettes
+    layout.set_palettes([p.copy() for p in palettes])
+    assert layout._sent_palettes is sent                                  # the same colours: nothing sent again
+    layout.queue_masks(2)
+    layout.queue_read(colour=False, depth=False, ids=True, stream=True, masks=2)
+    frame = layout.take()
+    geoms = layout.table[codes]                                           # code -> geom, -1 the background
+    for palette, mask in zip(palettes, frame.id_colours):
+        assert isinstance(mask, LabelImage) and mask.shape == (h, w, 4)
+        assert np.array_equal(np.ascontiguousarray(mask).view(np.uint32)[..., 0], palette[geoms])
+        assert isinstance(mask, PrecompressedLabelImage) == png
+        data = encode_png(mask)
+        assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), mask)
+        if png:
+            assert data == png_file(w, h, 8, 4, _compress(np.ascontiguousarray(mask)))
+    assert np.array_equal(frame.codes, codes)
+    with pytest.raises(ValueError, match="4 palettes for a layout with room for 2 class masks"):
+        layout.set_palettes(palettes * 2)

@@ -10,6 +10,7 @@ import doctest
 import importlib
 import math
 import os
+import re
 
 import pytest
 
@@ -318,8 +319,55 @@ def test_bench_gpu_counts_take_turns_over_rounds_and_scale_their_medians(monkeyp
                  "--resolution", "32", "24", "--asset-count", "1", "--skip-write", "--backend", "classic",
                  "--mps", "off", "--no-baseline"]) == 0     # no NVIDIA GPU here: each process renders with Mesa
     out = capsys.readouterr().out
-    for count, processes in ((1, 1), (2, 2)):
-        for number in (1, 2):
-            assert f"#### {count} GPU(s), {processes} processes, round {number}" in out
+    for number in (1, 2):   # --bind-cores auto: one GPU's process on every core, two GPUs' on their shares
+        assert f"#### 1 GPU(s), 1 processes, round {number}" in out
+        assert re.search(rf"#### 2 GPU\(s\), 2 processes, each GPU's processes on its \d+ cores, round {number}", out)
     assert "#### Rounds" in out and "x 1 GPU(s) with 2" in out
     assert "#### Scaling (each count's median round)" in out
+
+
+def test_bind_cores_binds_several_gpus_by_default_and_one_gpu_only_when_asked():
+    from graphsdg.jobs.cli import bound_cores, build_parser
+
+    shares = {0: [0, 1], 1: [2, 3], 2: [4, 5], 3: [6, 7]}
+    assert [bound_cores("auto", n, shares) for n in (1, 2, 4)] == [None, shares, shares]
+    assert [bound_cores("on", n, shares) for n in (1, 4)] == [shares, shares]
+    assert [bound_cores("off", n, shares) for n in (1, 4)] == [None, None]
+    parse = lambda *a: build_parser().parse_args(["bench", *a]).bind_cores   # noqa: E731
+    assert (parse(), parse("--bind-cores"), parse("--bind-cores", "off")) == ("auto", "on", "off")
+
+
+def test_a_gpu_shared_under_mps_gets_sixteen_processes_by_default():
+    from graphsdg.jobs.scaleout import default_workers
+    from graphsdg.render import cuda_mps
+
+    assert [default_processes_per_gpu(g, 64, mps=True) for g in (1, 2, 4, 8)] == [16, 16, 16, 8]
+    assert default_processes_per_gpu(4, 16, mps=True) == 4 and default_workers(4, 64, mps=True) == 64
+    assert cuda_mps.would_share("on") and not cuda_mps.would_share("off")
+    assert cuda_mps.would_share("auto", control="/bin/true")
+    with pytest.raises(ValueError, match="sometimes"):
+        cuda_mps.would_share("sometimes")
+
+
+def test_a_ray_worker_given_one_gpu_of_several_runs_on_that_gpus_cores(monkeypatch):
+    from graphsdg.jobs import scaleout
+    from graphsdg.render.gpu_cores import assigned_share
+
+    host = [GpuInfo(i) for i in range(4)]
+    assert assigned_share(["1"], host, range(8)) == [2, 3]
+    assert assigned_share([1], host, range(8), local=lambda g: {0, 1, 2, 3} if g.index < 2 else {4, 5, 6, 7}) \
+        == [2, 3]
+    assert assigned_share(["0", "1"], host, range(8)) is None          # a worker over two GPUs: every core
+    assert assigned_share(["0"], host[:1], range(8)) is None           # one GPU: every core
+    assert assigned_share(["GPU-abc"], host, range(8)) is None and assigned_share(["7"], host, range(8)) is None
+    ours = os.sched_getaffinity(0)
+    monkeypatch.setattr(scaleout, "host_gpus", lambda: host[:2])
+    monkeypatch.setattr(scaleout, "usable_core_set", lambda: set(sorted(ours)[:2]) if len(ours) > 1 else ours)
+    try:
+        cores = scaleout.bind_to_assigned_gpu(["1"])
+        assert os.sched_getaffinity(0) == {sorted(ours)[1 if len(ours) > 1 else 0]}
+        assert cores == str(sorted(os.sched_getaffinity(0))[0])
+    finally:
+        os.sched_setaffinity(0, ours)
+    monkeypatch.setattr(scaleout, "host_gpus", lambda: [])
+    assert scaleout.bind_to_assigned_gpu(["0"]) is None and os.sched_getaffinity(0) == ours

@@ -475,3 +475,60 @@ def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(
     cpu_pixels, cpu_written = capture(False, str(tmp_path / "cpu"))
     assert type(cpu_pixels) is np.ndarray and np.array_equal(cpu_pixels, pixels)
     assert cpu_written == encode_png(np.asarray(pixels)) != written
+
+
+def test_class_masks_coloured_on_the_device_are_the_annotators_and_the_files_basic_writer_writes(tmp_path):
+    """With /graphsdg/render/pbrPngOnDevice, the colorized semantic segmentation is coloured and compressed where
+    the ids are drawn: the same pixels as the CPU's lookup, a label image carrying the device's stream, which
+    BasicWriter's file wraps; without the setting the CPU colours it and stores its rows unfiltered."""
+    import io
+    import zlib
+
+    from PIL import Image
+
+    from graphsdg import settings
+    from graphsdg.imaging.label_image import LabelImage
+    from graphsdg.imaging.precompressed import PrecompressedLabelImage
+    from graphsdg.io.png import encode_png, filtered_lines
+    from graphsdg.render import device_png
+
+    import warp as wp
+
+    def capture(on_device: bool, out: str):
+        rep.stage.new_stage()
+        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
+                           "/graphsdg/render/pbrPngOnDevice": on_device}.items():
+            settings.set(key, value)
+        cube, ball, cam = _scene()
+        rep.functional.modify.semantics(cube, {"class": "cube"})
+        rep.functional.modify.semantics(ball, {"class": "ball"})
+        rp = rep.create.render_product(cam, (W, H))
+        seg = rep.annotators.get("semantic_segmentation", init_params={"colorize": True})
+        seg.attach(rp)
+        writer = rep.writers.get("BasicWriter", init_params={"output_dir": out, "semantic_segmentation": True},
+                                 render_products=rp)
+        rep.orchestrator.step(delta_time=0)
+        rep.orchestrator.wait_until_complete()
+        writer.detach()
+        with open(os.path.join(out, "semantic_segmentation_0000.png"), "rb") as f:
+            return seg.get_data()["data"], f.read()
+
+    def idat(png: bytes) -> bytes:
+        start = png.index(b"IDAT")
+        return png[start + 4:start + 4 + int.from_bytes(png[start - 4:start], "big")]
+
+    mask, written = capture(True, str(tmp_path / "device"))
+    cpu_mask, cpu_written = capture(False, str(tmp_path / "cpu"))
+    assert isinstance(mask, PrecompressedLabelImage) and isinstance(cpu_mask, LabelImage)
+    assert not isinstance(cpu_mask, PrecompressedLabelImage) and np.array_equal(mask, cpu_mask)
+    assert len({tuple(c) for c in np.asarray(mask).reshape(-1, 4).tolist()}) >= 3    # cube, ball, background
+    room = wp.zeros(W * H * 3, dtype=wp.uint32, device=DEVICE)           # the data is a view: no stream of its own
+    meta = wp.zeros(2, dtype=wp.int64, device=DEVICE)
+    device_png.DevicePng(W, H, DEVICE, room, meta).queue(
+        wp.array(np.ascontiguousarray(mask).view(np.uint32).reshape(-1), dtype=wp.uint32, device=DEVICE))
+    assert idat(written) == device_png.zlib_stream(meta.numpy(), room.numpy())
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(written))), mask)
+    assert zlib.decompress(idat(written)) == filtered_lines(np.asarray(mask)).tobytes()   # Sub rows
+    assert cpu_written == encode_png(cpu_mask) != written
+    assert zlib.decompress(idat(cpu_written)) == filtered_lines(cpu_mask).tobytes()        # unfiltered rows
+    assert set(zlib.decompress(idat(cpu_written))[::W * 4 + 1]) == {0}

@@ -22,6 +22,7 @@ import numpy as np
 
 from graphsdg.annotate import augmentation as augmentations
 from graphsdg.annotate.augmentation import Augmentation, AugmentationError, as_augmentation
+from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.errors import UnknownNameError, closest, unknown_name
 from graphsdg.render.attachments import attachments
 from graphsdg.render.render_product import RenderProduct, registry as rp_registry
@@ -42,6 +43,9 @@ class AnnotatorSpec:
     # Computed from the capture's pixels, camera and labels alone (no live scene state), so it may
     # run after the script has moved the scene on: what lets step(wait_for_render=False) pipeline.
     pixels_only: bool = False
+    # The class mask it colours from the ids for its params, as (kind, semantic filter) of
+    # FrameView.colorized_id_image, or None: a renderer may colour that where the ids are drawn.
+    id_colours: Callable[[dict], tuple[str, SemanticFilter] | None] | None = None
 
 
 @dataclass(frozen=True)

@@ -91,6 +91,22 @@ class Footprints:
     masks: dict = None     # k -> (x0, y0, x1, y1) crop and its bool mask (the full silhouette)
 
 
+def id_palette(imap: InstanceMap, kind: str) -> np.ndarray:
+    """Packed RGBA (uint32) of each geom index's ``"semantic"``/``"instance"`` id of ``imap``, coloured with
+    :func:`graphsdg.annotate.ids.color_of`, the background's last (index -1): the colorized id image is this at
+    each pixel's geom. Kept with the map, so it is the same array every frame until the labels change."""
+    def build():
+        ids = imap.id_lut(kind)
+        # one colour per distinct id, spread over the geoms (a Python step per geom cost ~1 us each: 5 ms
+        # a frame at 5,000 assets)
+        distinct, slot = np.unique(ids, return_inverse=True)
+        rgba = np.array([color_of(int(v)) for v in distinct.tolist()], dtype=np.uint8).reshape(-1, 4)[slot]
+        packed = np.ascontiguousarray(rgba).view(np.uint32)[:, 0]
+        packed.flags.writeable = False
+        return packed
+    return imap.derived(("palette", kind), build)
+
+
 class SceneLabels:
     """Per-model cache of instance maps, rebuilt when the model or labels change."""
 
@@ -260,16 +276,11 @@ class FrameView:
         """uint8 (H, W, 4): the ``"semantic"``/``"instance"`` id image already coloured with
         :func:`graphsdg.annotate.ids.color_of`, in one lookup per pixel (geom -> packed RGBA) instead of ids
         then colours; a :class:`~graphsdg.imaging.label_image.LabelImage` (its PNG's rows stored unfiltered)."""
-        imap = self.instance_map(semantic_filter)
-
-        def palette():   # packed RGBA per geom index (and the background's last)
-            ids = imap.id_lut(kind)
-            # one colour per distinct id, spread over the geoms (a Python step per geom cost ~1 us each: 5 ms
-            # a frame at 5,000 assets)
-            distinct, slot = np.unique(ids, return_inverse=True)
-            rgba = np.array([color_of(int(v)) for v in distinct.tolist()], dtype=np.uint8).reshape(-1, 4)[slot]
-            return np.ascontiguousarray(rgba).view(np.uint32)[:, 0]
-        packed = self.ids_through(imap.derived(("palette", kind), palette))
+        palette = id_palette(self.instance_map(semantic_filter), kind)
+        made = self.outputs.id_colours(palette) if self.outputs is not None else None
+        if made is not None:       # coloured where the ids were drawn (the pbr backend's device PNGs)
+            return made
+        packed = self.ids_through(palette)
         return label_image(packed.view(np.uint8).reshape(*packed.shape, 4))
 
     def _id_image(self, semantic_filter: SemanticFilter, kind: str) -> np.ndarray:

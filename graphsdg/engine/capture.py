@@ -14,7 +14,7 @@ from typing import Any
 from pxr import UsdGeom
 
 from graphsdg.annotate.annotator import Annotator
-from graphsdg.annotate.frame import FrameView
+from graphsdg.annotate.frame import FrameView, id_palette
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.base import interrupts, profiling
 from graphsdg.base import settings_store as settings
@@ -220,8 +220,10 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
         for a in annotators:
             passes |= a.spec.passes
         motion = motion_blur.motion_blur().samples(sim, rp.path, view) if passes & {"color", "hdr"} else None
+        palettes = _palettes(rt, annotators) if "segmentation" in passes else ()
         views.append(view)
-        requests.append(RenderRequest(view, passes, subframes, defer, motion, frame_number) if passes else None)
+        requests.append(RenderRequest(view, passes, subframes, defer, motion, frame_number, palettes)
+                        if passes else None)
     drawn = [r for r in requests if r is not None]
     outputs = iter(rt.renderer.render_batch(rt.render_scene, drawn) if drawn else [])   # sizes its buffers
     t = _timed("render", t)
@@ -236,6 +238,19 @@ def _render(rt, products: dict[str, tuple[Any, list[Annotator]]], subframes: int
         frames.append(frame)
     _timed("annotate:frame", t)
     return frames
+
+
+def _palettes(rt, annotators: list[Annotator]) -> tuple:
+    """The class masks ``annotators`` will colour from the ids (``AnnotatorSpec.id_colours``), as the per-geom
+    palettes :meth:`FrameView.colorized_id_image` looks up: the renderer may colour them where the ids are."""
+    palettes: dict[tuple[str, str], Any] = {}
+    for a in annotators:
+        asked = a.spec.id_colours(a.init_params) if a.spec.id_colours is not None else None
+        if asked is not None and (asked[0], asked[1].text) not in palettes:
+            kind, semantic_filter = asked
+            imap = rt.labels.instance_map(rt.sim, rt.stage, semantic_filter)   # kept by the labels: no rebuild
+            palettes[(kind, semantic_filter.text)] = id_palette(imap, kind)
+    return tuple(palettes.values())
 
 
 def draw(render_products: list, passes: frozenset[str] = frozenset({"color"})) -> list:

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from graphsdg.imaging.label_image import LabelImage
+
 
 class PrecompressedImage(np.ndarray):
     """An image array that carries the zlib stream of its PNG's filtered rows (:attr:`zlib_stream`).
@@ -31,13 +33,19 @@ class PrecompressedImage(np.ndarray):
         self.zlib_stream = None
 
 
-def precompressed(image: np.ndarray, zlib_stream: bytes) -> PrecompressedImage:
+class PrecompressedLabelImage(PrecompressedImage, LabelImage):
+    """A :class:`PrecompressedImage` of label colours (a class mask compressed where it was coloured): its
+    views and copies are :class:`~graphsdg.imaging.label_image.LabelImage` arrays without the stream."""
+
+
+def precompressed(image: np.ndarray, zlib_stream: bytes, labels: bool = False) -> PrecompressedImage:
     """``image`` (a uint8 (H, W, C) array, not copied) as a read-only :class:`PrecompressedImage` carrying
-    ``zlib_stream``, the zlib stream of its filtered rows (each row's filter-type byte, then its filtered bytes)."""
-    out = image.view(PrecompressedImage)
+    ``zlib_stream``, the zlib stream of its filtered rows (each row's filter-type byte, then its filtered bytes);
+    a :class:`PrecompressedLabelImage` with ``labels``."""
+    out = image.view(PrecompressedLabelImage if labels else PrecompressedImage)
     out.zlib_stream = zlib_stream
     out.flags.writeable = False
     return out
 
 
-__all__ = ["PrecompressedImage", "precompressed"]
+__all__ = ["PrecompressedImage", "PrecompressedLabelImage", "precompressed"]

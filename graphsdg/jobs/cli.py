@@ -28,7 +28,7 @@ def run_bench(args: argparse.Namespace) -> None:
     if args.processes_per_gpu and not args.gpus:
         raise ValueError(f"--processes-per-gpu {args.processes_per_gpu} needs --gpus: it is each GPU's share of the "
                          f"processes")
-    if args.bind_cores and not args.gpus:
+    if args.bind_cores == "on" and not args.gpus:
         raise ValueError("--bind-cores needs --gpus: it binds each GPU's processes to that GPU's share of the cores")
     unknown = [a for a in annotators if a not in throughput.ANNOTATOR_FLAGS]
     if unknown:
@@ -52,7 +52,7 @@ def run_bench(args: argparse.Namespace) -> None:
                        f", {args.spp} path samples" if args.spp else "",
                        f", pbr batch pixels {args.pbr_batch_pixels}" if args.pbr_batch_pixels is not None else "",
                        f", pbr kernel {args.pbr_kernel}" if args.pbr_kernel is not None else "",
-                       ", colour PNGs compressed on the GPU" if args.png_on_device else "",
+                       ", PNGs compressed on the GPU" if args.png_on_device else "",
                        f", {args.rounds} rounds alternately" if args.rounds > 1 else ""])
     length = f"{args.num_frames} frames" if args.seconds is None else \
         f"~{args.seconds:g} s a run (at most {args.num_frames} frames)"
@@ -125,7 +125,7 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
     scaling table. Every count is checked against the machine before anything runs."""
     from graphsdg.benchmark import multi_gpu
     from graphsdg.benchmark.throughput import format_table
-    from graphsdg.render.cuda_mps import shared_gpus
+    from graphsdg.render.cuda_mps import shared_gpus, would_share
     from graphsdg.render.gpu_assignment import check_egl_sees, choose_gpus, default_processes_per_gpu
     if args.processes and args.processes_per_gpu:
         raise ValueError(f"--processes {args.processes} and --processes-per-gpu {args.processes_per_gpu} both say "
@@ -134,13 +134,14 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
     if os.environ.get("MUJOCO_GL", "egl").lower() == "egl":
         from graphsdg.render.egl_device import egl_cuda_devices
         check_egl_sees(chosen[max(chosen)], egl_cuda_devices())
-    cores = _gpu_core_shares() if args.bind_cores else None
+    shares = _gpu_core_shares() if args.bind_cores != "off" else None
     rounds, parts = [], []
     for number in range(1, args.rounds + 1):     # with --rounds K the counts take turns: 1, 2, 4, 1, 2, 4, ...
         runs = []
         for count, gpus in chosen.items():
+            cores = bound_cores(args.bind_cores, count, shares)
             per_gpu = args.processes_per_gpu or default_processes_per_gpu(
-                count, cores=len(cores[gpus[0].index]) * count if cores else None)
+                count, cores=len(cores[gpus[0].index]) * count if cores else None, mps=would_share(args.mps))
             processes = args.processes or count * per_gpu
             with shared_gpus(args.mps, math.ceil(processes / count)) as mps:
                 run = multi_gpu.run_on_gpus(config, processes, gpus, cores)
@@ -157,6 +158,19 @@ def _bench_on_gpus(args: argparse.Namespace, config) -> str:
         title = "#### Scaling (each count's median round)" if args.rounds > 1 else "#### Scaling"
         parts.append(f"{title}\n\n" + format_table(multi_gpu.scaling_rows(multi_gpu.median_runs(rounds))))
     return "\n\n".join(parts)
+
+
+def bound_cores(mode: str, count: int, shares: dict[int, list[int]] | None) -> dict[int, list[int]] | None:
+    """``bench --bind-cores MODE``'s binding for a run on ``count`` GPUs: ``shares`` (each GPU's cores) or None
+    (every process may run on every core). ``on`` binds at every count, ``auto`` with more than one GPU (where
+    it measured faster; one GPU's processes then have every core), ``off`` never.
+
+    Example:
+        >>> shares = {0: [0, 1], 1: [2, 3]}
+        >>> bound_cores("auto", 1, shares), bound_cores("auto", 2, shares) is shares, bound_cores("on", 1, shares)
+        (None, True, {0: [0, 1], 1: [2, 3]})
+    """
+    return shares if mode == "on" or (mode == "auto" and count > 1) else None
 
 
 def _gpu_core_shares() -> dict[int, list[int]]:
@@ -253,7 +267,7 @@ def run_job_command(args: argparse.Namespace, script_args: list[str]) -> int:
         import_ray()                      # says how to get Ray before anything runs
         check_job_file(job)
         summary = run_sharded(job, args.workers, address=args.address, gpus_per_worker=args.gpus_per_worker,
-                              gpus=args.gpus, mps=args.mps)
+                              gpus=args.gpus, mps=args.mps, bind_cores=args.bind_cores == "auto")
     else:
         check_job_file(job)
         summary = run_job(job)
@@ -455,8 +469,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "the settings spp and totalSpp)")
     _add_pbr_kernel(bench)
     bench.add_argument("--png-on-device", action="store_true",
-                       help="on pbr, compress each frame's colour PNG on the GPU, /graphsdg/render/pbrPngOnDevice "
-                            "(graphsdg.render.device_png: less CPU a written frame, files about a tenth larger)")
+                       help="on pbr, compress each frame's colour PNG on the GPU and colour and compress its class "
+                            "masks there, /graphsdg/render/pbrPngOnDevice (graphsdg.render.device_png: less CPU a "
+                            "written frame, larger files)")
     bench.add_argument("--pbr-batch-pixels", type=_non_negative, metavar="N",
                        help="on pbr, draw a step's render products in one launch while their pixels add up to at "
                             "most N, 0 for a launch per product: /graphsdg/render/pbrBatchPixels (default: the "
@@ -471,12 +486,13 @@ def build_parser() -> argparse.ArgumentParser:
                             "after the other and end with a scaling table (no hand-written loop)")
     bench.add_argument("--processes-per-gpu", type=_positive, metavar="N",
                        help="with --gpus: N processes on each GPU (default: --processes spread over the GPUs, or "
-                            "the cores' share of each GPU, at most 8)")
-    bench.add_argument("--bind-cores", action="store_true",
+                            "the cores' share of each GPU, at most 16 under CUDA MPS and 8 without)")
+    bench.add_argument("--bind-cores", nargs="?", const="on", default="auto", choices=("auto", "on", "off"),
                        help="with --gpus: bind each GPU's processes to that GPU's share of the cores (its NUMA-local "
-                            "cores where the host lists them, split evenly among the GPUs near them), the same share "
-                            "whatever the GPU count, so --gpus 1 2 4 scales GPUs and cores together (default: every "
-                            "process may run on every core)")
+                            "cores where the host lists them, split evenly among the GPUs near them); on (the flag "
+                            "alone): at every GPU count, the same share whatever the count, so --gpus 1 2 4 scales "
+                            "GPUs and cores together; auto: with more than one GPU (one GPU's processes may run on "
+                            "every core); off: never (default: auto)")
     bench.add_argument("--mps", choices=MPS_MODES, default="auto",
                        help="with --processes or --gpus: CUDA MPS for the processes that share a GPU, so their "
                             "kernels run side by side (auto: when a GPU has several processes and the host has "
@@ -540,6 +556,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help="with --workers on this machine: CUDA MPS for the workers that share a GPU, so their "
                           "kernels run side by side (auto: when a GPU has several workers and the host has "
                           "nvidia-cuda-mps-control; on: required; off; default: auto)")
+    run.add_argument("--bind-cores", choices=("auto", "off"), default="auto",
+                     help="with --workers: auto binds each worker given one GPU of a machine with several to that "
+                          "GPU's share of the machine's cores (its NUMA-local cores where the machine lists them, "
+                          "split evenly among the GPUs near them), so a GPU's workers share its cores; off lets "
+                          "every worker run on every core (default: auto)")
     run.add_argument("--resume", action="store_true",
                      help="continue an interrupted run: frames complete on disk are kept, the rest are captured")
     folder = sub.add_parser("run-folder", parents=[common],

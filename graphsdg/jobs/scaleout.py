@@ -33,9 +33,10 @@ import tempfile
 import time
 from dataclasses import replace
 
-from graphsdg.base.cpu_share import cores_per_process, usable_cores
-from graphsdg.render.cuda_mps import MpsSession, check_mode, shared_gpus
+from graphsdg.base.cpu_share import cores_per_process, cpu_list, usable_core_set, usable_cores
+from graphsdg.render.cuda_mps import MpsSession, check_mode, shared_gpus, would_share
 from graphsdg.render.gpu_assignment import GpuCountError, default_processes_per_gpu, host_gpus, visible_gpus
+from graphsdg.render.gpu_cores import assigned_share
 from graphsdg.io import object_store
 from graphsdg.io.location import normalize
 from graphsdg.io.write_queue import threads_per_process
@@ -43,7 +44,7 @@ from graphsdg.jobs.job import JobSpec, run_job
 
 log = logging.getLogger("graphsdg.jobs.scaleout")
 RAY_HINT = "pip install 'graphsdg[ray]'"
-SHARD_COLUMNS = ("shard", "frames", "seconds", "node", "pid", "gpu_ids", "egl_device", "write_threads",
+SHARD_COLUMNS = ("shard", "frames", "seconds", "node", "pid", "gpu_ids", "egl_device", "cores", "write_threads",
                  "image_threads")   # per-shard summary
 # what the shards need from the driver's environment: rendering, reproducible dates, and where S3 is (the
 # endpoint and region; credentials come from each node's own AWS chain, never through Ray), and the node's
@@ -74,12 +75,13 @@ def import_ray():
 class ShardWorker:
     """One shard's process (made a Ray actor by :func:`run_sharded`)."""
 
-    def __init__(self) -> None:
+    def __init__(self, bind_cores: bool = True) -> None:
         import ray
         from graphsdg.render.egl_device import follow_assigned_gpu
         self.gpu_ids = list(ray.get_gpu_ids())
         self.node = ray.get_runtime_context().get_node_id()
         self.egl_device = follow_assigned_gpu(self.gpu_ids)   # before the first GL context
+        self.cores = bind_to_assigned_gpu(self.gpu_ids) if bind_cores else None
 
     def run(self, job: JobSpec, index: int, count: int, write_threads: int | None = None,
             image_threads: int | None = None) -> dict:
@@ -95,10 +97,21 @@ class ShardWorker:
         if image_threads is not None:
             limit_image_threads(image_threads)
         summary = run_job(script_here(job), FramePlan(index, count, job.resume))
-        summary.update(node=self.node, pid=os.getpid(),
+        summary.update(node=self.node, pid=os.getpid(), cores=self.cores,
                        gpu_ids=[str(g) for g in self.gpu_ids], egl_device=self.egl_device,
                        write_threads=get_write_queue().num_threads, image_threads=image_threads)
         return summary
+
+
+def bind_to_assigned_gpu(gpu_ids: list) -> str | None:
+    """Bind this process (its threads to come) to the cores of the one GPU Ray gave it, where its node has
+    several (:func:`~graphsdg.render.gpu_cores.assigned_share`): a GPU's workers share its cores and keep off
+    the other GPUs' (``graphsdg bench --bind-cores``, docs/performance.md); the cores as a list, or None."""
+    share = assigned_share(gpu_ids, host_gpus(), usable_core_set())
+    if share is None:
+        return None
+    os.sched_setaffinity(0, share)
+    return cpu_list(share)
 
 
 def script_here(job: JobSpec) -> JobSpec:
@@ -120,7 +133,8 @@ def script_here(job: JobSpec) -> JobSpec:
 
 
 def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gpus_per_worker: float | None = None,
-                num_cpus: int | None = None, gpus: int | None = None, mps: str = "auto") -> dict:
+                num_cpus: int | None = None, gpus: int | None = None, mps: str = "auto",
+                bind_cores: bool = True) -> dict:
     """Run ``job`` as ``workers`` Ray shards (``"auto"``: :func:`default_workers`), merge them; return the job
     summary (with per-shard and per-GPU rows).
 
@@ -128,7 +142,8 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
     error naming both counts. Each worker asks for :func:`~graphsdg.render.gpu_assignment.gpu_share` of a GPU
     unless ``gpus_per_worker`` says otherwise. ``mps`` (auto, on, off): CUDA MPS for the workers that share a
     GPU of the local cluster (:mod:`graphsdg.render.cuda_mps`); a cluster joined with ``address`` runs its
-    nodes' own daemons.
+    nodes' own daemons. ``bind_cores``: each worker given one GPU of a node with several runs on that GPU's
+    share of the node's cores (:func:`bind_to_assigned_gpu`).
     """
     from graphsdg.dataset import merge
     from graphsdg.render.gpu_assignment import choose_gpus, gpu_share
@@ -156,7 +171,7 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
             local_gpus = len(choose_gpus(gpus)) if gpus is not None else _visible_gpu_count()
             # address="local": a new cluster of this process's own, never one another run left on the machine
             cores = num_cpus or usable_cores()
-            wanted = default_workers(local_gpus, cores) if workers == "auto" else workers
+            wanted = default_workers(local_gpus, cores, mps=would_share(mps)) if workers == "auto" else workers
             # before Ray starts, so its workers (children of this process) find the daemon's pipe
             mps_session = daemon.enter_context(
                 shared_gpus(mps, math.ceil(wanted / local_gpus) if local_gpus else 0))
@@ -168,7 +183,8 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
             raise GpuCountError(f"--gpus {gpus} asks for {gpus} GPU(s) but the Ray cluster has {cluster_gpus:g}")
         used_gpus = float(gpus) if gpus is not None else cluster_gpus
         if workers == "auto":
-            workers = default_workers(int(used_gpus), int(ray.cluster_resources().get("CPU", 1)))
+            workers = default_workers(int(used_gpus), int(ray.cluster_resources().get("CPU", 1)),
+                                      mps=mps_session.active)
         per_worker = gpus_per_worker if gpus_per_worker is not None else gpu_share(workers, used_gpus)
         if per_worker > cluster_gpus:
             raise GpuCountError(f"--gpus-per-worker {per_worker:g} but the cluster has {cluster_gpus:g} GPU(s)")
@@ -183,7 +199,7 @@ def run_sharded(job: JobSpec, workers: int | str, address: str | None = None, gp
                       script_source=source)
         # one shard per node first: on a cluster each node's cores and GPUs are used
         actor = ray.remote(num_cpus=1, num_gpus=per_worker, scheduling_strategy="SPREAD")(ShardWorker)
-        actors = [actor.remote() for _ in range(workers)]
+        actors = [actor.remote(bind_cores) for _ in range(workers)]
         # shards of a local cluster share this machine's cores: a writer pool each of their share of them
         threads = None if address else threads_per_process(workers, num_cpus or usable_cores())
         image_threads = None if address else cores_per_process(workers, num_cpus or usable_cores())
@@ -232,18 +248,18 @@ def _visible_gpu_count() -> int:
     return len(visible_gpus(host_gpus(), os.environ.get("CUDA_VISIBLE_DEVICES")))
 
 
-def default_workers(gpus: int, cores: int) -> int:
+def default_workers(gpus: int, cores: int, mps: bool = False) -> int:
     """``--workers auto``: on GPUs, each GPU's default share of processes
-    (:func:`~graphsdg.render.gpu_assignment.default_processes_per_gpu`), a multiple of the GPU count so every
-    GPU gets as many; without GPUs, one a core.
+    (:func:`~graphsdg.render.gpu_assignment.default_processes_per_gpu`; more where a GPU's workers run under
+    CUDA MPS, ``mps``), a multiple of the GPU count so every GPU gets as many; without GPUs, one a core.
 
     Example:
-        >>> default_workers(4, 64), default_workers(2, 16), default_workers(0, 16)
-        (32, 16, 16)
+        >>> default_workers(4, 64), default_workers(2, 16), default_workers(0, 16), default_workers(4, 64, mps=True)
+        (32, 16, 16, 64)
     """
     if gpus < 1:
         return max(1, cores)
-    return gpus * default_processes_per_gpu(gpus, cores)
+    return gpus * default_processes_per_gpu(gpus, cores, mps=mps)
 
 
 def gpu_rows(results: list[dict]) -> list[dict]:

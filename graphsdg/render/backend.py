@@ -80,7 +80,10 @@ class RenderRequest:
     ``depth``, ``segmentation``; ``subframes``: renders accumulated; ``defer``: leave the pixels copying;
     ``motion``: motion-blur sub-frames (:mod:`graphsdg.render.motion_blur`) or None; ``frame``: the frame's
     number in the run (the graph's frame, which a shard or resumed run seeks to), which seeds the frame's
-    random samples (soft shadows, path tracing), so they do not depend on what the process drew before.
+    random samples (soft shadows, path tracing), so they do not depend on what the process drew before;
+    ``palettes``: with ``segmentation``, the class masks the annotators will colour from the ids, each a packed
+    RGBA (uint32) per geom id with the background's last (index -1), which a backend may colour where the ids
+    are (:attr:`RenderOutputs.palettes`).
     """
 
     view: CameraView
@@ -89,6 +92,7 @@ class RenderRequest:
     defer: bool = False
     motion: MotionSamples | None = None
     frame: int = 0
+    palettes: tuple[np.ndarray, ...] = ()
 
 
 Crop = tuple[int, int, int, int]   # x0, y0, x1, y1 pixel bounds (x1, y1 exclusive)
@@ -111,6 +115,9 @@ class RenderOutputs:
       and derived from the pixels by the annotators
     * ``render_isolated``: follow-up renders of the same view and state,
       ``(geom ids, crop) -> int32 ids of the crop``
+    * ``id_colours`` and ``palettes``: uint8 (H, W, 4) class masks, the ids coloured with each of
+      ``palettes`` (the request's :attr:`RenderRequest.palettes` the backend coloured where the ids are; an
+      empty tuple where it coloured none), each ``palettes[k][geom id]`` at every pixel
 
     A pass whose pixels are still being copied off the GPU (a deferred render)
     is finished on first access; a pass derived from others on the CPU (``geom_ids``
@@ -123,6 +130,14 @@ class RenderOutputs:
         self._derived: dict[str, Callable[[RenderOutputs], np.ndarray]] = {}
         self.id_lut: np.ndarray | None = None
         self.render_isolated: Callable[[Sequence[int], Crop], np.ndarray] | None = None
+        self.palettes: tuple[np.ndarray, ...] = ()
+
+    def id_colours(self, palette: np.ndarray) -> np.ndarray | None:
+        """The class mask the backend coloured with ``palette`` (the very array a request passed), or None."""
+        for k, made in enumerate(self.palettes):
+            if made is palette:
+                return self.get("id_colours")[k]
+        return None
 
     def put(self, name: str, value: np.ndarray | Callable[[], np.ndarray] | None) -> None:
         """Store a pass's pixels, or a callable that finishes them when first asked for."""

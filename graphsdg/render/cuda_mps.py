@@ -89,6 +89,21 @@ def running_daemon(control: str | None = None, environ=os.environ) -> str | None
     return pipe_dir if answered else None
 
 
+def would_share(mode: str, control: str | None = None) -> bool:
+    """Whether :func:`shared_gpus` in ``mode`` runs a GPU's several processes under MPS: ``on`` always (or it
+    raises), ``off`` never, ``auto`` where a daemon runs already or the host has the control program.
+
+    Example:
+        >>> would_share("off"), would_share("on")
+        (False, True)
+    """
+    check_mode(mode)
+    if mode != "auto":
+        return mode == "on"
+    control = control or shutil.which(CONTROL)
+    return control is not None or running_daemon(control) is not None
+
+
 @contextlib.contextmanager
 def shared_gpus(mode: str, processes_per_gpu: float, control: str | None = None) -> Iterator[MpsSession]:
     """MPS for the processes started inside the block, as ``mode`` says (module docstring).

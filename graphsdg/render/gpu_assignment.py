@@ -35,8 +35,10 @@ from typing import Callable, Sequence
 from graphsdg.base.cpu_share import usable_cores
 from graphsdg.render.egl_device import BIND_ENV   # at import a process given BIND_ENV renders on that GPU
 
-#: the most processes a default run puts on one GPU; bench/multi_gpu.sh measures 4, 8 and 16 a GPU (issue 37)
+#: the most processes a default run puts on one GPU whose processes take turns (no CUDA MPS), and on one whose
+#: processes' kernels run side by side under MPS (docs/performance.md, "Every GPU of the host")
 MAX_DEFAULT_PROCESSES_PER_GPU = 8
+MAX_DEFAULT_PROCESSES_PER_GPU_MPS = 16
 
 
 class GpuCountError(ValueError):
@@ -196,16 +198,20 @@ def process_environment(gpu: GpuInfo) -> dict[str, str]:
     return {"CUDA_VISIBLE_DEVICES": str(gpu.index), "CUDA_DEVICE_ORDER": "PCI_BUS_ID", BIND_ENV: str(gpu.index)}
 
 
-def default_processes_per_gpu(gpus: int, cores: int | None = None) -> int:
+def default_processes_per_gpu(gpus: int, cores: int | None = None, mps: bool = False) -> int:
     """Processes a GPU gets by default: the cores' share of each GPU, at most
-    :data:`MAX_DEFAULT_PROCESSES_PER_GPU`, at least 1.
+    :data:`MAX_DEFAULT_PROCESSES_PER_GPU`, or :data:`MAX_DEFAULT_PROCESSES_PER_GPU_MPS` where ``mps`` (the
+    processes sharing a GPU run under CUDA MPS), at least 1.
 
     Example:
         >>> default_processes_per_gpu(1, 16), default_processes_per_gpu(4, 64), default_processes_per_gpu(4, 2)
         (8, 8, 1)
+        >>> default_processes_per_gpu(4, 64, mps=True), default_processes_per_gpu(1, 64, mps=True)
+        (16, 16)
     """
     cores = cores if cores is not None else usable_cores()
-    return max(1, min(MAX_DEFAULT_PROCESSES_PER_GPU, cores // max(1, gpus)))
+    most = MAX_DEFAULT_PROCESSES_PER_GPU_MPS if mps else MAX_DEFAULT_PROCESSES_PER_GPU
+    return max(1, min(most, cores // max(1, gpus)))
 
 
 def gpu_share(workers: int, gpus: float) -> float:

@@ -71,4 +71,21 @@ def gpu_cores(host: Sequence[GpuInfo], usable: Iterable[int],
     return shares
 
 
-__all__ = ["SYSFS_PCI", "gpu_cores", "local_cores"]
+def assigned_share(gpu_ids: Sequence, host: Sequence[GpuInfo], usable: Iterable[int],
+                   local: Callable[[GpuInfo], set[int] | None] = local_cores) -> list[int] | None:
+    """The cores a process a scheduler gave ``gpu_ids`` (Ray's ids: the host's ``nvidia-smi`` indices) should
+    run on: its GPU's :func:`gpu_cores` share (``local``: as there), where the host has several GPUs and the
+    process one of them; None (every usable core) otherwise, or where the id is not one of the host's GPUs.
+
+    Example:
+        >>> from graphsdg.render.gpu_assignment import GpuInfo
+        >>> host = [GpuInfo(i) for i in range(4)]
+        >>> assigned_share(["2"], host, range(64)), assigned_share([], host, range(64))
+        ([32, 33, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 44, 45, 46, 47], None)
+    """
+    if len(host) < 2 or len(gpu_ids) != 1 or not str(gpu_ids[0]).isdigit():
+        return None
+    return gpu_cores(host, usable, local).get(int(gpu_ids[0]))
+
+
+__all__ = ["SYSFS_PCI", "assigned_share", "gpu_cores", "local_cores"]

@@ -245,10 +245,24 @@ class PbrRenderer:
             setattr(owners[name], name, view)
         return uploads
 
-    def _layout(self, view: CameraView, ngeom: int):
+    def _layout(self, view: CameraView, ngeom: int, masks: int = 0):
         return self._outputs.ClassicLayout(view.width, view.height, pbr_scene.ray_cosines(view), view.near,
                                            view.far, self._device, ngeom, self._wait_for_release,
-                                           png=bool(settings.get(PNG_ON_DEVICE_KEY, False)))
+                                           png=bool(settings.get(PNG_ON_DEVICE_KEY, False)), masks=masks)
+
+    def _device_masks(self, ctx: _Context, requests: list[RenderRequest], acc) -> tuple[int, ...]:
+        """How many class masks each camera of ``ctx`` colours on the device this frame (its request's
+        palettes, where PNGs are made on the device and the ids are drawn), with each layout made room for
+        and given its palettes."""
+        if acc is not None or not settings.get(PNG_ON_DEVICE_KEY, False):
+            return (0,) * len(requests)
+        counts = tuple(len(r.palettes) if "segmentation" in r.passes else 0 for r in requests)
+        for index, (count, request) in enumerate(zip(counts, requests)):
+            layout = ctx.layouts[index]
+            if count > layout.masks:
+                layout = ctx.layouts[index] = self._layout(request.view, layout.ngeom, count)
+            layout.set_palettes(request.palettes[:count])
+        return counts
 
     def _mesh_state(self, scene: RenderScene, rc) -> _MeshState:
         """The context was built from the model's current vertices: every mesh's BVH is up to date."""
@@ -349,24 +363,26 @@ class PbrRenderer:
                     acc = acc / launches
                 ids = tuple(bool({"segmentation", "depth"} & r.passes) for r in requests)
                 pngs = tuple(acc is None and "color" in r.passes for r in requests)
-                self._conversion(ctx, ids, pngs).run()
+                masks = self._device_masks(ctx, requests, acc)
+                self._conversion(ctx, ids, pngs, masks).run()
             with profiling.timed("readback:pbr"):
                 queued = self._outputs.queue_reads([
-                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes, read_ids, png)
-                    for layout, r, read_ids, png in zip(ctx.layouts, requests, ids, pngs)])
+                    (layout, acc is None and bool({"color", "hdr"} & r.passes), "depth" in r.passes, read_ids, png,
+                     count) for layout, r, read_ids, png, count in zip(ctx.layouts, requests, ids, pngs, masks)])
                 if all(r.defer for r in requests):   # pipelined: the copies finish while the script goes on
                     self._queued.append(queued)
                 else:
                     queued.hosts()
         self.stats["products"] += len(requests)
-        return [self._outputs_of(scene, r, _host_of(queued, i), layout.table, acc)
-                for i, (r, layout) in enumerate(zip(requests, ctx.layouts))]
+        return [self._outputs_of(scene, r, _host_of(queued, i), layout.table, acc, r.palettes[:count])
+                for i, (r, layout, count) in enumerate(zip(requests, ctx.layouts, masks))]
 
-    def _conversion(self, ctx: _Context, ids: tuple[bool, ...], pngs: tuple[bool, ...]):
+    def _conversion(self, ctx: _Context, ids: tuple[bool, ...], pngs: tuple[bool, ...], masks: tuple[int, ...]):
         """The :class:`~graphsdg.render.launch_graph.LaunchGraph` converting each camera's pixels of ``ctx``
-        to the classic layout, with their codes' pixel bounds where ``ids`` asks and their colour's PNG rows
-        compressed where ``pngs`` asks and the layout does that (one flag of each per camera)."""
-        key = (ids, pngs, tuple(id(layout) for layout in ctx.layouts))
+        to the classic layout, with their codes' pixel bounds where ``ids`` asks, their colour's PNG rows
+        compressed where ``pngs`` asks and the layout does that, and ``masks`` class masks (one of each per
+        camera)."""
+        key = (ids, pngs, masks, tuple(id(layout) for layout in ctx.layouts))
         graph = ctx.conversions.get(key)
         if graph is None:
             if len(ctx.conversions) >= self.MAX_CONVERSIONS:   # new intrinsics every frame make new layouts
@@ -374,8 +390,8 @@ class PbrRenderer:
             base, layouts = ctx.rc.base, list(ctx.layouts)
 
             def launches() -> None:
-                for index, (layout, boxes, png) in enumerate(zip(layouts, ids, pngs)):
-                    layout.convert(base, index, boxes=boxes, png=png)
+                for index, (layout, boxes, png, count) in enumerate(zip(layouts, ids, pngs, masks)):
+                    layout.convert(base, index, boxes=boxes, png=png, masks=count)
             graph = ctx.conversions[key] = self._launch_graph.LaunchGraph(self._device, launches)
         return graph
 
@@ -394,10 +410,11 @@ class PbrRenderer:
         self.stats["color"] += 1
 
     def _outputs_of(self, scene: RenderScene, request: RenderRequest, host: Callable[[], Any], table: np.ndarray,
-                    acc: np.ndarray | None) -> RenderOutputs:
+                    acc: np.ndarray | None, palettes: tuple = ()) -> RenderOutputs:
         """One product's :class:`RenderOutputs`, its passes taken from ``host()`` (its
         :class:`~graphsdg.render.pbr_outputs.HostFrame`, waited for on first use when the render was deferred);
-        ``table`` its id codes' code -> geom table (``acc``: an averaged colour, if any)."""
+        ``table`` its id codes' code -> geom table (``acc``: an averaged colour, if any); ``palettes`` those its
+        class masks were coloured with on the device."""
         view, passes = request.view, request.passes
         out = RenderOutputs()
         if acc is not None:
@@ -420,6 +437,9 @@ class PbrRenderer:
             out.put("code_boxes", lambda: host().code_boxes)
             out.id_lut = table
             out.derive("geom_ids", lambda done: lookup(table, done.id_codes))
+            if palettes:
+                out.put("id_colours", lambda: host().id_colours)
+                out.palettes = palettes
         out.render_isolated = lambda geoms, crop: self._classic().render_isolated(scene, view, geoms, crop)
         return out
 
@@ -545,7 +565,7 @@ class PbrRenderer:
         keys = [_rays_key(v) for v in views]
         if keys != ctx.rays_keys:
             self._mjpbr.set_camera_rays(ctx.rc, [pbr_scene.camera_rays(v) for v in views])
-            ctx.layouts = [layout if key == old else self._layout(view, layout.ngeom)
+            ctx.layouts = [layout if key == old else self._layout(view, layout.ngeom, layout.masks)
                            for layout, key, old, view in zip(ctx.layouts, keys, ctx.rays_keys, views)]
             ctx.rays_keys = keys
 

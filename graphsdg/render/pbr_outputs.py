@@ -16,7 +16,9 @@ are views of that page-locked buffer, not copies of it: a layout keeps a few buf
 into one that no array of an earlier frame still uses (:class:`HostBuffers`). About a quarter
 of the bytes the renderer's own float
 ``get_rgb`` readback moves, and no per-pixel numpy work on the CPU (scenes under 255
-geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host).
+geoms: one byte of ids a pixel instead of four, and no int32 -> code pass on the host). A layout may
+also colour class masks from the ids with palettes the annotators will look up, and compress the colour's
+and the masks' PNG rows (:mod:`graphsdg.render.device_png`), read back in the same copy.
 
 Imports Warp (``graphsdg[gpu]``); :mod:`graphsdg.render.pbr` loads it on construction.
 """
@@ -25,11 +27,12 @@ from __future__ import annotations
 import ctypes
 import weakref
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import warp as wp
 
+from graphsdg.imaging.label_image import label_image
 from graphsdg.imaging.precompressed import precompressed
 from graphsdg.render import device_png
 from graphsdg.render.polling import wait_until
@@ -53,6 +56,14 @@ def _classic_layout(packed: wp.array2d[wp.uint32], distance: wp.array2d[wp.float
     if geom < 0 or z > far:
         z = wp.inf
     depth[p] = z
+
+
+@wp.kernel(enable_backward=False)
+def _colour_codes(codes: wp.array(dtype=Any), palettes: wp.array2d[wp.uint32], palette: int,
+                  colours: wp.array[wp.uint32]):
+    # a class mask: each pixel's code through one palette (code -> packed RGBA)
+    p = wp.tid()
+    colours[p] = palettes[palette, int(codes[p])]
 
 
 @wp.kernel(enable_backward=False)
@@ -103,6 +114,7 @@ def _code_boxes(codes: wp.array(dtype=Any), width: int, boxes: wp.array2d[wp.int
 for _code in (wp.uint8, wp.uint16, wp.uint32):
     wp.overload(_classic_layout, {"codes": wp.array(dtype=_code)})
     wp.overload(_code_boxes, {"codes": wp.array(dtype=_code)})
+    wp.overload(_colour_codes, {"codes": wp.array(dtype=_code)})
 
 
 def code_format(ngeom: int) -> tuple[type, int]:
@@ -212,6 +224,7 @@ class HostFrame:
     codes: np.ndarray | None      # (H, W) id codes (:func:`code_format`): geom id + 1, 0 background
     code_boxes: np.ndarray | None = None   # (ngeom + 1, 4) int32 inclusive pixel bounds x_min, y_min, x_max,
     #                                        y_max of each code (row = code), -1 rows for codes not drawn
+    id_colours: tuple = ()        # (H, W, 4) uint8 label images, one per palette (ClassicLayout.set_palettes)
 
 
 class ClassicLayout:
@@ -221,11 +234,14 @@ class ClassicLayout:
     ``cosines``: (H, W) cosine between each pixel's ray and the optical axis (planar depth = near + t cos);
     ``wait_for_release``: as :class:`HostBuffers` takes it; ``png``: also compress the colour's PNG rows on the device
     (:mod:`graphsdg.render.device_png`), read back with the colour, so the frame's colour array is a
-    :class:`~graphsdg.imaging.precompressed.PrecompressedImage` (where the image fits :func:`device_png.fits`).
+    :class:`~graphsdg.imaging.precompressed.PrecompressedImage` (where the image fits :func:`device_png.fits`);
+    ``masks``: room for that many class masks coloured on the device from the ids (:meth:`set_palettes`), each
+    compressed there too with ``png``.
     """
 
     def __init__(self, width: int, height: int, cosines: np.ndarray, near: float, far: float, device: str,
-                 ngeom: int, wait_for_release: Callable[[], bool] | None = None, png: bool = False) -> None:
+                 ngeom: int, wait_for_release: Callable[[], bool] | None = None, png: bool = False,
+                 masks: int = 0) -> None:
         n = width * height
         self.shape, self.near, self.far, self.device = (height, width), float(near), float(far), device
         self.ngeom = int(ngeom)
@@ -237,9 +253,14 @@ class ClassicLayout:
         # are one copy of the span they cover, not one per array (each copy is a driver call of its own).
         png = png and device_png.fits(width, height)
         # the stream right after the colour: a read of the colour alone is one span without the other passes
-        stream = [("png_meta", wp.int64, (2,)), ("png_words", wp.uint32, (device_png.stream_words(width, height),))]
+        words = device_png.stream_words(width, height)
+        stream = [("png_meta", wp.int64, (2,)), ("png_words", wp.uint32, (words,))]
         parts = [("rgba", wp.uint32, (n,)), *(stream if png else []), ("depth", wp.float32, (n,)),
                  ("codes", _WARP_CODE_TYPES[code_type], (n,)), ("boxes", wp.int32, (self.ngeom + 1, 4))]
+        self.masks = int(masks)
+        for k in range(self.masks):          # after the ids: a read of the ids and masks is one span
+            parts += [(f"mask{k}", wp.uint32, (n,)),
+                      *([(f"mask{k}_meta", wp.int64, (2,)), (f"mask{k}_words", wp.uint32, (words,))] if png else [])]
         self._spans: dict[str, tuple[int, int, np.dtype, tuple]] = {}
         end = 0
         for name, dtype, shape in parts:
@@ -253,13 +274,37 @@ class ClassicLayout:
             setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
                                          shape=shape, device=device))
         self.png = device_png.DevicePng(width, height, device, self.png_words, self.png_meta) if png else None
+        self._mask_pngs = [device_png.DevicePng(width, height, device, getattr(self, f"mask{k}_words"),
+                                                getattr(self, f"mask{k}_meta")) if png else None
+                           for k in range(self.masks)]
+        # per mask, the code -> packed RGBA table the ids are coloured with, and the host copy last sent
+        self._palettes = wp.zeros((max(1, self.masks), len(self.table)), dtype=wp.uint32, device=device)
+        self._sent_palettes: np.ndarray | None = None
         self._adrs: dict[tuple, int] = {}
-        self._wanted = (False, False, False, False)    # (colour, depth, ids, stream) of the read last queued
+        self._wanted = (False, False, False, False, 0)   # (colour, depth, ids, stream, masks) of the read last queued
 
-    def convert(self, base, camera: int, boxes: bool = False, png: bool = True) -> None:
+    def set_palettes(self, palettes: Sequence[np.ndarray]) -> None:
+        """Colour the class masks of the frames converted from now on with ``palettes`` (at most :attr:`masks`
+        of them): each a packed RGBA (uint32) per geom id, the background's last (index -1), as
+        :meth:`FrameView.colorized_id_image <graphsdg.annotate.frame.FrameView.colorized_id_image>` looks them
+        up. Sent to the device only when they change (queued before the conversion that uses them)."""
+        if len(palettes) > self.masks:
+            raise ValueError(f"{len(palettes)} palettes for a layout with room for {self.masks} class masks")
+        if not palettes:
+            return
+        per_code = np.stack([np.asarray(p, dtype=np.uint32)[self.table] for p in palettes])   # code -> geom -> RGBA
+        if self._sent_palettes is not None and np.array_equal(per_code, self._sent_palettes[:len(palettes)]):
+            return
+        sent = np.zeros(self._palettes.shape, dtype=np.uint32)
+        sent[:len(palettes)] = per_code
+        wp.copy(self._palettes, wp.array(sent, dtype=wp.uint32, device="cpu"))   # pageable: staged before return
+        self._sent_palettes = sent
+
+    def convert(self, base, camera: int, boxes: bool = False, png: bool = True, masks: int = 0) -> None:
         """Queue the conversion of camera ``camera``'s pixels of render context ``base`` (world 0), with
-        ``boxes`` their codes' pixel bounds (:meth:`queue_boxes`; a read of the ids needs them), and with ``png``
-        their colour's PNG stream where this layout compresses it (a read of the colour needs it)."""
+        ``boxes`` their codes' pixel bounds (:meth:`queue_boxes`; a read of the ids needs them), with ``png``
+        their colour's PNG stream where this layout compresses it (a read of the colour needs it), and the first
+        ``masks`` class masks (:meth:`set_palettes`), compressed where this layout compresses."""
         wp.launch(_classic_layout, dim=self.shape[0] * self.shape[1],
                   inputs=[base.rgb_data, base.depth_data, base.seg_data, self._adr(base, "rgb", camera),
                           self._adr(base, "depth", camera), self._adr(base, "seg", camera), self.cosines, self.near,
@@ -269,6 +314,17 @@ class ClassicLayout:
             self.png.queue(self.rgba)
         if boxes:
             self.queue_boxes()
+        self.queue_masks(masks)
+
+    def queue_masks(self, count: int) -> None:
+        """Queue the first ``count`` class masks of the converted ids (:meth:`set_palettes`), each compressed
+        where this layout compresses (:attr:`HostFrame.id_colours`)."""
+        for k in range(count):
+            mask = getattr(self, f"mask{k}")
+            wp.launch(_colour_codes, dim=self.shape[0] * self.shape[1], inputs=[self.codes, self._palettes, k],
+                      outputs=[mask], device=self.device)
+            if self._mask_pngs[k] is not None:
+                self._mask_pngs[k].queue(mask)
 
     def _adr(self, base, kind: str, camera: int) -> int:
         """The camera's first pixel in one of ``base``'s buffers (read from the device once)."""
@@ -285,16 +341,20 @@ class ClassicLayout:
         wp.launch(_code_boxes, dim=(h, -(-w // BOX_SPAN)), inputs=[self.codes, w, self.boxes], device=self.device)
 
     def _parts(self) -> list[str]:
-        colour, depth, ids, stream = self._wanted
-        stream = stream and self.png is not None
-        return [name for name, want in (("rgba", colour), ("png_meta", stream), ("png_words", stream),
-                                        ("depth", depth), ("codes", ids), ("boxes", ids)) if want]
+        colour, depth, ids, stream, masks = self._wanted
+        compresses = self.png is not None
+        wanted = [("rgba", colour), ("png_meta", colour and stream and compresses),
+                  ("png_words", colour and stream and compresses), ("depth", depth), ("codes", ids), ("boxes", ids)]
+        for k in range(masks):
+            wanted += [(f"mask{k}", True), (f"mask{k}_meta", compresses), (f"mask{k}_words", compresses)]
+        return [name for name, want in wanted if want]
 
-    def queue_read(self, colour: bool, depth: bool, ids: bool, stream: bool = False) -> None:
+    def queue_read(self, colour: bool, depth: bool, ids: bool, stream: bool = False, masks: int = 0) -> None:
         """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds:
-        converted with ``boxes``; with ``stream``, the colour's PNG stream: converted with ``png``) into a
+        converted with ``boxes``; with ``stream``, the colour's PNG stream: converted with ``png``; the first
+        ``masks`` class masks, with their streams where this layout compresses: converted with as many) into a
         page-locked host buffer."""
-        self._wanted = (colour, depth, ids, colour and stream)
+        self._wanted = (colour, depth, ids, stream, masks)
         parts = self._parts()
         if parts:
             self._reading = self.host.acquire()
@@ -323,13 +383,23 @@ class ClassicLayout:
         if boxes is not None:
             boxes[boxes[:, 2] < 0] = -1          # codes no pixel has: -1 rows, as the classic path's boxes
         if rgba is not None:
-            rgba = rgba.view(np.uint8).reshape(h, w, 4)
-            stream = device_png.zlib_stream(own["png_meta"], own["png_words"]) if "png_meta" in own else None
-            if stream is not None:               # else too long for the room read back: the CPU compresses it
-                rgba = precompressed(rgba, stream)
+            rgba = _compressed(rgba.view(np.uint8).reshape(h, w, 4), own, "png")
+        masks = tuple(_compressed(own[f"mask{k}"].view(np.uint8).reshape(h, w, 4), own, f"mask{k}", labels=True)
+                      for k in range(self._wanted[4]))
         return HostFrame(rgba=rgba,
                          depth=own["depth"].reshape(h, w) if "depth" in own else None,
-                         codes=own["codes"].reshape(h, w) if "codes" in own else None, code_boxes=boxes)
+                         codes=own["codes"].reshape(h, w) if "codes" in own else None, code_boxes=boxes,
+                         id_colours=masks)
+
+
+def _compressed(image: np.ndarray, own: dict[str, np.ndarray], name: str, labels: bool = False) -> np.ndarray:
+    """``image`` with the PNG stream read back beside it (parts ``<name>_meta`` and ``<name>_words``) as a
+    :class:`~graphsdg.imaging.precompressed.PrecompressedImage`; as it is (a label image with ``labels``) where
+    none was read or the stream was too long for the room read back (the CPU compresses that frame's)."""
+    stream = device_png.zlib_stream(own[f"{name}_meta"], own[f"{name}_words"]) if f"{name}_meta" in own else None
+    if stream is not None:
+        return precompressed(image, stream, labels=labels)
+    return label_image(image) if labels else image
 
 
 class QueuedReads:
@@ -351,10 +421,10 @@ class QueuedReads:
         return self._hosts
 
 
-def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool, bool]]) -> QueuedReads:
-    """Queue each ``(layout, colour, depth, ids, stream)``'s asked-for copies, all behind one event."""
-    for layout, colour, depth, ids, stream in reads:
-        layout.queue_read(colour, depth, ids, stream)
+def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool, bool, int]]) -> QueuedReads:
+    """Queue each ``(layout, colour, depth, ids, stream, masks)``'s asked-for copies, all behind one event."""
+    for layout, colour, depth, ids, stream, masks in reads:
+        layout.queue_read(colour, depth, ids, stream, masks)
     cuda = bool(reads) and wp.get_device(reads[0][0].device).is_cuda   # CPU copies are done when queued
     return QueuedReads([layout for layout, *_ in reads], wp.record_event() if cuda else None)
 
