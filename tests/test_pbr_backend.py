@@ -429,6 +429,29 @@ def test_the_megakernels_replays_render_what_the_librarys_launches_render(render
         rc.geom_roughness, rc.shadow_samples = rough, samples
 
 
+def _scene_on_pbr(png_on_device: bool):
+    """A new stage of :func:`_scene` rendered by the pbr backend on the test's device, PNGs made on the device or
+    not."""
+    from graphsdg import settings
+    rep.stage.new_stage()
+    for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
+                       "/graphsdg/render/pbrPngOnDevice": png_on_device}.items():
+        settings.set(key, value)
+    return _scene()
+
+
+def _device_stream(image: np.ndarray) -> bytes:
+    """The zlib stream graphsdg.render.device_png makes of an RGBA image on the test's device."""
+    import warp as wp
+
+    from graphsdg.render import device_png
+    room = wp.zeros(W * H * 3, dtype=wp.uint32, device=DEVICE)
+    meta = wp.zeros(2, dtype=wp.int64, device=DEVICE)
+    device_png.DevicePng(W, H, DEVICE, room, meta).queue(
+        wp.array(np.ascontiguousarray(image).view(np.uint32).reshape(-1), dtype=wp.uint32, device=DEVICE))
+    return device_png.zlib_stream(meta.numpy(), room.numpy())
+
+
 def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(tmp_path):
     """With /graphsdg/render/pbrPngOnDevice, the rgb annotator's image carries the stream compressed where it was
     rendered, and BasicWriter's rgb file is that stream wrapped (not ISA-L's bytes), decoding to the pixels; the
@@ -438,19 +461,11 @@ def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(
 
     from PIL import Image
 
-    import warp as wp
-
-    from graphsdg import settings
     from graphsdg.imaging.precompressed import PrecompressedImage
     from graphsdg.io.png import encode_png, filtered_lines
-    from graphsdg.render import device_png
 
     def capture(on_device: bool, out: str):
-        rep.stage.new_stage()
-        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
-                           "/graphsdg/render/pbrPngOnDevice": on_device}.items():
-            settings.set(key, value)
-        _, _, cam = _scene()
+        _, _, cam = _scene_on_pbr(on_device)
         rp = rep.create.render_product(cam, (W, H))
         rgb = rep.annotators.get("rgb")
         rgb.attach(rp)
@@ -465,11 +480,7 @@ def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(
     assert isinstance(pixels, PrecompressedImage)         # a view of the frame's image: the stream stays with it
     start = written.index(b"IDAT")
     idat = written[start + 4:start + 4 + int.from_bytes(written[start - 4:start], "big")]
-    room = wp.zeros(W * H * 3, dtype=wp.uint32, device=DEVICE)
-    meta = wp.zeros(2, dtype=wp.int64, device=DEVICE)
-    device_png.DevicePng(W, H, DEVICE, room, meta).queue(
-        wp.array(np.ascontiguousarray(pixels).view(np.uint32).reshape(-1), dtype=wp.uint32, device=DEVICE))
-    assert idat == device_png.zlib_stream(meta.numpy(), room.numpy())
+    assert idat == _device_stream(pixels)
     assert zlib.decompress(idat) == filtered_lines(pixels).tobytes()
     assert np.array_equal(np.asarray(Image.open(io.BytesIO(written))), pixels)
     cpu_pixels, cpu_written = capture(False, str(tmp_path / "cpu"))
@@ -486,20 +497,12 @@ def test_class_masks_coloured_on_the_device_are_the_annotators_and_the_files_bas
 
     from PIL import Image
 
-    from graphsdg import settings
     from graphsdg.imaging.label_image import LabelImage
     from graphsdg.imaging.precompressed import PrecompressedLabelImage
     from graphsdg.io.png import encode_png, filtered_lines
-    from graphsdg.render import device_png
-
-    import warp as wp
 
     def capture(on_device: bool, out: str):
-        rep.stage.new_stage()
-        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
-                           "/graphsdg/render/pbrPngOnDevice": on_device}.items():
-            settings.set(key, value)
-        cube, ball, cam = _scene()
+        cube, ball, cam = _scene_on_pbr(on_device)
         rep.functional.modify.semantics(cube, {"class": "cube"})
         rep.functional.modify.semantics(ball, {"class": "ball"})
         rp = rep.create.render_product(cam, (W, H))
@@ -522,11 +525,7 @@ def test_class_masks_coloured_on_the_device_are_the_annotators_and_the_files_bas
     assert isinstance(mask, PrecompressedLabelImage) and isinstance(cpu_mask, LabelImage)
     assert not isinstance(cpu_mask, PrecompressedLabelImage) and np.array_equal(mask, cpu_mask)
     assert len({tuple(c) for c in np.asarray(mask).reshape(-1, 4).tolist()}) >= 3    # cube, ball, background
-    room = wp.zeros(W * H * 3, dtype=wp.uint32, device=DEVICE)           # the data is a view: no stream of its own
-    meta = wp.zeros(2, dtype=wp.int64, device=DEVICE)
-    device_png.DevicePng(W, H, DEVICE, room, meta).queue(
-        wp.array(np.ascontiguousarray(mask).view(np.uint32).reshape(-1), dtype=wp.uint32, device=DEVICE))
-    assert idat(written) == device_png.zlib_stream(meta.numpy(), room.numpy())
+    assert idat(written) == _device_stream(mask)                       # the data is a view: no stream of its own
     assert np.array_equal(np.asarray(Image.open(io.BytesIO(written))), mask)
     assert zlib.decompress(idat(written)) == filtered_lines(np.asarray(mask)).tobytes()   # Sub rows
     assert cpu_written == encode_png(cpu_mask) != written
