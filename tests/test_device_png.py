@@ -36,27 +36,30 @@ def _image(height: int, width: int, seed: int) -> np.ndarray:
     return image
 
 
-def _compress(image: np.ndarray, words: int | None = None) -> bytes | None:
+def _compress(image: np.ndarray, words: int | None = None, codes=device_png.COLOUR_CODES) -> bytes | None:
     height, width, _ = image.shape
-    room = (device_png.HEADER_BITS + 75 * width * height) // 32 + 2      # the longest a stream can be
+    room = (codes.header_bits + 75 * width * height) // 32 + 2      # the longest a stream can be
     out = wp.zeros(words or room, dtype=wp.uint32, device="cpu")
     meta = wp.zeros(2, dtype=wp.int64, device="cpu")
-    png = device_png.DevicePng(width, height, "cpu", out, meta)
+    png = device_png.DevicePng(width, height, "cpu", out, meta, codes)
     png.queue(wp.array(image.view(np.uint32).reshape(-1), dtype=wp.uint32, device="cpu"))
     return device_png.zlib_stream(meta.numpy(), out.numpy())
 
 
+@pytest.mark.parametrize("labels", [False, True])
 @pytest.mark.parametrize("shape", [(70, 53), (9, 1), (1, 300), (40, 130), (3, 8200)])
-def test_the_stream_is_the_reference_parse_with_the_fixed_codes(shape):
+def test_the_stream_is_the_reference_parse_with_the_fixed_codes(shape, labels):
     """Widths of one pixel, of several match pieces (130 > 2 x 64) and past deflate's window for the line above
-    (8,200 pixels: only the left neighbours are tried)."""
+    (8,200 pixels: only the left neighbours are tried); colour (rows Sub-filtered) and label images (unfiltered,
+    their own codes)."""
     png_codes = _png_codes()
+    codes = device_png.LABEL_CODES if labels else device_png.COLOUR_CODES
     image = _image(*shape, seed=sum(shape))
-    lines = filtered_lines(image)
-    stream = _compress(image)
+    lines = filtered_lines(image, unfiltered=labels)
+    stream = _compress(image, codes=codes)
     symbols = png_codes.pixel_run_parse(lines)
     assert png_codes.replayed(symbols) == lines.tobytes()
-    assert stream == png_codes.zlib_stream(symbols, lines.tobytes(), device_png.LENGTHS, device_png.DISTANCE_LENGTHS)
+    assert stream == png_codes.zlib_stream(symbols, lines.tobytes(), codes.lengths, codes.distance_lengths)
     assert zlib.decompress(stream) == lines.tobytes()                 # zlib checks the Adler-32 too
     if shape == (3, 8200):
         assert {d for _, d in symbols if d} <= {4, 8}
@@ -76,8 +79,9 @@ def test_runs_are_cut_where_their_neighbour_changes_and_every_64_pixels():
 
 def test_the_fixed_header_and_codes_are_those_of_the_code_lengths():
     png_codes = _png_codes()
-    assert png_codes.dynamic_header(device_png.LENGTHS, device_png.DISTANCE_LENGTHS) == \
-        (device_png.HEADER, device_png.HEADER_BITS)
+    for codes in (device_png.COLOUR_CODES, device_png.LABEL_CODES):
+        assert png_codes.dynamic_header(codes.lengths, codes.distance_lengths) == (codes.header, codes.header_bits)
+        assert len(codes.lengths) == 286 and len(codes.distance_lengths) == 30
     assert device_png.sent_codes(device_png.LENGTHS).tolist() == png_codes.sent_codes(device_png.LENGTHS).tolist()
     assert len(device_png.LENGTHS) == 286 and len(device_png.DISTANCE_LENGTHS) == 30
 
@@ -153,7 +157,8 @@ def test_class_masks_are_the_ids_coloured_with_each_palette_and_compressed_with_
         data = encode_png(mask)
         assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), mask)
         if png:
-            assert data == png_file(w, h, 8, 4, _compress(np.ascontiguousarray(mask)))
+            assert data == png_file(w, h, 8, 4, _compress(np.ascontiguousarray(mask), codes=device_png.LABEL_CODES))
+            assert zlib.decompress(mask.zlib_stream) == filtered_lines(np.asarray(mask), unfiltered=True).tobytes()
     assert np.array_equal(frame.codes, codes)
     with pytest.raises(ValueError, match="4 palettes for a layout with room for 2 class masks"):
         layout.set_palettes(palettes * 2)

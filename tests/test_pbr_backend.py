@@ -440,14 +440,16 @@ def _scene_on_pbr(png_on_device: bool):
     return _scene()
 
 
-def _device_stream(image: np.ndarray) -> bytes:
-    """The zlib stream graphsdg.render.device_png makes of an RGBA image on the test's device."""
+def _device_stream(image: np.ndarray, labels: bool = False) -> bytes:
+    """The zlib stream graphsdg.render.device_png makes of an RGBA image (a label image's: ``labels``) on the
+    test's device."""
     import warp as wp
 
     from graphsdg.render import device_png
     room = wp.zeros(W * H * 3, dtype=wp.uint32, device=DEVICE)
     meta = wp.zeros(2, dtype=wp.int64, device=DEVICE)
-    device_png.DevicePng(W, H, DEVICE, room, meta).queue(
+    codes = device_png.LABEL_CODES if labels else device_png.COLOUR_CODES
+    device_png.DevicePng(W, H, DEVICE, room, meta, codes).queue(
         wp.array(np.ascontiguousarray(image).view(np.uint32).reshape(-1), dtype=wp.uint32, device=DEVICE))
     return device_png.zlib_stream(meta.numpy(), room.numpy())
 
@@ -490,8 +492,9 @@ def test_colour_pngs_compressed_on_the_device_are_the_files_basic_writer_writes(
 
 def test_class_masks_coloured_on_the_device_are_the_annotators_and_the_files_basic_writer_writes(tmp_path):
     """With /graphsdg/render/pbrPngOnDevice, the colorized semantic segmentation is coloured and compressed where
-    the ids are drawn: the same pixels as the CPU's lookup, a label image carrying the device's stream, which
-    BasicWriter's file wraps; without the setting the CPU colours it and stores its rows unfiltered."""
+    the ids are drawn: the same pixels as the CPU's lookup, a label image carrying the device's stream (rows
+    unfiltered, the label codes), which BasicWriter's file wraps; without the setting the CPU colours it and
+    stores its rows unfiltered too."""
     import io
     import zlib
 
@@ -525,9 +528,9 @@ def test_class_masks_coloured_on_the_device_are_the_annotators_and_the_files_bas
     assert isinstance(mask, PrecompressedLabelImage) and isinstance(cpu_mask, LabelImage)
     assert not isinstance(cpu_mask, PrecompressedLabelImage) and np.array_equal(mask, cpu_mask)
     assert len({tuple(c) for c in np.asarray(mask).reshape(-1, 4).tolist()}) >= 3    # cube, ball, background
-    assert idat(written) == _device_stream(mask)                       # the data is a view: no stream of its own
+    assert idat(written) == _device_stream(mask, labels=True)          # the data is a view: no stream of its own
     assert np.array_equal(np.asarray(Image.open(io.BytesIO(written))), mask)
-    assert zlib.decompress(idat(written)) == filtered_lines(np.asarray(mask)).tobytes()   # Sub rows
     assert cpu_written == encode_png(cpu_mask) != written
-    assert zlib.decompress(idat(cpu_written)) == filtered_lines(cpu_mask).tobytes()        # unfiltered rows
-    assert set(zlib.decompress(idat(cpu_written))[::W * 4 + 1]) == {0}
+    for png in (written, cpu_written):                                 # both store the mask's rows unfiltered
+        assert zlib.decompress(idat(png)) == filtered_lines(cpu_mask).tobytes()
+        assert set(zlib.decompress(idat(png))[::W * 4 + 1]) == {0}

@@ -401,7 +401,8 @@ def test_a_node_dies_mid_run_and_resume_finishes_it(job_script, bucket, s3_serve
         while time.monotonic() < deadline:
             keys = [o["Key"] for o in client.list_objects_v2(Bucket=bucket, Prefix="killed/basic/rgb_")
                     .get("Contents", [])]
-            if sum(int(k[-8:-4]) % 2 for k in keys) >= 8 and sum(1 - int(k[-8:-4]) % 2 for k in keys) >= 8:
+            # early in each shard's 40 frames: a loaded machine must not finish the run before the kill
+            if sum(int(k[-8:-4]) % 2 for k in keys) >= 4 and sum(1 - int(k[-8:-4]) % 2 for k in keys) >= 4:
                 cluster.remove_node(cluster.extra_node)        # its worker process dies with it
                 killed.set()
                 return
@@ -417,7 +418,7 @@ def test_a_node_dies_mid_run_and_resume_finishes_it(job_script, bucket, s3_serve
     assert "shard" in err and "failed" in err and "--resume" in err
     left = s3_server.objects(bucket, "killed/")
     done = len([k for k in left if k.startswith("basic/rgb_")])
-    assert 16 <= done < frames, "the node was not killed mid-run"
+    assert 8 <= done < frames, "the node was not killed mid-run"
     cluster.extra_node = cluster.add_node(num_cpus=1, resources={"node_b": 1})   # a replacement node
     cluster.wait_for_nodes()
     assert main(args + ["--resume", "--", "--no-coco"]) == 0

@@ -275,8 +275,8 @@ class ClassicLayout:
                                          shape=shape, device=device))
         self.png = device_png.DevicePng(width, height, device, self.png_words, self.png_meta) if png else None
         self._mask_pngs = [device_png.DevicePng(width, height, device, getattr(self, f"mask{k}_words"),
-                                                getattr(self, f"mask{k}_meta")) if png else None
-                           for k in range(self.masks)]
+                                                getattr(self, f"mask{k}_meta"), device_png.LABEL_CODES)
+                           if png else None for k in range(self.masks)]
         # per mask, the code -> packed RGBA table the ids are coloured with, and the host copy last sent
         self._palettes = wp.zeros((max(1, self.masks), len(self.table)), dtype=wp.uint32, device=device)
         self._sent_palettes: np.ndarray | None = None
