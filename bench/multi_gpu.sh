@@ -6,10 +6,10 @@
 #             an empty cache (compiled once, the rest wait)
 #   bake      a cache baked without the GPU (warmup --arch 90 --device cpu, CUDA_VISIBLE_DEVICES empty) then demo,
 #             graphsdg warmup on the GPU then demo, 2 Ray workers on an empty cache
-#   scale     graphsdg bench --gpus 1 2 4 (or what the host has), 8 processes a GPU, pbr: per-GPU rows, scaling
-#             (CUDA MPS as --mps auto decides; MPS=off in the environment runs without it; PER_GPU=16 sets the
-#             processes a GPU; BIND=1 keeps each GPU's processes on its share of the cores, --bind-cores;
-#             ROUNDS=3 runs the counts in turn three times and scales their medians)
+#   scale     graphsdg bench --gpus 1 2 4 (or what the host has), pbr: per-GPU rows, scaling (CUDA MPS as --mps
+#             auto decides; MPS=off in the environment runs without it; PER_GPU=8 sets the processes a GPU, else
+#             bench's default; BIND=on|off sets --bind-cores, else auto: each GPU's processes on its share of the
+#             cores with more than one GPU; ROUNDS=3 runs the counts in turn three times and scales their medians)
 #   classic   the same with the classic rasteriser
 #   procs     one GPU: 4, 8, 16 processes on it (pbr) without CUDA MPS, then 8 and 16 with it where the host has it
 #   shards    a job sharded over every GPU writes the bytes of one process on GPU 0; a killed shard resumes to them
@@ -74,8 +74,9 @@ open(sys.argv[1], 'w').write(gpu_shards.JOB.format(backend='pbr', size=512))" "$
 scale|classic)
   backend=pbr; [ "$part" = classic ] && backend=classic
   warm_cache
-  "${gsdg[@]}" bench "${four[@]}" --backend "$backend" --gpus "${counts[@]}" --processes-per-gpu "${PER_GPU:-8}" \
-    --seconds 20 --num-frames 200000 --mps "${MPS:-auto}" ${BIND:+--bind-cores} --rounds "${ROUNDS:-1}" --report "$report"
+  "${gsdg[@]}" bench "${four[@]}" --backend "$backend" --gpus "${counts[@]}" ${PER_GPU:+--processes-per-gpu "$PER_GPU"} \
+    --seconds 20 --num-frames 200000 --mps "${MPS:-auto}" --bind-cores "${BIND:-auto}" --rounds "${ROUNDS:-1}" \
+    --report "$report"
   ;;
 procs)
   warm_cache
