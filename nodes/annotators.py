@@ -24,6 +24,7 @@ from graphsdg.annotate.ids import BACKGROUND_ID, UNLABELLED_ID, color_of
 from graphsdg.annotate.motion import motion_vectors as motion_between
 from graphsdg.annotate.semantic_filter import SemanticFilter
 from graphsdg.annotate.skeletons import skeleton_data as skeletons_seen
+from graphsdg.imaging.label_image import label_image
 from graphsdg.maths.reference_time import reference_time as maths_reference_time
 
 BBOX_2D_DTYPE = np.dtype([("semanticId", "<u4"), ("x_min", "<i4"), ("y_min", "<i4"), ("x_max", "<i4"),
@@ -62,6 +63,7 @@ def present_ids(ids: np.ndarray) -> np.ndarray:
 
 
 def _colorize(ids: np.ndarray, present: np.ndarray | None = None) -> np.ndarray:
+    """The id image coloured with :func:`color_of`, a label image (its PNG's rows stored unfiltered)."""
     present = present_ids(ids) if present is None else present
     colors = np.array([color_of(int(i)) for i in present], dtype=np.uint8).reshape(-1, 4)
     if present.size and int(present[-1]) < (1 << 20):
@@ -69,8 +71,8 @@ def _colorize(ids: np.ndarray, present: np.ndarray | None = None) -> np.ndarray:
         lut = np.zeros((int(present[-1]) + 1, 4), dtype=np.uint8)
         lut[present] = colors
         packed = lut.view(np.uint32)[:, 0][ids]
-        return packed.view(np.uint8).reshape(*ids.shape, 4)
-    return colors[np.searchsorted(present, ids)]
+        return label_image(packed.view(np.uint8).reshape(*ids.shape, 4))
+    return label_image(colors[np.searchsorted(present, ids)])
 
 
 def _color_key(id_: int) -> str:

@@ -664,6 +664,15 @@ def test_basic_writer_writes_every_flag(out_dir):
     assert params["renderProductResolution"] == [W, H] and len(params["cameraViewTransform"]) == 16
     assert load("skeleton_0001.json") == {}
     assert load("distance_to_camera_0001.png").dtype == np.uint8
+    # the class masks' rows are stored unfiltered (label images), the colour's and the colorized depth's Sub
+    import zlib
+    for stem, filter_type in (("semantic_segmentation", 0), ("instance_segmentation", 0),
+                              ("instance_id_segmentation", 0), ("rgb", 1), ("distance_to_camera", 1)):
+        png = open(os.path.join(out_dir, f"{stem}_0001.png"), "rb").read()
+        start = png.index(b"IDAT") + 4
+        lines = zlib.decompress(png[start:start + int.from_bytes(png[start - 8:start - 4], "big")])
+        row = len(lines) // H
+        assert set(lines[::row]) == {filter_type}, stem
 
 
 def test_orthographic_camera_boxes_depth_and_normals():
