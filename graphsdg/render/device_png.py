@@ -2,19 +2,20 @@
 
 A written frame's colour PNG (rows filtered, then deflated) was the largest CPU cost of its writing, and on a host
 feeding four GPUs the cores' shared memory bus runs out first (docs/performance.md, "The CPU a frame").
-This module compresses the RGBA colour of a :class:`~graphsdg.render.pbr_outputs.ClassicLayout` on its device
-in kernels of a thread a pixel, so only the zlib stream comes back for the writer to wrap as a PNG.
+This module compresses the RGBA colour and class masks of a :class:`~graphsdg.render.pbr_outputs.ClassicLayout`
+on its device in kernels of a thread a pixel, so only the zlib stream comes back for the writer to wrap as a PNG.
 
 The stream holds the image's rows as :func:`graphsdg.io.png.encode_png` filters them (``Sub``; a class mask's
 rows unfiltered) in one deflate block (RFC 1950/1951) whose Huffman codes are fixed in this module
-(:data:`COLOUR_CODES`, :data:`LABEL_CODES`), so a frame needs no count of its symbols and no wait for one. The parse is made of whole pixels: each line's filter byte is a
-literal; each pixel takes the first of :data:`NEIGHBOURS` whose filtered bytes equal its own, or none (four
-literals); a match starts at each pixel that takes a neighbour where its left pixel takes another (or none), and
-at each pixel whose x is a multiple of :data:`PIECE`, and covers the pixels after it that take the same
-neighbour, up to the next start. ``bench/png_codes.py`` makes the same parse on the CPU (``pixel_run_parse``),
-and the tests compare the bytes. The files are about a tenth larger than ISA-L's level 1 of the same rows
-(docs/performance.md); a stream longer than the room the layout reads back (:func:`stream_words`) is reported
-as none, and that frame's PNG is compressed on the CPU as before.
+(:data:`COLOUR_CODES`, :data:`LABEL_CODES`), so a frame needs no count of its symbols and no wait for one.
+The parse is made of whole pixels: each line's filter byte is a literal; each pixel takes the first of
+:data:`NEIGHBOURS` whose filtered bytes equal its own, or none (four literals); a match starts at each pixel
+that takes a neighbour where its left pixel takes another (or none), and at each pixel whose x is a multiple
+of :data:`PIECE`, and covers the pixels after it that take the same neighbour, up to the next start.
+``bench/png_codes.py`` makes the same parse on the CPU (``pixel_run_parse``), and the tests compare the bytes.
+The files are larger than ISA-L's level 1 of the same rows (docs/performance.md); a stream longer than the
+room the layout reads back (:func:`stream_words`) is reported as none, and that frame's PNG is compressed on
+the CPU as before.
 
 Kernels, one launch each: the pixels' filtered words and neighbours (``_modes``), each pixel's match length
 and bits (``_bits``), a prefix sum of the bits, the bits written at their offsets (``_write``, words two pixels
@@ -33,7 +34,7 @@ import warp as wp
 ADLER = 65521
 ADLER_CONST = wp.constant(ADLER)
 PIECE = wp.constant(64)          # pixels a match covers at most: 256 bytes (deflate's longest is 258)
-ADLER_PIECE = 32                 # pixels a thread sums for the Adler-32 (a thread a line left the GPU idle)
+ADLER_PIECE = 32                 # pixels a thread sums for the Adler-32
 ADLER_PIECE_CONST = wp.constant(ADLER_PIECE)
 #: the pixels a pixel may repeat, in the order tried, as (dy, dx): left, above, above-left, above-right, two left
 NEIGHBOURS = ((0, -1), (-1, 0), (-1, -1), (-1, 1), (0, -2))
