@@ -89,7 +89,8 @@ def greedy_parse(stream: np.ndarray, best: np.ndarray, best_distance: np.ndarray
 def pixel_run_parse(lines: np.ndarray, piece: int = 64) -> list[tuple[int, int]]:
     """The parse of :mod:`graphsdg.render.device_png`, made here one pixel after another: its reference.
 
-    ``lines``: the filtered lines of an RGBA image (Sub, or unfiltered for a label image), (H, 1 + 4 W) bytes. Each line's filter byte is a literal.
+    ``lines``: the filtered lines of an RGBA image (Sub, or unfiltered for a label image), (H, 1 + 4 W) bytes.
+    Each line's filter byte is a literal.
     Each pixel takes the first of its neighbours left, above, above-left, above-right and two to the left
     (:data:`~graphsdg.render.device_png.NEIGHBOURS`, those in the image and at most 32,768 bytes back) whose
     filtered bytes equal its own, or none: 4 literals. A match starts at each pixel that takes a neighbour
