@@ -40,15 +40,19 @@ ADLER_PIECE_CONST = wp.constant(ADLER_PIECE)
 NEIGHBOURS = ((0, -1), (-1, 0), (-1, -1), (-1, 1), (0, -2))
 _WINDOW = 32768                  # deflate's distances reach this far back
 
+def _lengths(digits: str) -> np.ndarray:
+    """Code lengths written one hex digit a symbol."""
+    return np.array([int(c, 16) for c in digits], dtype=np.int64)
+
+
 #: code lengths of the 286 literal/length symbols and the 30 distance symbols, one hex digit each: built (length-
 #: limited Huffman codes, every symbol counted once more) from the parse of five colour frames, pbr and classic
 #: renders of the bench scene (``bench/png_codes.py``)
-LENGTHS = np.array([int(c, 16) for c in
-                    "2456666777778888888999999999999aaa9aaaaaaa9aaaaaabaaabbbaaabbbbbabbbbbbbbbbbbbbbbbbbbbbbcccdc"
-                    "cccccccccccccccccceccccccccccbcccccccbcccccccccbcccccccccbcbccccccccbcccccbcccaabbbbbbbbbbbbba"
-                    "bbbbbabbbbbbbabbabbbbbbaaa98aaaaaaaaaaaaaaaaaaa99a9999999988888777665ff3fff5ff7f9f999a99998999"
-                    "8884f"], dtype=np.int64)
-DISTANCE_LENGTHS = np.array([int(c, 16) for c in "999194999999999999999329888888"], dtype=np.int64)
+LENGTHS = _lengths("2456666777778888888999999999999aaa9aaaaaaa9aaaaaabaaabbbaaabbbbbabbbbbbbbbbbbbbbbbbbbbbbcccdc"
+                   "cccccccccccccccccceccccccccccbcccccccbcccccccccbcccccccccbcbccccccccbcccccbcccaabbbbbbbbbbbbba"
+                   "bbbbbabbbbbbbabbabbbbbbaaa98aaaaaaaaaaaaaaaaaaa99a9999999988888777665ff3fff5ff7f9f999a99998999"
+                   "8884f")
+DISTANCE_LENGTHS = _lengths("999194999999999999999329888888")
 #: the dynamic block's header for these codes (BFINAL, BTYPE 10, the code lengths' own code), least bit first
 HEADER = int("20d5f5d2cc5ba3e92bdcccd2460b24ad59eecfbbb5eecfbef39ce86b164b3331adb41c4ec390ecc3b5b4a53729a6dca6dca"
              "7290cbff332bfb6a6661c876c49db18cb32db462c34385e7ef7e7ffe79e79d8005fded", 16)
@@ -56,12 +60,11 @@ HEADER_BITS = 674
 #: the same for label images (class masks), whose rows are stored unfiltered: built from the parse of five class
 #: masks of the bench scene with every literal counted alike (a mask's literals are its labels' colours, which
 #: differ from scene to scene), every symbol once more
-LABEL_LENGTHS = np.array([int(c, 16) for c in
-                          "4dcccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccc"
-                          "cccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccc"
-                          "ccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccef2fff6ff6f6f6"
-                          "666666655565552e"], dtype=np.int64)
-LABEL_DISTANCE_LENGTHS = np.array([int(c, 16) for c in "999194999999999999999329888888"], dtype=np.int64)
+LABEL_LENGTHS = _lengths("4dcccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccc"
+                         "cccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccc"
+                         "ccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccccef2fff6ff6f6f6"
+                         "666666655565552e")
+LABEL_DISTANCE_LENGTHS = _lengths("999194999999999999999329888888")
 LABEL_HEADER = int("11f93df2762793e49b9cccecccef5dbb76ddb4f6f7edb6db6db6db6db6db6db6db6db6db6d7ff3dfb7fd84118e003fded",
                    16)
 LABEL_HEADER_BITS = 385

@@ -280,6 +280,7 @@ class ClassicLayout:
         # per mask, the code -> packed RGBA table the ids are coloured with, and the host copy last sent
         self._palettes = wp.zeros((max(1, self.masks), len(self.table)), dtype=wp.uint32, device=device)
         self._sent_palettes: np.ndarray | None = None
+        self._palettes_given: tuple = ()
         self._adrs: dict[tuple, int] = {}
         self._wanted = (False, False, False, False, 0)   # (colour, depth, ids, stream, masks) of the read last queued
 
@@ -290,8 +291,10 @@ class ClassicLayout:
         up. Sent to the device only when they change (queued before the conversion that uses them)."""
         if len(palettes) > self.masks:
             raise ValueError(f"{len(palettes)} palettes for a layout with room for {self.masks} class masks")
-        if not palettes:
-            return
+        if not palettes or (len(palettes) == len(self._palettes_given)
+                            and all(a is b for a, b in zip(palettes, self._palettes_given))):
+            return                   # the same arrays as last frame (kept by the labels until they change)
+        self._palettes_given = tuple(palettes)
         per_code = np.stack([np.asarray(p, dtype=np.uint32)[self.table] for p in palettes])   # code -> geom -> RGBA
         if self._sent_palettes is not None and np.array_equal(per_code, self._sent_palettes[:len(palettes)]):
             return
