@@ -159,6 +159,22 @@ def test_file_system_of_names_the_deepest_mount_holding_the_path(tmp_path):
         assert file_system_of("/dev/shm/any/file") == mounts["/dev/shm"]
 
 
+def test_huge_pages_of_reads_a_tmpfs_mounts_huge_option(tmp_path):
+    from graphsdg.benchmark.throughput import file_system_of, huge_pages_of
+    mounts = tmp_path / "mounts"
+    mounts.write_text("/dev/vda / ext4 rw,relatime 0 0\n"
+                      "tmpfs /dev/shm tmpfs rw,relatime,size=536870912k,huge=within_size 0 0\n"
+                      "tmpfs /tmp/small tmpfs rw,relatime,huge=never 0 0\n"
+                      "tmpfs /run tmpfs rw,nosuid,size=100k 0 0\n"
+                      "/dev/vdb /data\\040set xfs rw,huge=always 0 0\n")
+    assert huge_pages_of("/dev/shm/out/frame.npy", str(mounts)) == "within_size"
+    assert huge_pages_of("/tmp/small/x", str(mounts)) is None           # small pages said outright
+    assert huge_pages_of("/run/x", str(mounts)) is None                 # the default: small pages
+    assert huge_pages_of("/data set/x", str(mounts)) is None            # not a tmpfs
+    assert file_system_of("/data set/x", str(mounts)) == "xfs"
+    assert huge_pages_of("/x", str(tmp_path / "absent")) is None
+
+
 def test_a_bench_run_writes_its_frames_inside_temp_dir_and_removes_them(tmp_path):
     import os
 

@@ -167,27 +167,42 @@ def _writer_processes_cpu_counters() -> np.ndarray:
     return total
 
 
-def file_system_of(path: str) -> str:
-    """The type of the file system holding ``path`` (``ext4``, ``tmpfs``, ...), from /proc/mounts; "unknown"
+def file_system_of(path: str, mounts: str = "/proc/mounts") -> str:
+    """The type of the file system holding ``path`` (``ext4``, ``tmpfs``, ...), from ``mounts``; "unknown"
     where that cannot be read.
 
     Example:
         >>> file_system_of("/proc")
         'proc'
     """
+    return _mount_of(path, mounts)[0]
+
+
+def huge_pages_of(path: str, mounts: str = "/proc/mounts") -> str | None:
+    """The ``huge=`` option of the tmpfs holding ``path`` (``always``, ``within_size``, ``advise``), or None where
+    it is not a tmpfs or gives its files small pages only. A tmpfs with large pages allocates a written file's
+    memory in far fewer pieces, which decides how fast many processes writing at once can go
+    (docs/performance.md, "Four GPUs and the output file system")."""
+    kind, options = _mount_of(path, mounts)
+    huge = dict(o.partition("=")[::2] for o in options.split(",")).get("huge", "never")
+    return huge if kind == "tmpfs" and huge not in ("never", "deny") else None
+
+
+def _mount_of(path: str, mounts: str) -> tuple[str, str]:
+    """(type, options) of the deepest mount in ``mounts`` holding ``path``; ("unknown", "") where unreadable."""
     try:
-        with open("/proc/mounts") as f:
-            mounts = [line.split()[1:3] for line in f]
+        with open(mounts) as f:
+            rows = [line.split()[1:4] for line in f]
     except OSError:
-        return "unknown"
+        return "unknown", ""
     real = os.path.realpath(path)
-    best, kind = "", "unknown"
-    for point, fs in mounts:
+    best, found = "", ("unknown", "")
+    for point, fs, options in rows:
         point = point.replace("\\040", " ")
         inside = real == point or real.startswith(point.rstrip("/") + "/")
         if inside and len(point) >= len(best):
-            best, kind = point, fs
-    return kind
+            best, found = point, (fs, options)
+    return found
 
 
 def _peak_rss_mb() -> float:

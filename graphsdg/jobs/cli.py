@@ -326,12 +326,14 @@ def _folder(value: str) -> str:
 
 
 def _written_where(temp_dir: str | None) -> str:
-    """Where the bench's frames go, for its report: the folder and its file system's type."""
+    """Where the bench's frames go, for its report: the folder, its file system's type and a tmpfs's large
+    pages."""
     import tempfile
 
-    from graphsdg.benchmark.throughput import file_system_of
+    from graphsdg.benchmark.throughput import file_system_of, huge_pages_of
     folder = temp_dir or tempfile.gettempdir()
-    return f"{folder} ({file_system_of(folder)})"
+    huge = huge_pages_of(folder)
+    return f"{folder} ({file_system_of(folder)}{f', huge={huge}' if huge else ''})"
 
 
 def _positive(value: str) -> int:
