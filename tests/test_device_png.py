@@ -126,30 +126,6 @@ def test_a_layout_reads_the_stream_with_the_colour_and_lends_a_precompressed_ima
     assert type(plain.take().rgba) is np.ndarray
 
 
-def test_a_stream_past_its_reach_is_read_whole_and_widens_the_reach():
-    """A read copies each stream's words only as far as ``reach``: a longer stream's rest is copied when the
-    frame is taken (the same bytes as a read of the whole room), and the next reads reach 1.25 times as far;
-    the masks' streams keep their own reach."""
-    h, w = 16, 24
-    layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4, png=True, masks=1)
-    image = _image(h, w, seed=7)
-    image[:h // 2] = 40                           # flat enough for the layout's room
-    layout.rgba.assign(wp.array(image.view(np.uint32).reshape(-1), dtype=wp.uint32, device="cpu"))
-    layout.png.queue(layout.rgba)
-    layout.set_palettes([np.arange(5, dtype=np.uint32) * 0x01020304])
-    layout.queue_masks(1)
-    layout.reach["png"] = 4
-    layout.queue_read(colour=True, depth=False, ids=True, stream=True, masks=1)
-    frame = layout.take()
-    full = _compress(image)
-    assert full is not None and len(full) > 4 * 4 + 6                   # longer than the reach
-    assert frame.rgba.zlib_stream == full
-    assert layout.reach["png"] >= (len(full) - 6) // 4 * 5 // 4 > 4
-    assert layout.reach["mask0"] == layout.png_words.shape[0]             # a small image's whole room
-    assert zlib.decompress(frame.id_colours[0].zlib_stream) == \
-        filtered_lines(np.asarray(frame.id_colours[0]), unfiltered=True).tobytes()
-
-
 @pytest.mark.parametrize("png", [True, False])
 def test_class_masks_are_the_ids_coloured_with_each_palette_and_compressed_with_them(png):
     """ClassicLayout(masks=2): each mask is its palette at every pixel's geom (code 0 and codes past the model:

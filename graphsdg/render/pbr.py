@@ -165,10 +165,9 @@ class PbrRenderer:
         import warp as wp
 
         from graphsdg.render import (backend, launch_graph, megakernel_launch, pbr_meshes, pbr_outputs, pbr_scene_bvh,
-                                     pbr_uploads, warp_calls)
+                                     pbr_uploads)
         if wp.get_device(device or "cuda:0").is_cuda:
             kernel_cache.compile_in_background(self.FIRST_FRAME_MODULES, device or "cuda:0")
-            warp_calls.keep_lock_for_short_calls()   # a frame's launches and polls beside a writer thread
         backend.pbr_in_use = True
         self._wp, self._mjw, self._mjpbr = wp, mjw, mjpbr
         self._outputs, self._meshes, self._uploads = pbr_outputs, pbr_meshes, pbr_uploads

@@ -34,7 +34,7 @@ import warp as wp
 
 from graphsdg.imaging.label_image import label_image
 from graphsdg.imaging.precompressed import precompressed
-from graphsdg.render import device_png, warp_calls
+from graphsdg.render import device_png
 from graphsdg.render.polling import wait_until
 
 GEOM_TYPE = 5          # mujoco.mjtObj.mjOBJ_GEOM, as the renderer writes it into segmentation pairs
@@ -252,20 +252,15 @@ class ClassicLayout:
         # The outputs lie in one device allocation, mirrored by one page-locked host buffer, so a frame's reads
         # are one copy of the span they cover, not one per array (each copy is a driver call of its own).
         png = png and device_png.fits(width, height)
-        # the stream's length right after the colour: a read of the colour alone is one span without the other
-        # passes; the streams' words last, each read only as far as its streams have reached (:meth:`queue_read`)
+        # the stream right after the colour: a read of the colour alone is one span without the other passes
         words = device_png.stream_words(width, height)
-        parts = [("rgba", wp.uint32, (n,)), *([("png_meta", wp.int64, (2,))] if png else []),
-                 ("depth", wp.float32, (n,)), ("codes", _WARP_CODE_TYPES[code_type], (n,)),
-                 ("boxes", wp.int32, (self.ngeom + 1, 4))]
+        stream = [("png_meta", wp.int64, (2,)), ("png_words", wp.uint32, (words,))]
+        parts = [("rgba", wp.uint32, (n,)), *(stream if png else []), ("depth", wp.float32, (n,)),
+                 ("codes", _WARP_CODE_TYPES[code_type], (n,)), ("boxes", wp.int32, (self.ngeom + 1, 4))]
         self.masks = int(masks)
         for k in range(self.masks):          # after the ids: a read of the ids and masks is one span
-            parts += [(f"mask{k}", wp.uint32, (n,)), *([(f"mask{k}_meta", wp.int64, (2,))] if png else [])]
-        streams = ["png", *(f"mask{k}" for k in range(self.masks))] if png else []
-        parts += [(f"{name}_words", wp.uint32, (words,)) for name in streams]
-        # words of each stream a read copies: an eighth of the room at first, then 1.25 times the longest stream
-        # so far; a longer stream's rest is copied when its frame is taken, so the bytes never depend on it
-        self.reach = {name: max(words // 8, min(words, 1024)) for name in streams}
+            parts += [(f"mask{k}", wp.uint32, (n,)),
+                      *([(f"mask{k}_meta", wp.int64, (2,)), (f"mask{k}_words", wp.uint32, (words,))] if png else [])]
         self._spans: dict[str, tuple[int, int, np.dtype, tuple]] = {}
         end = 0
         for name, dtype, shape in parts:
@@ -355,55 +350,20 @@ class ClassicLayout:
                   ("png_words", colour and stream and compresses), ("depth", depth), ("codes", ids), ("boxes", ids)]
         for k in range(masks):
             wanted += [(f"mask{k}", True), (f"mask{k}_meta", compresses), (f"mask{k}_words", compresses)]
-        return sorted((name for name, want in wanted if want), key=lambda name: self._spans[name][0])
+        return [name for name, want in wanted if want]
 
     def queue_read(self, colour: bool, depth: bool, ids: bool, stream: bool = False, masks: int = 0) -> None:
         """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds:
         converted with ``boxes``; with ``stream``, the colour's PNG stream: converted with ``png``; the first
         ``masks`` class masks, with their streams where this layout compresses: converted with as many) into a
-        page-locked host buffer, and one of each asked-for stream's words as far as :attr:`reach` (the rest,
-        if any, is copied by :meth:`take`)."""
+        page-locked host buffer."""
         self._wanted = (colour, depth, ids, stream, masks)
         parts = self._parts()
         if parts:
             self._reading = self.host.acquire()
-            target = self._target()
-            dense = [name for name in parts if not name.endswith("_words")]
-            if dense:
-                self._copy(target, self._spans[dense[0]][0], self._spans[dense[-1]][1])
-            for name in parts:
-                if name.endswith("_words"):
-                    start = self._spans[name][0]
-                    self._copy(target, start, start + 4 * self.reach[name[:-len("_words")]])
-
-    def _target(self) -> Any:
-        """The page-locked buffer the read last queued goes into."""
-        return self.host.spare if self._reading is None else self.host.buffer(self._reading)
-
-    def _copy(self, target: Any, lo: int, hi: int) -> None:
-        with warp_calls.page_locked_copies():     # the host buffers are page-locked wherever the device is a GPU
+            target = self.host.spare if self._reading is None else self.host.buffer(self._reading)
+            lo, hi = self._spans[parts[0]][0], self._spans[parts[-1]][1]
             wp.copy(target, self._device_bytes, dest_offset=lo, src_offset=lo, count=hi - lo)
-
-    def _read_rest_of_streams(self, parts: list[str]) -> None:
-        """Copy the words of each stream read that went past its reach (waiting for them: the layout's device
-        buffers still hold the frame, since a render takes its frames before converting the next), and widen
-        the reach for the next frames."""
-        target, rest = self._target(), []
-        for name in parts:
-            if name.endswith("_words"):
-                stream = name[:-len("_words")]
-                meta_start = self._spans[f"{stream}_meta"][0]
-                bits = int(target.numpy()[meta_start:meta_start + 8].view(np.int64)[0])
-                needed = -(-bits // 32)
-                reach = self.reach[stream]
-                if needed > reach:
-                    start = self._spans[name][0]
-                    self._copy(target, start + 4 * reach, start + 4 * needed)
-                    rest.append(stream)
-                capacity = self._spans[name][3][0]
-                self.reach[stream] = min(capacity, max(reach, needed + needed // 4))
-        if rest and wp.get_device(self.device).is_cuda:
-            wp.synchronize_stream(wp.get_stream(self.device))
 
     def take(self) -> HostFrame:
         """The queued copies (done) as arrays: views of the page-locked buffer they were read into, lent until
@@ -412,7 +372,6 @@ class ClassicLayout:
         parts = self._parts()
         if not parts:
             return HostFrame(rgba=None, depth=None, codes=None)
-        self._read_rest_of_streams(parts)
         if self._reading is None:
             whole, lent = self.host.spare.numpy(), False
         else:

@@ -20,7 +20,6 @@ from typing import Any
 import numpy as np
 import warp as wp
 
-from graphsdg.render import warp_calls
 from graphsdg.render.polling import wait_until
 
 _ALIGN = 256      # bytes: each gathered array's start in the allocation
@@ -100,16 +99,14 @@ class PinnedUploads:
             self._buffers[name] = entry
         host, view = entry
         _fill(name, view, values, target)
-        with warp_calls.page_locked_copies():
-            wp.copy(target, host)
+        wp.copy(target, host)
 
     def end(self) -> None:
         """End a round: send the gathered arrays if any was put, and mark where the round's copies end, so
         the next round's :meth:`begin` can wait for them."""
         if self._arena_put:
             device_bytes, host_bytes = self._arena
-            with warp_calls.page_locked_copies():
-                wp.copy(device_bytes, host_bytes)
+            wp.copy(device_bytes, host_bytes)
             self._arena_put = False
         if self._pinned and (self._buffers or self._arena is not None):
             self._done = wp.record_event()
