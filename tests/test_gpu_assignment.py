@@ -228,7 +228,9 @@ def test_bench_processes_each_start_on_their_own_gpu(monkeypatch):
     run = run_on_gpus(config, 3, gpus)          # no NVIDIA GPU here: each renders with Mesa, bound to nothing
     assert run.total["GPUs"] == 2 and run.total["processes"] == 3
     assert [(r["GPU"], r["processes"]) for r in run.per_gpu] == [("GPU 0 (first)", 2), ("GPU 3 (fourth)", 1)]
-    assert all(r["frames/s"] > 0 and r["GPU busy %"] == "-" for r in run.per_gpu)
+    assert all(r["frames/s"] > 0 and r["GPU busy %"] == "-" and r["SM clock MHz"] == "-" for r in run.per_gpu)
+    stolen = run.total["CPU stolen by the host %"]
+    assert stolen == "-" or 0.0 <= stolen <= 100.0
     with pytest.raises(ValueError, match="--processes 1 cannot keep --gpus 2 busy"):
         run_on_gpus(config, 1, gpus)
 

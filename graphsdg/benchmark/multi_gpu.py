@@ -3,9 +3,10 @@
 The processes are dealt out to the first K GPUs this process sees
 (:mod:`graphsdg.render.gpu_assignment`): each starts with ``CUDA_VISIBLE_DEVICES`` naming its GPU, so its
 CUDA device (Warp, the pbr backend) and, at import, its EGL device (the classic rasteriser) are that GPU.
-The table has the run's total row (:func:`graphsdg.benchmark.throughput.summarize_processes`) and a row per
-GPU: its processes, their frames/s over their common window and while all of them ran, the CPU time a
-frame, and how busy the GPU was (``nvidia-smi``, :mod:`graphsdg.benchmark.gpu_sampler`). Several counts
+The table has the run's total row (:func:`graphsdg.benchmark.throughput.summarize_processes`, with the share
+of the machine's CPU time a virtual machine's host took meanwhile: :mod:`graphsdg.benchmark.host_steal`) and a
+row per GPU: its processes, their frames/s over their common window and while all of them ran, the CPU time a
+frame, and how busy the GPU was and at what clock (``nvidia-smi``, :mod:`graphsdg.benchmark.gpu_sampler`). Several counts
 (``--gpus 1 2 4``) run one after the other and end with a scaling table: frames/s, frames/s a GPU, and the
 scaling efficiency, each count's rate a GPU over the smallest count's. With ``--rounds K`` the counts run K
 times in turn (1, 2, 4, 1, 2, 4, ...): runs of one configuration on a shared host vary by tens of percent, so
@@ -28,6 +29,7 @@ from dataclasses import dataclass, field
 
 from graphsdg.base.cpu_share import cpu_list
 from graphsdg.benchmark.gpu_sampler import GpuSampler, summarize
+from graphsdg.benchmark.host_steal import CpuTimesSampler, steal_percent
 from graphsdg.benchmark.throughput import BenchConfig, _steady_rate, launch_processes, summarize_processes
 from graphsdg.render.gpu_assignment import GpuInfo, gpu_of_process, process_environment
 
@@ -58,26 +60,27 @@ def run_on_gpus(config: BenchConfig, processes: int, gpus: list[GpuInfo],
     environments = [process_environment(gpu) for gpu in placed]
     bound = [cores[gpu.index] for gpu in placed] if cores is not None else None
     started = time.time()
-    with GpuSampler() as sampler:
+    with GpuSampler() as sampler, CpuTimesSampler() as host:
         results, elapsed, config = launch_processes(config, processes, environments, bound)
     total = summarize_processes(results, config, elapsed)
-    total = {"GPUs": len(gpus), **total}
     lo = max((r["start"] for r in results), default=started)
     hi = min((r["start"] + r["wall"] for r in results), default=time.time())
+    stolen = steal_percent(host.samples, lo, hi)
+    total = {"GPUs": len(gpus), **total, "CPU stolen by the host %": "-" if stolen is None else stolen}
     busy = summarize(sampler.samples, lo, hi)
     return GpuRun(gpus=list(gpus), total=total, per_gpu=per_gpu_rows(results, gpus, busy, cores))
 
 
-def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple[float, float]],
+def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple[float, float, float]],
                  cores: dict[int, list[int]] | None = None) -> list[dict]:
     """A row per GPU from the processes' results (each names its ``gpu`` index) and ``busy``
-    (:func:`graphsdg.benchmark.gpu_sampler.summarize`: index -> (busy %, memory MiB)); with ``cores``, the cores
-    its processes were bound to.
+    (:func:`graphsdg.benchmark.gpu_sampler.summarize`: index -> (busy %, memory MiB, SM clock MHz)); with
+    ``cores``, the cores its processes were bound to.
 
     Example:
         >>> a = {"gpu": 0, "frames": 100, "start": 0.0, "wall": 10.0, "cpu": 5.0, "frame_ends": [10.0]}
         >>> b = {"gpu": 1, "frames": 50, "start": 0.0, "wall": 10.0, "cpu": 5.0, "frame_ends": [10.0]}
-        >>> rows = per_gpu_rows([a, b], [GpuInfo(0), GpuInfo(1)], {0: (90.0, 4000.0)})
+        >>> rows = per_gpu_rows([a, b], [GpuInfo(0), GpuInfo(1)], {0: (90.0, 4000.0, 1980.0)})
         >>> [(r["GPU"], r["frames/s"], r["CPU ms per frame"], r["GPU busy %"]) for r in rows]
         [('GPU 0', 10.0, 50.0, 90.0), ('GPU 1', 5.0, 100.0, '-')]
     """
@@ -89,12 +92,12 @@ def per_gpu_rows(results: list[dict], gpus: list[GpuInfo], busy: dict[int, tuple
         window = max(r["start"] + r["wall"] for r in mine) - min(r["start"] for r in mine)
         frames = sum(r["frames"] for r in mine)
         steady = _steady_rate(mine)
-        percent, memory = busy.get(gpu.index, ("-", "-"))
+        percent, memory, clock = busy.get(gpu.index, ("-", "-", "-"))
         rows.append({"GPU": gpu.label(), "processes": len(mine),
                      "frames/s": round(frames / window, 1) if window > 0 else 0.0,
                      "steady frames/s": round(steady, 1) if steady == steady else "-",
                      "CPU ms per frame": round(1000 * sum(r["cpu"] for r in mine) / frames, 1) if frames else 0.0,
-                     "GPU busy %": percent, "GPU memory MiB": memory})
+                     "GPU busy %": percent, "GPU memory MiB": memory, "SM clock MHz": clock})
         if cores is not None:
             rows[-1]["cores"] = cpu_list(cores[gpu.index])
     return rows
