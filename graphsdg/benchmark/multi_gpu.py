@@ -6,12 +6,12 @@ CUDA device (Warp, the pbr backend) and, at import, its EGL device (the classic 
 The table has the run's total row (:func:`graphsdg.benchmark.throughput.summarize_processes`, with the share
 of the machine's CPU time a virtual machine's host took meanwhile: :mod:`graphsdg.benchmark.host_steal`) and a
 row per GPU: its processes, their frames/s over their common window and while all of them ran, the CPU time a
-frame, and how busy the GPU was and at what clock (``nvidia-smi``, :mod:`graphsdg.benchmark.gpu_sampler`). Several counts
-(``--gpus 1 2 4``) run one after the other and end with a scaling table: frames/s, frames/s a GPU, and the
-scaling efficiency, each count's rate a GPU over the smallest count's. With ``--rounds K`` the counts run K
-times in turn (1, 2, 4, 1, 2, 4, ...): runs of one configuration on a shared host vary by tens of percent, so
-:func:`round_rows` gives each round's rates and its own ratios, and the scaling table is made of each count's
-median run (:func:`median_runs`).
+frame, and how busy the GPU was and at what clock (``nvidia-smi``, :mod:`graphsdg.benchmark.gpu_sampler`).
+Several counts (``--gpus 1 2 4``) run one after the other and end with a scaling table: frames/s, frames/s a
+GPU, and the scaling efficiency, each count's rate a GPU over the smallest count's. With ``--rounds K`` the
+counts run K times in turn (1, 2, 4, 1, 2, 4, ...): runs of one configuration on a shared host vary by tens of
+percent, so :func:`round_rows` gives each round's rates and its own ratios, and the scaling table is made of
+each count's median run (:func:`median_runs`).
 
 Example:
     >>> one = GpuRun(gpus=[GpuInfo(0)], total={"processes": 8, "aggregate frames/s (all frames / common window)":
