@@ -94,6 +94,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--pin-main", type=int, default=None, help="pin the main thread to this core after warm-up")
     p.add_argument("--hand", action="store_true", help="also time the hand-written loop")
     p.add_argument("--backend", choices=("classic", "pbr"), default="classic", help="renderer (default: classic)")
+    p.add_argument("--pbr-device", default=None,
+                   help="Warp device pbr renders on, /graphsdg/render/pbrDevice (cpu: without a GPU, slowly)")
     p.add_argument("--phase-cpu", action="store_true",
                    help="time phases (and frames) in the CPU time of the thread that runs them, not wall time")
     a = p.parse_args(argv)
@@ -101,6 +103,9 @@ def main(argv: list[str] | None = None) -> int:
         time.perf_counter = time.thread_time   # every phase timer and the frame clock read it at call time
     if a.switch_interval is not None:
         sys.setswitchinterval(a.switch_interval)
+    if a.pbr_device is not None:
+        from graphsdg import settings
+        settings.set("/graphsdg/render/pbrDevice", a.pbr_device)
     if a.inline_writes:
         from graphsdg.io.write_queue import WriteQueue
         WriteQueue._start_threads = lambda self, wanted=1: False   # the queue's own fallback: run tasks in place
