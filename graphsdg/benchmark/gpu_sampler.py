@@ -14,9 +14,10 @@ Example:
 from __future__ import annotations
 
 import subprocess
-import threading
 import time
 from dataclasses import dataclass
+
+from graphsdg.benchmark.periodic_sampler import PeriodicSampler
 
 QUERY = ["nvidia-smi", "--query-gpu=index,utilization.gpu,memory.used,clocks.sm", "--format=csv,noheader,nounits"]
 
@@ -59,39 +60,23 @@ def summarize(samples: list[GpuSample], start: float, end: float) -> dict[int, t
             for i, v in sorted(by_gpu.items())}
 
 
-class GpuSampler:
-    """Polls :data:`QUERY` every ``interval`` seconds on a thread until :meth:`stop`; a context manager."""
+class GpuSampler(PeriodicSampler):
+    """Polls :data:`QUERY` every ``interval`` seconds on a thread until :meth:`stop`; a context manager.
+    :attr:`available` is False once ``nvidia-smi`` is missing or fails."""
 
     def __init__(self, interval: float = 0.5) -> None:
-        self.interval = interval
-        self.samples: list[GpuSample] = []
+        super().__init__(interval, name="graphsdg-gpu-sampler")
         self.available = True
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._poll, name="graphsdg-gpu-sampler", daemon=True)
 
-    def _poll(self) -> None:
-        while not self._stop.is_set():
-            stamp = time.time()
-            try:
-                done = subprocess.run(QUERY, capture_output=True, text=True, timeout=10, check=False)
-            except (OSError, subprocess.TimeoutExpired):
-                self.available = False
-                return
-            if done.returncode != 0:
-                self.available = False
-                return
-            self.samples += parse_samples(done.stdout.splitlines(), stamp)
-            self._stop.wait(self.interval)
+    def read(self) -> list[GpuSample] | None:
+        stamp = time.time()
+        try:
+            done = subprocess.run(QUERY, capture_output=True, text=True, timeout=10, check=False)
+        except (OSError, subprocess.TimeoutExpired):
+            done = None
+        if done is None or done.returncode != 0:
+            self.available = False
+            return None
+        return parse_samples(done.stdout.splitlines(), stamp)
 
-    def __enter__(self) -> "GpuSampler":
-        self._thread.start()
-        return self
 
-    def __exit__(self, *exc) -> None:
-        self.stop()
-
-    def stop(self) -> None:
-        """Stop polling (waits for the poll under way)."""
-        self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join()

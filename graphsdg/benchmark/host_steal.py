@@ -16,9 +16,10 @@ Example:
 """
 from __future__ import annotations
 
-import threading
 import time
 from dataclasses import dataclass
+
+from graphsdg.benchmark.periodic_sampler import PeriodicSampler
 
 STAT = "/proc/stat"
 
@@ -64,37 +65,21 @@ def steal_percent(samples: list[CpuTimes], start: float, end: float) -> float | 
     return round(100.0 * (inside[-1].steal - inside[0].steal) / (inside[-1].total - inside[0].total), 1)
 
 
-class CpuTimesSampler:
+class CpuTimesSampler(PeriodicSampler):
     """Reads :func:`read_cpu_times` every ``interval`` seconds on a thread until :meth:`stop`; a context
     manager (no samples where ``/proc/stat`` cannot be read)."""
 
     def __init__(self, interval: float = 0.5, path: str = STAT) -> None:
-        self.interval, self.path = interval, path
-        self.samples: list[CpuTimes] = []
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._poll, name="graphsdg-cpu-times", daemon=True)
+        super().__init__(interval, name="graphsdg-cpu-times")
+        self.path = path
 
-    def _poll(self) -> None:
-        while True:
-            sample = read_cpu_times(self.path)
-            if sample is None:
-                return
-            self.samples.append(sample)
-            if self._stop.wait(self.interval):
-                return
-
-    def __enter__(self) -> "CpuTimesSampler":
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.stop()
+    def read(self) -> list[CpuTimes] | None:
+        sample = read_cpu_times(self.path)
+        return None if sample is None else [sample]
 
     def stop(self) -> None:
         """Stop reading, after one last sample (so the window's end has one)."""
-        self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join()
+        super().stop()
         last = read_cpu_times(self.path)
         if last is not None:
             self.samples.append(last)
