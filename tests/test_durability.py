@@ -143,11 +143,8 @@ def test_wait_until_complete_returns_only_when_every_file_is_on_disk(out_dir, mo
     writer.detach()
 
 
-@pytest.mark.parametrize("threads", [None, 0])
-def test_worker_failure_is_raised_at_the_next_step(out_dir, monkeypatch, threads):
+def test_worker_failure_is_raised_at_the_next_step(out_dir, monkeypatch):
     from graphsdg.io import backends
-    if threads is not None:
-        rep.settings.set("/omni/replicator/backend/writeThreads", threads)   # conftest resets it afterwards
     real = backends.write_file_atomic
 
     def failing(path, data):
@@ -236,12 +233,9 @@ def test_queue_size_and_byte_limit_are_live_settings():
     with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/queueSize must be an integer >= 1, "
                                          r"got 0"):
         rep.settings.set("/omni/replicator/backend/queueSize", 0)
-    with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/writeThreads must be an integer >= 0 "
-                                         r"\(0: writes on the scheduling thread\), got -1"):
-        WriteQueue(num_threads=-1)
-    with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/writeThreads must be an integer >= 0, "
-                                         r"got -1"):
-        rep.settings.set("/omni/replicator/backend/writeThreads", -1)
+    with pytest.raises(ValueError, match=r"setting /omni/replicator/backend/writeThreads must be a positive integer, "
+                                         r"got 0"):
+        WriteQueue(num_threads=0)
 
 
 def test_byte_limit_throttles_the_producer_and_bounds_memory():
@@ -275,48 +269,6 @@ def test_a_task_may_schedule_follow_ups_on_a_full_queue():
         q.schedule(parent, k)
     q.wait_until_done()
     assert sorted(done) == [(k, i) for k in range(3) for i in range(3)]
-    q.shutdown()
-
-
-def test_with_no_writer_threads_each_task_runs_where_it_is_scheduled():
-    """writeThreads 0: a task has run when schedule() returns, on the scheduling thread; follow-ups, groups and
-    failures behave as with threads."""
-    q = WriteQueue(num_threads=0)
-    ran, groups = [], []
-
-    def parent(k):
-        ran.append(("parent", k, threading.current_thread().name))
-        q.schedule(lambda: ran.append(("child", k, threading.current_thread().name)))
-
-    with q.group(lambda ok: groups.append(ok)):
-        q.schedule(parent, 0)
-        here = threading.current_thread().name
-        assert ran == [("parent", 0, here), ("child", 0, here)]     # both done before schedule() returned
-    with q.group(lambda ok: groups.append(ok)):
-        q.schedule(lambda: 1 / 0)
-    assert groups == [True, False] and q.pending() == 0
-    with pytest.raises(WriterError, match="ZeroDivisionError"):
-        q.raise_errors()
-    assert q.process_ids() == [] and not [t for t in threading.enumerate() if t.name.startswith("graphsdg-writer")]
-    q.shutdown()
-
-
-def test_tasks_left_by_workers_configured_away_run_first_and_in_order():
-    """Configured from two threads to none, the tasks still queued run on the next scheduling thread, before
-    its own task: the order of scheduling is the order of running."""
-    q = WriteQueue(num_threads=2, max_size=100)
-    gate = threading.Event()
-    order = []
-    q.schedule(lambda: (gate.wait(10), order.append("blocked")))
-    q.schedule(lambda: (gate.wait(10), order.append("blocked too")))
-    with q.batch():                                 # queued, not yet handed to a worker
-        for i in range(3):
-            q.schedule(order.append, i)
-        q.configure(0, q.max_size, q.max_bytes)
-    threading.Timer(0.2, gate.set).start()
-    q.schedule(order.append, "in place")            # waits for the two running tasks, then runs the queued three
-    assert sorted(order[:2]) == ["blocked", "blocked too"] and order[2:] == [0, 1, 2, "in place"]
-    q.wait_until_done()
     q.shutdown()
 
 

@@ -178,7 +178,7 @@ def test_a_batch_wakes_the_workers_once_when_it_ends():
     q.shutdown()
 
 
-@pytest.mark.parametrize("threads", [0, 1, 3])
+@pytest.mark.parametrize("threads", [1, 3])
 def test_bytes_do_not_depend_on_writer_threads(tmp_path, threads):
     from test_foundation import _capture
     from graphsdg.io.write_queue import reset_write_queue

@@ -33,8 +33,7 @@ KNOWN_KEYS: dict[str, tuple[Any, str]] = {
     "/omni/replicator/RTSubframes": (1, "default number of accumulated subframes per capture"),
     "/omni/replicator/globalSeed": (None, "global seed of every distribution and ReplicatorRNG"),
     "/omni/replicator/backend/writeThreads": (4, "writer worker threads of the I/O pool, at most (they start as "
-                                                   "the backlog needs them); 0: each write runs on the thread "
-                                                   "that schedules it"),
+                                                   "the backlog needs them)"),
     "/omni/replicator/backend/queueSize": (1000, "queued writes before the producer is throttled"),
     "/omni/replicator/backends/disk/root_dir": (None, "root of relative DiskBackend output dirs"),
     "/graphsdg/io/queueMaxBytes": (1 << 30, "bytes of image/array data queued writes may hold before the producer "
@@ -180,7 +179,7 @@ VALIDATORS: dict[str, Callable[[str, Any], None]] = {
     "/omni/replicator/captureOnPlay": _boolean,
     "/omni/replicator/RTSubframes": _integer(0),
     "/omni/replicator/globalSeed": _integer(0, none_ok=True),
-    "/omni/replicator/backend/writeThreads": _integer(0),
+    "/omni/replicator/backend/writeThreads": _integer(1),
     "/omni/replicator/backend/queueSize": _integer(1),
     "/omni/replicator/backends/disk/root_dir": _path_or_none,
     "/graphsdg/io/queueMaxBytes": _integer(1),

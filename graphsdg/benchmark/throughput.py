@@ -31,7 +31,6 @@ import resource
 import tempfile
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
 
 import numpy as np
 
@@ -225,19 +224,6 @@ class Randomization:
                 "camera": g.uniform(5, 10, (self.cameras, 3))}
 
 
-class _InPlaceExecutor(concurrent.futures.Executor):
-    """The hand-written loop's executor with no writer threads (``--write-threads 0``): each write runs when
-    submitted, as graphsdg's queue then runs it."""
-
-    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> concurrent.futures.Future:
-        future: concurrent.futures.Future = concurrent.futures.Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # noqa: BLE001 - the loop's result() raises it, as a thread's would
-            future.set_exception(exc)
-        return future
-
-
 def _write_threads(config: BenchConfig) -> int:
     """Writer threads of both loops: ``config.write_threads``, or one process's default for this machine's cores."""
     from graphsdg.io.write_queue import default_threads
@@ -413,8 +399,7 @@ def run_handwritten(config: BenchConfig) -> BenchResult:
     want = set(config.annotators)
     need_depth = bool(want & {"distance_to_image_plane", "distance_to_camera"})
     need_seg = bool(want - {"rgb", "distance_to_image_plane", "distance_to_camera"})
-    threads = _write_threads(config)
-    pool = concurrent.futures.ThreadPoolExecutor(threads) if threads else _InPlaceExecutor()
+    pool = concurrent.futures.ThreadPoolExecutor(_write_threads(config))
     if config.out_dir:
         tmp = os.path.join(config.out_dir, "hand-written")
         os.makedirs(tmp, exist_ok=True)

@@ -6,9 +6,7 @@ and the arrays held by waiting and running tasks stay under
 ``/graphsdg/io/queueMaxBytes``. A producer that outruns the disk blocks
 ("throttles") instead of growing memory. Both settings, and
 ``/omni/replicator/backend/writeThreads``, apply to the live queue. Workers start
-as the backlog needs them, up to ``writeThreads``: one while it keeps up. With ``writeThreads`` 0 there are no
-workers: each task runs on the thread that schedules it, once the tasks before it are done (a process that
-renders on a core of its own among many then hands no interpreter lock to a writer thread).
+as the backlog needs them, up to ``writeThreads``: one while it keeps up.
 
 Writes of image, array and JSON files to a local folder (what BasicWriter and most writers schedule) go to
 writer *processes* instead when ``/graphsdg/io/writeProcesses`` allows them
@@ -213,20 +211,12 @@ def _positive_int(key: str, value: Any) -> int:
     return int(value)
 
 
-def _thread_count(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"setting {THREADS_KEY} must be an integer >= 0 (0: writes on the scheduling thread), "
-                         f"got {value!r}")
-    return int(value)
-
-
 class WriteQueue:
-    """Runs scheduled callables on worker threads (or, with none, on the scheduling thread), in order, with bounded
-    memory."""
+    """Runs scheduled callables on worker threads, in order, with bounded memory."""
 
     def __init__(self, num_threads: int | None = None, max_size: int | None = None,
                  max_bytes: int | None = None, num_processes: int = 0) -> None:
-        self.num_threads = _thread_count(num_threads if num_threads is not None
+        self.num_threads = _positive_int(THREADS_KEY, num_threads if num_threads is not None
                                          else settings.get(THREADS_KEY, DEFAULT_THREADS))
         self.num_processes = num_processes     # writer processes at most; 0: every write on the threads
         self.max_size = _positive_int(SIZE_KEY, max_size if max_size is not None else settings.get(SIZE_KEY, 1000))
@@ -254,7 +244,6 @@ class WriteQueue:
         self.peak_bytes = 0
         self._processes: WriteProcesses | None = None
         self._in_processes = 0            # writes handed to the processes and not finished
-        self._running_here = 0            # tasks running on their scheduling thread (no writer threads)
 
     # ---- workers ---------------------------------------------------------
     def _start_threads(self, wanted: int = 1) -> bool:
@@ -365,11 +354,7 @@ class WriteQueue:
                 self._schedule_in_process(write, nbytes, group)
                 return
         with self._cond:
-            stranded: list[tuple] = []
-            if self.num_threads == 0:
-                stranded = self._take_stranded()
-                inline = True
-            elif not self._start_threads(self._workers_wanted()):
+            if not self._start_threads(self._workers_wanted()):
                 inline = True
             else:
                 inline = False
@@ -389,30 +374,8 @@ class WriteQueue:
                 else:
                     self._has_work.notify()    # one idle worker takes it
         if inline:
-            for task in stranded:
-                self._run_here(task)
-            self._run_here(item)
-            del item
-
-    def _take_stranded(self) -> list[tuple]:
-        """Wait (lock held) until no task runs on a worker or in a writer process, then take the queued tasks
-        that no worker will run now (left when the workers were configured away), to run here first: a task
-        run in place must not overtake the tasks scheduled before it."""
-        while self._unfinished - len(self._items) > self._running_here:
-            self._wait_for_progress()
-        stranded = list(self._items)
-        self._items.clear()
-        return stranded
-
-    def _run_here(self, item: tuple) -> None:
-        """Run one task on this thread (no writer threads, or none can start), counted as running here."""
-        with self._cond:
-            self._running_here += 1
-        try:
             self._run([item])
-        finally:
-            with self._cond:
-                self._running_here -= 1
+            del item
 
     def schedule_many(self, calls: list[tuple[Callable[..., Any], dict[str, Any]]]) -> None:
         """:meth:`schedule` ``fn(**kwargs)`` of each ``(fn, kwargs)``, in order: a frame's files in one call.
@@ -716,7 +679,7 @@ class ProcessQueue:
         changed (a frame asks for the queue ~10 times)."""
         generation = settings.generation()
         if self._configured_at[0] != generation:
-            threads = _thread_count(settings.get(THREADS_KEY, DEFAULT_THREADS))
+            threads = _positive_int(THREADS_KEY, settings.get(THREADS_KEY, DEFAULT_THREADS))
             self._configured_at = (generation, (threads, _positive_int(SIZE_KEY, settings.get(SIZE_KEY, 1000)),
                                                 _positive_int(BYTES_KEY, settings.get(BYTES_KEY, 1 << 30)),
                                                 processes_wanted(settings.get(PROCESSES_KEY, "auto"), threads)))

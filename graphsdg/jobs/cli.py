@@ -442,11 +442,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--no-replicator-write-to-fabric", action="store_true",
                        help="write randomized poses and colours to USD and sync them, instead of straight into "
                             "MuJoCo (Isaac Sim 6's write-to-fabric, on by default)")
-    bench.add_argument("--write-threads", type=_non_negative,
+    bench.add_argument("--write-threads", type=_positive,
                        help="writer threads per process, shared by both loops; graphsdg starts them as its backlog needs "
                             "(default: 4 on 16 cores or more, "
-                            "a quarter of the cores below, at least 1; with --processes each process's share); 0: "
-                            "each write runs on the thread that renders")
+                            "a quarter of the cores below, at least 1; with --processes each process's share)")
     bench.add_argument("--write-processes", type=_count_or_auto, metavar="N",
                        help="graphsdg's writer processes per process, which encode and write its image, array "
                             "and JSON files outside the interpreter lock: a count, 0 for writer threads only, or "
