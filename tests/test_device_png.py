@@ -109,21 +109,19 @@ def test_a_layout_reads_the_stream_with_the_colour_and_lends_a_precompressed_ima
     image[:h // 2] = 40                           # flat enough for the room a layout reads back
     layout.rgba.assign(wp.array(image.view(np.uint32).reshape(-1), dtype=wp.uint32, device="cpu"))
     layout.png.queue(layout.rgba)                 # what convert() queues after the conversion
-    layout.queue_read(colour=True, depth=False, ids=False, stream=True)
-    frame = layout.take()
+    frame = layout.take(layout.queue_read(colour=True, depth=False, ids=False, stream=True))
     assert isinstance(frame.rgba, PrecompressedImage) and not frame.rgba.flags.writeable
     assert np.array_equal(frame.rgba, image)
     data = encode_png(frame.rgba)
     assert data == png_file(w, h, 8, 4, _compress(image)) and data != encode_png(np.array(frame.rgba))
     assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), image)
-    layout.queue_read(colour=False, depth=True, ids=False, stream=True)
-    assert layout._parts() == ["depth"]
-    layout.queue_read(colour=True, depth=False, ids=False)             # the colour without its stream (hdr alone)
-    assert layout._parts() == ["rgba"] and type(layout.take().rgba) is np.ndarray
+    read = layout.queue_read(colour=False, depth=True, ids=False, stream=True)
+    assert layout._parts(read.wanted) == ["depth"]
+    read = layout.queue_read(colour=True, depth=False, ids=False)      # the colour without its stream (hdr alone)
+    assert layout._parts(read.wanted) == ["rgba"] and type(layout.take(read).rgba) is np.ndarray
     plain = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4)
     plain.rgba.assign(layout.rgba)
-    plain.queue_read(colour=True, depth=False, ids=False, stream=True)
-    assert type(plain.take().rgba) is np.ndarray
+    assert type(plain.take(plain.queue_read(colour=True, depth=False, ids=False, stream=True)).rgba) is np.ndarray
 
 
 @pytest.mark.parametrize("png", [True, False])
@@ -147,8 +145,7 @@ def test_class_masks_are_the_ids_coloured_with_each_palette_and_compressed_with_
     layout.set_palettes([p.copy() for p in palettes])
     assert layout._sent_palettes is sent                                  # the same colours: nothing sent again
     layout.queue_masks(2)
-    layout.queue_read(colour=False, depth=False, ids=True, stream=True, masks=2)
-    frame = layout.take()
+    frame = layout.take(layout.queue_read(colour=False, depth=False, ids=True, stream=True, masks=2))
     geoms = layout.table[codes]                                           # code -> geom, -1 the background
     for palette, mask in zip(palettes, frame.id_colours):
         assert isinstance(mask, LabelImage) and mask.shape == (h, w, 4)

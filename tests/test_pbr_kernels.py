@@ -141,14 +141,22 @@ def test_gathered_uploads_go_in_one_copy_and_keep_what_was_not_put():
         uploads.gather({"ids": ids})
 
 
-def _layout_frame(layout: po.ClassicLayout, value: int) -> po.HostFrame:
-    """Fill ``layout``'s device outputs with ``value`` and read them back as a host frame."""
+def _fill_layout(layout: po.ClassicLayout, value: int) -> None:
+    """Fill ``layout``'s device outputs with ``value`` (what a conversion of a frame leaves there)."""
     layout.rgba.fill_(value)
     layout.depth.fill_(float(value))
     layout.codes.fill_(value % 5)
     layout.queue_boxes()                   # as convert(..., boxes=True) queues them after the conversion
-    layout.queue_read(colour=True, depth=True, ids=True)
-    return layout.take()
+
+
+def _layout_frame(layout: po.ClassicLayout, value: int, reads: list | None = None) -> po.HostFrame:
+    """Fill ``layout``'s device outputs with ``value`` and read them back as a host frame (the read appended
+    to ``reads``)."""
+    _fill_layout(layout, value)
+    read = layout.queue_read(colour=True, depth=True, ids=True)
+    if reads is not None:
+        reads.append(read)
+    return layout.take(read)
 
 
 def test_host_frames_are_lent_views_that_no_later_read_overwrites():
@@ -169,6 +177,29 @@ def test_host_frames_are_lent_views_that_no_later_read_overwrites():
         frame = _layout_frame(layout, 100 + v)
         assert np.all(frame.depth == 100 + v)
     assert np.all(lent.view(np.uint32) == 0) and len(layout.host._buffers) == po.HOST_BUFFERS
+
+
+def test_reads_queued_together_each_keep_their_own_frame():
+    """Two frames' reads queued before either is taken (a pipelined step's frame still copying when the next
+    renders) each read their own frame, in buffers of their own or, with every buffer lent, the later one
+    taking the earlier one's spare copy out first."""
+    h, w = 3, 5
+    layout = po.ClassicLayout(w, h, np.ones((h, w)), 0.0, 100.0, "cpu", ngeom=4)
+    queued = []
+    for v in (7, 8):
+        _fill_layout(layout, v)
+        queued.append(po.queue_reads([(layout, True, True, True, False, 0)]))
+    first, second = (q.hosts()[0] for q in queued)
+    assert np.all(first.depth == 7) and np.all(second.depth == 8) and np.all(first.rgba.view(np.uint32) == 7)
+    kept = [_layout_frame(layout, v) for v in range(po.HOST_BUFFERS - 2)]   # every buffer lent now
+    _fill_layout(layout, 20)
+    earlier = po.queue_reads([(layout, True, True, True, False, 0)])        # into the spare
+    assert not earlier.taken
+    _fill_layout(layout, 21)
+    later = po.queue_reads([(layout, True, True, True, False, 0)])          # the spare again: takes `earlier`
+    assert earlier.taken
+    assert np.all(earlier.hosts()[0].depth == 20) and np.all(later.hosts()[0].depth == 21)
+    assert [int(f.depth[0, 0]) for f in kept] == list(range(po.HOST_BUFFERS - 2))
 
 
 def test_large_frames_lend_fewer_buffers():
@@ -196,11 +227,12 @@ def test_a_read_with_every_buffer_lent_waits_for_their_release_instead_of_copyin
         queue.schedule(lambda frame: gate.wait(), _layout_frame(layout, v))
     assert layout.host.lent() == po.HOST_BUFFERS
     threading.Timer(0.05, gate.set).start()
-    frame = _layout_frame(layout, 50)
-    assert layout._reading is not None                      # read into a freed buffer, not the spare
+    reads: list = []
+    frame = _layout_frame(layout, 50, reads)
+    assert not reads[-1].spare                              # read into a freed buffer, not the spare
     assert np.all(frame.rgba.view(np.uint32) == 50) and queue.completed >= 1
     queue.wait_until_done()
-    kept = [frame] + [_layout_frame(layout, v) for v in range(po.HOST_BUFFERS)]   # held here: nothing to wait for
-    assert layout._reading is None                          # the last one read into the spare and copied
+    kept = [frame] + [_layout_frame(layout, v, reads) for v in range(po.HOST_BUFFERS)]   # held: nothing to wait for
+    assert reads[-1].spare                                  # the last one read into the spare and copied
     assert [int(f.depth[0, 0]) for f in kept] == [50] + list(range(po.HOST_BUFFERS))
     queue.shutdown()

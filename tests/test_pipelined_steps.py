@@ -1,4 +1,5 @@
-"""``step(wait_for_render=False)``: the frame's annotators and writers run at the next step, with the same result."""
+"""``step(wait_for_render=False)``: the frame's annotators and writers run in the next step, once that step's frame
+is drawn, with the same result."""
 from __future__ import annotations
 
 import hashlib
@@ -60,6 +61,67 @@ def test_pipelined_steps_write_the_same_bytes(tmp_path):
     labels = [open(tmp_path / "pipelined" / f).read() for f in sorted(os.listdir(tmp_path / "pipelined"))
               if f.startswith("semantic_segmentation_labels")]
     assert any("orb" in text for text in labels) and any("ball" in text for text in labels)
+
+
+def _graph_run(out, wait_for_render: bool) -> dict[str, str]:
+    """Frames randomized by the graph (inside each step, before the frame is drawn), labels by the script."""
+    rep.stage.new_stage()
+    rep.set_global_seed(11)
+    shapes, rp = _scene()
+    with rep.trigger.on_frame():
+        with rep.get.prims(semantics=[("class", "box"), ("class", "ring")]):
+            rep.modify.pose(position=rep.distribution.uniform((-1.2, -1.2, 0), (1.2, 1.2, 0.5)),
+                            rotation=rep.distribution.uniform((0, 0, 0), (360, 360, 360)))
+            rep.randomizer.color(colors=rep.distribution.uniform((0, 0, 0), (1, 1, 1)))
+    writer = rep.writers.get("BasicWriter")
+    writer.initialize(output_dir=out, **FLAGS)
+    writer.attach(rp)
+    for frame in range(5):
+        rep.functional.modify.semantics(shapes[2], {"class": "ball" if frame % 2 else "orb"}, mode="replace")
+        rep.orchestrator.step(wait_for_render=wait_for_render)
+    rep.orchestrator.wait_until_complete()
+    writer.detach()
+    return {f: hashlib.sha256(open(os.path.join(out, f), "rb").read()).hexdigest()
+            for f in sorted(os.listdir(out)) if not f.startswith("graphsdg_run")}
+
+
+def test_pipelined_steps_randomized_by_the_graph_write_the_same_bytes(tmp_path):
+    """The graph randomizes the next frame before the previous one is annotated: that frame's files are still
+    its own (its pixels, its boxes, its labels)."""
+    waited = _graph_run(str(tmp_path / "waited"), True)
+    pipelined = _graph_run(str(tmp_path / "pipelined"), False)
+    rgb = [f for f in waited if f.startswith("rgb_")]
+    assert len(rgb) == 5 and len({waited[f] for f in rgb}) == 5 and pipelined == waited
+
+
+def test_a_pipelined_frame_is_written_after_the_next_frame_is_drawn():
+    """Two frames in flight: step k draws frame k, then annotates and writes frame k - 1."""
+    _, rp = _scene()
+    events = []
+
+    class Recorder(rep.Writer):
+        def __init__(self):
+            self.annotators = ["rgb"]
+            self.frame = 0
+
+        def write(self, data):
+            events.append(f"write {self.frame}")
+            self.frame += 1
+
+    rep.writers.register_writer(Recorder)
+    recorder = rep.writers.get("Recorder")
+    recorder.initialize()
+    recorder.attach(rp)
+    runtime().render_observers.append(lambda products: events.append("draw"))
+    for _ in range(3):
+        rep.orchestrator.step(wait_for_render=False)
+    rep.orchestrator.wait_until_complete()
+    assert events == ["draw", "draw", "write 0", "draw", "write 1", "write 2"]
+    events.clear()
+    rep.orchestrator.step(wait_for_render=False)
+    rep.orchestrator.step()                         # waited: the pending frame first, then its own
+    assert events == ["draw", "draw", "write 3", "write 4"] and runtime().pending_capture is None
+    recorder.detach()
 
 
 def test_get_data_finishes_a_pipelined_step():

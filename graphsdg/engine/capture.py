@@ -61,9 +61,10 @@ def step(rt_subframes: int = -1, pause_timeline: bool = True, delta_time: float 
     to the writers (:mod:`graphsdg.base.interrupts`).
 
     ``wait_for_render=False`` pipelines: the step returns once the frame is drawn
-    and its pixels are copying off the GPU; its annotators and writers run at the
-    start of the next step (or at ``wait_until_complete``, ``get_data``, a
-    detach), so the GPU's work overlaps the script's next randomization. Only
+    and its pixels are copying off the GPU; its annotators and writers run in the
+    next step once that step's frame is drawn (or at ``wait_until_complete``,
+    ``get_data``, a detach), so the GPU's work overlaps the script's next
+    randomization, simulation and upload, and two frames are in flight. Only
     annotators that need nothing but the capture's pixels, camera and labels are
     deferred (``AnnotatorSpec.pixels_only``: colour, depth, segmentation, tight
     boxes); with any other attached the step waits as with ``True``.
@@ -81,7 +82,6 @@ def _step(rt_subframes: int, pause_timeline: bool, delta_time: float | None, def
     rt = runtime()
     queue = get_write_queue()
     try:
-        rt.complete_capture()   # the previous step's, when it was pipelined
         queue.raise_errors(collect=False)   # writer processes' replies are taken as frames are sent
     except BaseException:
         run_state.mark_failed()
@@ -193,10 +193,22 @@ def _capture(subframes: int, graph: GraphStep, defer: bool = False) -> None:
     if products:
         for observer in list(rt.render_observers):
             observer(list(products))
+    _finish_previous(rt)
     if defer:
         rt.pending_capture = capture.finish
     else:
         capture.finish()
+
+
+def _finish_previous(rt) -> None:
+    """Annotate and write the previous step's capture, when it was pipelined: once this step's frame is drawn,
+    so that the previous frame's pixels copied off the GPU while this one was randomized, simulated and
+    drawn (two frames in flight); frames are still written in order."""
+    try:
+        rt.complete_capture()
+    except BaseException:
+        run_state.mark_failed()
+        raise
 
 
 def _frame_number(rt) -> int:

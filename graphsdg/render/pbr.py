@@ -340,7 +340,7 @@ class PbrRenderer:
                 raise ValueError(f"unknown render passes {sorted(unknown)}; known: {PASSES}")
             if r.subframes < 1:
                 raise ValueError(f"subframes must be >= 1, got {r.subframes}")
-        self._take_queued()
+        self._take_queued(keep=1)
         views = [r.view for r in requests]
         wp, first = self._wp, requests[0]
         ctx = self._context(scene, views, first.subframes)
@@ -395,11 +395,13 @@ class PbrRenderer:
             graph = ctx.conversions[key] = self._launch_graph.LaunchGraph(self._device, launches)
         return graph
 
-    def _take_queued(self) -> None:
-        """Take every deferred render's pixels still in page-locked buffers, before a render reuses them."""
-        queued, self._queued = self._queued, []
-        for reads in queued:
-            reads.hosts()
+    def _take_queued(self, keep: int = 0) -> None:
+        """Take the deferred renders' pixels still in page-locked buffers but the newest ``keep`` (a pipelined
+        step's frame, finished after the next frame's render): at most one frame copies while another renders."""
+        queued = [reads for reads in self._queued if not reads.taken]
+        while len(queued) > keep:
+            queued.pop(0).hosts()
+        self._queued = queued
 
     def _launch(self, ctx: _Context, seeds: _LaunchSeeds) -> None:
         """One launch of every camera of ``ctx``, with the frame's next seed for these products."""

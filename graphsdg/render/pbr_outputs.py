@@ -269,7 +269,7 @@ class ClassicLayout:
             self._spans[name] = (start, end, np.dtype(wp.dtype_to_numpy(dtype)), shape)
         self._device_bytes = wp.empty(end, dtype=wp.uint8, device=device)
         self.host = HostBuffers(end, device, max(1, min(HOST_BUFFERS, HOST_BUFFER_BYTES // end)), wait_for_release)
-        self._reading: int | None = None       # the host buffer of the read last queued (None: the spare)
+        self._spare_read: QueuedReads | None = None   # the reads whose copy into the spare buffer is not taken
         for name, dtype, shape in parts:    # typed views of the allocation, which the layout keeps alive
             setattr(self, name, wp.array(ptr=self._device_bytes.ptr + self._spans[name][0], dtype=dtype,
                                          shape=shape, device=device))
@@ -282,7 +282,6 @@ class ClassicLayout:
         self._sent_palettes: np.ndarray | None = None
         self._palettes_given: tuple = ()
         self._adrs: dict[tuple, int] = {}
-        self._wanted = (False, False, False, False, 0)   # (colour, depth, ids, stream, masks) of the read last queued
 
     def set_palettes(self, palettes: Sequence[np.ndarray]) -> None:
         """Colour the class masks of the frames converted from now on with ``palettes`` (at most :attr:`masks`
@@ -343,8 +342,9 @@ class ClassicLayout:
         wp.launch(_clear_boxes, dim=self.ngeom + 1, inputs=[self.boxes], device=self.device)
         wp.launch(_code_boxes, dim=(h, -(-w // BOX_SPAN)), inputs=[self.codes, w, self.boxes], device=self.device)
 
-    def _parts(self) -> list[str]:
-        colour, depth, ids, stream, masks = self._wanted
+    def _parts(self, wanted: tuple[bool, bool, bool, bool, int]) -> list[str]:
+        """The arrays a read of ``wanted`` (colour, depth, ids, stream, masks) copies, in allocation order."""
+        colour, depth, ids, stream, masks = wanted
         compresses = self.png is not None
         wanted = [("rgba", colour), ("png_meta", colour and stream and compresses),
                   ("png_words", colour and stream and compresses), ("depth", depth), ("codes", ids), ("boxes", ids)]
@@ -352,30 +352,44 @@ class ClassicLayout:
             wanted += [(f"mask{k}", True), (f"mask{k}_meta", compresses), (f"mask{k}_words", compresses)]
         return [name for name, want in wanted if want]
 
-    def queue_read(self, colour: bool, depth: bool, ids: bool, stream: bool = False, masks: int = 0) -> None:
+    def queue_read(self, colour: bool, depth: bool, ids: bool, stream: bool = False, masks: int = 0) -> LayoutRead:
         """Queue one device copy of the span of the asked-for arrays (with the ids, their codes' pixel bounds:
         converted with ``boxes``; with ``stream``, the colour's PNG stream: converted with ``png``; the first
         ``masks`` class masks, with their streams where this layout compresses: converted with as many) into a
-        page-locked host buffer."""
-        self._wanted = (colour, depth, ids, stream, masks)
-        parts = self._parts()
+        page-locked host buffer; returns the read, for :meth:`take`. Several reads may be queued at once (a
+        pipelined step's frame still copying when the next frame renders), each into a buffer of its own."""
+        read = LayoutRead((colour, depth, ids, stream, masks), None, False)
+        parts = self._parts(read.wanted)
         if parts:
-            self._reading = self.host.acquire()
-            target = self.host.spare if self._reading is None else self.host.buffer(self._reading)
+            read.buffer = self.host.acquire()
+            read.spare = read.buffer is None
+            if read.spare and self._spare_read is not None:
+                self._spare_read.hosts()           # the spare holds an earlier read: its arrays are copied out
+            target = self.host.spare if read.spare else self.host.buffer(read.buffer)
             lo, hi = self._spans[parts[0]][0], self._spans[parts[-1]][1]
             wp.copy(target, self._device_bytes, dest_offset=lo, src_offset=lo, count=hi - lo)
+        return read
 
-    def take(self) -> HostFrame:
-        """The queued copies (done) as arrays: views of the page-locked buffer they were read into, lent until
-        every one of them is gone (:class:`HostBuffers`), or copies of their own when no buffer was free.
+    def hold_spare(self, reads: QueuedReads) -> None:
+        """Note that ``reads`` copy into the spare buffer: a later read needing it takes them first."""
+        self._spare_read = reads
+
+    def release_spare(self, reads: QueuedReads) -> None:
+        """Note that ``reads`` were taken (the spare is free again if they held it)."""
+        if self._spare_read is reads:
+            self._spare_read = None
+
+    def take(self, read: LayoutRead) -> HostFrame:
+        """The copies of ``read`` (done) as arrays: views of the page-locked buffer they were read into, lent
+        until every one of them is gone (:class:`HostBuffers`), or copies of their own when no buffer was free.
         Annotators and writer threads may keep them past later renders."""
-        parts = self._parts()
+        parts = self._parts(read.wanted)
         if not parts:
             return HostFrame(rgba=None, depth=None, codes=None)
-        if self._reading is None:
+        if read.spare:
             whole, lent = self.host.spare.numpy(), False
         else:
-            whole, lent = self.host.lend(self._reading), True
+            whole, lent = self.host.lend(read.buffer), True
         own = {}
         for name in parts:
             start, end, dtype, shape = self._spans[name]
@@ -388,7 +402,7 @@ class ClassicLayout:
         if rgba is not None:
             rgba = _compressed(rgba.view(np.uint8).reshape(h, w, 4), own, "png")
         masks = tuple(_compressed(own[f"mask{k}"].view(np.uint8).reshape(h, w, 4), own, f"mask{k}", labels=True)
-                      for k in range(self._wanted[4]))
+                      for k in range(read.wanted[4]))
         return HostFrame(rgba=rgba,
                          depth=own["depth"].reshape(h, w) if "depth" in own else None,
                          codes=own["codes"].reshape(h, w) if "codes" in own else None, code_boxes=boxes,
@@ -405,13 +419,30 @@ def _compressed(image: np.ndarray, own: dict[str, np.ndarray], name: str, labels
     return label_image(image) if labels else image
 
 
+@dataclass
+class LayoutRead:
+    """One read queued by :meth:`ClassicLayout.queue_read`: what it copies, and into which host buffer."""
+
+    wanted: tuple[bool, bool, bool, bool, int]   # colour, depth, ids, stream, masks
+    buffer: int | None                           # the layout's host buffer (None: none, or its spare)
+    spare: bool                                  # copied into the layout's spare buffer (none was free)
+
+
 class QueuedReads:
     """Copies queued by :func:`queue_reads`, behind one event: :meth:`hosts` waits for them and takes the arrays,
-    once. Until then the layouts' page-locked buffers are in use: take them before those layouts read again."""
+    once. Until then their page-locked buffers are in use (a layout reads into others meanwhile)."""
 
-    def __init__(self, layouts: list[ClassicLayout], done: Any) -> None:
-        self._layouts, self._done = layouts, done
+    def __init__(self, reads: list[tuple[ClassicLayout, LayoutRead]], done: Any) -> None:
+        self._reads, self._done = reads, done
         self._hosts: list[HostFrame] | None = None
+        for layout, read in reads:
+            if read.spare:
+                layout.hold_spare(self)
+
+    @property
+    def taken(self) -> bool:
+        """Whether :meth:`hosts` took the arrays (the buffers are the frames' now, no longer the reads')."""
+        return self._hosts is not None
 
     def hosts(self) -> list[HostFrame]:
         """Each layout's :class:`HostFrame`, waiting for the copies the first time (polled: CUDA's own
@@ -420,16 +451,19 @@ class QueuedReads:
             done = self._done
             if done is not None:
                 wait_until(lambda: done.is_complete)
-            self._hosts = [layout.take() for layout in self._layouts]
+            self._hosts = [layout.take(read) for layout, read in self._reads]
+            for layout, _ in self._reads:
+                layout.release_spare(self)
         return self._hosts
 
 
 def queue_reads(reads: list[tuple[ClassicLayout, bool, bool, bool, bool, int]]) -> QueuedReads:
     """Queue each ``(layout, colour, depth, ids, stream, masks)``'s asked-for copies, all behind one event."""
-    for layout, colour, depth, ids, stream, masks in reads:
-        layout.queue_read(colour, depth, ids, stream, masks)
+    queued = [(layout, layout.queue_read(colour, depth, ids, stream, masks))
+              for layout, colour, depth, ids, stream, masks in reads]
     cuda = bool(reads) and wp.get_device(reads[0][0].device).is_cuda   # CPU copies are done when queued
-    return QueuedReads([layout for layout, *_ in reads], wp.record_event() if cuda else None)
+    return QueuedReads(queued, wp.record_event() if cuda else None)
 
 
-__all__ = ["ClassicLayout", "HostBuffers", "HostFrame", "QueuedReads", "code_format", "code_table", "queue_reads"]
+__all__ = ["ClassicLayout", "HostBuffers", "HostFrame", "LayoutRead", "QueuedReads", "code_format", "code_table",
+           "queue_reads"]
