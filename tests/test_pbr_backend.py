@@ -337,8 +337,8 @@ def test_pbr_tight_boxes_and_segmentation_ids_come_from_the_devices_code_bounds(
 
 
 def test_a_deferred_pbr_render_gives_its_own_frames_pixels_when_read_after_the_next_render(renderer):
-    """``defer`` (a pipelined step) leaves the copies in flight; the pixels are taken on first use, or before
-    the next render reuses the buffers, so a deferred frame read late still shows its own instant."""
+    """``defer`` (a pipelined step) leaves the copies in flight; the next render reads into other buffers, so a
+    deferred frame read after it still shows its own instant."""
     from graphsdg.render.backend import RenderRequest
     cube, ball, cam = _scene()
     sim = runtime().sim
@@ -438,6 +438,23 @@ def _scene_on_pbr(png_on_device: bool):
                        "/graphsdg/render/pbrPngOnDevice": png_on_device}.items():
         settings.set(key, value)
     return _scene()
+
+
+@pytest.mark.parametrize("png_on_device", [False, True])
+def test_pipelined_pbr_steps_write_the_bytes_of_waited_steps(tmp_path, png_on_device):
+    """Two frames in flight on the pbr backend (each step draws its frame, then writes the previous one) write
+    what steps that wait for each frame write, PNGs made on the device or not."""
+    from graphsdg import settings
+    from test_pipelined_steps import _graph_run
+
+    def run(name, wait):
+        for key, value in {"/graphsdg/render/backend": "pbr", "/graphsdg/render/pbrDevice": DEVICE,
+                           "/graphsdg/render/pbrPngOnDevice": png_on_device}.items():
+            settings.set(key, value)
+        return _graph_run(str(tmp_path / name), wait)
+
+    waited, pipelined = run("waited", True), run("pipelined", False)
+    assert len([f for f in waited if f.startswith("rgb_")]) == 5 and pipelined == waited
 
 
 def _device_stream(image: np.ndarray, labels: bool = False) -> bytes:
