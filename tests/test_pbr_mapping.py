@@ -349,9 +349,17 @@ def test_folded_frames_touch_only_moved_mesh_geoms():
     built = np.stack([np.eye(3), 0.5 * np.eye(3), np.eye(3)])
     relative = mesh_folds.relative_maps(now, built)
     np.testing.assert_allclose(relative[1], 4.0 * np.eye(3))
-    moved = np.array([False, True, False])
+    assert np.array_equal(mesh_folds.relative_maps(now, built, np.linalg.inv(built)), relative)
+    moved = mesh_folds.moved_maps(relative)
+    assert moved.tolist() == [False, True, False]
+    all_rescaled = MeshMaps()
+    for mesh_id in range(3):
+        all_rescaled[mesh_id] = (mesh_id + 1.0) * np.eye(3)
+    np.testing.assert_array_equal(mesh_folds.current_maps(all_rescaled, 3), all_rescaled.matrices[:3])
+    assert mesh_folds.current_maps(all_rescaled, 3) is not all_rescaled.matrices   # a copy the caller may keep
     xmat = np.tile(np.eye(3), (4, 1, 1))
     geom_mesh = np.array([-1, 0, 1, 1])                  # a primitive, an unmoved mesh, two geoms of mesh 1
     frames = mesh_folds.traced_frames(xmat, geom_mesh, relative, moved)
+    assert np.array_equal(mesh_folds.traced_frames(xmat, geom_mesh, relative, moved, np.array([1, 2, 3])), frames)
     np.testing.assert_array_equal(frames[:2], xmat[:2])
     np.testing.assert_allclose(frames[2:], np.tile(0.25 * np.eye(3), (2, 1, 1)))

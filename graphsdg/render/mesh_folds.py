@@ -25,21 +25,33 @@ from graphsdg.sim.mesh_scaling import MeshMaps
 def current_maps(maps: MeshMaps, nmesh: int) -> np.ndarray:
     """(nmesh, 3, 3) maps from the compiled vertices to the current ones (identity where none):
     :attr:`RenderScene.mesh_maps` as one array."""
-    out = np.tile(np.eye(3), (nmesh, 1, 1))
-    present = np.flatnonzero(maps.present[:nmesh]) if len(maps.present) else np.zeros(0, dtype=np.int64)
-    out[present] = maps.matrices[present]
+    present = maps.present[:nmesh]
+    if present.size == nmesh and present.all():      # every mesh rescaled (a randomized batch): one copy
+        return maps.matrices[:nmesh].copy()
+    out = np.empty((nmesh, 3, 3))
+    out[:] = np.eye(3)
+    rows = np.flatnonzero(present)
+    out[rows] = maps.matrices[rows]
     return out
 
 
-def relative_maps(now: np.ndarray, built: np.ndarray) -> np.ndarray:
-    """``G = now @ built^-1`` per mesh: from the vertices a BVH was built from to the current ones."""
-    return np.matmul(now, np.linalg.inv(built))
+def relative_maps(now: np.ndarray, built: np.ndarray, built_inverse: np.ndarray | None = None) -> np.ndarray:
+    """``G = now @ built^-1`` per mesh: from the vertices a BVH was built from to the current ones
+    (``built_inverse``: ``built``'s inverses, where the caller keeps them between frames)."""
+    return np.matmul(now, np.linalg.inv(built) if built_inverse is None else built_inverse)
 
 
-def traced_frames(xmat: np.ndarray, geom_mesh: np.ndarray, relative: np.ndarray, moved: np.ndarray) -> np.ndarray:
+def moved_maps(relative: np.ndarray) -> np.ndarray:
+    """(nmesh,) whether each relative map differs from the identity (its mesh's traced frame must be folded)."""
+    return (relative != np.eye(3)).any(axis=(1, 2))
+
+
+def traced_frames(xmat: np.ndarray, geom_mesh: np.ndarray, relative: np.ndarray, moved: np.ndarray,
+                  mesh_rows: np.ndarray | None = None) -> np.ndarray:
     """The geom frames to trace with: ``xmat @ G^-T`` for mesh geoms whose mesh moved (``moved[mesh]``),
-    ``xmat`` elsewhere (see the module docstring). ``geom_mesh``: each geom's mesh id, -1 for other types."""
-    rows = np.flatnonzero(geom_mesh >= 0)
+    ``xmat`` elsewhere (see the module docstring). ``geom_mesh``: each geom's mesh id, -1 for other types;
+    ``mesh_rows``: the mesh geoms, ``np.flatnonzero(geom_mesh >= 0)``, where the caller keeps them."""
+    rows = np.flatnonzero(geom_mesh >= 0) if mesh_rows is None else mesh_rows
     if rows.size:
         rows = rows[moved[geom_mesh[rows]]]
     if not rows.size:
@@ -61,4 +73,4 @@ def vertex_extents(model: mujoco.MjModel) -> np.ndarray:
     return np.maximum.reduceat(np.abs(np.asarray(model.mesh_vert)), np.asarray(model.mesh_vertadr), axis=0)
 
 
-__all__ = ["current_maps", "folded_bounds", "relative_maps", "traced_frames", "vertex_extents"]
+__all__ = ["current_maps", "folded_bounds", "moved_maps", "relative_maps", "traced_frames", "vertex_extents"]

@@ -111,7 +111,9 @@ class _MeshState:
     """The context's mesh BVHs against the simulation's meshes (:mod:`graphsdg.render.pbr_meshes`)."""
 
     geom_mesh: np.ndarray      # (ngeom,) each geom's mesh id, -1 for other geom types
+    mesh_rows: np.ndarray      # the mesh geoms (geom_mesh >= 0)
     built_maps: np.ndarray     # (nmesh, 3, 3) RenderScene.mesh_maps (identity where none) the BVHs' vertices had
+    built_inverse: np.ndarray  # their inverses
     half_extents: np.ndarray   # (nmesh, 3) the scene BVH's mesh bounds for those vertices
     reshapes: np.ndarray       # RenderScene.mesh_reshapes when the BVHs last took new vertices
     stamps: np.ndarray         # RenderScene.mesh_stamps when the traced frames below were computed
@@ -269,8 +271,10 @@ class PbrRenderer:
         model, nmesh = scene.sim.model, scene.sim.model.nmesh
         geom_mesh = np.where(model.geom_type == mujoco.mjtGeom.mjGEOM_MESH, model.geom_dataid, -1).astype(np.int64)
         half = rc.base.mesh_bounds_size.numpy().astype(np.float64) if nmesh else np.zeros((0, 3))
-        return _MeshState(geom_mesh=geom_mesh, built_maps=mesh_folds.current_maps(scene.mesh_maps, nmesh),
-                          half_extents=half, reshapes=_counts(scene.mesh_reshapes, nmesh),
+        built = mesh_folds.current_maps(scene.mesh_maps, nmesh)
+        return _MeshState(geom_mesh=geom_mesh, mesh_rows=np.flatnonzero(geom_mesh >= 0), built_maps=built,
+                          built_inverse=np.linalg.inv(built), half_extents=half,
+                          reshapes=_counts(scene.mesh_reshapes, nmesh),
                           stamps=_counts(scene.mesh_stamps, nmesh),
                           mirror_vert=np.array(model.mesh_vert, dtype=np.float32),
                           mirror_normal=np.array(model.mesh_normal, dtype=np.float32),
@@ -524,18 +528,19 @@ class PbrRenderer:
                 with profiling.timed("render:pbr_mesh_refit"):
                     meshes.refit(model, ctx.model, ctx.rc, reshaped, state.mirror_vert, state.mirror_normal)
                 state.built_maps[reshaped] = now[reshaped]
+                state.built_inverse = np.linalg.inv(state.built_maps)
                 state.half_extents[reshaped] = folds.vertex_extents(model)[reshaped]
                 state.reshapes = reshapes
                 state.bounds = None
-            state.relative = folds.relative_maps(now, state.built_maps)
-            state.moved = ~np.all(np.abs(state.relative - np.eye(3)) <= 0.0, axis=(1, 2))
+            state.relative = folds.relative_maps(now, state.built_maps, state.built_inverse)
+            state.moved = folds.moved_maps(state.relative)
             state.stamps = stamps
             bounds = folds.folded_bounds(state.relative, state.half_extents).astype(np.float32)
             if state.bounds is None or not np.array_equal(bounds, state.bounds):
                 # through the page-locked buffers: a pageable copy waits for the stream's earlier work
                 ctx.uploads.put("mesh_bounds_size", ctx.rc.base.mesh_bounds_size, bounds)
                 state.bounds = bounds
-        return folds.traced_frames(xmat, state.geom_mesh, state.relative, state.moved)
+        return folds.traced_frames(xmat, state.geom_mesh, state.relative, state.moved, state.mesh_rows)
 
     @staticmethod
     def _upload_changed(ctx: _Context, fields: list) -> set[str]:
