@@ -356,7 +356,7 @@ def test_folded_frames_touch_only_moved_mesh_geoms():
     for mesh_id in range(3):
         all_rescaled[mesh_id] = (mesh_id + 1.0) * np.eye(3)
     np.testing.assert_array_equal(mesh_folds.current_maps(all_rescaled, 3), all_rescaled.matrices[:3])
-    assert mesh_folds.current_maps(all_rescaled, 3) is not all_rescaled.matrices   # a copy the caller may keep
+    assert not np.shares_memory(mesh_folds.current_maps(all_rescaled, 3), all_rescaled.matrices)   # the caller's
     xmat = np.tile(np.eye(3), (4, 1, 1))
     geom_mesh = np.array([-1, 0, 1, 1])                  # a primitive, an unmoved mesh, two geoms of mesh 1
     frames = mesh_folds.traced_frames(xmat, geom_mesh, relative, moved)
