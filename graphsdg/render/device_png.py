@@ -40,6 +40,7 @@ ADLER_PIECE_CONST = wp.constant(ADLER_PIECE)
 NEIGHBOURS = ((0, -1), (-1, 0), (-1, -1), (-1, 1), (0, -2))
 _WINDOW = 32768                  # deflate's distances reach this far back
 
+
 def _lengths(digits: str) -> np.ndarray:
     """Code lengths written one hex digit a symbol."""
     return np.array([int(c, 16) for c in digits], dtype=np.int64)
